@@ -1,0 +1,1 @@
+"""Pure-Python core of ShapeMove (torch, numpy, transformers, smplx). Never imports bpy."""

@@ -1,0 +1,1 @@
+"""Body models (OpenBody, SMPL family), kinematics, shape fitting, measurements and IK."""
