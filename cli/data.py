@@ -1,0 +1,30 @@
+"""`python -m shapemove data build --source PATH [PATH ...] --out DIR`."""
+from __future__ import annotations
+
+from pathlib import Path
+
+
+def add_arguments(p):
+    sub = p.add_subparsers(dest="action", required=True)
+    b = sub.add_parser("build", help="mocap folders/archives -> HumanML3D-style dataset (resumable)")
+    b.add_argument("--source", type=Path, nargs="+", required=True,
+                   help="folder or .tar.xz/.zip: the ../shared/data layout (bandai/, hdm05/, cmu/) or any "
+                        "folder of BVH/AMC files with optional same-name .txt captions")
+    b.add_argument("--out", type=Path, required=True)
+    b.add_argument("--body-model", default=None, help="openbody (default) or a path to SMPL model files")
+    b.add_argument("--augment-share", type=float, default=None,
+                   help="fraction of Bandai clips that get a copy on a sampled body (default 0.5)")
+    b.add_argument("--limit", type=int, default=None, help="only the first N clips (for a quick look)")
+    b.add_argument("--only", nargs="*", default=None, help="only clips whose id starts with one of these")
+
+
+def run(args) -> int:
+    from ..core.body.load import load_body_model
+    from ..core.data.build import AUGMENT_SHARE, build_dataset
+
+    body = load_body_model(args.body_model)
+    report = build_dataset(args.source, args.out, body=body,
+                           augment_share=AUGMENT_SHARE if args.augment_share is None else args.augment_share,
+                           limit=args.limit, only=args.only)
+    print(report.summary())
+    return 0 if report.built + report.skipped_done + report.augmented > 0 else 1

@@ -1,0 +1,285 @@
+"""Inverse kinematics: world joint positions -> SMPL local rotations + root translation.
+
+``solve_ik`` is analytic and batched over frames (a Python loop over the 24 joints only):
+
+* the pelvis and spine3 (several children) get a Kabsch fit of all their child bones;
+* spine1/spine2 align their bone and take a left-right axis blended between the pelvis and the
+  chest, so a torso twist is spread along the spine;
+* hips and shoulders align their bone and choose the twist so that the knee/elbow bends about a
+  fixed hinge axis (knees about +X, elbows about -/+Y in the rest pose): limbs bend consistently
+  and never flip; the knee/elbow is then a pure hinge rotation when the pose allows it;
+* every other joint with a child takes the minimal rotation (swing) from its parent's frame;
+  the leaves of the 22-joint body (head, feet, wrists) and the hands keep the identity.
+
+Each bone is aimed from where forward kinematics actually puts its parent, so bone-length
+mismatches do not accumulate down the chains. An optional short batched LBFGS refinement
+(axis-angle corrections on all frames at once + a temporal smoothness term) reduces what is left.
+
+Positions: metres, Y up. Local rotations as in ``kinematics.forward_kinematics``:
+``forward_kinematics(rotations, rest_joints) + transl`` reproduces the joints.
+``ik_lbfgs_baseline`` is the SMPLify-style optimisation from identity rotations used by the bench.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import torch
+
+from ..errors import ShapeMoveError
+from .kinematics import axis_angle_to_matrix, forward_kinematics
+from .skeleton import NUM_BODY_JOINTS, NUM_JOINTS, PARENTS
+
+# (limb root, hinge joint, end joint, hinge axis in the rest pose; positive angle = flexion)
+LIMBS = [
+    (1, 4, 7, (1.0, 0.0, 0.0)),     # left hip, knee, ankle: shin swings back (-Z)
+    (2, 5, 8, (1.0, 0.0, 0.0)),     # right leg
+    (16, 18, 20, (0.0, -1.0, 0.0)),  # left shoulder, elbow, wrist: forearm swings forward (+Z)
+    (17, 19, 21, (0.0, 1.0, 0.0)),   # right arm
+]
+SPINE_BLEND = {3: 1.0 / 3.0, 6: 2.0 / 3.0}  # share of the chest's left-right axis per spine joint
+_EPS = 1e-9
+
+
+@dataclass
+class IKResult:
+    rotations: np.ndarray    # (T,24,3,3) local rotations
+    transl: np.ndarray       # (T,3) metres, added to FK (root stays at its rest position in FK)
+    joint_error: np.ndarray  # (T,22) metres, |FK + transl - target| per joint
+    mean_error_cm: float
+
+    def per_joint_error_cm(self) -> np.ndarray:
+        """(22,) mean error of each joint over the frames, centimetres."""
+        return self.joint_error.mean(0) * 100.0
+
+
+# -- small batched rotation helpers (torch, (...,3) vectors) -------------------------------------
+def _unit(v: torch.Tensor) -> torch.Tensor:
+    return v / torch.linalg.norm(v, dim=-1, keepdim=True).clamp_min(_EPS)
+
+
+def _frame(a: torch.Tensor, b: torch.Tensor) -> torch.Tensor:
+    """Orthonormal frame (...,3,3) with columns [a, b orthogonalised to a, a x b]."""
+    e1 = _unit(a)
+    b = b - (b * e1).sum(-1, keepdim=True) * e1
+    # b parallel to a: any perpendicular will do
+    alt = torch.where(e1[..., :1].abs() < 0.9, torch.tensor([1.0, 0, 0], dtype=a.dtype),
+                      torch.tensor([0, 1.0, 0], dtype=a.dtype))
+    alt = alt - (alt * e1).sum(-1, keepdim=True) * e1
+    bad = torch.linalg.norm(b, dim=-1, keepdim=True) < 1e-7
+    e2 = _unit(torch.where(bad, alt, b))
+    return torch.stack([e1, e2, torch.cross(e1, e2, dim=-1)], dim=-1)
+
+
+def _align_two(a1, a2, b1, b2) -> torch.Tensor:
+    """Rotation taking a1 exactly onto b1's direction and a2 as close as possible to b2."""
+    return _frame(b1, b2) @ _frame(a1, a2).transpose(-1, -2)
+
+
+def _swing(a: torch.Tensor, b: torch.Tensor) -> torch.Tensor:
+    """Minimal rotation (...,3,3) taking direction a onto direction b."""
+    a, b = _unit(a), _unit(b)
+    v = torch.cross(a, b, dim=-1)
+    c = (a * b).sum(-1)
+    x, y, z = v.unbind(-1)
+    zero = torch.zeros_like(x)
+    k = torch.stack([zero, -z, y, z, zero, -x, -y, x, zero], -1).reshape(*v.shape[:-1], 3, 3)
+    eye = torch.eye(3, dtype=a.dtype).expand(k.shape)
+    rot = eye + k + (k @ k) / (1 + c).clamp_min(1e-6)[..., None, None]
+    # (anti)parallel: half-turn about an axis perpendicular to a
+    anti = c < -1 + 1e-6
+    if anti.any():
+        p = _frame(a, torch.ones_like(a))[..., 1]
+        half = 2 * p[..., :, None] * p[..., None, :] - eye
+        rot = torch.where(anti[..., None, None], half, rot)
+    return rot
+
+
+def _kabsch(src: torch.Tensor, dst: torch.Tensor) -> torch.Tensor:
+    """Rotation (T,3,3) best mapping the vectors src (n,3) onto dst (T,n,3) (least squares)."""
+    h = torch.einsum("ni,tnj->tij", src, dst)
+    u, _, vt = torch.linalg.svd(h)
+    d = torch.sign(torch.linalg.det(vt.transpose(-1, -2) @ u.transpose(-1, -2)))
+    d = torch.where(d == 0, torch.ones_like(d), d)
+    fix = torch.diag_embed(torch.stack([torch.ones_like(d), torch.ones_like(d), d], -1))
+    return vt.transpose(-1, -2) @ fix @ u.transpose(-1, -2)
+
+
+def _smoothstep(x: torch.Tensor, lo: float, hi: float) -> torch.Tensor:
+    t = ((x - lo) / (hi - lo)).clamp(0, 1)
+    return t * t * (3 - 2 * t)
+
+
+# -- input checks --------------------------------------------------------------------------------
+def _prepare(joints, rest_joints, parents):
+    j = torch.as_tensor(np.asarray(joints, dtype=np.float64) if not torch.is_tensor(joints) else joints)
+    r = torch.as_tensor(np.asarray(rest_joints, dtype=np.float64) if not torch.is_tensor(rest_joints)
+                        else rest_joints)
+    j, r = j.detach().double(), r.detach().double()
+    if j.dim() == 2:
+        j = j[None]
+    if j.dim() != 3 or j.shape[-1] != 3 or j.shape[1] not in (NUM_BODY_JOINTS, NUM_JOINTS):
+        raise ShapeMoveError(f"IK joints must be (frames, 22, 3) metres, got shape {tuple(j.shape)}")
+    if j.shape[0] == 0:
+        raise ShapeMoveError("IK joints have no frames")
+    if r.dim() == 3 and r.shape[0] == 1:
+        r = r[0]
+    if tuple(r.shape) != (NUM_JOINTS, 3):
+        raise ShapeMoveError(f"rest_joints must be (24, 3) metres, got shape {tuple(r.shape)}")
+    if not (torch.isfinite(j).all() and torch.isfinite(r).all()):
+        raise ShapeMoveError("IK input contains NaN or infinite values")
+    parents = np.asarray(parents, dtype=np.int64)
+    if parents.shape != (NUM_JOINTS,) or parents[0] != -1 or np.any(parents[1:] >= np.arange(1, NUM_JOINTS)):
+        raise ShapeMoveError("parents must be the 24-joint SMPL tree (parents[0] = -1, parents[j] < j)")
+    return j[:, :NUM_BODY_JOINTS], r, parents
+
+
+def _fk(rot: torch.Tensor, rest: torch.Tensor, parents, transl: torch.Tensor) -> torch.Tensor:
+    pos, _ = forward_kinematics(rot, rest.expand(rot.shape[0], -1, -1), parents)
+    return pos[:, :NUM_BODY_JOINTS] + transl[:, None]
+
+
+def _result(rot, transl, target, rest, parents) -> IKResult:
+    with torch.no_grad():
+        err = torch.linalg.norm(_fk(rot, rest, parents, transl) - target, dim=-1)
+    return IKResult(rotations=rot.detach().float().numpy(), transl=transl.detach().float().numpy(),
+                    joint_error=err.float().numpy(), mean_error_cm=float(err.mean()) * 100.0)
+
+
+# -- analytic solve ------------------------------------------------------------------------------
+def analytic_ik(target: torch.Tensor, rest: torch.Tensor, parents) -> tuple[torch.Tensor, torch.Tensor]:
+    """target (T,22,3), rest (24,3) float64 -> local rotations (T,24,3,3), transl (T,3)."""
+    T = target.shape[0]
+    dt = target.dtype
+    offs = rest.clone()
+    offs[1:] = rest[1:] - rest[parents[1:]]
+    kids = [[c for c in range(1, NUM_BODY_JOINTS) if parents[c] == j] for j in range(NUM_JOINTS)]
+    limb_of = {l[0]: l for l in LIMBS}
+    hinge_of = {l[1]: l for l in LIMBS}
+    hinge_axis = {}
+    for root, mid, _, axis in LIMBS:  # hinge axis made orthogonal to the upper bone
+        a = _unit(offs[mid])
+        h = torch.tensor(axis, dtype=dt)
+        hinge_axis[root] = _unit(h - (h @ a) * a)
+    ex = torch.tensor([1.0, 0, 0], dtype=dt)
+    # chest orientation straight from the targets (used to spread the spine twist)
+    chest = _kabsch(offs[kids[9]], target[:, kids[9]] - target[:, 9:10])
+
+    G = [None] * NUM_JOINTS  # world rotations (T,3,3)
+    P = [None] * NUM_JOINTS  # FK positions (T,3)
+    P[0] = target[:, 0]
+    for j in range(NUM_JOINTS):
+        p = parents[j]
+        if j > 0:
+            P[j] = P[p] + G[p] @ offs[j]
+        ch = kids[j]
+        if not ch:
+            G[j] = G[p]
+        elif len(ch) > 1:
+            G[j] = _kabsch(offs[ch], target[:, ch] - P[j][:, None])
+        elif j in SPINE_BLEND:
+            s = SPINE_BLEND[j]
+            side = (1 - s) * (G[0] @ ex) + s * (chest @ ex)
+            G[j] = _align_two(offs[ch[0]].expand(T, 3), ex.expand(T, 3), target[:, ch[0]] - P[j], side)
+        elif j in limb_of:
+            G[j] = _limb_root(j, limb_of[j], hinge_axis[j], offs, target, P[j], G[p])
+        elif j in hinge_of:
+            h = hinge_axis[hinge_of[j][0]]
+            c = ch[0]
+            G[j] = _align_two(offs[c].expand(T, 3), h.expand(T, 3), target[:, c] - P[j], G[p] @ h)
+        else:
+            G[j] = _swing(G[p] @ offs[ch[0]], target[:, ch[0]] - P[j]) @ G[p]
+    rot = torch.stack([G[0]] + [G[parents[j]].transpose(-1, -2) @ G[j] for j in range(1, NUM_JOINTS)], 1)
+    return rot, target[:, 0] - rest[0]
+
+
+def _limb_root(j, limb, h, offs, target, pj, gp):
+    """World rotation of a hip/shoulder: aim at the knee/elbow, twist so that the knee/elbow
+    bends about its hinge axis ``h``; near-straight limbs keep the minimal swing's twist."""
+    _, mid, end, _ = limb
+    a = _unit(offs[mid])
+    bj = _unit(target[:, mid] - pj)
+    g0 = _swing(gp @ a, bj) @ gp
+    u = g0 @ h                                     # hinge axis with the minimal twist
+    p_mid = pj + torch.linalg.norm(offs[mid]) * bj  # where FK will put the knee/elbow
+    bk = _unit(target[:, end] - p_mid)
+    dvec = bk - (bk * bj).sum(-1, keepdim=True) * bj
+    r = torch.linalg.norm(dvec, dim=-1, keepdim=True)  # sin of the bend angle
+    d = dvec / r.clamp_min(_EPS)
+    e = torch.cross(bj, d, dim=-1)                 # hinge direction for a flexion towards d
+    flex = torch.cross(u, bj, dim=-1)               # flexion direction predicted by the swing
+    # slightly bent limbs bending "backwards" are read as hyperextension, not as a half twist
+    sign = torch.where(((d * flex).sum(-1, keepdim=True) >= 0) | (r > 0.5), 1.0, -1.0).to(bj.dtype)
+    c = _unit(offs[end]) @ h                        # rest lower bone's component along the hinge
+    alpha = (c / r.clamp_min(_EPS)).clamp(-1, 1)
+    w = alpha * d + sign * torch.sqrt(1 - alpha * alpha) * e
+    s = _smoothstep(r, np.sin(np.radians(2.0)), np.sin(np.radians(12.0)))
+    w = s * w + (1 - s) * u
+    return _align_two(a.expand_as(bj), h.expand_as(bj), bj, w)
+
+
+# -- refinement ----------------------------------------------------------------------------------
+def refine(rot0, transl0, target, rest, parents, iters: int = 10, smooth: float = 1e-3):
+    """A few batched LBFGS steps on axis-angle corrections of all frames at once.
+    Loss: mean squared joint error + ``smooth`` x squared frame-to-frame change of the local
+    rotations + a small pull towards the analytic solution. Returns (rotations, transl)."""
+    T = rot0.shape[0]
+    delta = torch.zeros(T, NUM_BODY_JOINTS, 3, dtype=rot0.dtype, requires_grad=True)
+    dtr = torch.zeros(T, 3, dtype=rot0.dtype, requires_grad=True)
+    tail = rot0[:, NUM_BODY_JOINTS:]
+    opt = torch.optim.LBFGS([delta, dtr], lr=1.0, max_iter=iters, line_search_fn="strong_wolfe",
+                            tolerance_grad=1e-12, tolerance_change=1e-15)
+
+    def compose():
+        head = rot0[:, :NUM_BODY_JOINTS] @ axis_angle_to_matrix(delta)
+        return torch.cat([head, tail], 1), transl0 + dtr
+
+    def closure():
+        opt.zero_grad()
+        rot, tr = compose()
+        err = ((_fk(rot, rest, parents, tr) - target) ** 2).sum(-1).mean()
+        loss = err + 1e-6 * (delta ** 2).sum(-1).mean()
+        if T > 1 and smooth > 0:
+            loss = loss + smooth * ((rot[1:] - rot[:-1]) ** 2).sum((-1, -2)).mean()
+        loss.backward()
+        return loss
+
+    opt.step(closure)
+    with torch.no_grad():
+        return compose()
+
+
+def solve_ik(joints, rest_joints, parents=PARENTS, refine_iters: int = 10) -> IKResult:
+    """joints (T,22,3) metres Y-up; rest_joints (24,3) of the target body (e.g.
+    ``BodyModel.rest_joints(betas)[0]``). Analytic IK then ``refine_iters`` LBFGS iterations
+    (0 = analytic only; skipped when the analytic error is already below 0.01 mm).
+    Returns local rotations (T,24,3,3) and transl (T,3) such that FK + transl ~ joints."""
+    target, rest, parents = _prepare(joints, rest_joints, parents)
+    rot, transl = analytic_ik(target, rest, parents)
+    if refine_iters > 0:
+        with torch.no_grad():
+            before = torch.linalg.norm(_fk(rot, rest, parents, transl) - target, dim=-1).max()
+        if before > 1e-5:
+            rot, transl = refine(rot, transl, target, rest, parents, iters=refine_iters)
+    return _result(rot, transl, target, rest, parents)
+
+
+def ik_lbfgs_baseline(joints, rest_joints, iters: int = 100, parents=PARENTS) -> IKResult:
+    """SMPLify-style baseline: LBFGS on axis-angle from identity rotations (transl started at
+    the pelvis), ``iters`` iterations over all frames at once, small L2 pose prior."""
+    target, rest, parents = _prepare(joints, rest_joints, parents)
+    T = target.shape[0]
+    aa = torch.zeros(T, NUM_JOINTS, 3, dtype=target.dtype, requires_grad=True)
+    tr = (target[:, 0] - rest[0]).clone().requires_grad_(True)
+    opt = torch.optim.LBFGS([aa, tr], lr=1.0, max_iter=iters, line_search_fn="strong_wolfe",
+                            tolerance_grad=1e-12, tolerance_change=1e-15)
+
+    def closure():
+        opt.zero_grad()
+        pos = _fk(axis_angle_to_matrix(aa), rest, parents, tr)
+        loss = ((pos - target) ** 2).sum(-1).mean() + 1e-6 * (aa ** 2).sum(-1).mean()
+        loss.backward()
+        return loss
+
+    opt.step(closure)
+    return _result(axis_angle_to_matrix(aa.detach()), tr.detach(), target, rest, parents)

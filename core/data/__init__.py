@@ -1,0 +1,1 @@
+"""Dataset building: clip discovery, captions, shape texts, the builder."""

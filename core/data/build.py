@@ -1,0 +1,249 @@
+"""The dataset builder: mocap clips -> HumanML3D-style training data, shape-aware and normalized.
+
+For each clip (see ``sources.discover``):
+  1. read it as 22 SMPL joints at 20 fps (``io.mocap.load_smpl22``),
+  2. fit the body's betas to the subject's bone lengths (``body.fit``),
+  3. IK onto that body -> local rotations + root translation (``body.ik``),
+  4. shape-aware motion = FK of the fitted body; normalized motion = the same rotations on the
+     canonical body (betas = 0), root trajectory scaled by the pelvis-height ratio (stride follows
+     leg length) and put back on the ground,
+  5. HumanML3D features of both, captions, shape texts from the mesh measurements.
+Bandai clips (one shared skeleton) additionally get retargeted copies on bodies sampled from the
+shape space (``AUGMENT_SHARE``). Each clip is written atomically and marked done by its
+``meta/ID.json``, so an interrupted build resumes where it stopped.
+"""
+from __future__ import annotations
+
+import json
+import os
+import time
+import traceback
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import ShapeMoveError
+from .shape_text import shape_adjectives, shape_sentence
+from .sources import ClipSource, discover, open_source
+from .splits import split_of
+
+FPS = 20
+MIN_FRAMES = 40          # 2 s, as HumanML3D
+AUGMENT_SHARE = 0.5      # fraction of Bandai clips that get one copy on a sampled body
+AUGMENT_BETA_CLIP = 2.5  # sampled betas ~ N(0,1) clipped to +-2.5
+
+SUBDIRS = ["new_joints", "new_joint_vecs", "norm_joints", "norm_joint_vecs", "betas", "poses", "transl",
+           "texts", "shape_texts", "meta"]
+
+
+def _save_npy(path: Path, arr: np.ndarray) -> None:
+    tmp = path.with_name(path.name + ".tmp.npy")
+    np.save(tmp, arr)
+    os.replace(tmp, path)
+
+
+def _save_text(path: Path, text: str) -> None:
+    tmp = path.with_name(path.name + ".tmp")
+    tmp.write_text(text, encoding="utf-8")
+    os.replace(tmp, path)
+
+
+@dataclass
+class BuildReport:
+    built: int = 0
+    skipped_done: int = 0
+    augmented: int = 0
+    failures: list[tuple[str, str]] = field(default_factory=list)
+    seconds: float = 0.0
+    splits: dict = field(default_factory=dict)
+
+    def summary(self) -> str:
+        lines = [f"clips built: {self.built} (+{self.augmented} augmented), already done: {self.skipped_done}, "
+                 f"failed: {len(self.failures)}, time: {self.seconds:.0f} s",
+                 "splits: " + ", ".join(f"{k} {v}" for k, v in sorted(self.splits.items()))]
+        for cid, why in self.failures:
+            lines.append(f"  failed {cid}: {why}")
+        return "\n".join(lines)
+
+
+class ClipProcessor:
+    """Turns one clip into the arrays of the dataset (no file I/O besides reading the clip)."""
+
+    def __init__(self, body=None, ik_refine_iters: int = 10):
+        from ..body.load import load_body_model
+
+        self.body = body if body is not None else load_body_model(None)
+        self.ik_refine_iters = ik_refine_iters
+        self.rest0 = self.body.rest_joints(None)[0].numpy()
+
+    def load(self, clip: ClipSource):
+        from ..io.mocap import load_smpl22
+
+        kwargs = {"fps": FPS}
+        if clip.skeleton_path is not None:
+            kwargs["skeleton"] = clip.skeleton_path
+        motion = load_smpl22(clip.path, **kwargs)
+        joints = np.asarray(motion.joints, dtype=np.float32)
+        if joints.shape[0] < MIN_FRAMES:
+            raise ShapeMoveError(f"too short: {joints.shape[0]} frames at {FPS} fps (need {MIN_FRAMES})")
+        if not np.isfinite(joints).all():
+            raise ShapeMoveError("non-finite joint positions")
+        return joints
+
+    def fit(self, joints: np.ndarray) -> np.ndarray:
+        from ..body.fit import fit_betas_to_skeleton
+        from ..body.skeleton import BODY_BONES
+
+        # the subject's bone lengths: median over frames is robust to marker noise
+        lengths = np.stack([np.linalg.norm(joints[:, c] - joints[:, p], axis=-1) for p, c in BODY_BONES], 1)
+        fit = fit_betas_to_skeleton(self.body, np.median(lengths, 0))
+        return np.asarray(getattr(fit, "betas", fit), dtype=np.float32)
+
+    def pose_on(self, rotations: np.ndarray, root: np.ndarray, betas: np.ndarray, scale: float):
+        """FK of the body with ``betas`` with its root on the trajectory ``root`` (T,3) scaled by
+        ``scale`` (stride follows leg length); then the lowest foot joint is put on the floor."""
+        import torch
+
+        from ..body.kinematics import forward_kinematics
+
+        rest = self.body.rest_joints(torch.as_tensor(betas)[None])  # (1,24,3)
+        R = torch.as_tensor(rotations, dtype=torch.float32)
+        joints, _ = forward_kinematics(R, rest.expand(R.shape[0], -1, -1), self.body.parents)
+        joints = joints[:, :22].numpy() - rest[0, 0].numpy() + (root * scale)[:, None, :]
+        joints[..., 1] -= joints[:, [7, 8, 10, 11], 1].min()
+        return joints.astype(np.float32)
+
+    def process(self, clip: ClipSource, joints: np.ndarray, betas: np.ndarray | None = None):
+        """Returns dict of arrays/texts for a clip on body ``betas`` (fitted when None)."""
+        import torch
+
+        from ..body.ik import solve_ik
+        from ..body.measure import measure
+        from ..motion.features import features_from_joints
+
+        fitted = self.fit(joints)
+        rest = self.body.rest_joints(torch.as_tensor(fitted)[None])[0].numpy()
+        ik = solve_ik(joints, rest, refine_iters=self.ik_refine_iters)
+        rot = np.asarray(ik.rotations, dtype=np.float32)
+        root = np.asarray(ik.transl, dtype=np.float32) + rest[0]  # world root trajectory (T,3)
+        target = fitted if betas is None else betas.astype(np.float32)
+        rest_t = self.body.rest_joints(torch.as_tensor(target)[None])[0].numpy()
+        pelvis_h = lambda r: r[0, 1] - min(r[7, 1], r[8, 1], r[10, 1], r[11, 1])  # noqa: E731
+        s_target = pelvis_h(rest_t) / pelvis_h(rest)
+        s_norm = pelvis_h(self.rest0) / pelvis_h(rest)
+        shaped = self.pose_on(rot, root, target, s_target if betas is not None else 1.0)
+        normal = self.pose_on(rot, root, np.zeros(10, np.float32), s_norm)
+        local22 = rot[:, :22]
+        from ..body.kinematics import matrix_to_axis_angle
+
+        m = measure(self.body, target)
+        return {
+            "new_joints": shaped, "new_joint_vecs": features_from_joints(shaped, local22),
+            "norm_joints": normal, "norm_joint_vecs": features_from_joints(normal, local22),
+            "betas": target,
+            "poses": matrix_to_axis_angle(torch.as_tensor(rot)).numpy().astype(np.float32),
+            "transl": shaped[:, 0] - rest_t[0],  # BodyModel.forward(target, poses, transl) -> shaped
+            "ik_error_cm": float(ik.mean_error_cm),
+            "measure": {k: float(v) for k, v in m.items()},
+        }
+
+
+def _write_clip(out: Path, cid: str, arrays: dict, clip: ClipSource, split: str, extra: dict) -> None:
+    for key in ("new_joints", "new_joint_vecs", "norm_joints", "norm_joint_vecs", "betas", "poses", "transl"):
+        _save_npy(out / key / f"{cid}.npy", np.asarray(arrays[key], dtype=np.float32))
+    _save_text(out / "texts" / f"{cid}.txt", "\n".join(clip.captions) + "\n")
+    m = arrays["measure"]
+    _save_text(out / "shape_texts" / f"{cid}.txt", shape_sentence(m) + "\n" + shape_adjectives(m) + "\n")
+    meta = {"id": cid, "source": str(clip.path), "dataset": clip.dataset, "subject": clip.subject,
+            "licence": clip.licence, "fps": FPS, "frames": int(arrays["new_joints"].shape[0]),
+            "labels": clip.labels, "split": split, "ik_error_cm": round(arrays["ik_error_cm"], 3),
+            "measure": {k: round(v, 1) for k, v in m.items()}, **extra}
+    _save_text(out / "meta" / f"{cid}.json", json.dumps(meta))  # written last: marks the clip done
+
+
+def _augment_betas(cid: str) -> np.ndarray:
+    seed = int.from_bytes(cid.encode()[-8:].rjust(8, b"\0"), "little") % (2**32)
+    rng = np.random.default_rng(seed)
+    return np.clip(rng.standard_normal(10), -AUGMENT_BETA_CLIP, AUGMENT_BETA_CLIP).astype(np.float32)
+
+
+def _wants_augment(clip: ClipSource, share: float) -> bool:
+    import hashlib
+
+    return clip.dataset == "bandai" and int(hashlib.md5(clip.id.encode()).hexdigest()[:8], 16) / 0xFFFFFFFF < share
+
+
+def build_dataset(sources: list[Path], out: Path, body=None, augment_share: float = AUGMENT_SHARE,
+                  limit: int | None = None, only: list[str] | None = None, progress=None, cancel=None,
+                  verbose: bool = True) -> BuildReport:
+    """Build (or resume building) a dataset folder from mocap sources. See the module docstring."""
+    from tqdm import tqdm
+
+    t0 = time.time()
+    out = Path(out)
+    for d in SUBDIRS:
+        (out / d).mkdir(parents=True, exist_ok=True)
+    clips: list[ClipSource] = []
+    for src in sources:
+        clips += discover(open_source(Path(src)))
+    if only:
+        clips = [c for c in clips if any(c.id.startswith(o) for o in only)]
+    if limit:
+        clips = clips[:limit]
+    if not clips:
+        raise ShapeMoveError(f"no motion clips found in {', '.join(map(str, sources))}")
+    proc = ClipProcessor(body)
+    report = BuildReport()
+    bar = tqdm(clips, desc="building", unit="clip", disable=not verbose)
+    for i, clip in enumerate(bar):
+        if cancel is not None and cancel():
+            break
+        split = split_of(clip.id, clip.subject, clip.dataset)
+        todo = [(clip.id, None)]
+        if _wants_augment(clip, augment_share):
+            todo.append((f"{clip.id}_aug", _augment_betas(clip.id)))
+        todo = [(cid, b) for cid, b in todo if not (out / "meta" / f"{cid}.json").exists()]
+        if not todo:
+            report.skipped_done += 1
+            continue
+        try:
+            joints = proc.load(clip)
+            for cid, b in todo:
+                arrays = proc.process(clip, joints, b)
+                extra = {"augmented_from": clip.id} if b is not None else {}
+                _write_clip(out, cid, arrays, clip, split, extra)
+                if b is None:
+                    report.built += 1
+                else:
+                    report.augmented += 1
+        except ShapeMoveError as exc:
+            report.failures.append((clip.id, str(exc)))
+        except Exception as exc:  # a bad clip must not stop the build: report it with its reason
+            report.failures.append((clip.id, f"{type(exc).__name__}: {exc}"))
+            if os.environ.get("SHAPEMOVE_DEBUG"):
+                traceback.print_exc()
+        if progress is not None:
+            progress((i + 1) / len(clips), clip.id)
+    finalize(out)
+    report.seconds = time.time() - t0
+    report.splits = {s: len((out / f"{s}.txt").read_text().split()) for s in ("train", "val", "test")}
+    _save_text(out / "build_report.txt", report.summary() + "\n")
+    return report
+
+
+def finalize(out: Path) -> None:
+    """meta.jsonl, split lists and Mean/Std (over the training split) from the per-clip files."""
+    from ..motion.features import mean_std
+
+    metas = [json.loads(p.read_text()) for p in sorted((out / "meta").glob("*.json"))]
+    _save_text(out / "meta.jsonl", "".join(json.dumps(m) + "\n" for m in metas))
+    for s in ("train", "val", "test"):
+        _save_text(out / f"{s}.txt", "".join(m["id"] + "\n" for m in metas if m["split"] == s))
+    train = [m["id"] for m in metas if m["split"] == "train"] or [m["id"] for m in metas]
+    if train:
+        feats = [np.load(out / "new_joint_vecs" / f"{cid}.npy") for cid in train]
+        feats += [np.load(out / "norm_joint_vecs" / f"{cid}.npy") for cid in train]
+        mean, std = mean_std(feats)
+        _save_npy(out / "Mean.npy", np.asarray(mean, np.float32))
+        _save_npy(out / "Std.npy", np.asarray(std, np.float32))

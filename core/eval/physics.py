@@ -1,0 +1,147 @@
+"""Ground-contact plausibility: penetrate, float and foot skating (metres in, cm / % out).
+
+Conventions: Y up, ground plane y = 0, 20 fps. All functions are vectorised over frames.
+
+Definitions (as in HUMOS's ``all_physics_metrics``, which implements the PhysDiff wording
+"distance below/above the ground of the lowest body-mesh vertex"):
+
+* **penetrate**: per frame, ``h = min_v y_v`` (lowest vertex). A frame *penetrates* when
+  ``h < -tol``; the metric is the mean of ``-h`` over those frames only (cm). ``tol`` (5 mm)
+  absorbs mesh approximations. PhysDiff/UHC average over *all* frames (0 where there is no
+  penetration): that number equals ours times ``count / n_frames``, both are returned.
+* **float**: a frame *floats* (is unsupported) when ``h > tol``; the metric is the mean of ``h``
+  over those frames (cm). A motion that jumps floats during the flight phase, as in HUMOS/PhysDiff.
+* **skate** (GMD's "foot skating ratio", Karunratanakul et al. 2023): over the T-1 pairs of
+  adjacent frames, the % of pairs in which a foot *in contact in both frames* moves horizontally
+  (XZ) by more than ``max_step``. With a mesh, a foot is the set of vertices whose dominant skin
+  weight is its ankle or foot joint; the foot is in contact when some of its vertices are below
+  ``height`` in both frames and its displacement is the mean XZ displacement of exactly those
+  vertices (the part that should stay planted). Without a mesh, the foot is the foot joint (10/11)
+  as in GMD. GMD uses ``height`` 5 cm and 0.5 m/s (2.5 cm per frame at 20 fps) averaged over a
+  5-frame window (``GMD_SKATE``); our default step is 2.5 mm per frame (5 cm/s, no window), so a
+  contact foot sliding 1 cm per frame is caught.
+"""
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+import torch
+
+from ..errors import ShapeMoveError
+
+GROUND_TOL = 0.005          # m, penetrate / float tolerance (HUMOS)
+CONTACT_HEIGHT = 0.05       # m, foot contact height (GMD, HUMOS)
+SKATE_STEP = 0.0025         # m per frame at 20 fps
+GMD_SKATE = {"height": 0.05, "max_step": 0.025, "window": 5}
+FOOT_JOINTS = {"left": (7, 10), "right": (8, 11)}   # ankle, foot (SMPL order)
+FOOT_JOINT_IDS = [7, 8, 10, 11]
+
+
+class Stat(NamedTuple):
+    """A metric value and the number of frames (or frame pairs) it is averaged over."""
+    value: float
+    count: int
+
+
+def _np(x, name: str, ndim: int) -> np.ndarray:
+    a = x.detach().cpu().numpy() if isinstance(x, torch.Tensor) else np.asarray(x)
+    if a.ndim != ndim or a.shape[-1] != 3:
+        raise ShapeMoveError(f"{name} must have {ndim} dimensions ending in 3 (x,y,z), got shape {a.shape}")
+    if not np.isfinite(a).all():
+        raise ShapeMoveError(f"{name} contains NaN or infinite values")
+    return a.astype(np.float64)
+
+
+def lowest_heights(vertices) -> np.ndarray:
+    """(T,V,3) vertices (or (T,J,3) joints) -> (T,) height of the lowest point per frame, m."""
+    return _np(vertices, "vertices", 3)[..., 1].min(axis=1)
+
+
+def lowest_from_joints(joints, sole_offsets=None) -> np.ndarray:
+    """Joint-only fallback for the lowest point: (T,>=22,3) joints -> (T,) estimated sole height.
+
+    Uses the ankle and foot joints (7, 8, 10, 11) minus their rest height above the sole
+    (``sole_offsets`` (4,), from ``sole_offsets(body, betas)``; 0 = raw joint heights as GMD).
+    """
+    j = _np(joints, "joints", 3)
+    if j.shape[1] < 22:
+        raise ShapeMoveError(f"joints must have at least 22 joints (SMPL order), got {j.shape[1]}")
+    off = np.zeros(4) if sole_offsets is None else np.asarray(sole_offsets, dtype=np.float64)
+    return (j[:, FOOT_JOINT_IDS, 1] - off).min(axis=1)
+
+
+def sole_offsets(body, betas=None) -> np.ndarray:
+    """(4,) rest-pose height of joints 7, 8, 10, 11 above the lowest vertex of the body."""
+    with torch.no_grad():
+        joints = body.rest_joints(betas)[0].double().numpy()
+        verts = body.rest_vertices(betas)[0].double().numpy()
+    return joints[FOOT_JOINT_IDS, 1] - verts[:, 1].min()
+
+
+def penetrate(lowest, tol: float = GROUND_TOL) -> Stat:
+    """Mean depth (cm) below the ground of the lowest point, over frames with ``lowest < -tol``."""
+    h = np.asarray(lowest, dtype=np.float64)
+    hit = h < -tol
+    return Stat(float(-h[hit].mean() * 100) if hit.any() else 0.0, int(hit.sum()))
+
+
+def floating(lowest, tol: float = GROUND_TOL) -> Stat:
+    """Mean height (cm) above the ground of the lowest point, over frames with ``lowest > tol``."""
+    h = np.asarray(lowest, dtype=np.float64)
+    hit = h > tol
+    return Stat(float(h[hit].mean() * 100) if hit.any() else 0.0, int(hit.sum()))
+
+
+def _window_mean(x: np.ndarray, window: int) -> np.ndarray:
+    """Centred moving average along the last axis, zero padded (scipy uniform_filter1d 'constant')."""
+    if window <= 1:
+        return x
+    kernel = np.ones(window) / window
+    return np.apply_along_axis(lambda r: np.convolve(r, kernel, mode="same"), -1, x)
+
+
+def skate(feet: list, height: float = CONTACT_HEIGHT, max_step: float = SKATE_STEP, window: int = 1) -> Stat:
+    """Foot skating ratio (%) over the T-1 adjacent frame pairs.
+
+    ``feet``: one (T,P,3) array per foot (its vertices, or (T,1,3) for a joint). A foot is in
+    contact over a pair when any of its points is below ``height`` in both frames; its step is
+    the mean XZ displacement of those points. A pair skates when some foot in contact steps more
+    than ``max_step`` (and, with ``window`` > 1, its windowed mean step too, as GMD).
+    Returns (% of pairs that skate, number of pairs).
+    """
+    skating = None
+    for pts in feet:
+        p = _np(pts, "foot points", 3)
+        if p.shape[0] < 2:
+            return Stat(0.0, 0)
+        low = p[..., 1] < height
+        both = low[:-1] & low[1:]                                   # (T-1,P)
+        d = np.linalg.norm(p[1:, :, [0, 2]] - p[:-1, :, [0, 2]], axis=-1)
+        n = both.sum(-1)
+        contact = n > 0
+        step = np.where(contact, (d * both).sum(-1) / np.maximum(n, 1), 0.0)
+        s = contact & (step > max_step) & (_window_mean(step, window) > max_step)
+        skating = s if skating is None else skating | s
+    if skating is None:
+        raise ShapeMoveError("skate needs at least one foot")
+    return Stat(float(skating.mean() * 100), int(skating.size))
+
+
+def foot_vertex_ids(skin_weights) -> dict[str, np.ndarray]:
+    """Vertex indices of each foot: dominant skin weight on its ankle or foot joint."""
+    w = skin_weights.detach().cpu().numpy() if isinstance(skin_weights, torch.Tensor) else np.asarray(skin_weights)
+    label = w.argmax(axis=1)
+    out = {side: np.flatnonzero(np.isin(label, joints)) for side, joints in FOOT_JOINTS.items()}
+    for side, ids in out.items():
+        if ids.size == 0:
+            raise ShapeMoveError(f"the body model has no vertices skinned to the {side} ankle/foot")
+    return out
+
+
+def skate_from_joints(joints, height: float = CONTACT_HEIGHT, max_step: float = SKATE_STEP, window: int = 1) -> Stat:
+    """Joint-only fallback (GMD): the feet are the foot joints 10 and 11 of (T,>=22,3) joints."""
+    j = _np(joints, "joints", 3)
+    if j.shape[1] < 22:
+        raise ShapeMoveError(f"joints must have at least 22 joints (SMPL order), got {j.shape[1]}")
+    return skate([j[:, [FOOT_JOINTS["left"][1]]], j[:, [FOOT_JOINTS["right"][1]]]], height, max_step, window)
