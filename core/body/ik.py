@@ -146,6 +146,19 @@ def _result(rot, transl, target, rest, parents) -> IKResult:
                     joint_error=err.float().numpy(), mean_error_cm=float(err.mean()) * 100.0)
 
 
+def hinge_axes(rest_joints, parents=PARENTS) -> dict:
+    """{knee/elbow joint index: (3,) unit hinge axis} in the rest frame: the knee's +X and the
+    elbows' -Y/+Y made orthogonal to the upper bone (thigh/upper arm). Rotating the knee/elbow
+    about this axis by a positive angle flexes it; ``solve_ik`` recovers such rotations exactly."""
+    rest = torch.as_tensor(np.asarray(rest_joints, dtype=np.float64)).reshape(NUM_JOINTS, 3)
+    out = {}
+    for root, mid, _, axis in LIMBS:
+        a = _unit(rest[mid] - rest[parents[mid]])
+        h = torch.tensor(axis, dtype=torch.float64)
+        out[mid] = _unit(h - (h @ a) * a).numpy()
+    return out
+
+
 # -- analytic solve ------------------------------------------------------------------------------
 def analytic_ik(target: torch.Tensor, rest: torch.Tensor, parents) -> tuple[torch.Tensor, torch.Tensor]:
     """target (T,22,3), rest (24,3) float64 -> local rotations (T,24,3,3), transl (T,3)."""
@@ -156,11 +169,8 @@ def analytic_ik(target: torch.Tensor, rest: torch.Tensor, parents) -> tuple[torc
     kids = [[c for c in range(1, NUM_BODY_JOINTS) if parents[c] == j] for j in range(NUM_JOINTS)]
     limb_of = {l[0]: l for l in LIMBS}
     hinge_of = {l[1]: l for l in LIMBS}
-    hinge_axis = {}
-    for root, mid, _, axis in LIMBS:  # hinge axis made orthogonal to the upper bone
-        a = _unit(offs[mid])
-        h = torch.tensor(axis, dtype=dt)
-        hinge_axis[root] = _unit(h - (h @ a) * a)
+    axes = hinge_axes(rest, parents)
+    hinge_axis = {root: torch.as_tensor(axes[mid], dtype=dt) for root, mid, _, _ in LIMBS}
     ex = torch.tensor([1.0, 0, 0], dtype=dt)
     # chest orientation straight from the targets (used to spread the spine twist)
     chest = _kabsch(offs[kids[9]], target[:, kids[9]] - target[:, 9:10])
@@ -198,7 +208,7 @@ def _limb_root(j, limb, h, offs, target, pj, gp):
     bends about its hinge axis ``h``; near-straight limbs keep the minimal swing's twist."""
     _, mid, end, _ = limb
     a = _unit(offs[mid])
-    bj = _unit(target[:, mid] - pj)
+    bj = _unit(_two_bone_mid(pj, target[:, mid], target[:, end], offs[mid], offs[end]) - pj)
     g0 = _swing(gp @ a, bj) @ gp
     u = g0 @ h                                     # hinge axis with the minimal twist
     p_mid = pj + torch.linalg.norm(offs[mid]) * bj  # where FK will put the knee/elbow
@@ -216,6 +226,25 @@ def _limb_root(j, limb, h, offs, target, pj, gp):
     s = _smoothstep(r, np.sin(np.radians(2.0)), np.sin(np.radians(12.0)))
     w = s * w + (1 - s) * u
     return _align_two(a.expand_as(bj), h.expand_as(bj), bj, w)
+
+
+def _two_bone_mid(root, mid, end, off_mid, off_end):
+    """Where to put the knee/elbow (T,3) so that the ankle/wrist lands on its target when it can:
+    on the circle of positions at the body's bone lengths from the hip and the ankle, on the side
+    of the target knee (the nearest point of that circle). Equals the target knee whenever the
+    targets have the body's bone lengths."""
+    l1, l2 = torch.linalg.norm(off_mid), torch.linalg.norm(off_end)
+    v = end - root
+    dist = torch.linalg.norm(v, dim=-1, keepdim=True)
+    n = v / dist.clamp_min(_EPS)
+    d = dist.clamp(abs(l1 - l2) + 1e-6, l1 + l2 - 1e-9)
+    x = (l1 * l1 - l2 * l2 + d * d) / (2 * d)
+    rho = torch.sqrt((l1 * l1 - x * x).clamp_min(0))
+    m = (mid - root) - ((mid - root) * n).sum(-1, keepdim=True) * n
+    mn = torch.linalg.norm(m, dim=-1, keepdim=True)
+    ok = mn > 1e-6
+    mid_new = root + x * n + rho * m / mn.clamp_min(_EPS)
+    return torch.where(ok, mid_new, mid)
 
 
 # -- refinement ----------------------------------------------------------------------------------
@@ -237,8 +266,8 @@ def refine(rot0, transl0, target, rest, parents, iters: int = 10, smooth: float 
     def closure():
         opt.zero_grad()
         rot, tr = compose()
-        err = ((_fk(rot, rest, parents, tr) - target) ** 2).sum(-1).mean()
-        loss = err + 1e-6 * (delta ** 2).sum(-1).mean()
+        sq = ((_fk(rot, rest, parents, tr) - target) ** 2).sum(-1)
+        loss = torch.sqrt(sq + 1e-8).mean() + 1e-6 * (delta ** 2).sum(-1).mean()
         if T > 1 and smooth > 0:
             loss = loss + smooth * ((rot[1:] - rot[:-1]) ** 2).sum((-1, -2)).mean()
         loss.backward()

@@ -7,8 +7,6 @@ direction is HumanML3D's: ``across = (r_hip - l_hip) + (r_shoulder - l_shoulder)
 from __future__ import annotations
 
 import numpy as np
-from scipy.ndimage import gaussian_filter1d
-
 from ..body.skeleton import FACE_JOINTS
 from ..errors import ShapeMoveError
 from .rotations import yaw_matrix
@@ -49,13 +47,25 @@ def heading_angles(forward: np.ndarray) -> np.ndarray:
     return np.arctan2(forward[:, 0], forward[:, 2])
 
 
+def gaussian_smooth(x: np.ndarray, sigma: float) -> np.ndarray:
+    """Gaussian filter along axis 0 with 'nearest' edges, truncated at 4 sigma: the same numbers as
+    ``scipy.ndimage.gaussian_filter1d(x, sigma, axis=0, mode="nearest")`` without needing scipy
+    (Blender ships numpy only)."""
+    radius = int(4.0 * sigma + 0.5)
+    offsets = np.arange(-radius, radius + 1)
+    weights = np.exp(-0.5 * (offsets / sigma) ** 2)
+    weights /= weights.sum()
+    index = np.clip(np.arange(len(x))[:, None] + offsets[None, :], 0, len(x) - 1)
+    return np.einsum("tk,tk...->t...", np.broadcast_to(weights, index.shape), x[index])
+
+
 def smooth_directions(forward: np.ndarray, sigma: float) -> np.ndarray:
     """Gaussian-smooth (T, 3) directions over time (HumanML3D: sigma 20 frames, 'nearest' edges)
     and renormalise. Frames whose smoothed vector vanishes (a spin faster than the window) keep
     their raw direction."""
     if sigma <= 0:
         return forward
-    smooth = gaussian_filter1d(forward, sigma, axis=0, mode="nearest")
+    smooth = gaussian_smooth(forward, sigma)
     norm = np.linalg.norm(smooth, axis=-1, keepdims=True)
     ok = norm > 1e-6
     return np.where(ok, smooth / np.where(ok, norm, 1.0), forward)

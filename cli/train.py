@@ -1,0 +1,48 @@
+"""`python -m shapemove train KIND --data DIR --config small|paper|PATH.json --out RUN [--steps N] [--resume]`.
+
+KIND is vae (SA-VAE), t5 or tma. Each kind lives in ``core/train/train_KIND.py`` and defines
+``from_cli(args) -> dict`` (the final metrics) reading the common arguments below (add a kind to
+``KINDS``). Several processes: ``torchrun --nproc_per_node N -m
+shapemove train vae ...`` (DistributedDataParallel; gloo on CPU, nccl on GPU).
+"""
+from __future__ import annotations
+
+import importlib
+import json
+import os
+from pathlib import Path
+
+KINDS = {"vae": "the shape-aware VAE (stage 1)", "t5": "text -> motion tokens + [BETA] head (stage 2)",
+         "tma": "the text-motion retrieval model (TMA)"}
+
+
+def _module(kind: str):
+    from ..core.errors import ShapeMoveError
+
+    try:
+        return importlib.import_module(f"...core.train.train_{kind}", __name__)
+    except ModuleNotFoundError as exc:
+        if exc.name and exc.name.endswith(f"train_{kind}"):
+            raise ShapeMoveError(f"`train {kind}` is not available in this build") from exc
+        raise
+
+
+def add_arguments(p):
+    sub = p.add_subparsers(dest="kind", metavar="KIND", required=True)
+    for kind, help_text in KINDS.items():
+        s = sub.add_parser(kind, help=help_text, description=help_text)
+        s.add_argument("--data", type=Path, required=True, help="dataset folder from `data build`")
+        s.add_argument("--config", default="small", help="small | paper | a JSON file (default: small)")
+        s.add_argument("--out", type=Path, required=True, help="run folder (checkpoints, log.jsonl)")
+        s.add_argument("--steps", type=int, help="override the config's number of steps")
+        s.add_argument("--resume", action="store_true", help="continue from RUN/last.pt if it exists")
+        s.add_argument("--device", choices=["cpu", "cuda"], help="default: cuda when available")
+        s.add_argument("--body", help="body model: openbody (default) or an SMPL-family file")
+        s.add_argument("--quiet", action="store_true", help="no progress bar")
+
+
+def run(args) -> int:
+    metrics = _module(args.kind).from_cli(args)
+    if int(os.environ.get("RANK", 0)) == 0 and metrics:
+        print(json.dumps(metrics, indent=1))
+    return 0

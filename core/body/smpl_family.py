@@ -1,0 +1,276 @@
+"""SMPL, SMPL-H and SMPL-X bodies from the user's own model files, as a 24-joint ``BodyModel``.
+
+ShapeMove never ships these models (their licence forbids it): the user downloads them and passes
+the path (``--body-model /path/to/SMPL_NEUTRAL.npz``). Accepted files are the official ``.npz``
+and ``.pkl`` files (SMPL ``basicModel_*.pkl``, ``SMPL_*.pkl/.npz``, SMPL-H ``SMPLH_*.pkl`` or AMASS
+``model.npz``, SMPL-X ``SMPLX_*.npz/.pkl``). Keys read: v_template (V,3), shapedirs (V,3,K),
+J_regressor (J,V) dense or scipy.sparse, weights (V,J), kintree_table (2,J), f (F,3), optionally
+posedirs (V,3,9(J-1)).
+
+Reading is done here rather than by ``smplx.SMPL(...)`` because the official SMPL ``.pkl`` files are
+Python-2 pickles holding ``chumpy`` arrays and chumpy is not installed (and does not import on
+current numpy): the pickle is opened with ``encoding='latin1'`` and each chumpy array is rebuilt
+from its pickled value (``x``), which is exactly what ``smplx``'s ``tools/clean_ch.py`` produces.
+The maths (shape blend shapes, pose correctives, FK, LBS) is the same as ``smplx.lbs.lbs``; the
+tests compare against smplx on the same files.
+
+Mapping to the SMPL 24 joints:
+- SMPL: unchanged.
+- SMPL-H (52 joints) / SMPL-X (55): joints 0..21 are the SMPL body joints. ``left_hand`` /
+  ``right_hand`` (22/23) are regressed as the mean of the four finger knuckles (index, middle,
+  ring, pinky base) of that hand, close to where SMPL puts its hand joint. Skinning weights of every
+  finger joint are summed into the hand joint of its side, those of jaw and eyes into ``head``;
+  so the fingers stay flat (SMPL-H/X zero hand pose with ``flat_hand_mean=True``).
+- Pose-corrective blend shapes (posedirs) ARE applied, as smplx does, for the joints the 24-joint
+  rig drives: all 23 for SMPL, the 21 body joints for SMPL-H/X (finger/jaw/eye rotations are zero).
+  Pass ``pose_correctives=False`` for plain linear blend skinning.
+"""
+from __future__ import annotations
+
+import pickle
+import re
+import zipfile
+from pathlib import Path
+
+import numpy as np
+import torch
+
+from ..errors import ShapeMoveError
+from .kinematics import as_rotation_matrices, forward_kinematics, linear_blend_skinning, skinning_transforms
+from .model import BodyModel, BodyOutput
+from .skeleton import NUM_BODY_JOINTS, NUM_JOINTS, PARENTS
+
+REQUIRED_KEYS = ("v_template", "shapedirs", "J_regressor", "weights", "kintree_table", "f")
+EXTENSIONS = (".npz", ".pkl")
+FAMILY_BY_JOINTS = {24: "smpl", 52: "smplh", 55: "smplx"}
+# the four finger knuckles (index1, middle1, pinky1, ring1) of the left / right hand
+KNUCKLES = {"smplh": ([22, 25, 28, 31], [37, 40, 43, 46]), "smplx": ([25, 28, 31, 34], [40, 43, 46, 49])}
+HOW_TO = ("download the model yourself (SMPL: smpl.is.tue.mpg.de, SMPL-H: mano.is.tue.mpg.de, "
+          "SMPL-X: smpl-x.is.tue.mpg.de), then pass --body-model /path/to/SMPL_NEUTRAL.npz "
+          "(or .pkl); expected keys " + ", ".join(REQUIRED_KEYS))
+
+
+# -- reading the files ---------------------------------------------------------------------------
+class _ChumpyArray:
+    """Stand-in for a pickled ``chumpy.Ch``: keeps its state; a plain Ch holds its value in ``x``."""
+
+    def __new__(cls, *args, **kwargs):
+        return object.__new__(cls)
+
+    def __setstate__(self, state):
+        self.state = state
+
+    def value(self):
+        x = self.state.get("x") if isinstance(self.state, dict) else None
+        if x is None:
+            raise ValueError("a chumpy expression (not a plain array) cannot be read without chumpy")
+        return x.value() if isinstance(x, _ChumpyArray) else np.asarray(x)
+
+
+class _ModelUnpickler(pickle.Unpickler):
+    """Only numpy / scipy.sparse / builtins classes; chumpy classes become ``_ChumpyArray``."""
+
+    def find_class(self, module, name):
+        top = module.split(".")[0]
+        if top == "chumpy":
+            return _ChumpyArray
+        if module.startswith("scipy.sparse"):
+            import scipy.sparse
+
+            return getattr(scipy.sparse, name)
+        if top in ("numpy", "copy_reg", "copyreg", "__builtin__", "builtins", "_codecs", "collections"):
+            return super().find_class(module, name)
+        raise pickle.UnpicklingError(f"unexpected class {module}.{name} in a body-model file")
+
+
+def _plain(value):
+    """chumpy / scipy.sparse / ndarray -> ndarray (or the value unchanged if it is none of those)."""
+    if isinstance(value, _ChumpyArray):
+        return value.value()
+    if hasattr(value, "toarray") and "scipy.sparse" in type(value).__module__:
+        return value.toarray()
+    return value
+
+
+def read_model_file(path: str | Path) -> dict:
+    """Read an SMPL-family ``.npz`` / ``.pkl`` into a dict of numpy arrays (only the keys we use)."""
+    path = Path(path).expanduser()
+    if not path.is_file():
+        raise ShapeMoveError(f"body model file {path} not found: {HOW_TO}")
+    if path.suffix.lower() not in EXTENSIONS:
+        raise ShapeMoveError(f"body model file {path} has extension '{path.suffix}', expected .npz or .pkl: {HOW_TO}")
+    wanted = REQUIRED_KEYS + ("posedirs", "gender")
+    try:
+        if path.suffix.lower() == ".npz":
+            with np.load(path, allow_pickle=True) as data:
+                raw = {k: data[k] for k in wanted if k in data.files}
+        else:
+            with open(path, "rb") as fh:
+                raw = _ModelUnpickler(fh, encoding="latin1").load()
+            if not isinstance(raw, dict):
+                raise ValueError(f"the pickle holds a {type(raw).__name__}, not a dict of arrays")
+            raw = {k: raw[k] for k in wanted if k in raw}
+        out = {k: _plain(v) for k, v in raw.items()}
+        for k, v in out.items():  # npz may store a sparse regressor as a pickled object array
+            if isinstance(v, np.ndarray) and v.dtype == object and v.shape == ():
+                out[k] = _plain(v.item())
+    except ShapeMoveError:
+        raise
+    except (OSError, ValueError, EOFError, KeyError, AttributeError, ImportError, pickle.UnpicklingError,
+            zipfile.BadZipFile) as exc:
+        raise ShapeMoveError(f"could not read body model file {path}: {exc}. {HOW_TO}") from None
+    missing = [k for k in REQUIRED_KEYS if k not in out]
+    if missing:
+        raise ShapeMoveError(f"body model file {path} lacks key(s) {', '.join(missing)}: is it an SMPL/SMPL-H/SMPL-X "
+                             f"model? {HOW_TO}")
+    return out
+
+
+# -- checking and converting ---------------------------------------------------------------------
+def _check_shapes(a: dict, where: str) -> tuple[int, int]:
+    """Validate the arrays; return (num_vertices, num_joints)."""
+    def bad(msg):
+        return ShapeMoveError(f"body model {where}: {msg}. {HOW_TO}")
+
+    v = np.asarray(a["v_template"])
+    if v.ndim != 2 or v.shape[1] != 3:
+        raise bad(f"v_template should be (V,3), got {v.shape}")
+    V = v.shape[0]
+    sd = np.asarray(a["shapedirs"])
+    if sd.ndim != 3 or sd.shape[:2] != (V, 3) or sd.shape[2] < 1:
+        raise bad(f"shapedirs should be ({V},3,K), got {sd.shape}")
+    jr = np.asarray(a["J_regressor"])
+    if jr.ndim != 2 or jr.shape[1] != V:
+        raise bad(f"J_regressor should be (J,{V}), got {jr.shape}")
+    J = jr.shape[0]
+    if J not in FAMILY_BY_JOINTS:
+        raise bad(f"{J} joints; expected 24 (SMPL), 52 (SMPL-H) or 55 (SMPL-X) - MANO/FLAME are not body models")
+    if np.asarray(a["weights"]).shape != (V, J):
+        raise bad(f"weights should be ({V},{J}), got {np.asarray(a['weights']).shape}")
+    if np.asarray(a["kintree_table"]).shape != (2, J):
+        raise bad(f"kintree_table should be (2,{J}), got {np.asarray(a['kintree_table']).shape}")
+    f = np.asarray(a["f"])
+    if f.ndim != 2 or f.shape[1] != 3 or (f.size and (f.min() < 0 or f.max() >= V)):
+        raise bad(f"f should be (F,3) vertex indices below {V}, got shape {f.shape}")
+    if "posedirs" in a and np.asarray(a["posedirs"]).shape != (V, 3, 9 * (J - 1)):
+        raise bad(f"posedirs should be ({V},3,{9 * (J - 1)}), got {np.asarray(a['posedirs']).shape}")
+    parents = _parents(a)
+    n = NUM_JOINTS if J == NUM_JOINTS else NUM_BODY_JOINTS
+    if not np.array_equal(parents[:n], PARENTS[:n]):
+        raise bad("kintree_table is not the SMPL joint tree")
+    return V, J
+
+
+def _parents(a: dict) -> np.ndarray:
+    parents = np.asarray(a["kintree_table"])[0].astype(np.int64)
+    parents[0] = -1  # stored as 2**32-1
+    return parents
+
+
+def to_24_joints(a: dict) -> dict:
+    """SMPL/SMPL-H/SMPL-X arrays -> 24-joint arrays (see module docstring for the mapping).
+
+    Returns j_regressor (24,V), skin_weights (V,24), family, and the number of joints (after the
+    root) whose pose correctives the 24-joint rig drives.
+    """
+    jr = np.asarray(a["J_regressor"], dtype=np.float64)
+    w = np.asarray(a["weights"], dtype=np.float64)
+    J = jr.shape[0]
+    family = FAMILY_BY_JOINTS[J]
+    if family == "smpl":
+        return {"j_regressor": jr, "skin_weights": w, "family": family, "posed_joints": NUM_JOINTS - 1}
+    parents = _parents(a)
+    group = np.arange(J)
+    for j in range(NUM_BODY_JOINTS, J):
+        anc = j
+        while anc >= NUM_BODY_JOINTS:
+            anc = parents[anc]
+        group[j] = {20: 22, 21: 23}.get(int(anc), int(anc))
+    weights = np.zeros((w.shape[0], NUM_JOINTS))
+    np.add.at(weights.T, group, w.T)
+    left, right = KNUCKLES[family]
+    if any(parents[k] != 20 for k in left) or any(parents[k] != 21 for k in right):
+        raise ShapeMoveError(f"{family} model: finger joints are not where expected (children of the wrists)")
+    reg = np.concatenate([jr[:NUM_BODY_JOINTS], jr[left].mean(0, keepdims=True), jr[right].mean(0, keepdims=True)])
+    return {"j_regressor": reg, "skin_weights": weights, "family": family, "posed_joints": NUM_BODY_JOINTS - 1}
+
+
+def model_name(path: Path, family: str, gender_key=None) -> str:
+    """'smplx-male' etc. from the file name, its folder (AMASS: male/model.npz) or a gender key."""
+    aliases = {"f": "female", "female": "female", "m": "male", "male": "male", "neutral": "neutral"}
+    for text in (path.stem, path.parent.name):
+        for tok in re.split(r"[^a-z]+", text.lower()):
+            if tok in aliases:
+                return f"{family}-{aliases[tok]}"
+    if gender_key is not None:
+        g = np.asarray(gender_key).item()
+        g = (g.decode() if isinstance(g, bytes) else str(g)).lower()
+        if g in aliases:
+            return f"{family}-{aliases[g]}"
+    return f"{family}-{path.stem.lower()}"
+
+
+def find_model_file(folder: Path, gender: str = "neutral") -> Path:
+    """The one model file in ``folder`` (or its smpl/smplh/smplx subfolders), preferring ``gender``."""
+    files = sorted(p for d in (folder, folder / "smpl", folder / "smplh", folder / "smplx") if d.is_dir()
+                   for p in d.iterdir() if p.suffix.lower() in EXTENSIONS and p.is_file())
+    if len(files) > 1:
+        tagged = [p for p in files if model_name(p, "x").endswith("-" + gender)]
+        files = tagged or files
+    if not files:
+        raise ShapeMoveError(f"no .npz/.pkl body model in {folder}: {HOW_TO}")
+    if len(files) > 1:
+        names = ", ".join(str(p) for p in files)
+        raise ShapeMoveError(f"several body models in {folder} ({names}): pass the file you want to --body-model")
+    return files[0]
+
+
+# -- the body model ------------------------------------------------------------------------------
+class SMPLFamilyBody(BodyModel):
+    """A 24-joint ``BodyModel`` from an SMPL / SMPL-H / SMPL-X file; pose correctives optional.
+
+    Extra buffer ``posedirs`` (P,V*3) with P = 9 * ``posed_joints`` (smplx layout), or None.
+    """
+
+    def __init__(self, arrays: dict, name: str, pose_correctives: bool = True, where: str = "arrays"):
+        V, J = _check_shapes(arrays, where)
+        m = to_24_joints(arrays)
+        super().__init__(arrays["v_template"], arrays["shapedirs"], m["j_regressor"], m["skin_weights"],
+                         arrays["f"], name=name)
+        self.family = m["family"]
+        self.posed_joints = m["posed_joints"]
+        posedirs = None
+        if pose_correctives and "posedirs" in arrays:
+            pd = np.asarray(arrays["posedirs"], dtype=np.float32)
+            posedirs = torch.from_numpy(pd.reshape(-1, pd.shape[-1]).T[: 9 * self.posed_joints].copy())
+        self.register_buffer("posedirs", posedirs)
+
+    @classmethod
+    def load(cls, path: str | Path, gender: str = "neutral", pose_correctives: bool = True) -> "SMPLFamilyBody":
+        """From a model file, or a folder holding one (``gender`` picks among several)."""
+        path = Path(path).expanduser()
+        if path.is_dir():
+            path = find_model_file(path, gender)
+        arrays = read_model_file(path)
+        family = FAMILY_BY_JOINTS.get(np.asarray(arrays["J_regressor"]).shape[0], "smpl")
+        return cls(arrays, model_name(path, family, arrays.get("gender")), pose_correctives, where=str(path))
+
+    def forward(self, betas=None, rotations=None, transl=None) -> BodyOutput:
+        """As ``BodyModel.forward`` plus the pose-corrective offsets (smplx's ``lbs``)."""
+        if self.posedirs is None or rotations is None:
+            return super().forward(betas, rotations, transl)
+        rotmats = as_rotation_matrices(torch.as_tensor(rotations, dtype=torch.float32))
+        B = rotmats.shape[0]
+        b = self._betas(betas, B)
+        if b.shape[0] == 1 and B > 1:
+            b = b.expand(B, -1)
+        joints_rest = self.rest_joints(b)
+        feature = (rotmats[:, 1: 1 + self.posed_joints] - torch.eye(3)).reshape(B, -1)
+        verts = self.rest_vertices(b) + (feature @ self.posedirs).reshape(B, -1, 3)
+        posed_joints, world = forward_kinematics(rotmats, joints_rest, self.parents)
+        verts = linear_blend_skinning(verts, self.skin_weights_t, skinning_transforms(world, joints_rest))
+        if transl is not None:
+            t = torch.as_tensor(transl, dtype=torch.float32).reshape(-1, 1, 3)
+            verts = verts + t
+            posed_joints = posed_joints + t
+        return BodyOutput(vertices=verts, joints=posed_joints)

@@ -1,0 +1,1 @@
+"""Text -> body shape + motion: prompt checks and the generation pipeline."""

@@ -1,0 +1,197 @@
+"""Map a mocap skeleton onto the 22 SMPL body joints (HumanML3D order) by joint POSITION.
+
+Every SMPL joint is a fixed linear combination of source joint positions, so a whole clip maps
+with one matrix product: ``smpl22 = W @ source`` with W (22, J). A rule is one of
+
+- ``"Name"``: the source joint itself (hips, knees, ankles, shoulders, elbows, wrists, head);
+- ``("lerp", "A", "B", t)``: (1-t)*A + t*B (CMU clavicles start on the mid-line: the SMPL collar
+  sits ~45% of the way to the shoulder);
+- ``("chain", f)``: the point at fraction f of the arc length of the rig's spine chain, which runs
+  from the midpoint of the two hip joints to the neck. SMPL's pelvis, spine1, spine2 and spine3
+  sit at 0.15, 0.34, 0.56 and 0.64 of that arc (neutral SMPL rest pose), so every rig gets
+  SMPL-like spine proportions whatever its own spine joints are.
+
+Left means the subject's left (SMPL/HumanML3D: left hip at +X when the body faces +Z).
+Source names are compared case-insensitively after dropping a namespace (``mixamorig:Hips``).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..body.skeleton import JOINT_NAMES, NUM_BODY_JOINTS
+from ..errors import ShapeMoveError
+
+SMPL22 = JOINT_NAMES[:NUM_BODY_JOINTS]
+
+# fractions of the mid-hips -> neck arc (neutral SMPL: hips 0.09 below the pelvis, neck 0.51 above)
+SPINE_FRACTIONS = {"pelvis": 0.15, "spine1": 0.34, "spine2": 0.56, "spine3": 0.64}
+
+
+def _limbs(hip, knee, ankle, foot, collar, shoulder, elbow, wrist):
+    """Rules for both sides from templates containing '{s}' (side letter/word)."""
+    out = {}
+    for side, s in (("left", "L"), ("right", "R")):
+        for smpl, tmpl in (("hip", hip), ("knee", knee), ("ankle", ankle), ("foot", foot),
+                           ("collar", collar), ("shoulder", shoulder), ("elbow", elbow), ("wrist", wrist)):
+            out[f"{side}_{smpl}"] = _side(tmpl, s)
+    return out
+
+
+def _side(rule, s):
+    sides = {"L": ("l", "Left", "L", "left"), "R": ("r", "Right", "R", "right")}[s]
+    fill = lambda name: name.format(s=sides[0], S=sides[1], X=sides[2], w=sides[3])  # noqa: E731
+    if isinstance(rule, str):
+        return fill(rule)
+    return tuple(fill(x) if isinstance(x, str) else x for x in rule)
+
+
+@dataclass(frozen=True)
+class Rig:
+    """How one family of skeletons maps to SMPL22. ``chain``: spine points from the hips upward
+    (the mid-hips point is prepended automatically; names in ``optional`` may be missing)."""
+
+    name: str
+    rules: dict
+    chain: tuple
+    neck: str
+    head: str
+    optional: tuple = ()
+
+
+def _rig(name, chain, neck, head, limbs, optional=()):
+    rules = dict(limbs)
+    rules["neck"] = neck
+    rules["head"] = head
+    for joint, frac in SPINE_FRACTIONS.items():
+        rules[joint] = ("chain", frac)
+    return Rig(name, rules, tuple(chain) + (neck,), neck, head, tuple(optional))
+
+
+RIGS = [
+    # SMPL itself (AMASS): identity
+    Rig("smpl", {n: n for n in SMPL22}, (), "neck", "head"),
+    _rig("bandai", ("Hips", "Spine", "Chest"), "Neck", "Head",
+         _limbs("UpperLeg_{X}", "LowerLeg_{X}", "Foot_{X}", "Toes_{X}",
+                "Shoulder_{X}", "UpperArm_{X}", "LowerArm_{X}", "Hand_{X}")),
+    # ASF bones, each placed at its START (see asf_amc): lfemur = hip joint, ltoes = ball of foot
+    _rig("cmu_asf", ("root", "upperback", "thorax", "lowerneck"), "upperneck", "head",
+         _limbs("{s}femur", "{s}tibia", "{s}foot", "{s}toes",
+                ("lerp", "{s}clavicle", "{s}humerus", 0.45), "{s}humerus", "{s}radius", "{s}wrist")),
+    # cgspeed's BVH conversion of CMU (same joints as the ASF, BVH names)
+    _rig("cmu_cgspeed", ("Hips", "Spine", "Spine1", "Neck"), "Neck1", "Head",
+         _limbs("{S}UpLeg", "{S}Leg", "{S}Foot", "{S}ToeBase",
+                ("lerp", "{S}Shoulder", "{S}Arm", 0.45), "{S}Arm", "{S}ForeArm", "{S}Hand")),
+    # Daz/Poser-style rig of the CMU BVH release (lFoot's End Site is the ball of the foot)
+    _rig("daz", ("abdomen", "chest"), "neck", "head",
+         _limbs("{s}Thigh", "{s}Shin", "{s}Foot", "{s}Foot_End",
+                "{s}Collar", "{s}Shldr", "{s}ForeArm", "{s}Hand")),
+    _rig("mixamo", ("Hips", "Spine", "Spine1", "Spine2"), "Neck", "Head",
+         _limbs("{S}UpLeg", "{S}Leg", "{S}Foot", "{S}ToeBase",
+                "{S}Shoulder", "{S}Arm", "{S}ForeArm", "{S}Hand"),
+         optional=("Hips", "Spine", "Spine1", "Spine2")),
+]
+
+
+def normalize(name: str) -> str:
+    """Case-folded joint name without a namespace prefix (``mixamorig:LeftArm`` -> ``leftarm``)."""
+    for sep in (":", "|"):
+        name = name.rsplit(sep, 1)[-1]
+    return name.strip().lower()
+
+
+def _rule_names(rule) -> list[str]:
+    if isinstance(rule, str):
+        return [rule]
+    if rule[0] == "lerp":
+        return [rule[1], rule[2]]
+    return []
+
+
+def _required(rig: Rig) -> dict:
+    """SMPL joint -> source names it needs (chain joints need the whole non-optional chain)."""
+    chain_needs = [n for n in rig.chain if n not in rig.optional]
+    chain_needs += [rig.rules["left_hip"], rig.rules["right_hip"]] if rig.chain else []
+    return {j: chain_needs if isinstance(r, tuple) and r[0] == "chain" else _rule_names(r)
+            for j, r in rig.rules.items()}
+
+
+def find_rig(names) -> Rig | None:
+    """The first rig whose every rule resolves against ``names``, else None."""
+    have = {normalize(n) for n in names}
+    for rig in RIGS:
+        if all(normalize(n) in have for needs in _required(rig).values() for n in needs):
+            return rig
+    return None
+
+
+def detect_rig(names) -> Rig:
+    """Like ``find_rig`` but raises ShapeMoveError listing the SMPL joints that could not be mapped
+    (for the rig that came closest)."""
+    rig = find_rig(names)
+    if rig is not None:
+        return rig
+    have = {normalize(n) for n in names}
+    best, best_missing = None, None
+    for cand in RIGS:
+        missing = [j for j, needs in _required(cand).items() if any(normalize(n) not in have for n in needs)]
+        if best_missing is None or len(missing) < len(best_missing):
+            best, best_missing = cand, missing
+    missing = [j for j in SMPL22 if j in best_missing]
+    raise ShapeMoveError(
+        f"unknown skeleton: cannot map SMPL joints {', '.join(missing)} "
+        f"(closest known rig: {best.name}; joints in file: {', '.join(list(names)[:12])}"
+        f"{', ...' if len(names) > 12 else ''})")
+
+
+def mapping_matrix(rig: Rig, names, positions: np.ndarray) -> np.ndarray:
+    """W (22, J) such that ``W @ positions[t]`` is the SMPL22 skeleton at frame t.
+
+    ``positions`` (T,J,3) fixes the spine-chain segment lengths (median over frames, so it works
+    whatever the rig's rest pose is)."""
+    index = {normalize(n): i for i, n in enumerate(names)}
+    J = len(names)
+
+    def onehot(name):
+        w = np.zeros(J)
+        w[index[normalize(name)]] = 1.0
+        return w
+
+    def rule_weights(rule):
+        if isinstance(rule, str):
+            return onehot(rule)
+        if rule[0] == "lerp":
+            return (1 - rule[3]) * onehot(rule[1]) + rule[3] * onehot(rule[2])
+        raise AssertionError(rule)
+
+    points = []
+    if rig.chain:
+        points.append(0.5 * (rule_weights(rig.rules["left_hip"]) + rule_weights(rig.rules["right_hip"])))
+        points += [onehot(n) for n in rig.chain if normalize(n) in index]
+        pts = np.stack(points)                                          # (K,J)
+        chain_pos = np.einsum("kj,tjc->tkc", pts, positions)            # (T,K,3)
+        seg = np.median(np.linalg.norm(np.diff(chain_pos, axis=1), axis=-1), axis=0)  # (K-1,)
+        cum = np.concatenate([[0.0], np.cumsum(seg)])
+        total = cum[-1]
+
+    W = np.zeros((len(SMPL22), J))
+    for i, joint in enumerate(SMPL22):
+        rule = rig.rules[joint]
+        if isinstance(rule, tuple) and rule[0] == "chain":
+            if not total > 0:
+                raise ShapeMoveError(f"degenerate skeleton: the spine chain of the {rig.name} rig has zero length")
+            s = rule[1] * total
+            k = int(np.clip(np.searchsorted(cum, s, side="right") - 1, 0, len(seg) - 1))
+            t = 0.0 if seg[k] <= 0 else (s - cum[k]) / seg[k]
+            W[i] = (1 - t) * pts[k] + t * pts[k + 1]
+        else:
+            W[i] = rule_weights(rule)
+    return W
+
+
+def map_positions(names, positions: np.ndarray, rig: Rig | None = None) -> tuple[np.ndarray, Rig]:
+    """(T,J,3) source positions -> ((T,22,3) SMPL22 positions, rig used)."""
+    rig = rig or detect_rig(names)
+    W = mapping_matrix(rig, names, positions)
+    return np.einsum("sj,tjc->tsc", W, positions), rig

@@ -1,0 +1,69 @@
+"""Decoding ShapeMove's output: `[BETA]`, `[SOM]`, then only motion codes until `[EOM]`.
+
+Logits are masked so that nothing but motion tokens (and `[EOM]` once the minimum length is
+reached) can appear in the motion span; `[EOM]` is forced at the maximum length. The betas come
+from the decoder state whose input is `[BETA]`. Batched; sampling with temperature/top-k, or
+greedy at temperature 0.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import torch
+
+
+@dataclass
+class Decoded:
+    codes: list[list[int]]   # per sample, FSQ indices 0..999
+    betas: torch.Tensor      # (B,10)
+    token_ids: list[list[int]]
+
+
+def motion_mask(vocab, vocab_size: int, allow_end: bool) -> torch.Tensor:
+    """Additive logit mask: 0 for motion codes (and [EOM] when allowed), -inf elsewhere."""
+    mask = torch.full((vocab_size,), float("-inf"))
+    mask[vocab.first_code_id: vocab.first_code_id + 1000] = 0.0
+    if allow_end:
+        mask[vocab.eom_id] = 0.0
+    return mask
+
+
+@torch.no_grad()
+def decode(model, input_ids, attention_mask, min_codes: int, max_codes: int, temperature: float = 1.0,
+           top_k: int | None = None, generator: torch.Generator | None = None) -> Decoded:
+    lm, vocab = model.lm, model.vocab
+    B = input_ids.shape[0]
+    enc = lm.get_encoder()(input_ids=input_ids, attention_mask=attention_mask)
+    start = lm.config.decoder_start_token_id
+    seq = torch.tensor([[start, vocab.beta_id, vocab.som_id]] * B, dtype=torch.long)
+    # the state whose input is [BETA] (position 1) gives the betas
+    out = lm(encoder_outputs=enc, attention_mask=attention_mask, decoder_input_ids=seq, output_hidden_states=True)
+    betas = model.beta_head(out.decoder_hidden_states[-1][:, 1])
+    V = out.logits.shape[-1]
+    mask_open, mask_closed = motion_mask(vocab, V, True), motion_mask(vocab, V, False)
+    done = torch.zeros(B, dtype=torch.bool)
+    codes: list[list[int]] = [[] for _ in range(B)]
+    for step in range(max_codes + 1):
+        logits = out.logits[:, -1].float()
+        if step >= max_codes:  # forced end
+            nxt = torch.full((B,), vocab.eom_id, dtype=torch.long)
+        else:
+            logits = logits + (mask_open if step >= min_codes else mask_closed)
+            if temperature <= 0:
+                nxt = logits.argmax(-1)
+            else:
+                logits = logits / temperature
+                if top_k:
+                    kth = logits.topk(top_k, dim=-1).values[:, -1:]
+                    logits = logits.masked_fill(logits < kth, float("-inf"))
+                nxt = torch.multinomial(torch.softmax(logits, -1), 1, generator=generator).squeeze(1)
+        nxt = torch.where(done, torch.full_like(nxt, vocab.pad_id), nxt)
+        for b in range(B):
+            if not done[b] and vocab.is_code(nxt[b]):
+                codes[b].append(int(nxt[b]) - vocab.first_code_id)
+        done |= nxt == vocab.eom_id
+        seq = torch.cat([seq, nxt[:, None]], 1)
+        if done.all():
+            break
+        out = lm(encoder_outputs=enc, attention_mask=attention_mask, decoder_input_ids=seq)
+    return Decoded(codes=codes, betas=betas, token_ids=seq[:, 1:].tolist())

@@ -1,0 +1,110 @@
+"""The motion file (``.npz``) that the generator writes and the Blender side reads.
+
+Keys: ``joints`` (T,22,3) metres Y-up, ``betas`` (10,), ``poses`` (T,24,3) axis-angle local
+rotations (SMPL convention, relative to the body's rest pose), ``transl`` (T,3) root offset as in
+``BodyModel.forward`` (posed joints = FK(rest joints) + transl), ``fps``, ``body_model`` (id such as
+"openbody-v1"); optional ``prompt`` (str), ``tokens`` and ``features`` (arrays).
+"""
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..body.skeleton import NUM_BODY_JOINTS, NUM_JOINTS
+from ..errors import ShapeMoveError
+
+
+@dataclass
+class Motion:
+    joints: np.ndarray   # (T,22,3)
+    betas: np.ndarray    # (10,)
+    poses: np.ndarray    # (T,24,3)
+    transl: np.ndarray   # (T,3)
+    fps: float
+    body_model: str
+    prompt: str | None = None
+    tokens: np.ndarray | None = None
+    features: np.ndarray | None = None
+
+    @property
+    def num_frames(self) -> int:
+        return int(self.poses.shape[0])
+
+
+def make_motion(body, poses, transl, betas, fps: float = 20.0, prompt: str | None = None, **extra) -> Motion:
+    """Motion for ``body`` (a BodyModel): joints computed with ``body.forward``.
+
+    poses (T,24,3) axis-angle, transl (T,3), betas (10,)."""
+    import torch
+
+    poses = np.asarray(poses, dtype=np.float32)
+    transl = np.asarray(transl, dtype=np.float32)
+    betas = np.asarray(betas, dtype=np.float32).reshape(-1)
+    with torch.no_grad():
+        out = body.forward(torch.as_tensor(betas)[None], torch.as_tensor(poses), torch.as_tensor(transl))
+    m = Motion(joints=out.joints[:, :NUM_BODY_JOINTS].numpy(), betas=betas, poses=poses, transl=transl,
+               fps=float(fps), body_model=str(body.name), prompt=prompt, **extra)
+    validate(m)
+    return m
+
+
+def validate(m: Motion) -> None:
+    T = m.poses.shape[0] if m.poses.ndim else 0
+    checks = [
+        (m.poses.shape == (T, NUM_JOINTS, 3) and T > 0, f"poses must be (T,{NUM_JOINTS},3) with T > 0, got {m.poses.shape}"),
+        (m.transl.shape == (T, 3), f"transl must be ({T},3), got {m.transl.shape}"),
+        (m.joints.shape == (T, NUM_BODY_JOINTS, 3), f"joints must be ({T},{NUM_BODY_JOINTS},3), got {m.joints.shape}"),
+        (m.betas.shape == (10,), f"betas must have 10 values, got shape {m.betas.shape}"),
+        (np.isfinite(m.fps) and m.fps > 0, f"fps must be positive, got {m.fps}"),
+        (bool(m.body_model), "body_model id is empty"),
+    ]
+    for ok, message in checks:
+        if not ok:
+            raise ShapeMoveError(f"bad motion: {message}")
+    for name in ("poses", "transl", "betas"):
+        if not np.isfinite(getattr(m, name)).all():
+            raise ShapeMoveError(f"bad motion: {name} contains NaN or infinite values")
+
+
+def save_motion(path, m: Motion) -> Path:
+    """Write ``m`` atomically to ``path`` (.npz)."""
+    validate(m)
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    arrays = dict(joints=m.joints, betas=m.betas, poses=m.poses, transl=m.transl,
+                  fps=np.float32(m.fps), body_model=np.str_(m.body_model))
+    if m.prompt is not None:
+        arrays["prompt"] = np.str_(m.prompt)
+    for name in ("tokens", "features"):
+        if getattr(m, name) is not None:
+            arrays[name] = np.asarray(getattr(m, name))
+    tmp = path.with_name(path.name + ".tmp")
+    with open(tmp, "wb") as f:
+        np.savez(f, **arrays)
+    os.replace(tmp, path)
+    return path
+
+
+def load_motion(path) -> Motion:
+    """Read and validate a motion file; ShapeMoveError names what is missing or malformed."""
+    path = Path(path)
+    if not path.is_file():
+        raise ShapeMoveError(f"motion file not found: {path}")
+    try:
+        with np.load(path, allow_pickle=False) as z:
+            data = {k: z[k] for k in z.files}
+    except Exception as exc:  # corrupt zip, not an npz, pickled objects
+        raise ShapeMoveError(f"cannot read motion file {path}: {exc}") from None
+    missing = [k for k in ("joints", "betas", "poses", "transl", "fps", "body_model") if k not in data]
+    if missing:
+        raise ShapeMoveError(f"motion file {path} lacks {', '.join(missing)}")
+    m = Motion(joints=data["joints"].astype(np.float32), betas=data["betas"].astype(np.float32).reshape(-1),
+               poses=data["poses"].astype(np.float32), transl=data["transl"].astype(np.float32),
+               fps=float(data["fps"]), body_model=str(data["body_model"]),
+               prompt=str(data["prompt"]) if "prompt" in data else None,
+               tokens=data.get("tokens"), features=data.get("features"))
+    validate(m)
+    return m

@@ -1,0 +1,113 @@
+"""Training clips of a built dataset folder, served as random crops.
+
+Folder layout (written by ``core/data/build.py``): ``norm_joint_vecs/ID.npy`` (T,263) features of
+the motion on the canonical body (encoder input), ``new_joint_vecs/ID.npy`` (T,263) shape-aware
+features (decoder target), ``betas/ID.npy`` (10,), ``Mean.npy``/``Std.npy`` (263,),
+``train.txt``/``val.txt``/``test.txt`` (one id a line).
+
+Crops are deterministic functions of (seed, epoch, clip index), and batches of (seed, step), so a
+resumed run sees exactly the batches an uninterrupted one would, with any number of workers.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import torch
+from torch.utils.data import Dataset, DistributedSampler
+
+from ..errors import ShapeMoveError
+
+
+def load_stats(root) -> tuple[np.ndarray, np.ndarray]:
+    """Mean/Std (263,) float32 of a dataset folder."""
+    root = Path(root)
+    try:
+        mean = np.load(root / "Mean.npy").astype(np.float32)
+        std = np.load(root / "Std.npy").astype(np.float32)
+    except FileNotFoundError as exc:
+        raise ShapeMoveError(f"{root}: Mean.npy/Std.npy missing; is this a built dataset folder? (`data build`)") from exc
+    if mean.shape != std.shape or mean.ndim != 1 or not (np.isfinite(mean).all() and np.isfinite(std).all()):
+        raise ShapeMoveError(f"{root}: Mean.npy/Std.npy must be finite vectors of equal length")
+    if (std <= 0).any():
+        raise ShapeMoveError(f"{root}: Std.npy has values <= 0")
+    return mean, std
+
+
+def read_split(root, split: str) -> list[str]:
+    p = Path(root) / f"{split}.txt"
+    return p.read_text().split() if p.is_file() else []
+
+
+class MotionClips(Dataset):
+    """Item ``(index, epoch)`` (or ``index``, epoch 0) -> dict of float32 tensors:
+    x (window, D) normalized canonical features, y (window, D) normalized shape-aware features
+    (same frames), betas (10,). Clips shorter than ``window`` are left out (``self.skipped``)."""
+
+    def __init__(self, root, split: str = "train", window: int = 64, seed: int = 0):
+        self.root = Path(root)
+        if not self.root.is_dir():
+            raise ShapeMoveError(f"dataset folder not found: {self.root}")
+        self.window, self.seed = window, seed
+        self.mean, self.std = load_stats(self.root)
+        self.ids, self.lengths, self.skipped = [], [], []
+        for cid in read_split(self.root, split):
+            try:
+                x = np.load(self.root / "norm_joint_vecs" / f"{cid}.npy", mmap_mode="r")
+                y = np.load(self.root / "new_joint_vecs" / f"{cid}.npy", mmap_mode="r")
+            except FileNotFoundError as exc:
+                raise ShapeMoveError(f"{self.root}: clip '{cid}' of {split}.txt has no features ({exc.filename})") from exc
+            if x.shape != y.shape or x.ndim != 2 or x.shape[1] != self.mean.shape[0]:
+                raise ShapeMoveError(f"{self.root}: clip '{cid}': feature shapes {x.shape} / {y.shape} do not match Mean ({self.mean.shape[0]})")
+            if x.shape[0] < window:
+                self.skipped.append(cid)
+                continue
+            self.ids.append(cid)
+            self.lengths.append(int(x.shape[0]))
+
+    def __len__(self) -> int:
+        return len(self.ids)
+
+    def _load(self, sub: str, cid: str, start: int | None = None) -> np.ndarray:
+        a = np.load(self.root / sub / f"{cid}.npy", mmap_mode="r")
+        return np.asarray(a if start is None else a[start:start + self.window], dtype=np.float32)
+
+    def __getitem__(self, key) -> dict:
+        index, epoch = key if isinstance(key, tuple) else (key, 0)
+        cid = self.ids[index]
+        rng = np.random.default_rng([self.seed, epoch, index])
+        start = int(rng.integers(0, self.lengths[index] - self.window + 1))
+        x = (self._load("norm_joint_vecs", cid, start) - self.mean) / self.std
+        y = (self._load("new_joint_vecs", cid, start) - self.mean) / self.std
+        betas = self._load("betas", cid).reshape(-1)
+        return {"x": torch.from_numpy(x), "y": torch.from_numpy(y), "betas": torch.from_numpy(betas)}
+
+
+class BatchStream:
+    """Endless batches of dataset keys ``(index, epoch)`` for one process, starting at ``start_step``.
+
+    Epoch e is ``DistributedSampler(shuffle, seed).set_epoch(e)`` over the clips (each rank gets
+    its share); batches run across epoch boundaries, so step s always holds items
+    [s*batch, (s+1)*batch) of this rank's stream, whatever step training (re)started at."""
+
+    def __init__(self, dataset: MotionClips, batch: int, rank: int = 0, world_size: int = 1, seed: int = 0,
+                 start_step: int = 0):
+        if len(dataset) == 0:
+            raise ShapeMoveError(f"{dataset.root}: no clips of at least {dataset.window} frames in this split")
+        self.sampler = DistributedSampler(dataset, num_replicas=world_size, rank=rank, shuffle=True, seed=seed)
+        self.batch, self.start_step = batch, start_step
+
+    def __iter__(self):
+        per_epoch = len(self.sampler)
+        j = self.start_step * self.batch
+        epoch, order = -1, []
+        while True:
+            keys = []
+            for _ in range(self.batch):
+                e, pos = divmod(j, per_epoch)
+                if e != epoch:
+                    self.sampler.set_epoch(e)
+                    epoch, order = e, list(self.sampler)
+                keys.append((order[pos], e))
+                j += 1
+            yield keys

@@ -1,0 +1,228 @@
+"""Train the SA-VAE (stage 1). One file, top to bottom, in the spirit of nanoGPT's train.py.
+
+    train_vae(data="DATA", out="runs/vae", config=SAVAEConfig.small())           # one process
+    torchrun --nproc_per_node 2 -m shapemove train vae --data DATA --out RUN     # DDP
+
+Writes into ``out``: ``last.pt`` (full training state, every ``ckpt_every`` steps and at the end,
+atomic), ``savae.pt`` (model + metadata, at the end), ``config.json``, ``log.jsonl``.
+``resume=True`` continues from ``last.pt`` with the same model, optimizer, scheduler, step and
+RNG states, and the data stream is a pure function of the step, so an interrupted and resumed run
+ends with the same parameters as an uninterrupted one.
+"""
+from __future__ import annotations
+
+import json
+import math
+import os
+import random
+import time
+from pathlib import Path
+
+import numpy as np
+import torch
+from torch.nn.parallel import DistributedDataParallel as DDP
+from torch.utils.data import DataLoader
+
+from ..errors import ShapeMoveError
+from ..models.savae import SAVAE, SAVAEConfig, TrainSettings
+from ..models.vae_losses import bone_lengths, vae_losses
+from . import distributed
+from .checkpoint import load_checkpoint, make_metadata, save_checkpoint, stats_hash
+from .motion_dataset import BatchStream, MotionClips
+
+KIND = "savae"
+RESUME_IGNORES = ("train.steps",)  # a resumed run may be extended; anything else must match
+
+
+def lr_factor(step: int, t: TrainSettings, total: int) -> float:
+    """Multiplier of ``t.lr`` at ``step``: linear warm-up, then step decay or cosine."""
+    if step < t.warmup_steps:
+        return (step + 1) / t.warmup_steps
+    if t.decay == "step":
+        return t.gamma ** sum(step >= m * total for m in t.milestones)
+    if t.decay == "cosine":
+        p = min(1.0, (step - t.warmup_steps) / max(1, total - t.warmup_steps))
+        return t.min_lr_ratio + (1 - t.min_lr_ratio) * 0.5 * (1 + math.cos(math.pi * p))
+    return 1.0
+
+
+def resolve_body(body):
+    """A BodyModel instance, a body spec ("openbody", an SMPL-family file) or None (the default)."""
+    if body is not None and not isinstance(body, str):
+        return body
+    from ..body.load import load_body_model
+
+    return load_body_model(body)
+
+
+def rng_state() -> dict:
+    np_state = np.random.get_state()
+    py = random.getstate()
+    return {"torch": torch.get_rng_state(), "python": list(py[1]), "python_gauss": py[2],
+            "numpy": torch.from_numpy(np_state[1].astype(np.int64)), "numpy_pos": int(np_state[2]),
+            "numpy_gauss": [int(np_state[3]), float(np_state[4])],
+            "cuda": torch.cuda.get_rng_state_all() if torch.cuda.is_available() else []}
+
+
+def set_rng_state(s: dict) -> None:
+    torch.set_rng_state(s["torch"])
+    random.setstate((3, tuple(s["python"]), s["python_gauss"]))
+    np.random.set_state(("MT19937", s["numpy"].numpy().astype(np.uint32), s["numpy_pos"], *s["numpy_gauss"]))
+    if s["cuda"] and torch.cuda.is_available():
+        torch.cuda.set_rng_state_all(s["cuda"])
+
+
+def target_bones(body, betas: torch.Tensor) -> torch.Tensor | None:
+    """(B, 21) rest bone lengths of ``body`` with ``betas`` (B, 10). Computed on the CPU: the body
+    model is a shared cached instance that must stay where it is."""
+    with torch.no_grad():
+        return bone_lengths(body.rest_joints(betas.detach().cpu())[:, :22]).to(betas.device)
+
+
+def _to(batch: dict, device) -> dict:
+    return {k: v.to(device, non_blocking=True) for k, v in batch.items()}
+
+
+@torch.no_grad()
+def evaluate(model: SAVAE, dataset: MotionClips, cfg: SAVAEConfig, device, body=None) -> dict:
+    """Mean losses and codebook usage over up to ``val_batches`` fixed crops of ``dataset``."""
+    from ..models.fsq import codebook_usage
+
+    model.eval()
+    bs = cfg.train.batch_size
+    keys = [(i, 0) for i in range(len(dataset))][: bs * cfg.train.val_batches]
+    sums, n, indices = {}, 0, []
+    for k in range(0, len(keys), bs):
+        items = [dataset[key] for key in keys[k:k + bs]]
+        b = _to({name: torch.stack([it[name] for it in items]) for name in items[0]}, device)
+        out = model(b["x"], b["betas"])
+        losses = vae_losses(out["recon"], b["y"], model.mean, model.std, cfg.loss, target_bones(body, b["betas"]))
+        for name, v in losses.items():
+            sums[name] = sums.get(name, 0.0) + float(v) * len(items)
+        n += len(items)
+        indices.append(out["indices"].reshape(-1))
+    model.train()
+    if not n:
+        return {}
+    usage = codebook_usage(torch.cat(indices), model.quantizer.codebook_size)
+    return {**{k: v / n for k, v in sums.items()}, "code_usage": usage["used_fraction"], "perplexity": usage["perplexity"]}
+
+
+def train_vae(data, out, config: SAVAEConfig | None = None, steps: int | None = None, resume: bool = False,
+              body=None, device: str | None = None, progress=None, cancel=None, verbose: bool = True) -> dict:
+    """Train (or resume) an SA-VAE on the dataset folder ``data``; returns the last metrics.
+
+    progress(fraction, message) is called on rank 0 every ``log_every`` steps; when cancel()
+    returns True training stops after saving ``last.pt`` (resume later with resume=True).
+    """
+    cfg = config or SAVAEConfig.small()
+    if steps is not None:
+        cfg.train.steps = int(steps)
+    cfg.validate()
+    t = cfg.train
+    out = Path(out)
+    dist = distributed.setup(device)
+    try:
+        return _train(Path(data), out, cfg, t, resume, body, dist, progress, cancel, verbose)
+    finally:
+        distributed.cleanup()
+
+
+def _train(data, out, cfg, t, resume, body, dist, progress, cancel, verbose) -> dict:
+    from tqdm import tqdm
+
+    if t.batch_size % dist.world_size:
+        raise ShapeMoveError(f"batch_size {t.batch_size} must be divisible by the number of processes ({dist.world_size})")
+    # -- data ----------------------------------------------------------------------------------
+    train_set = MotionClips(data, "train", t.window, seed=t.seed)
+    val_set = MotionClips(data, "val", t.window, seed=t.seed + 1)
+    mean, std = train_set.mean, train_set.std
+    # -- model, body, optimizer, schedule ----------------------------------------------------
+    torch.manual_seed(t.seed)  # same initial weights on every rank
+    model = SAVAE(cfg, mean, std).to(dist.device)
+    body = resolve_body(body)
+    body_name = body.name
+    optimizer = torch.optim.AdamW(model.parameters(), lr=t.lr, betas=tuple(t.adam_betas), weight_decay=t.weight_decay)
+    scheduler = torch.optim.lr_scheduler.LambdaLR(optimizer, lambda s: lr_factor(s, t, t.steps))
+    step = 0
+    last = out / "last.pt"
+    if resume and last.exists():
+        ckpt = load_checkpoint(last, map_location=dist.device, kind=KIND, body=body_name, config=cfg.to_dict(),
+                               ignore=RESUME_IGNORES, stats_hash_=stats_hash(mean, std))
+        model.load_state_dict(ckpt["model"])
+        optimizer.load_state_dict(ckpt["optimizer"])
+        scheduler.load_state_dict(ckpt["scheduler"])
+        step = int(ckpt["step"])
+        set_rng_state(ckpt["rng"])
+    elif resume and dist.is_main and verbose:
+        print(f"no checkpoint in {out}: starting from scratch")
+    raw = model
+    if dist.enabled:
+        model = DDP(model, device_ids=[dist.device.index] if dist.device.type == "cuda" else None)
+
+    def save(final: bool = False) -> None:
+        if not dist.is_main:
+            return
+        meta = make_metadata(KIND, cfg.to_dict(), body_name, mean, std, step)
+        save_checkpoint(last, {"model": raw.state_dict(), "optimizer": optimizer.state_dict(),
+                               "scheduler": scheduler.state_dict(), "step": step, "rng": rng_state()}, meta)
+        if final:
+            save_checkpoint(out / "savae.pt", {"model": raw.state_dict()}, meta)
+
+    if dist.is_main:
+        out.mkdir(parents=True, exist_ok=True)
+        tmp = out / "config.json.tmp"
+        tmp.write_text(json.dumps(cfg.to_dict(), indent=2))
+        os.replace(tmp, out / "config.json")
+    batches = DataLoader(train_set, batch_sampler=BatchStream(train_set, t.batch_size // dist.world_size, dist.rank,
+                                                              dist.world_size, t.seed, start_step=step),
+                         num_workers=t.num_workers, pin_memory=dist.device.type == "cuda")
+    batch_iter = iter(batches)
+    bar = tqdm(total=t.steps, initial=step, desc="train vae", unit="step", disable=not (dist.is_main and verbose))
+    metrics: dict = {"step": step}
+    t0, t0_step = time.time(), step
+    model.train()
+    # -- loop ----------------------------------------------------------------------------------
+    while step < t.steps:
+        if distributed.broadcast_flag(bool(cancel and dist.is_main and cancel()), dist):
+            break
+        b = _to(next(batch_iter), dist.device)
+        result = model(b["x"], b["betas"])
+        losses = vae_losses(result["recon"], b["y"], raw.mean, raw.std, cfg.loss, target_bones(body, b["betas"]))
+        optimizer.zero_grad(set_to_none=True)
+        losses["total"].backward()
+        if t.grad_clip:
+            torch.nn.utils.clip_grad_norm_(raw.parameters(), t.grad_clip)
+        optimizer.step()
+        scheduler.step()
+        step += 1
+        bar.update(1)
+        done = step == t.steps
+        if done or step % t.log_every == 0 or step % t.val_every == 0:
+            train_metrics = distributed.mean_over_ranks({k: float(v) for k, v in losses.items()}, dist)
+            metrics = {"step": step, "lr": scheduler.get_last_lr()[0], "train": train_metrics,
+                       "sec_per_step": (time.time() - t0) / (step - t0_step)}
+            if dist.is_main and (done or step % t.val_every == 0) and len(val_set):
+                metrics["val"] = evaluate(raw, val_set, cfg, dist.device, body)
+            t0, t0_step = time.time(), step
+            if dist.is_main:
+                bar.set_postfix(loss=f"{train_metrics['total']:.4f}",
+                                **({"val": f"{metrics['val']['total']:.4f}"} if "val" in metrics else {}))
+                with open(out / "log.jsonl", "a") as f:
+                    f.write(json.dumps(metrics) + "\n")
+                if progress is not None:
+                    progress(step / t.steps, f"step {step}/{t.steps} loss {train_metrics['total']:.4f}")
+        if step % t.ckpt_every == 0 and step < t.steps:
+            save()
+            distributed.barrier(dist)
+    bar.close()
+    save(final=step >= t.steps)
+    distributed.barrier(dist)
+    metrics["step"] = step
+    return metrics
+
+
+def from_cli(args) -> dict:
+    """Entry point of `python -m shapemove train vae` (see cli/train.py)."""
+    return train_vae(args.data, args.out, SAVAEConfig.load(args.config), steps=args.steps, resume=args.resume,
+                     body=args.body, device=args.device, verbose=not args.quiet)

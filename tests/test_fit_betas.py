@@ -1,0 +1,125 @@
+"""Betas from a skeleton: generate rest joints for known betas, fit, recover lengths (< 1 mm) and betas."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import torch
+from synthetic_smpl import write_model
+
+from shapemove.core.body.fit import (DEFAULT_REG, _bone_basis, body_bone_lengths, bone_lengths,
+                                     fit_betas_to_bone_lengths, fit_betas_to_skeleton)
+from shapemove.core.body.kinematics import axis_angle_to_matrix, forward_kinematics
+from shapemove.core.body.skeleton import BODY_BONES
+from shapemove.core.body.smpl_family import SMPLFamilyBody
+from shapemove.core.errors import ShapeMoveError
+
+
+@pytest.fixture(scope="module")
+def body(tmp_path_factory):
+    path = tmp_path_factory.mktemp("fit") / "SMPL_NEUTRAL.npz"
+    write_model(path, seed=7)
+    return SMPLFamilyBody.load(path)
+
+
+def _rest_joints(body, betas) -> np.ndarray:
+    return body.rest_joints(torch.as_tensor(betas, dtype=torch.float32))[0].double().numpy()
+
+
+def _mocap_pose(joints: np.ndarray, parents) -> np.ndarray:
+    """The same skeleton in another rest pose: arms down, elbows bent, turned and moved away."""
+    rot = torch.zeros(1, 24, 3)
+    rot[0, 0] = torch.tensor([0.1, 2.0, 0.0])
+    rot[0, 16, 2], rot[0, 17, 2] = -1.3, 1.3
+    rot[0, 18, 1], rot[0, 19, 1] = 0.4, -0.4
+    posed, _ = forward_kinematics(axis_angle_to_matrix(rot), torch.as_tensor(joints, dtype=torch.float32)[None], parents)
+    return posed[0].double().numpy() + np.array([3.0, 0.9, -2.0])
+
+
+def test_bone_lengths_hand_derived():
+    j = np.zeros((22, 3))
+    j[1] = [0.1, 0.0, 0.0]     # pelvis -> left hip: 0.1
+    j[4] = [0.1, -0.4, 0.0]    # left hip -> left knee: 0.4
+    j[7] = [0.1, -0.4, 0.3]    # left knee -> left ankle: 0.3
+    L = bone_lengths(j)
+    assert L.shape == (21,) and BODY_BONES[0] == (0, 1) and BODY_BONES[3] == (1, 4) and BODY_BONES[6] == (4, 7)
+    np.testing.assert_allclose(L[[0, 3, 6]], [0.1, 0.4, 0.3])
+
+
+def test_recovers_betas_from_rest_joints_in_another_pose(body):
+    rng = np.random.default_rng(0)
+    for _ in range(4):
+        betas = rng.uniform(-2, 2, 10)
+        joints = _rest_joints(body, betas)
+        true = bone_lengths(joints)
+        for skeleton in (joints, joints[:22], _mocap_pose(joints, body.parents)):
+            fit = fit_betas_to_skeleton(body, skeleton)
+            assert fit.max_error < 1e-3 and fit.residual <= fit.max_error
+            np.testing.assert_allclose(body_bone_lengths(body, fit.betas), true, atol=1e-3)
+            np.testing.assert_allclose(fit.betas, betas, atol=0.05)  # all 10 betas move bones in this model
+    # plain ridge on positions is exact for the body's own rest pose but not for another pose
+    assert fit_betas_to_skeleton(body, joints, match="positions").max_error < 1e-3
+    assert fit_betas_to_skeleton(body, _mocap_pose(joints, body.parents), match="positions").max_error > 0.01
+
+
+def test_bone_length_dict_with_missing_bones(body):
+    betas = np.array([1.5, -1.0, 0.5, 0.0, 2.0, -2.0, 0.3, -0.7, 1.0, 0.2])
+    true = body_bone_lengths(body, betas)
+    names = body.joint_names
+    given = {names[c]: true[i] for i, (p, c) in enumerate(BODY_BONES) if i % 4}  # drop every 4th bone
+    given[("pelvis", "left_hip")] = true[0]
+    fit = fit_betas_to_skeleton(body, given)
+    known = np.isfinite(fit.target_lengths)
+    assert known.sum() == len(given)
+    np.testing.assert_allclose(fit.fitted_lengths[known], true[known], atol=1e-3)
+
+
+def test_zero_betas_and_weights(body):
+    fit = fit_betas_to_bone_lengths(body, body_bone_lengths(body))
+    np.testing.assert_allclose(fit.betas, 0, atol=1e-6)
+    assert fit.residual < 1e-9
+    # a 5 cm error on one bone: weight 0 ignores it, so the other bones still fit the true betas
+    betas = np.linspace(-1, 1, 10)
+    lengths = body_bone_lengths(body, betas)
+    lengths[5] += 0.05
+    w = np.ones(21)
+    w[5] = 0
+    fit = fit_betas_to_bone_lengths(body, lengths, weights=w)
+    np.testing.assert_allclose(fit.betas, betas, atol=0.05)
+    assert fit_betas_to_bone_lengths(body, lengths).max_error > 1e-3
+
+
+def test_bad_input(body):
+    with pytest.raises(ShapeMoveError, match=r"\(22,3\) or \(24,3\)"):
+        fit_betas_to_skeleton(body, np.zeros((17, 3)))
+    with pytest.raises(ShapeMoveError, match="21 values"):
+        fit_betas_to_bone_lengths(body, np.ones(20))
+    with pytest.raises(ShapeMoveError, match="unknown bone"):
+        fit_betas_to_bone_lengths(body, {"left_thumb": 0.1})
+    with pytest.raises(ShapeMoveError, match="positive"):
+        fit_betas_to_bone_lengths(body, -body_bone_lengths(body))
+    with pytest.raises(ShapeMoveError, match="metres"):
+        fit_betas_to_bone_lengths(body, 100 * body_bone_lengths(body))  # centimetres
+    with pytest.raises(ShapeMoveError, match="NaN"):
+        fit_betas_to_skeleton(body, np.full((22, 3), np.nan))
+
+
+def test_openbody_recovery(request):
+    try:
+        import shapemove.core.body.openbody  # noqa: F401
+    except ImportError:
+        pytest.skip("core/body/openbody.py is not written yet")
+    body = request.getfixturevalue("openbody")
+    a, B = _bone_basis(body)
+    rng = np.random.default_rng(1)
+    for _ in range(3):
+        betas = rng.uniform(-2, 2, 10)
+        joints = _rest_joints(body, betas)
+        fit = fit_betas_to_skeleton(body, _mocap_pose(joints, body.parents))
+        assert fit.max_error < 1e-3
+        # betas must agree along the directions bone lengths can see (singular value >= 2 mm per unit)
+        v = a + B @ betas
+        jac = np.einsum("ic,icb->ib", v / np.linalg.norm(v, axis=-1)[:, None], B)
+        _, s, vt = np.linalg.svd(jac)
+        seen = vt[s > 2e-3]
+        assert len(seen) >= 1
+        np.testing.assert_allclose(seen @ fit.betas, seen @ betas, atol=0.1 + DEFAULT_REG)

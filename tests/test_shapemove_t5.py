@@ -1,0 +1,102 @@
+"""The ShapeMove T5: tokenizer with motion tokens, [BETA] head, constrained decoding, save/load."""
+from pathlib import Path
+
+import pytest
+import torch
+
+from shapemove.core.errors import ShapeMoveError
+from shapemove.core.generation.prompts import check_prompt
+from shapemove.core.models.constrained_decoding import decode
+from shapemove.core.models.shapemove_t5 import ShapeMoveT5, T5Size, shapemove_prompt
+from shapemove.core.models.tokenizer import (BETA, EOM, MOTION_TOKENS, SOM, MotionVocab, load_tokenizer,
+                                             tokenizer_from_sentencepiece, train_sentencepiece)
+
+TEXTS = ["A person walks forward.", "Someone waves with the left hand.", "An elderly person runs in a circle.",
+         "A male standing 182 cm tall, with a chest circumference of 101 cm and a waist circumference of 90 cm.",
+         "a tall, heavy-set man", "The person demonstrates a motion like: kicks forward with the left leg."] * 30
+
+
+@pytest.fixture(scope="module")
+def tok(tmp_path_factory):
+    d = tmp_path_factory.mktemp("tok")
+    return tokenizer_from_sentencepiece(train_sentencepiece(TEXTS, d / "sp", vocab_size=200))
+
+
+@pytest.fixture(scope="module")
+def model(tok):
+    torch.manual_seed(0)
+    return ShapeMoveT5.build(tok, T5Size.tiny()).eval()
+
+
+def test_tokenizer_round_trip_with_added_tokens(tok, tmp_path):
+    vocab = MotionVocab(tok)
+    assert len(tok) == vocab.first_code_id + 1000 + 3
+    codes = [0, 7, 999, 500]
+    ids = vocab.target_ids(codes)
+    assert tok.convert_ids_to_tokens(ids) == [BETA, SOM, "[MID_0]", "[MID_7]", "[MID_999]", "[MID_500]", EOM, "</s>"]
+    assert vocab.ids_to_codes(ids) == codes
+    # added tokens are single ids inside text, and text survives encode/decode (case-folded)
+    enc = tok("A person waves. [BETA][SOM][MID_42][EOM]").input_ids
+    assert [i for i in enc if i >= vocab.first_code_id] == [vocab.beta_id, vocab.som_id, vocab.first_code_id + 42, vocab.eom_id]
+    assert tok.decode(enc, skip_special_tokens=True).strip() == "a person waves."
+    tok.save_pretrained(str(tmp_path))
+    again = load_tokenizer(tmp_path)
+    assert again("A PERSON waves. [MID_42]").input_ids == tok("a person waves. [MID_42]").input_ids
+    assert again.convert_tokens_to_ids(MOTION_TOKENS) == tok.convert_tokens_to_ids(MOTION_TOKENS)
+
+
+def test_constrained_decoding_never_emits_text_in_motion_span(model, tok):
+    enc = tok([shapemove_prompt(t) for t in TEXTS[:4]], return_tensors="pt", padding=True)
+    g = torch.Generator().manual_seed(1)
+    for temperature in (0.0, 1.0, 3.0):
+        out = decode(model, enc.input_ids, enc.attention_mask, min_codes=5, max_codes=12, temperature=temperature,
+                     generator=g)
+        for ids, codes in zip(out.token_ids, out.codes):
+            assert ids[0] == model.vocab.beta_id and ids[1] == model.vocab.som_id
+            span = ids[2: ids.index(model.vocab.eom_id)]
+            assert all(model.vocab.is_code(i) for i in span)
+            assert 5 <= len(codes) <= 12 and len(codes) == len(span)
+        assert out.betas.shape == (4, 10)
+
+
+def test_beta_projection_gets_gradient(model, tok):
+    m = ShapeMoveT5.build(tok, T5Size.tiny()).train()
+    enc = tok([shapemove_prompt("a person walks", "a tall man")] * 2, return_tensors="pt", padding=True)
+    labels = torch.tensor([m.vocab.target_ids([1, 2, 3])] * 2)
+    out = m(enc.input_ids, enc.attention_mask, labels, torch.ones(2, 10))
+    out["loss"].backward()
+    assert out["l1"] > 0
+    assert m.beta_head.net[0].weight.grad.abs().sum() > 0
+    # and the gradient reaches the decoder through the [BETA] state
+    assert m.lm.decoder.block[0].layer[0].SelfAttention.q.weight.grad.abs().sum() > 0
+
+
+def test_save_load_round_trip_via_plain_transformers(model, tok, tmp_path):
+    from transformers import T5ForConditionalGeneration
+
+    model.save(tmp_path / "t5", tok, meta={"vae": "none"})
+    plain = T5ForConditionalGeneration.from_pretrained(str(tmp_path / "t5"), local_files_only=True)
+    assert plain.config.vocab_size == len(tok)
+    sd = model.lm.state_dict()
+    for k, v in plain.state_dict().items():
+        assert torch.equal(v, sd[k]), k
+    again, tok2 = ShapeMoveT5.load(tmp_path / "t5")
+    enc = tok(["a person walks forward."], return_tensors="pt")
+    a = decode(model, enc.input_ids, enc.attention_mask, 3, 6, temperature=0)
+    b = decode(again, enc.input_ids, enc.attention_mask, 3, 6, temperature=0)
+    assert a.codes == b.codes and torch.allclose(a.betas, b.betas)
+    with pytest.raises(ShapeMoveError, match="not a ShapeMove T5"):
+        ShapeMoveT5.load(tmp_path)
+
+
+@pytest.mark.parametrize("bad, match", [
+    ("", "empty"), ("   \n", "empty"), ("x" * 10_000, "10000 characters"),
+    ("a person\x00 walks", "control"), ("walk\u200b", "control"), ("12345 !!", "no words"),
+])
+def test_bad_prompts_give_clear_errors(bad, match):
+    with pytest.raises(ShapeMoveError, match=match):
+        check_prompt(bad)
+
+
+def test_good_prompt_is_tidied():
+    assert check_prompt("  a person\n walks   forward ") == "a person walks forward"
