@@ -22,6 +22,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "blend": ("blend", "build a .blend scene from a motion (.npz), optionally render a frame"),
     "render": ("render", "generate and render a batch of prompts headless"),
     "demo": ("demo", "prompt -> .blend + rendered preview with the default model"),
+    "worker": ("worker", "serve jobs over stdin/stdout (JSON lines) for the Blender extension"),
     "bench": ("bench", "speed benchmarks that print ratios against a baseline run alongside"),
 }
 

@@ -131,9 +131,9 @@ def test_com_of_box_body_is_the_volume_weighted_box_centre(body):
     vol, _ = mass.part_volumes(body.v_template)
     sizes = [np.prod(np.subtract(hi, lo)) for lo, hi, _ in BOXES]
     centres = [np.add(lo, hi) / 2 for lo, hi, _ in BOXES]
-    assert vol.sum().item() == pytest.approx(sum(sizes), rel=1e-9)
+    assert vol.sum().item() == pytest.approx(sum(sizes), rel=1e-6)     # float32 template
     expected = np.average(centres, axis=0, weights=sizes)
-    assert mass.center_of_mass(body.v_template)[0].numpy() == pytest.approx(expected, abs=1e-9)
+    assert mass.center_of_mass(body.v_template)[0].numpy() == pytest.approx(expected, abs=1e-6)
     # a symmetric single box: CoM at its centre
     v, f = box_mesh((-0.2, 0.0, -0.1), (0.2, 1.8, 0.1), 3)
     assert MassModel(f, one_part(v)).center_of_mass(torch.tensor(v))[0].numpy() == pytest.approx([0, 0.9, 0], abs=1e-12)
@@ -169,7 +169,8 @@ def test_sliding_feet_skate_and_standing_feet_do_not(body):
     # GMD's setting (2.5 cm/frame over a 5-frame window) lets 1 cm/frame pass but catches 3 cm/frame
     feet = mesh_motion(body, None, rot, tr - torch.tensor([0, 0.10, 0]))["feet"]
     assert skate(list(feet.values()), **GMD_SKATE).value == 0.0
-    assert skate([f * [3, 1, 3] for f in feet.values()], **GMD_SKATE).value == pytest.approx(100.0)
+    # (the zero-padded window, as GMD's uniform_filter1d, drops the first and last two pairs)
+    assert skate([f * [3, 1, 3] for f in feet.values()], **GMD_SKATE).value == pytest.approx(100 * 15 / 19)
 
 
 def test_skate_one_foot_sliding_half_the_time():

@@ -6,7 +6,7 @@ import pytest
 import torch
 from synthetic_smpl import write_model
 
-from shapemove.core.body.fit import (DEFAULT_REG, _bone_basis, body_bone_lengths, bone_lengths,
+from shapemove.core.body.fit import (_bone_basis, body_bone_lengths, bone_lengths,
                                      fit_betas_to_bone_lengths, fit_betas_to_skeleton)
 from shapemove.core.body.kinematics import axis_angle_to_matrix, forward_kinematics
 from shapemove.core.body.skeleton import BODY_BONES
@@ -31,7 +31,8 @@ def _mocap_pose(joints: np.ndarray, parents) -> np.ndarray:
     rot[0, 0] = torch.tensor([0.1, 2.0, 0.0])
     rot[0, 16, 2], rot[0, 17, 2] = -1.3, 1.3
     rot[0, 18, 1], rot[0, 19, 1] = 0.4, -0.4
-    posed, _ = forward_kinematics(axis_angle_to_matrix(rot), torch.as_tensor(joints, dtype=torch.float32)[None], parents)
+    rest = torch.as_tensor(joints, dtype=torch.float32)[None]
+    posed, _ = forward_kinematics(axis_angle_to_matrix(rot), rest, parents)
     return posed[0].double().numpy() + np.array([3.0, 0.9, -2.0])
 
 
@@ -116,10 +117,11 @@ def test_openbody_recovery(request):
         joints = _rest_joints(body, betas)
         fit = fit_betas_to_skeleton(body, _mocap_pose(joints, body.parents))
         assert fit.max_error < 1e-3
-        # betas must agree along the directions bone lengths can see (singular value >= 2 mm per unit)
+        # betas must agree along the directions bone lengths see well (>= 1 cm per unit beta; there the
+        # prior's pull reg / s^2 is <= 1 %)
         v = a + B @ betas
         jac = np.einsum("ic,icb->ib", v / np.linalg.norm(v, axis=-1)[:, None], B)
         _, s, vt = np.linalg.svd(jac)
-        seen = vt[s > 2e-3]
+        seen = vt[s > 1e-2]
         assert len(seen) >= 1
-        np.testing.assert_allclose(seen @ fit.betas, seen @ betas, atol=0.1 + DEFAULT_REG)
+        np.testing.assert_allclose(seen @ fit.betas, seen @ betas, atol=0.1)

@@ -37,6 +37,7 @@ LIMBS = [
     (16, 18, 20, (0.0, -1.0, 0.0)),  # left shoulder, elbow, wrist: forearm swings forward (+Z)
     (17, 19, 21, (0.0, 1.0, 0.0)),   # right arm
 ]
+END_JOINTS = [7, 8, 10, 11, 20, 21]  # ankles, feet, wrists
 SPINE_BLEND = {3: 1.0 / 3.0, 6: 2.0 / 3.0}  # share of the chest's left-right axis per spine joint
 _EPS = 1e-9
 
@@ -159,6 +160,24 @@ def hinge_axes(rest_joints, parents=PARENTS) -> dict:
     return out
 
 
+def rest_with_bone_lengths(rest_joints, lengths) -> np.ndarray:
+    """(24,3) rest joints with the 21 body bones (``skeleton.BODY_BONES`` order, metres) set to
+    ``lengths``, directions kept; the hands keep the forearm's scale. A stand-in for a body fit
+    when the exact bone lengths of a target skeleton are wanted (e.g. ``Motion22.bone_lengths()[1:]``)."""
+    rest = np.asarray(rest_joints, dtype=np.float64).reshape(NUM_JOINTS, 3)
+    lengths = np.asarray(lengths, dtype=np.float64).reshape(-1)
+    if lengths.shape != (NUM_BODY_JOINTS - 1,) or not np.all(np.isfinite(lengths)) or np.any(lengths <= 0):
+        raise ShapeMoveError(f"need {NUM_BODY_JOINTS - 1} positive bone lengths in metres")
+    offs = rest.copy()
+    offs[1:] = rest[1:] - rest[PARENTS[1:]]
+    out = rest.copy()
+    for j in range(1, NUM_JOINTS):
+        bone = j if j < NUM_BODY_JOINTS else PARENTS[j]
+        scale = lengths[bone - 1] / max(np.linalg.norm(rest[bone] - rest[PARENTS[bone]]), 1e-9)
+        out[j] = out[PARENTS[j]] + offs[j] * scale
+    return out
+
+
 # -- analytic solve ------------------------------------------------------------------------------
 def analytic_ik(target: torch.Tensor, rest: torch.Tensor, parents) -> tuple[torch.Tensor, torch.Tensor]:
     """target (T,22,3), rest (24,3) float64 -> local rotations (T,24,3,3), transl (T,3)."""
@@ -248,14 +267,17 @@ def _two_bone_mid(root, mid, end, off_mid, off_end):
 
 
 # -- refinement ----------------------------------------------------------------------------------
-def refine(rot0, transl0, target, rest, parents, iters: int = 10, smooth: float = 1e-3):
+def refine(rot0, transl0, target, rest, parents, iters: int = 10, smooth: float = 1e-3, end_weight: float = 3.0):
     """A few batched LBFGS steps on axis-angle corrections of all frames at once.
-    Loss: mean squared joint error + ``smooth`` x squared frame-to-frame change of the local
+    Loss: mean joint distance (ankles, feet and wrists weighted ``end_weight``: contacts matter
+    most) + ``smooth`` x squared frame-to-frame change of the local
     rotations + a small pull towards the analytic solution. Returns (rotations, transl)."""
     T = rot0.shape[0]
     delta = torch.zeros(T, NUM_BODY_JOINTS, 3, dtype=rot0.dtype, requires_grad=True)
     dtr = torch.zeros(T, 3, dtype=rot0.dtype, requires_grad=True)
     tail = rot0[:, NUM_BODY_JOINTS:]
+    weight = torch.ones(NUM_BODY_JOINTS, dtype=rot0.dtype)
+    weight[END_JOINTS] = end_weight
     opt = torch.optim.LBFGS([delta, dtr], lr=1.0, max_iter=iters, line_search_fn="strong_wolfe",
                             tolerance_grad=1e-12, tolerance_change=1e-15)
 
@@ -267,7 +289,7 @@ def refine(rot0, transl0, target, rest, parents, iters: int = 10, smooth: float 
         opt.zero_grad()
         rot, tr = compose()
         sq = ((_fk(rot, rest, parents, tr) - target) ** 2).sum(-1)
-        loss = torch.sqrt(sq + 1e-8).mean() + 1e-6 * (delta ** 2).sum(-1).mean()
+        loss = (torch.sqrt(sq + 1e-8) * weight).mean() + 1e-6 * (delta ** 2).sum(-1).mean()
         if T > 1 and smooth > 0:
             loss = loss + smooth * ((rot[1:] - rot[:-1]) ** 2).sum((-1, -2)).mean()
         loss.backward()

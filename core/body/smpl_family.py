@@ -10,7 +10,7 @@ posedirs (V,3,9(J-1)).
 Reading is done here rather than by ``smplx.SMPL(...)`` because the official SMPL ``.pkl`` files are
 Python-2 pickles holding ``chumpy`` arrays and chumpy is not installed (and does not import on
 current numpy): the pickle is opened with ``encoding='latin1'`` and each chumpy array is rebuilt
-from its pickled value (``x``), which is exactly what ``smplx``'s ``tools/clean_ch.py`` produces.
+from its pickled value (``x``), the same arrays ``smplx``'s ``tools/clean_ch.py`` would write.
 The maths (shape blend shapes, pose correctives, FK, LBS) is the same as ``smplx.lbs.lbs``; the
 tests compare against smplx on the same files.
 
@@ -116,7 +116,7 @@ def read_model_file(path: str | Path) -> dict:
                 out[k] = _plain(v.item())
     except ShapeMoveError:
         raise
-    except (OSError, ValueError, EOFError, KeyError, AttributeError, ImportError, pickle.UnpicklingError,
+    except (OSError, ValueError, TypeError, EOFError, KeyError, AttributeError, ImportError, pickle.UnpicklingError,
             zipfile.BadZipFile) as exc:
         raise ShapeMoveError(f"could not read body model file {path}: {exc}. {HOW_TO}") from None
     missing = [k for k in REQUIRED_KEYS if k not in out]
@@ -265,7 +265,8 @@ class SMPLFamilyBody(BodyModel):
         if b.shape[0] == 1 and B > 1:
             b = b.expand(B, -1)
         joints_rest = self.rest_joints(b)
-        feature = (rotmats[:, 1: 1 + self.posed_joints] - torch.eye(3)).reshape(B, -1)
+        eye = torch.eye(3, dtype=rotmats.dtype, device=rotmats.device)
+        feature = (rotmats[:, 1: 1 + self.posed_joints] - eye).reshape(B, -1)
         verts = self.rest_vertices(b) + (feature @ self.posedirs).reshape(B, -1, 3)
         posed_joints, world = forward_kinematics(rotmats, joints_rest, self.parents)
         verts = linear_blend_skinning(verts, self.skin_weights_t, skinning_transforms(world, joints_rest))

@@ -40,6 +40,7 @@ GRAVITY = 9.81
 FPS = 20.0
 SUPPORT_HEIGHT = 0.05      # m (HUMOS CONTACT_THRESH)
 SUPPORT_STEP = 0.02        # m per frame (HUMOS VELOCITY_THRESH)
+_OCTAGON = np.stack([np.cos(np.arange(8) * np.pi / 4), np.sin(np.arange(8) * np.pi / 4)], axis=1)
 
 
 class MassModel:
@@ -154,7 +155,18 @@ def support_points(vertices, next_vertices, height: float = SUPPORT_HEIGHT, max_
 def convex_hull_2d(points) -> np.ndarray:
     """(N,2) points -> (K,2) convex hull, counter-clockwise (Andrew's monotone chain).
     Degenerate inputs give 1 (a point) or 2 (a segment) vertices; empty input gives (0,2)."""
-    p = np.unique(np.round(np.asarray(points, dtype=np.float64), 6), axis=0)   # sorted by x, then z
+    p = np.round(np.asarray(points, dtype=np.float64).reshape(-1, 2), 6)
+    if len(p) > 16:   # Akl-Toussaint: drop points strictly inside the octagon of extreme points
+        ext = p[(p @ _OCTAGON.T).argmax(axis=0)]
+        ext = ext[np.any(ext != np.roll(ext, 1, axis=0), axis=1)]
+        if len(ext) >= 3:
+            e0, e1 = ext, np.roll(ext, -1, axis=0)
+            cross = ((e1 - e0)[None, :, 0] * (p[:, None, 1] - e0[None, :, 1])
+                     - (e1 - e0)[None, :, 1] * (p[:, None, 0] - e0[None, :, 0]))
+            p = p[(cross <= 1e-12).any(axis=1)]
+    p = p[np.lexsort((p[:, 1], p[:, 0]))]                                     # by x, then z
+    if len(p):
+        p = p[np.r_[True, np.any(p[1:] != p[:-1], axis=1)]]
     if len(p) <= 2:
         return p
 

@@ -83,5 +83,5 @@ def codebook_usage(indices: torch.Tensor, codebook_size: int) -> dict:
     counts = torch.bincount(indices.reshape(-1).long().cpu(), minlength=codebook_size).double()
     p = counts / counts.sum().clamp(min=1)
     entropy = -(p[p > 0] * p[p > 0].log()).sum()
-    return {"used_fraction": float((counts > 0).float().mean()), "perplexity": float(entropy.exp()),
+    return {"used_fraction": float((counts > 0).double().mean()), "perplexity": float(entropy.exp()),
             "counts": counts}

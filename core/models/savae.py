@@ -206,3 +206,17 @@ class SAVAE(nn.Module):
             out[:, s * up:(s + chunk) * up] += self.decode(codes[:, s:s + chunk], betas) * w
             total[s * up:(s + chunk) * up] += w
         return out / total
+
+
+def load_savae(path, body=None, device="cpu") -> SAVAE:
+    """A trained SA-VAE from ``savae.pt`` or ``last.pt`` (eval mode). ``body``: a BodyModel or its
+    name; when given, a checkpoint trained for another body model is a ShapeMoveError."""
+    from ..train.checkpoint import load_checkpoint
+
+    name = body if body is None or isinstance(body, str) else body.name
+    ckpt = load_checkpoint(path, map_location=device, kind="savae", body=name)
+    meta = ckpt["metadata"]
+    model = SAVAE(SAVAEConfig.from_dict(meta["config"]))
+    model.load_state_dict(ckpt["model"])
+    model.metadata = meta
+    return model.to(device).eval()

@@ -1,20 +1,25 @@
-"""Body model by id, as stored in motion files (``body_model``)."""
+"""Body model for a motion file's ``body_model`` id."""
 from __future__ import annotations
 
 from ..errors import ShapeMoveError
 
 
-def load_body(name: str):
-    """"openbody-*" -> OpenBody.load(); "capsule-v1" -> the procedural capsule body."""
-    if name.startswith("openbody"):
-        from ..body.openbody import OpenBody
+def load_body(name: str, model_file=None):
+    """"openbody-*" -> the bundled OpenBody; "capsule-v1" -> the procedural capsule body;
+    an SMPL-family id ("smplx-male", ...) needs ``model_file`` (the user's own model file)."""
+    from ..body.load import load_body_model
 
-        body = OpenBody.load()
-        if str(body.name) != name:
-            raise ShapeMoveError(f"the motion was made for body model {name!r} but the installed one is {body.name!r}")
-        return body
     if name == "capsule-v1":
         from .capsule_body import capsule_body
 
         return capsule_body()
-    raise ShapeMoveError(f"unknown body model {name!r}: expected openbody-v1 or capsule-v1")
+    if name.startswith("openbody"):
+        body = load_body_model("openbody")
+    elif model_file:
+        body = load_body_model(model_file)
+    else:
+        raise ShapeMoveError(f"the motion was made for body model {name!r}: give its model file (SMPL family), "
+                             "or use a motion made for openbody")
+    if str(body.name) != name:
+        raise ShapeMoveError(f"the motion was made for body model {name!r} but the loaded one is {body.name!r}")
+    return body

@@ -1,0 +1,341 @@
+"""Acclaim ASF (skeleton) + AMC (motion) reader, as used by CMU and HDM05.
+
+ASF ``:units``: ``length L`` means file lengths are in units of 1/L inches (CMU/HDM05: 0.45), so
+metres = value / L * 0.0254; ``angle deg|rad``. Each bone has a direction and length in the rest
+pose, an ``axis`` frame C (Euler angles + order) and ``dof`` channels; its pose is
+``W_bone = W_parent @ C @ M(dof values) @ C^-1`` and its end lies at ``start + length * W_bone @ dir``.
+Euler orders compose in the listed order about fixed axes (``XYZ`` -> Rz @ Ry @ Rx).
+
+In the returned Mocap every bone is a joint placed at the bone's START (so ``lfemur`` is the hip
+joint, ``ltibia`` the knee, ``ltoes`` the ball of the foot); leaf bones get an End Site joint
+``<bone>_End`` at their tip. AMC files carry no frame rate: CMU and HDM05 are 120 fps
+(``HDM_.._120.amc``: the suffix is read).
+"""
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import ShapeMoveError
+from .fk import axis_rotation, forward_kinematics
+from .mocap import Mocap, finish_mocap
+
+INCH = 0.0254
+MAX_VALUE = 1e7
+
+
+@dataclass
+class Bone:
+    name: str
+    direction: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    length: float = 0.0
+    axis: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    axis_order: str = "XYZ"
+    dof: list = field(default_factory=list)
+
+
+@dataclass
+class Skeleton:
+    """A parsed ASF: bones by name, children lists, root channel order and axis order,
+    metres per length unit and radians per angle unit."""
+
+    bones: dict
+    children: dict
+    root_order: list
+    root_axis: str
+    root_position: np.ndarray
+    root_orientation: np.ndarray
+    length_scale: float
+    angle_scale: float
+    source: str = ""
+
+
+def fixed_axes_matrix(order: str, angles) -> np.ndarray:
+    """Rotation about fixed axes applied in ``order`` (e.g. 'XYZ' -> Rz @ Ry @ Rx); angles (...,3)
+    radians given in X,Y,Z slots."""
+    angles = np.asarray(angles, dtype=np.float64)
+    out = np.broadcast_to(np.eye(3), (*angles.shape[:-1], 3, 3)).copy()
+    for ax in order.upper():
+        k = "XYZ".index(ax)
+        out = axis_rotation(ax.lower(), angles[..., k]) @ out
+    return out
+
+
+def _floats(parts, n, what, source):
+    if len(parts) < n:
+        raise ShapeMoveError(f"{source}: ASF {what} needs {n} numbers")
+    try:
+        vals = np.array([float(p) for p in parts[:n]])
+    except ValueError:
+        raise ShapeMoveError(f"{source}: ASF {what}: not a number in {' '.join(parts)[:60]!r}") from None
+    if not np.all(np.isfinite(vals)) or np.abs(vals).max(initial=0) > MAX_VALUE:
+        raise ShapeMoveError(f"{source}: ASF {what}: value not finite")
+    return vals
+
+
+def _order(s: str, source) -> str:
+    s = s.upper()
+    if sorted(s) != ["X", "Y", "Z"]:
+        raise ShapeMoveError(f"{source}: ASF rotation order {s[:10]!r} is not a permutation of XYZ")
+    return s
+
+
+def parse_asf(text: str, source="ASF") -> Skeleton:
+    bones, children = {}, {}
+    root_order, root_axis = ["TX", "TY", "TZ", "RX", "RY", "RZ"], "XYZ"
+    root_pos, root_ori = np.zeros(3), np.zeros(3)
+    length_unit, angle_deg = 1.0, True
+    section, bone = None, None
+    for raw in text.splitlines():
+        line = raw.split("#", 1)[0].strip()
+        if not line:
+            continue
+        parts = line.split()
+        key = parts[0].lower()
+        if key.startswith(":"):
+            section = key
+            continue
+        if section == ":units":
+            if key == "length":
+                length_unit = float(_floats(parts[1:], 1, "units length", source)[0])
+                if length_unit <= 0:
+                    raise ShapeMoveError(f"{source}: ASF units length must be positive")
+            elif key == "angle":
+                if len(parts) < 2 or parts[1].lower() not in ("deg", "rad"):
+                    raise ShapeMoveError(f"{source}: ASF units angle must be deg or rad")
+                angle_deg = parts[1].lower() == "deg"
+        elif section == ":root":
+            if key == "order":
+                root_order = [p.upper() for p in parts[1:]]
+                bad = [p for p in root_order if p not in ("TX", "TY", "TZ", "RX", "RY", "RZ")]
+                if bad or len(set(root_order)) != len(root_order):
+                    raise ShapeMoveError(f"{source}: ASF root order {' '.join(parts[1:])[:60]!r} is not valid")
+            elif key == "axis":
+                root_axis = _order(parts[1] if len(parts) > 1 else "", source)
+            elif key == "position":
+                root_pos = _floats(parts[1:], 3, "root position", source)
+            elif key == "orientation":
+                root_ori = _floats(parts[1:], 3, "root orientation", source)
+        elif section == ":bonedata":
+            if key == "begin":
+                bone = Bone("")
+            elif key == "end":
+                if bone is None or not bone.name:
+                    raise ShapeMoveError(f"{source}: ASF bone block without a name")
+                if bone.name in bones or bone.name == "root":
+                    raise ShapeMoveError(f"{source}: ASF bone {bone.name!r} defined twice")
+                bones[bone.name] = bone
+                bone = None
+            elif bone is not None:
+                if key == "name" and len(parts) > 1:
+                    bone.name = parts[1]
+                elif key == "direction":
+                    bone.direction = _floats(parts[1:], 3, "direction", source)
+                elif key == "length":
+                    bone.length = float(_floats(parts[1:], 1, "length", source)[0])
+                elif key == "axis":
+                    bone.axis = _floats(parts[1:], 3, "axis", source)
+                    bone.axis_order = _order(parts[4] if len(parts) > 4 else "XYZ", source)
+                elif key == "dof":
+                    bone.dof = [p.lower() for p in parts[1:]]
+                    bad = [p for p in bone.dof if p not in ("rx", "ry", "rz", "tx", "ty", "tz", "l")]
+                    if bad or len(set(bone.dof)) != len(bone.dof):
+                        raise ShapeMoveError(f"{source}: ASF bone {bone.name!r}: bad dof {' '.join(parts[1:])[:60]!r}")
+        elif section == ":hierarchy":
+            if key in ("begin", "end"):
+                continue
+            parent = parts[0]
+            for child in parts[1:]:
+                if child in children.get(parent, []) or any(child in c for c in children.values()):
+                    raise ShapeMoveError(f"{source}: ASF hierarchy lists {child!r} twice")
+                children.setdefault(parent, []).append(child)
+    if not bones:
+        raise ShapeMoveError(f"{source}: ASF has no bones (not an ASF skeleton file?)")
+    for parent, kids in children.items():
+        for name in [parent, *kids]:
+            if name != "root" and name not in bones:
+                raise ShapeMoveError(f"{source}: ASF hierarchy names unknown bone {name!r}")
+    for b in bones.values():
+        n = np.linalg.norm(b.direction)
+        if b.length and not n > 0:
+            raise ShapeMoveError(f"{source}: ASF bone {b.name!r} has a zero direction")
+        b.direction = b.direction / n if n > 0 else b.direction
+    ang = np.pi / 180 if angle_deg else 1.0
+    return Skeleton(bones, children, root_order, root_axis, root_pos, root_ori * ang, INCH / length_unit, ang,
+                    str(source))
+
+
+def _joint_order(skel: Skeleton):
+    """DFS from the root: (names, parents, bone or None) with End Sites after leaf bones.
+    Iterative; a cycle or a bone unreachable from the root is an error."""
+    names, parents, owners = ["root"], [-1], [None]
+    stack = [(c, 0) for c in reversed(skel.children.get("root", []))]
+    seen = set()
+    while stack:
+        name, parent = stack.pop()
+        if name in seen:
+            raise ShapeMoveError(f"{skel.source}: ASF hierarchy has a cycle at {name!r}")
+        seen.add(name)
+        names.append(name)
+        parents.append(parent)
+        owners.append(name)
+        idx = len(names) - 1
+        kids = skel.children.get(name, [])
+        if kids:
+            stack.extend((c, idx) for c in reversed(kids))
+        else:
+            names.append(name + "_End")
+            parents.append(idx)
+            owners.append(None)
+    if len(seen) < len(skel.bones):
+        missing = sorted(set(skel.bones) - seen)[:5]
+        raise ShapeMoveError(f"{skel.source}: ASF bones not connected to the root: {', '.join(missing)}")
+    return names, np.array(parents, dtype=np.int64), owners
+
+
+def parse_amc(text: str, skel: Skeleton, source="AMC"):
+    """AMC text -> (root values (T, len(root order)), {bone: (T, len(dof))}, radians per angle)."""
+    angle = skel.angle_scale
+    dofs = {name: len(b.dof) for name, b in skel.bones.items() if b.dof}
+    dofs["root"] = len(skel.root_order)
+    chunks = {name: [] for name in dofs}
+    frames = 0
+    for raw in text.splitlines():
+        line = raw.strip()
+        if not line or line[0] == "#":
+            continue
+        if line[0] == ":":
+            key = line.upper()
+            if key.startswith(":RADIANS"):
+                angle = 1.0
+            elif key.startswith(":DEGREES"):
+                angle = np.pi / 180
+            continue
+        name, _, rest = line.partition(" ")
+        if name.isdigit():
+            frames += 1
+            continue
+        if frames == 0:
+            raise ShapeMoveError(f"{source}: AMC data before the first frame number: {line[:40]!r}")
+        if name not in chunks:
+            if name in skel.bones:  # a bone without dof listed with no values is harmless
+                if rest.strip():
+                    raise ShapeMoveError(f"{source}: AMC gives values for {name!r}, which has no dof in the ASF")
+                continue
+            raise ShapeMoveError(f"{source}: AMC names bone {name[:40]!r}, which the ASF does not define")
+        chunks[name].append(rest)
+    if frames == 0:
+        raise ShapeMoveError(f"{source}: AMC has no frames")
+    values = {}
+    for name, lines in chunks.items():
+        if len(lines) != frames:
+            raise ShapeMoveError(f"{source}: AMC has {len(lines)} lines for {name!r} in {frames} frames "
+                                 "(truncated file or wrong skeleton)")
+        try:
+            arr = np.array(" ".join(lines).split(), dtype=np.float64)
+        except ValueError:
+            raise ShapeMoveError(f"{source}: AMC values for {name!r} contain something that is not a number") from None
+        if arr.size != frames * dofs[name]:
+            raise ShapeMoveError(f"{source}: AMC has {arr.size} values for {name!r}, expected {dofs[name]} per frame")
+        if not np.all(np.isfinite(arr)) or (arr.size and np.abs(arr).max() > MAX_VALUE):
+            raise ShapeMoveError(f"{source}: AMC values for {name!r} are NaN, inf or absurdly large")
+        values[name] = arr.reshape(frames, dofs[name])
+    root = values.pop("root")
+    return root, values, angle
+
+
+def amc_to_positions(skel: Skeleton, root: np.ndarray, values: dict, angle: float):
+    """FK in file units: (names, parents, offsets (J,3), positions (T,J,3), rotations (T,J,3,3))."""
+    names, parents, owners = _joint_order(skel)
+    T, J = root.shape[0], len(names)
+    offsets = np.zeros((J, 3))
+    trans = np.zeros((T, J, 3))
+    rots = np.broadcast_to(np.eye(3), (T, J, 3, 3)).copy()
+    # root
+    rv = {k: root[:, i] for i, k in enumerate(skel.root_order)}
+    zero = np.zeros(T)
+    offsets[0] = skel.root_position
+    trans[:, 0] = np.stack([rv.get("TX", zero + skel.root_position[0]), rv.get("TY", zero + skel.root_position[1]),
+                            rv.get("TZ", zero + skel.root_position[2])], -1)
+    C = fixed_axes_matrix(skel.root_axis, skel.root_orientation)
+    M = fixed_axes_matrix(skel.root_axis, np.stack([rv.get(k, zero) for k in ("RX", "RY", "RZ")], -1) * angle)
+    rots[:, 0] = C @ M @ C.T
+    for j in range(1, J):
+        p = int(parents[j])
+        parent_bone = skel.bones.get(owners[p]) if owners[p] else None
+        offsets[j] = parent_bone.length * parent_bone.direction if parent_bone is not None else 0.0
+        trans[:, j] = offsets[j]
+        if owners[j] is None:
+            continue
+        b = skel.bones[owners[j]]
+        if not b.dof:
+            continue
+        v = values[b.name]
+        ang = np.zeros((T, 3))
+        order = ""
+        for i, d in enumerate(b.dof):
+            if d[0] == "r":
+                ang[:, "xyz".index(d[1])] = v[:, i] * angle
+                order += d[1].upper()
+        if order:
+            C = fixed_axes_matrix(b.axis_order, b.axis * skel.angle_scale)
+            M = fixed_axes_matrix(order, ang)
+            rots[:, j] = C @ M @ C.T
+    positions = forward_kinematics(parents, trans, rots)
+    return names, parents, offsets, positions, rots
+
+
+def _read_text(path: Path, what: str) -> str:
+    try:
+        raw = path.read_bytes()
+    except OSError as exc:
+        raise ShapeMoveError(f"cannot read {what} {path}: {exc.strerror}") from None
+    if b"\0" in raw[:4096]:
+        raise ShapeMoveError(f"{path}: binary data, not an {what} text file")
+    return raw.decode("utf-8", errors="replace")
+
+
+def load_asf(path) -> Skeleton:
+    path = Path(path)
+    return parse_asf(_read_text(path, "ASF"), path)
+
+
+def find_asf(amc_path) -> Path:
+    """The ASF for an AMC: CMU ``02/02_01.amc`` -> ``02/02.asf``; HDM05 ``HDM_bd_*.amc`` ->
+    ``HDM_bd.asf``; otherwise the only .asf in the folder."""
+    amc_path = Path(amc_path)
+    folder, stem = amc_path.parent, amc_path.stem
+    parts = stem.split("_")
+    candidates = [folder / f"{parts[0]}.asf"]
+    if len(parts) > 1:
+        candidates.append(folder / f"{parts[0]}_{parts[1]}.asf")
+    for c in candidates:
+        if c.is_file():
+            return c
+    found = sorted(folder.glob("*.asf")) + sorted(folder.glob("*.ASF"))
+    if len(found) == 1:
+        return found[0]
+    raise ShapeMoveError(f"{amc_path}: cannot find its ASF skeleton (looked for {candidates[0].name}"
+                         f"{' among ' + ', '.join(f.name for f in found) if found else ''}); pass asf=...")
+
+
+def amc_fps(amc_path, default: float = 120.0) -> float:
+    """HDM05 names carry the rate (``HDM_bd_kickLFront_001_120.amc``); CMU is 120 fps."""
+    m = re.match(r"^HDM_.*_(\d+)$", Path(amc_path).stem)
+    return float(m.group(1)) if m and 1 <= int(m.group(1)) <= 1000 else default
+
+
+def load_amc(path, asf=None, fps: float | None = None) -> Mocap:
+    """Read an AMC with its ASF into a Mocap (metres, Y up)."""
+    path = Path(path)
+    asf_path = Path(asf) if asf else find_asf(path)
+    skel = load_asf(asf_path)
+    root, values, angle = parse_amc(_read_text(path, "AMC"), skel, path)
+    names, parents, offsets, positions, rots = amc_to_positions(skel, root, values, angle)
+    subject = asf_path.stem[4:] if asf_path.stem.startswith("HDM_") else asf_path.stem
+    return finish_mocap(names, parents, offsets, positions, fps or amc_fps(path), str(path), rotations=rots,
+                        unit=f"asf length {INCH / skel.length_scale:g}", scale=skel.length_scale, subject=subject,
+                        meta={"asf": str(asf_path)})

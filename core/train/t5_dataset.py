@@ -1,0 +1,101 @@
+"""Training examples for ShapeMove's T5: motion tokens from the frozen SA-VAE + captions + shape texts.
+
+``tokenize_clips`` runs the SA-VAE encoder once over each clip's normalized features and caches
+the FSQ indices. ``T2MExamples`` draws (input text, target tokens, betas) pairs: the input is the
+paper's "shape text + The person demonstrates a motion like: caption", the target
+``[BETA] [SOM] codes [EOM]``; with ``m2t_share`` > 0 some examples are the reverse task
+(motion tokens in, caption out), the paper's motion-to-text pre-training.
+"""
+from __future__ import annotations
+
+import random
+from pathlib import Path
+
+import numpy as np
+import torch
+
+from ..errors import ShapeMoveError
+from ..models.shapemove_t5 import shapemove_prompt
+from ..models.tokenizer import EOM, SOM
+from .motion_dataset import read_split
+
+
+def read_lines(path: Path) -> list[str]:
+    return [ln.strip() for ln in Path(path).read_text(encoding="utf-8").splitlines() if ln.strip()] if Path(path).is_file() else []
+
+
+@torch.no_grad()
+def tokenize_clips(vae, root: Path, ids: list[str], progress=None) -> dict[str, np.ndarray]:
+    """FSQ indices (N,) of each clip's normalized motion (cropped to a multiple of 4 frames)."""
+    vae.eval()
+    down = vae.cfg.downsample
+    out = {}
+    for i, cid in enumerate(ids):
+        f = np.load(Path(root) / "norm_joint_vecs" / f"{cid}.npy")
+        n = (len(f) // down) * down
+        if n < down:
+            continue
+        x = vae.normalize(torch.as_tensor(f[:n], dtype=torch.float32)[None])
+        _, idx = vae.encode(x)
+        out[cid] = idx[0].numpy().astype(np.int16)
+        if progress:
+            progress((i + 1) / len(ids), cid)
+    return out
+
+
+def all_texts(root: Path, ids: list[str]) -> list[str]:
+    """Every caption and shape text of the clips (the tokenizer's training corpus)."""
+    texts = []
+    for cid in ids:
+        texts += read_lines(Path(root) / "texts" / f"{cid}.txt")
+        texts += read_lines(Path(root) / "shape_texts" / f"{cid}.txt")
+    return texts
+
+
+class T2MExamples:
+    def __init__(self, root: Path, split: str, tokens: dict[str, np.ndarray], max_codes: int = 50,
+                 m2t_share: float = 0.0, no_shape_share: float = 0.2):
+        root = Path(root)
+        self.ids = [c for c in read_split(root, split) if c in tokens and len(tokens[c])]
+        if not self.ids:
+            raise ShapeMoveError(f"{root}: no tokenized clips in split '{split}'")
+        self.tokens = tokens
+        self.captions = {c: read_lines(root / "texts" / f"{c}.txt") or ["a person moves."] for c in self.ids}
+        self.shapes = {c: read_lines(root / "shape_texts" / f"{c}.txt") for c in self.ids}
+        self.betas = {c: np.load(root / "betas" / f"{c}.npy").astype(np.float32) for c in self.ids}
+        self.max_codes, self.m2t_share, self.no_shape_share = max_codes, m2t_share, no_shape_share
+
+    def __len__(self) -> int:
+        return len(self.ids)
+
+    def sample(self, rng: random.Random) -> dict:
+        cid = self.ids[rng.randrange(len(self.ids))]
+        codes = self.tokens[cid]
+        if len(codes) > self.max_codes:
+            s = rng.randrange(len(codes) - self.max_codes + 1)
+            codes = codes[s: s + self.max_codes]
+        caption = rng.choice(self.captions[cid])
+        if self.m2t_share and rng.random() < self.m2t_share:
+            motion = SOM + "".join(f"[MID_{int(c)}]" for c in codes) + EOM
+            return {"input": f"Describe the motion: {motion}", "codes": None, "text": caption, "betas": None,
+                    "key": caption}
+        shapes = self.shapes[cid]
+        shape = None if (not shapes or rng.random() < self.no_shape_share) else rng.choice(shapes)
+        return {"input": shapemove_prompt(caption, shape), "codes": codes.tolist(), "text": None,
+                "betas": self.betas[cid], "key": caption}
+
+
+def collate(examples: list[dict], tok, vocab, max_input: int = 160):
+    enc = tok([e["input"] for e in examples], return_tensors="pt", padding=True, truncation=True, max_length=max_input)
+    targets = []
+    for e in examples:
+        if e["codes"] is not None:
+            targets.append(vocab.target_ids(e["codes"]))
+        else:
+            targets.append(tok(e["text"], truncation=True, max_length=64).input_ids)
+    L = max(len(t) for t in targets)
+    labels = torch.full((len(targets), L), -100, dtype=torch.long)
+    for i, t in enumerate(targets):
+        labels[i, : len(t)] = torch.tensor(t)
+    betas = torch.stack([torch.as_tensor(e["betas"]) if e["betas"] is not None else torch.zeros(10) for e in examples])
+    return enc.input_ids, enc.attention_mask, labels, betas

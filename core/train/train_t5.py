@@ -1,0 +1,209 @@
+"""Train ShapeMove's T5 (stage 2). Read top to bottom like nanoGPT's train.py.
+
+    train_t5(data="DATA", vae="runs/vae/savae.pt", out="runs/t5")                 # one process
+    torchrun --nproc_per_node 2 -m shapemove train t5 --data DATA --vae V --out R  # DDP
+
+1. the frozen SA-VAE turns every clip's normalized motion into FSQ tokens (cached in ``out``);
+2. a sentencepiece tokenizer is trained on the captions + shape texts (or the tokenizer of a
+   pretrained T5 folder given as ``base_model`` is extended);
+3. T5 + [BETA] head learn text -> [BETA] [SOM] codes [EOM] (+ optional motion-to-text examples).
+Writes ``out/last.pt`` (full training state, atomic; ``resume=True`` continues from it) and, at
+the end, ``out/t5/`` (``save_pretrained`` safetensors + tokenizer + beta head + metadata).
+"""
+from __future__ import annotations
+
+import json
+import os
+import random
+import time
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+
+import numpy as np
+import torch
+from torch.nn.parallel import DistributedDataParallel as DDP
+
+from ..errors import ShapeMoveError
+from ..models.shapemove_t5 import ShapeMoveT5, T5Size, size_from_dict
+from ..models.tokenizer import add_motion_tokens, load_tokenizer, tokenizer_from_sentencepiece, train_sentencepiece
+from . import distributed
+from .checkpoint import config_differences, save_checkpoint
+from .t5_dataset import T2MExamples, all_texts, collate, tokenize_clips
+from .train_vae import rng_state, set_rng_state
+
+KIND = "shapemove-t5"
+
+
+@dataclass
+class T5TrainConfig:
+    size: dict = field(default_factory=lambda: asdict(T5Size()))
+    steps: int = 3000
+    batch_size: int = 32
+    lr: float = 5e-4
+    warmup_steps: int = 200
+    weight_decay: float = 0.01
+    grad_clip: float = 1.0
+    beta_weight: float = 1.0
+    max_codes: int = 50            # 10 s at 20 fps, 4x downsampling
+    m2t_share: float = 0.0         # share of motion-to-text examples (the paper's pre-training)
+    vocab_size: int = 2000
+    seed: int = 0
+    log_every: int = 50
+    ckpt_every: int = 250
+
+    @classmethod
+    def tiny(cls) -> "T5TrainConfig":
+        return cls(size=asdict(T5Size.tiny()), steps=20, batch_size=4, warmup_steps=2, log_every=5, ckpt_every=10,
+                   vocab_size=300, max_codes=16)
+
+    @classmethod
+    def load(cls, name_or_path: str | None) -> "T5TrainConfig":
+        if name_or_path in (None, "small"):
+            return cls()
+        if name_or_path == "tiny":
+            return cls.tiny()
+        p = Path(name_or_path)
+        if not p.is_file():
+            raise ShapeMoveError(f"T5 config {name_or_path!r}: use 'small', 'tiny' or a JSON file")
+        data = json.loads(p.read_text())
+        unknown = set(data) - set(asdict(cls()))
+        if unknown:
+            raise ShapeMoveError(f"{p}: unknown T5 config keys {sorted(unknown)}")
+        return cls(**data)
+
+
+def lr_at(step: int, c: T5TrainConfig) -> float:
+    if step < c.warmup_steps:
+        return (step + 1) / c.warmup_steps
+    p = (step - c.warmup_steps) / max(1, c.steps - c.warmup_steps)
+    return 0.1 + 0.9 * 0.5 * (1 + np.cos(np.pi * min(1.0, p)))
+
+
+def load_vae(path):
+    from ..models.savae import load_savae
+
+    return load_savae(path)
+
+
+def train_t5(data, vae, out, config: T5TrainConfig | None = None, base_model=None, resume: bool = False,
+             steps: int | None = None, device: str | None = None, progress=None, cancel=None, verbose: bool = True) -> dict:
+    c = config or T5TrainConfig()
+    if steps is not None:
+        c.steps = int(steps)
+    data, out = Path(data), Path(out)
+    dist = distributed.setup(device)
+    try:
+        return _train(data, Path(vae), out, c, base_model, resume, dist, progress, cancel, verbose)
+    finally:
+        distributed.cleanup()
+
+
+def _train(data, vae_path, out, c, base_model, resume, dist, progress, cancel, verbose) -> dict:
+    from tqdm import tqdm
+
+    out.mkdir(parents=True, exist_ok=True)
+    # -- 1. motion tokens from the frozen SA-VAE (cached per VAE file) -------------------------
+    vae = load_vae(vae_path)
+    from .motion_dataset import read_split
+
+    ids = sorted(set(read_split(data, "train")) | set(read_split(data, "val")))
+    cache = out / "tokens.npz"
+    vae_stamp = f"{vae_path.resolve()}:{vae_path.stat().st_mtime_ns}"
+    tokens = None
+    if cache.is_file():
+        z = np.load(cache, allow_pickle=False)
+        if str(z["__vae__"]) == vae_stamp:
+            tokens = {k: z[k] for k in z.files if k != "__vae__"}
+    if tokens is None:
+        tokens = tokenize_clips(vae, data, ids)
+        if dist.is_main:
+            tmp = out / "tokens.tmp.npz"
+            np.savez(tmp, __vae__=np.array(vae_stamp), **tokens)
+            os.replace(tmp, cache)
+    # -- 2. tokenizer ------------------------------------------------------------------------
+    tok_dir = out / "tokenizer"
+    if (tok_dir / "tokenizer.json").is_file():
+        tok = load_tokenizer(tok_dir)
+    elif base_model is not None:
+        tok = add_motion_tokens(load_tokenizer(Path(base_model)))
+    else:
+        texts = all_texts(data, read_split(data, "train"))
+        tok = tokenizer_from_sentencepiece(train_sentencepiece(texts, out / "spm" / "sp", c.vocab_size, c.seed))
+    if dist.is_main and not (tok_dir / "tokenizer.json").is_file():
+        tok.save_pretrained(str(tok_dir))
+    # -- 3. model, optimizer, resume ---------------------------------------------------------
+    torch.manual_seed(c.seed)
+    model = ShapeMoveT5.build(tok, size_from_dict(c.size), base_model=base_model, beta_weight=c.beta_weight).to(dist.device)
+    optimizer = torch.optim.AdamW(model.parameters(), lr=c.lr, weight_decay=c.weight_decay)
+    scheduler = torch.optim.lr_scheduler.LambdaLR(optimizer, lambda s: lr_at(s, c))
+    step, rng = 0, random.Random(c.seed + 1000 * dist.rank)
+    last = out / "last.pt"
+    if resume and last.is_file():
+        ckpt = torch.load(last, map_location=dist.device, weights_only=False)
+        diff = config_differences(ckpt["config"], asdict(c), ignore=("steps",))
+        if ckpt.get("kind") != KIND or diff:
+            raise ShapeMoveError(f"{last}: cannot resume, the configuration differs ({', '.join(diff) or 'kind'})")
+        model.load_state_dict(ckpt["model"])
+        optimizer.load_state_dict(ckpt["optimizer"])
+        scheduler.load_state_dict(ckpt["scheduler"])
+        step = int(ckpt["step"])
+        set_rng_state(ckpt["rng"])
+        rng.setstate(ckpt["py_rng_examples"])
+    raw = model
+    if dist.enabled:
+        model = DDP(model, find_unused_parameters=True)
+    train_set = T2MExamples(data, "train", tokens, c.max_codes, c.m2t_share)
+    meta = {"vae": str(vae_path), "vae_body": getattr(vae, "body_name", None), "config": asdict(c),
+            "downsample": vae.cfg.downsample, "max_codes": c.max_codes, "data": str(data)}
+
+    def save(final: bool = False):
+        if not dist.is_main:
+            return
+        save_checkpoint(last, {"kind": KIND, "config": asdict(c), "model": raw.state_dict(),
+                               "optimizer": optimizer.state_dict(), "scheduler": scheduler.state_dict(),
+                               "step": step, "rng": rng_state(), "py_rng_examples": rng.getstate()},
+                        {"format": 1, "kind": KIND})
+        if final:
+            raw.save(out / "t5", tok, meta | {"step": step})
+
+    bar = tqdm(total=c.steps, initial=step, desc="train t5", unit="step", disable=not (dist.is_main and verbose))
+    metrics: dict = {"step": step}
+    t0, s0 = time.time(), step
+    model.train()
+    while step < c.steps:
+        if distributed.broadcast_flag(bool(cancel and dist.is_main and cancel()), dist):
+            break
+        batch = [train_set.sample(rng) for _ in range(c.batch_size // dist.world_size)]
+        input_ids, attn, labels, betas = (t.to(dist.device) for t in collate(batch, tok, raw.vocab))
+        res = model(input_ids, attn, labels, betas)
+        optimizer.zero_grad(set_to_none=True)
+        res["loss"].backward()
+        torch.nn.utils.clip_grad_norm_(raw.parameters(), c.grad_clip)
+        optimizer.step()
+        scheduler.step()
+        step += 1
+        bar.update(1)
+        if step % c.log_every == 0 or step == c.steps:
+            m = distributed.mean_over_ranks({"loss": float(res["loss"]), "ce": float(res["ce"]), "l1": float(res["l1"])}, dist)
+            metrics = {"step": step, "lr": scheduler.get_last_lr()[0], "train": m,
+                       "sec_per_step": (time.time() - t0) / max(1, step - s0)}
+            t0, s0 = time.time(), step
+            if dist.is_main:
+                bar.set_postfix(ce=f"{m['ce']:.3f}", l1=f"{m['l1']:.3f}")
+                with open(out / "log.jsonl", "a") as f:
+                    f.write(json.dumps(metrics) + "\n")
+                if progress:
+                    progress(step / c.steps, f"step {step}/{c.steps} ce {m['ce']:.3f}")
+        if step % c.ckpt_every == 0 and step < c.steps:
+            save()
+    bar.close()
+    save(final=step >= c.steps)
+    distributed.barrier(dist)
+    metrics["step"] = step
+    return metrics
+
+
+def from_cli(args) -> dict:
+    c = T5TrainConfig.load(args.config)
+    return train_t5(args.data, args.vae, args.out, c, base_model=args.base_model, resume=args.resume,
+                    steps=args.steps, device=args.device, verbose=not args.quiet)

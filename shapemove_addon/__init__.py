@@ -1,0 +1,25 @@
+"""The Blender side of ShapeMove (imports bpy): UI, operators and scene building.
+
+``register``/``unregister`` are called by the extension's top-level ``__init__``.
+"""
+from __future__ import annotations
+
+import bpy
+
+from . import operators, panels, preferences, properties, shape_sync
+
+classes = (*properties.classes, *preferences.classes, *operators.classes, *panels.classes)
+
+
+def register():
+    for cls in classes:
+        bpy.utils.register_class(cls)
+    properties.register()
+    shape_sync.register()
+
+
+def unregister():
+    shape_sync.unregister()
+    properties.unregister()
+    for cls in reversed(classes):
+        bpy.utils.unregister_class(cls)
