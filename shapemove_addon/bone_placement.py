@@ -34,7 +34,10 @@ def edit_bones_of(context, arm_obj):
     try:
         with context.temp_override(**override):
             if arm_obj.mode != "EDIT":
-                bpy.ops.object.mode_set(mode="EDIT")
+                try:
+                    bpy.ops.object.mode_set(mode="EDIT")
+                except RuntimeError as exc:  # hidden, linked from a library, ...
+                    raise ShapeMoveError(f"cannot edit the bones of {arm_obj.name!r}: {exc}".strip()) from None
         yield arm_obj.data.edit_bones
     finally:
         with context.temp_override(**override):

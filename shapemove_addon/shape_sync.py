@@ -13,6 +13,7 @@ import bpy
 import numpy as np
 from bpy.app.handlers import persistent
 
+from ..core.errors import ShapeMoveError
 from ..core.scene.shape_keys import rest_joints_for
 from .bone_placement import place_bones
 from .scene_build import RIG_MARK, SLIDER_RANGE
@@ -48,6 +49,8 @@ def placed_betas(rig) -> np.ndarray:
 def set_betas(rig, betas, context=None) -> None:
     """Write ``betas`` (10,) into the shape keys and move the bones to match."""
     body = body_of(rig)
+    if body is None or body.data.shape_keys is None:
+        raise ShapeMoveError(f"{rig.name!r} has lost its body mesh or its shape keys")
     keys = body.data.shape_keys.key_blocks
     for i, b in enumerate(np.asarray(betas, dtype=np.float64)):
         kb = keys.get(f"beta_{i}")
@@ -104,8 +107,8 @@ def _run_pending():
 
 @persistent
 def depsgraph_handler(scene, depsgraph=None):
-    kinds = (bpy.types.Key, bpy.types.Mesh, bpy.types.Object)
-    if depsgraph is not None and not any(isinstance(u.id, kinds) for u in depsgraph.updates):
+    # only shape-key edits can change betas; skip the scan for every other update
+    if depsgraph is not None and not any(isinstance(u.id, bpy.types.Key) for u in depsgraph.updates):
         return
     for rig in stale_rigs(scene):
         if rig.name not in _pending:

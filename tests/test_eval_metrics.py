@@ -9,7 +9,7 @@ import torch
 
 from shapemove.core.body.kinematics import axis_angle_to_matrix
 from shapemove.core.body.model import BodyModel
-from shapemove.core.body.skeleton import BODY_BONES, PARENTS
+from shapemove.core.body.skeleton import BODY_BONES
 from shapemove.core.errors import ShapeMoveError
 from shapemove.core.eval import (
     MassModel, aggregate, bone_length_error_mm, bone_length_variance_mm, convex_hull_2d, distance_outside,
@@ -17,7 +17,7 @@ from shapemove.core.eval import (
     skate, skate_from_joints, target_bone_lengths, zmp,
 )
 from shapemove.core.eval.evaluate import METRIC_KEYS
-from shapemove.core.eval.physics import GMD_SKATE, foot_vertex_ids
+from shapemove.core.eval.physics import STRICT_SKATE, foot_vertex_ids
 
 
 # -- fixtures: meshes -----------------------------------------------------------------------------
@@ -159,33 +159,36 @@ def test_sunk_motion_penetrates_2cm_and_lifted_motion_floats_3cm(body):
 
 def test_sliding_feet_skate_and_standing_feet_do_not(body):
     rot, tr = still()
-    tr[:, 0] = 0.01 * torch.arange(20)                       # 1 cm per frame on the ground
+    tr[:, 0] = 0.03 * torch.arange(20)                       # 3 cm per frame on the ground
     r = evaluate_motion(body, None, rot, tr)
     assert r["skate_pct"] == pytest.approx(100.0) and r["n_skate"] == 19
     assert evaluate_motion(body, None, *still())["skate_pct"] == 0.0
+    assert evaluate_motion(body, None, *still(), skate_params=STRICT_SKATE)["skate_pct"] == 0.0
+    # 1 cm per frame: below GMD's 0.5 m/s, caught by the strict 2.5 mm/frame setting
+    tr[:, 0] = 0.01 * torch.arange(20)
+    assert evaluate_motion(body, None, rot, tr)["skate_pct"] == 0.0
+    assert evaluate_motion(body, None, rot, tr, skate_params=STRICT_SKATE)["skate_pct"] == pytest.approx(100.0)
     # the same slide 10 cm above the ground is not skating (no contact)
     tr[:, 1] = 0.10
-    assert evaluate_motion(body, None, rot, tr)["skate_pct"] == 0.0
-    # GMD's setting (2.5 cm/frame over a 5-frame window) lets 1 cm/frame pass but catches 3 cm/frame
-    feet = mesh_motion(body, None, rot, tr - torch.tensor([0, 0.10, 0]))["feet"]
-    assert skate(list(feet.values()), **GMD_SKATE).value == 0.0
-    # (the zero-padded window, as GMD's uniform_filter1d, drops the first and last two pairs)
-    assert skate([f * [3, 1, 3] for f in feet.values()], **GMD_SKATE).value == pytest.approx(100 * 15 / 19)
+    assert evaluate_motion(body, None, rot, tr, skate_params=STRICT_SKATE)["skate_pct"] == 0.0
 
 
 def test_skate_one_foot_sliding_half_the_time():
     T = 21
     still_foot = np.zeros((T, 1, 3))
     moving = np.zeros((T, 1, 3))
-    moving[:, 0, 2] = np.r_[np.zeros(11), 0.01 * np.arange(1, 11)]   # slides in the last 10 pairs
-    s = skate([still_foot, moving])
+    moving[:, 0, 2] = np.r_[np.zeros(11), 0.03 * np.arange(1, 11)]   # slides in the last 10 pairs
+    s = skate([still_foot, moving], **STRICT_SKATE)
     assert s.value == pytest.approx(50.0) and s.count == 20
+    # GMD's 5-pair window: the first two sliding pairs average 1.8 and 2.4 cm < 2.5 cm
+    assert skate([still_foot, moving]).value == pytest.approx(40.0)
+    assert skate([still_foot, moving + [0, 0.06, 0]]).value == pytest.approx(0.0)   # above 5 cm
 
 
 def test_joint_fallbacks():
     j = np.tile(JOINTS[:22], (20, 1, 1))
     assert skate_from_joints(j).value == 0.0
-    slid = j + np.arange(20)[:, None, None] * [0.01, 0, 0]
+    slid = j + np.arange(20)[:, None, None] * [0.03, 0, 0]
     assert skate_from_joints(slid).value == pytest.approx(100.0)
     r = evaluate_joints(slid - [0, 0.05, 0], sole_offsets=[0.07, 0.07, 0.03, 0.03])
     assert r["penetrate_cm"] == pytest.approx(5.0) and r["skate_pct"] == pytest.approx(100.0)
@@ -295,7 +298,7 @@ def test_dynamic_stability_counts():
 # -- evaluate / aggregate / report ----------------------------------------------------------------
 def test_evaluate_motion_keys_chunking_and_betas(body):
     rot, tr = still(T=150)
-    tr[:, 0] = 0.01 * torch.arange(150)
+    tr[:, 0] = 0.03 * torch.arange(150)
     r = evaluate_motion(body, np.zeros(10), rot, tr)
     assert set(METRIC_KEYS) <= set(r) and r["n_frames"] == 150 and r["skate_pct"] == pytest.approx(100.0)
     # joints of a different (taller) body: bone error against the target betas

@@ -14,11 +14,7 @@ from shapemove.core.errors import ShapeMoveError
 
 
 @pytest.fixture(scope="module")
-def rest():  # DEV-TEMP
-    import sys; sys.path.insert(0, "/tmp/ikdev"); from smpl_rest import REST; return REST  # DEV-TEMP
-
-
-def _rest_openbody(openbody):
+def rest(openbody):
     """(24,3) rest joints of an OpenBody with non-zero betas (float64)."""
     betas = torch.tensor([[0.8, -0.5, 0.3, 0.0, 0.4, -0.2, 0.0, 0.1, 0.0, -0.3]])
     return openbody.rest_joints(betas)[0].double().numpy()
@@ -191,6 +187,19 @@ def test_real_clip_with_fitted_skeleton(mocap_root, rest, clip):
     for j in (J["left_knee"], J["right_knee"], J["left_elbow"], J["right_elbow"], J["left_hip"], J["right_hip"]):
         step = angle_deg(res.rotations[1:, j], res.rotations[:-1, j])
         assert step.max() < 45, f"{JOINT_NAMES[j]} jumps by {step.max():.0f} deg between frames"
+
+
+@pytest.mark.parametrize("clip", BANDAI_CLIPS)
+def test_real_clip_on_body_fitted_to_bone_lengths(mocap_root, openbody, clip):
+    """The real path: OpenBody betas fitted to the clip's bone lengths, then IK."""
+    from shapemove.core.body.fit import fit_betas_to_bone_lengths
+
+    joints = _load_bandai(mocap_root, clip)
+    fit = fit_betas_to_bone_lengths(openbody, bone_lengths(joints))
+    rest = openbody.rest_joints(torch.tensor(fit.betas)[None])[0].double().numpy()
+    res = solve_ik(joints, rest)
+    _report(res, f"{clip} OpenBody fitted (bone RMS {fit.residual * 100:.2f} cm)")
+    assert res.mean_error_cm <= 1.0
 
 
 def test_real_clip_bone_lengths_only(mocap_root, rest):

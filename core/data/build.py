@@ -29,7 +29,7 @@ from .sources import ClipSource, discover, open_source
 from .splits import split_of
 
 FPS = 20
-MIN_FRAMES = 40          # 2 s, as HumanML3D
+MIN_FRAMES = 24          # 1.2 s; the SA-VAE trains on the clips of >= 64 frames, the T5 on all
 AUGMENT_SHARE = 0.5      # fraction of Bandai clips that get one copy on a sampled body
 AUGMENT_BETA_CLIP = 2.5  # sampled betas ~ N(0,1) clipped to +-2.5
 
@@ -80,10 +80,7 @@ class ClipProcessor:
     def load(self, clip: ClipSource):
         from ..io.mocap import load_smpl22
 
-        kwargs = {"fps": FPS}
-        if clip.skeleton_path is not None:
-            kwargs["skeleton"] = clip.skeleton_path
-        motion = load_smpl22(clip.path, **kwargs)
+        motion = load_smpl22(clip.path, fps=FPS)
         joints = np.asarray(motion.joints, dtype=np.float32)
         if joints.shape[0] < MIN_FRAMES:
             raise ShapeMoveError(f"too short: {joints.shape[0]} frames at {FPS} fps (need {MIN_FRAMES})")
@@ -92,13 +89,11 @@ class ClipProcessor:
         return joints
 
     def fit(self, joints: np.ndarray) -> np.ndarray:
-        from ..body.fit import fit_betas_to_skeleton
-        from ..body.skeleton import BODY_BONES
+        from ..body.fit import bone_lengths, fit_betas_to_bone_lengths
 
-        # the subject's bone lengths: median over frames is robust to marker noise
-        lengths = np.stack([np.linalg.norm(joints[:, c] - joints[:, p], axis=-1) for p, c in BODY_BONES], 1)
-        fit = fit_betas_to_skeleton(self.body, np.median(lengths, 0))
-        return np.asarray(getattr(fit, "betas", fit), dtype=np.float32)
+        # the subject's bone lengths: the median over frames is robust to marker noise
+        fit = fit_betas_to_bone_lengths(self.body, np.median(bone_lengths(joints), 0))
+        return np.asarray(fit.betas, dtype=np.float32)
 
     def pose_on(self, rotations: np.ndarray, root: np.ndarray, betas: np.ndarray, scale: float):
         """FK of the body with ``betas`` with its root on the trajectory ``root`` (T,3) scaled by

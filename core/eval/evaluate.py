@@ -62,7 +62,7 @@ def mesh_motion(body, betas, rotations, transl, chunk: int = CHUNK, mass: stabil
             joints.append(out.joints[s - lo:s - lo + (e - s)].double())
             for side, ids in feet_ids.items():
                 feet[side].append(inner[:, ids])
-            com.append(mass.center_of_mass(inner))
+            com.append(mass.center_of_mass(out.vertices[s - lo:s - lo + (e - s)]).double())
             # step of each vertex to the next frame (the last frame uses the step from the previous)
             vn = v.numpy()
             idx = np.arange(s, e) - lo
@@ -80,19 +80,21 @@ def mesh_motion(body, betas, rotations, transl, chunk: int = CHUNK, mass: stabil
 
 
 def evaluate_motion(body, betas, rotations, transl, joints=None, target_betas=None, fps: float = 20.0,
-                    no_contact: str = "unstable") -> dict:
+                    no_contact: str = "unstable", skate_params: dict | None = None) -> dict:
     """Metrics of one clip performed by ``body`` with shape ``betas``.
 
     rotations (T,24,3,3) local rotations, transl (T,3) m, 20 fps. ``joints`` (T,>=22,3): the
     motion's own joint positions for the bone metrics (e.g. decoded from features); defaults to
     the posed body's joints. ``target_betas``: the body the bone lengths should match (defaults to
-    ``betas``). Returns the ``METRIC_KEYS`` plus the frame counts used by ``report.aggregate``.
+    ``betas``). ``skate_params``: keyword arguments of ``physics.skate`` (default GMD's setting);
+    ``no_contact``: see ``stability.dynamic_stability``. Returns the ``METRIC_KEYS`` plus the
+    frame counts used by ``report.aggregate``.
     """
     m = mesh_motion(body, betas, rotations, transl)
     T = len(m["lowest"])
     pen = physics.penetrate(m["lowest"])
     flo = physics.floating(m["lowest"])
-    sk = physics.skate(list(m["feet"].values()))
+    sk = physics.skate(list(m["feet"].values()), **(skate_params or {}))
     j = m["joints"][:, :22] if joints is None else bones._joints(joints)
     if len(j) != T:
         raise ShapeMoveError(f"joints have {len(j)} frames but the motion has {T}")

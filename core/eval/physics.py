@@ -8,18 +8,21 @@ Definitions (as in HUMOS's ``all_physics_metrics``, which implements the PhysDif
 * **penetrate**: per frame, ``h = min_v y_v`` (lowest vertex). A frame *penetrates* when
   ``h < -tol``; the metric is the mean of ``-h`` over those frames only (cm). ``tol`` (5 mm)
   absorbs mesh approximations. PhysDiff/UHC average over *all* frames (0 where there is no
-  penetration): that number equals ours times ``count / n_frames``, both are returned.
+  penetration): that is ``value * n_penetrate / n_frames`` from the counts ``evaluate`` returns.
 * **float**: a frame *floats* (is unsupported) when ``h > tol``; the metric is the mean of ``h``
   over those frames (cm). A motion that jumps floats during the flight phase, as in HUMOS/PhysDiff.
 * **skate** (GMD's "foot skating ratio", Karunratanakul et al. 2023): over the T-1 pairs of
   adjacent frames, the % of pairs in which a foot *in contact in both frames* moves horizontally
-  (XZ) by more than ``max_step``. With a mesh, a foot is the set of vertices whose dominant skin
-  weight is its ankle or foot joint; the foot is in contact when some of its vertices are below
-  ``height`` in both frames and its displacement is the mean XZ displacement of exactly those
-  vertices (the part that should stay planted). Without a mesh, the foot is the foot joint (10/11)
-  as in GMD. GMD uses ``height`` 5 cm and 0.5 m/s (2.5 cm per frame at 20 fps) averaged over a
-  5-frame window (``GMD_SKATE``); our default step is 2.5 mm per frame (5 cm/s, no window), so a
-  contact foot sliding 1 cm per frame is caught.
+  (XZ) by more than ``max_step`` and whose mean XZ step over a centred ``window`` of pairs also
+  exceeds it (GMD: height 5 cm, 0.5 m/s = 2.5 cm per frame at 20 fps, 5-frame window; these are
+  the defaults). With a mesh, a foot is the set of vertices whose dominant skin weight is its ankle
+  or foot joint; it is in contact when some of its vertices are below ``height`` in both frames,
+  and its step is the mean XZ displacement of exactly those vertices (the part that should stay
+  planted). Without a mesh, the foot is the foot joint (10/11) as in GMD. GMD pads the window with
+  zeros (clip edges never skate); we repeat the edge values instead. ``STRICT_SKATE`` (2.5 mm per
+  frame, no window) flags any slide over 5 cm/s, e.g. a planted foot sliding 1 cm per frame, but
+  on real mocap it also flags most swing-phase frames where the foot passes low over the ground
+  (CMU walking 02_01, foot joints: 91 % strict vs 21 % GMD), so it is not the default.
 """
 from __future__ import annotations
 
@@ -32,8 +35,10 @@ from ..errors import ShapeMoveError
 
 GROUND_TOL = 0.005          # m, penetrate / float tolerance (HUMOS)
 CONTACT_HEIGHT = 0.05       # m, foot contact height (GMD, HUMOS)
-SKATE_STEP = 0.0025         # m per frame at 20 fps
-GMD_SKATE = {"height": 0.05, "max_step": 0.025, "window": 5}
+SKATE_STEP = 0.025          # m per frame at 20 fps (0.5 m/s, GMD)
+SKATE_WINDOW = 5            # frames (GMD)
+GMD_SKATE = {"height": CONTACT_HEIGHT, "max_step": SKATE_STEP, "window": SKATE_WINDOW}
+STRICT_SKATE = {"height": CONTACT_HEIGHT, "max_step": 0.0025, "window": 1}
 FOOT_JOINTS = {"left": (7, 10), "right": (8, 11)}   # ankle, foot (SMPL order)
 FOOT_JOINT_IDS = [7, 8, 10, 11]
 
@@ -94,20 +99,22 @@ def floating(lowest, tol: float = GROUND_TOL) -> Stat:
 
 
 def _window_mean(x: np.ndarray, window: int) -> np.ndarray:
-    """Centred moving average along the last axis, zero padded (scipy uniform_filter1d 'constant')."""
-    if window <= 1:
+    """(N,) -> centred moving average over ``window`` samples, edge values repeated."""
+    if window <= 1 or len(x) == 0:
         return x
-    kernel = np.ones(window) / window
-    return np.apply_along_axis(lambda r: np.convolve(r, kernel, mode="same"), -1, x)
+    left = (window - 1) // 2
+    padded = np.pad(x, (left, window - 1 - left), mode="edge")
+    return np.convolve(padded, np.ones(window) / window, mode="valid")
 
 
-def skate(feet: list, height: float = CONTACT_HEIGHT, max_step: float = SKATE_STEP, window: int = 1) -> Stat:
+def skate(feet: list, height: float = CONTACT_HEIGHT, max_step: float = SKATE_STEP,
+          window: int = SKATE_WINDOW) -> Stat:
     """Foot skating ratio (%) over the T-1 adjacent frame pairs.
 
     ``feet``: one (T,P,3) array per foot (its vertices, or (T,1,3) for a joint). A foot is in
     contact over a pair when any of its points is below ``height`` in both frames; its step is
     the mean XZ displacement of those points. A pair skates when some foot in contact steps more
-    than ``max_step`` (and, with ``window`` > 1, its windowed mean step too, as GMD).
+    than ``max_step`` and the foot's mean step (all its points) over ``window`` pairs does too.
     Returns (% of pairs that skate, number of pairs).
     """
     skating = None
@@ -121,7 +128,7 @@ def skate(feet: list, height: float = CONTACT_HEIGHT, max_step: float = SKATE_ST
         n = both.sum(-1)
         contact = n > 0
         step = np.where(contact, (d * both).sum(-1) / np.maximum(n, 1), 0.0)
-        s = contact & (step > max_step) & (_window_mean(step, window) > max_step)
+        s = contact & (step > max_step) & (_window_mean(d.mean(-1), window) > max_step)
         skating = s if skating is None else skating | s
     if skating is None:
         raise ShapeMoveError("skate needs at least one foot")
@@ -139,7 +146,8 @@ def foot_vertex_ids(skin_weights) -> dict[str, np.ndarray]:
     return out
 
 
-def skate_from_joints(joints, height: float = CONTACT_HEIGHT, max_step: float = SKATE_STEP, window: int = 1) -> Stat:
+def skate_from_joints(joints, height: float = CONTACT_HEIGHT, max_step: float = SKATE_STEP,
+                      window: int = SKATE_WINDOW) -> Stat:
     """Joint-only fallback (GMD): the feet are the foot joints 10 and 11 of (T,>=22,3) joints."""
     j = _np(joints, "joints", 3)
     if j.shape[1] < 22:

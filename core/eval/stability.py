@@ -40,7 +40,7 @@ GRAVITY = 9.81
 FPS = 20.0
 SUPPORT_HEIGHT = 0.05      # m (HUMOS CONTACT_THRESH)
 SUPPORT_STEP = 0.02        # m per frame (HUMOS VELOCITY_THRESH)
-_OCTAGON = np.stack([np.cos(np.arange(8) * np.pi / 4), np.sin(np.arange(8) * np.pi / 4)], axis=1)
+_DIRECTIONS = np.stack([np.cos(np.arange(32) * np.pi / 16), np.sin(np.arange(32) * np.pi / 16)], axis=1)
 
 
 class MassModel:
@@ -95,8 +95,10 @@ class MassModel:
         return np.asarray(caps, dtype=np.int64).reshape(-1, 3), np.asarray(cap_part, dtype=np.int64), groups
 
     def part_volumes(self, vertices) -> tuple[torch.Tensor, torch.Tensor]:
-        """(B,V,3) vertices -> part volumes (B,J) in m^3 and part centroids (B,J,3) (NaN if empty)."""
-        v = torch.as_tensor(vertices).to(torch.float64)
+        """(B,V,3) vertices -> part volumes (B,J) in m^3 and part centroids (B,J,3) (NaN if empty).
+        Computed in the input's precision (float32: ~1e-5 relative, float64 for exact checks)."""
+        v = torch.as_tensor(vertices)
+        v = v if v.dtype in (torch.float32, torch.float64) else v.to(torch.float64)
         if v.dim() == 2:
             v = v[None]
         if v.dim() != 3 or v.shape[1:] != (self.num_vertices, 3):
@@ -105,10 +107,10 @@ class MassModel:
         v = v - origin
         B = v.shape[0]
         apex = v.new_zeros(B, self.num_groups, 3).index_add_(1, self.apex_group, v[:, self.apex_vertex])
-        apex = apex / self.apex_count[None, :, None]
+        apex = apex / self.apex_count.to(v.dtype)[None, :, None]
         tris = self.tris
         pts = torch.cat([v, apex], dim=1)
-        a, b, c = pts[:, tris[:, 0]], pts[:, tris[:, 1]], pts[:, tris[:, 2]]
+        a, b, c = (pts.index_select(1, tris[:, k]) for k in range(3))
         det = (a * torch.linalg.cross(b, c)).sum(-1) / 6.0                     # (B,N)
         vol = v.new_zeros(B, self.num_parts).index_add_(1, self.tri_part, det)
         mom = v.new_zeros(B, self.num_parts, 3).index_add_(1, self.tri_part, det[..., None] * (a + b + c) / 4)
@@ -122,7 +124,7 @@ class MassModel:
     def center_of_mass(self, vertices) -> torch.Tensor:
         """(B,V,3) vertices -> (B,3) CoM = density*volume-weighted mean of the part centroids."""
         vol, cen = self.part_volumes(vertices)
-        m = vol * self.densities
+        m = vol * self.densities.to(vol.dtype)
         cen = torch.nan_to_num(cen)
         return (m[..., None] * cen).sum(1) / m.sum(1, keepdim=True)
 
@@ -156,8 +158,8 @@ def convex_hull_2d(points) -> np.ndarray:
     """(N,2) points -> (K,2) convex hull, counter-clockwise (Andrew's monotone chain).
     Degenerate inputs give 1 (a point) or 2 (a segment) vertices; empty input gives (0,2)."""
     p = np.round(np.asarray(points, dtype=np.float64).reshape(-1, 2), 6)
-    if len(p) > 16:   # Akl-Toussaint: drop points strictly inside the octagon of extreme points
-        ext = p[(p @ _OCTAGON.T).argmax(axis=0)]
+    if len(p) > 32:   # Akl-Toussaint: drop points strictly inside the polygon of extreme points
+        ext = p[(p @ _DIRECTIONS.T).argmax(axis=0)]
         ext = ext[np.any(ext != np.roll(ext, 1, axis=0), axis=1)]
         if len(ext) >= 3:
             e0, e1 = ext, np.roll(ext, -1, axis=0)

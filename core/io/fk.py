@@ -51,5 +51,5 @@ def forward_kinematics(parents, translations: np.ndarray, rotations: np.ndarray)
             world_pos[:, j] = translations[:, j]
         else:
             world_rot[:, j] = world_rot[:, p] @ rotations[:, j]
-            world_pos[:, j] = world_pos[:, p] + np.einsum("tij,tj->ti", world_rot[:, p], translations[:, j])
+            world_pos[:, j] = world_pos[:, p] + (world_rot[:, p] @ translations[:, j, :, None])[..., 0]
     return world_pos

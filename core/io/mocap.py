@@ -12,7 +12,8 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ShapeMoveError
-from .units_axes import detect_unit, detect_up_axis, to_y_up
+from .fk import forward_kinematics
+from .units_axes import detect_unit, detect_up_axis, smpl22_or_none, to_y_up
 
 
 @dataclass
@@ -67,14 +68,19 @@ def finish_mocap(names, parents, offsets, positions, fps, source, *, rotations=N
         raise ShapeMoveError(f"{source}: no frames of joint positions")
     if not np.all(np.isfinite(positions)):
         raise ShapeMoveError(f"{source}: joint positions are not finite (NaN/inf or numbers too large in the file)")
+    offsets = np.asarray(offsets, dtype=np.float64)
+    j22 = smpl22_or_none(names, positions) if scale is None or up_axis is None else None
     if scale is None:
-        unit, scale = detect_unit(names, positions)
-    up_axis = up_axis or detect_up_axis(names, positions)
-    A = to_y_up(up_axis) * float(scale)
+        unit, scale = detect_unit(names, positions, smpl22=j22)
+    if up_axis is None:
+        eye = np.broadcast_to(np.eye(3), (1, len(names), 3, 3))
+        rest = forward_kinematics(parents, offsets[None], eye)[0]
+        up_axis = detect_up_axis(names, positions, rest=rest, smpl22=j22)
     R = to_y_up(up_axis)
+    A = R * float(scale)
     positions = positions @ A.T
-    offsets = np.asarray(offsets, dtype=np.float64) @ A.T
-    if rotations is not None:
+    offsets = offsets @ A.T
+    if rotations is not None and up_axis != "Y":
         rotations = R @ rotations @ R.T
     if not (np.all(np.isfinite(positions)) and np.all(np.isfinite(offsets))):
         raise ShapeMoveError(f"{source}: joint positions overflow after unit conversion")
@@ -137,14 +143,13 @@ class Motion22:
 def mocap_to_smpl22(mocap: Mocap, fps: float = 20.0, drop_tpose: bool = True) -> Motion22:
     """Map a Mocap to SMPL22 positions, cut a T-pose lead-in, resample to ``fps``."""
     from ..body.skeleton import PARENTS
-    from .fk import forward_kinematics
     from .resample import resample_positions
     from .rig_map import detect_rig, mapping_matrix
     from .tpose import tpose_lead_in
 
     rig = detect_rig(mocap.names)
     W = mapping_matrix(rig, mocap.names, mocap.positions)
-    joints = np.einsum("sj,tjc->tsc", W, mocap.positions)
+    joints = np.matmul(W, mocap.positions)
     cut = tpose_lead_in(joints, mocap.fps) if drop_tpose else 0
     if cut >= len(joints) - 1:
         raise ShapeMoveError(f"{mocap.source}: the clip holds nothing but a T-pose")

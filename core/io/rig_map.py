@@ -17,6 +17,7 @@ Source names are compared case-insensitively after dropping a namespace (``mixam
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 
@@ -119,6 +120,11 @@ def _required(rig: Rig) -> dict:
 
 def find_rig(names) -> Rig | None:
     """The first rig whose every rule resolves against ``names``, else None."""
+    return _find_rig(tuple(names))
+
+
+@lru_cache(maxsize=256)
+def _find_rig(names: tuple) -> Rig | None:
     have = {normalize(n) for n in names}
     for rig in RIGS:
         if all(normalize(n) in have for needs in _required(rig).values() for n in needs):
@@ -170,7 +176,7 @@ def mapping_matrix(rig: Rig, names, positions: np.ndarray) -> np.ndarray:
         points.append(0.5 * (rule_weights(rig.rules["left_hip"]) + rule_weights(rig.rules["right_hip"])))
         points += [onehot(n) for n in rig.chain if normalize(n) in index]
         pts = np.stack(points)                                          # (K,J)
-        chain_pos = np.einsum("kj,tjc->tkc", pts, positions)            # (T,K,3)
+        chain_pos = np.matmul(pts, positions)  # (T,K,3)
         seg = np.median(np.linalg.norm(np.diff(chain_pos, axis=1), axis=-1), axis=0)  # (K-1,)
         cum = np.concatenate([[0.0], np.cumsum(seg)])
         total = cum[-1]
@@ -194,4 +200,4 @@ def map_positions(names, positions: np.ndarray, rig: Rig | None = None) -> tuple
     """(T,J,3) source positions -> ((T,22,3) SMPL22 positions, rig used)."""
     rig = rig or detect_rig(names)
     W = mapping_matrix(rig, names, positions)
-    return np.einsum("sj,tjc->tsc", W, positions), rig
+    return np.matmul(W, positions), rig

@@ -3,8 +3,9 @@ BVH converters put first) so it can be cut.
 
 Works on SMPL22 positions (T,22,3), metres, Y up. A frame is a T-pose when both arms are straight,
 horizontal (within 25 deg) and point sideways. A leading run of such frames is cut when it is
-static (joints moving < 0.5 m/s) or ends in a jump (a converter's rest frame); the blend frames that follow it (joint speeds
-far above the clip's own, at most 0.25 s of them) are cut too.
+held (joints moving < 0.5 m/s); a single rest frame followed by a jump (what BVH converters write)
+is cut too; so are the blend frames that follow either (joint speeds far above the clip's own,
+at most 0.25 s of them).
 """
 from __future__ import annotations
 
@@ -43,11 +44,19 @@ def tpose_lead_in(joints: np.ndarray, fps: float) -> int:
         return 0
     speed = np.linalg.norm(np.diff(joints, axis=0), axis=-1).max(-1) * fps  # speed[k]: frame k -> k+1
     threshold = max(5.0, 2.0 * float(np.median(speed)))
-    jump = speed[0] > threshold                                   # a converter's rest frame
-    static = np.median(speed[: max(1, run - 1)]) < STATIC_SPEED    # a held calibration pose
-    if not (jump or static):
+    jump = speed[0] > threshold  # a converter's rest frame, then a jump into the motion
+    held = lambda a, b: b - a > 1 and np.median(speed[a: b - 1]) < STATIC_SPEED  # noqa: E731
+    if not (jump or held(0, run)):
         return 0  # arms out while moving: part of the motion
-    cut, limit = run, min(T - 1, run + int(round(0.25 * fps)))
-    while cut < limit and speed[cut - 1] > threshold:
-        cut += 1
+    cut = 1 if jump else run
+
+    def skip_blend(k):  # frames far faster than the clip are the converter's blend out of the T-pose
+        limit = min(T - 1, k + int(round(0.25 * fps)))
+        while k < limit and speed[k - 1] > threshold:
+            k += 1
+        return k
+
+    cut = skip_blend(cut)
+    if cut < run and held(cut, run):  # a held T-pose after the rest frame
+        cut = skip_blend(run)
     return min(cut, T)

@@ -27,11 +27,13 @@ _TO_Y_UP = {
 }
 
 
-def _smpl22(names, positions):
+def smpl22_or_none(names, positions):
+    """SMPL22 positions (T,22,3) of a sample of frames, or None for a rig we cannot map."""
     rig = find_rig(names)
     if rig is None:
         return None
-    return np.einsum("sj,tjc->tsc", mapping_matrix(rig, names, positions), positions)
+    pos = _sample(positions)
+    return np.matmul(mapping_matrix(rig, names, pos), pos)
 
 
 def _sample(positions, n=200):
@@ -40,33 +42,62 @@ def _sample(positions, n=200):
     return positions[::step]
 
 
-def detect_unit(names, positions: np.ndarray) -> tuple[str, float]:
+def detect_unit(names, positions: np.ndarray, smpl22=None) -> tuple[str, float]:
     """(unit name, metres per unit) for positions (T,J,3) in file units."""
-    pos = _sample(positions)
-    j = _smpl22(names, pos)
+    j = smpl22 if smpl22 is not None else smpl22_or_none(names, positions)
     if j is not None:
         legs = [np.linalg.norm(j[:, a] - j[:, b], axis=-1) for a, b in ((1, 4), (4, 7), (2, 5), (5, 8))]
         size, ref = float(np.median(legs[0] + legs[1]) + np.median(legs[2] + legs[3])) / 2, LEG_M
     else:
-        size, ref = float(np.median(np.ptp(pos, axis=1).max(-1))), EXTENT_M
+        size, ref = float(np.median(np.ptp(_sample(positions), axis=1).max(-1))), EXTENT_M
     if not np.isfinite(size) or size <= 0:
         return "m", 1.0
     unit = min(UNITS, key=lambda u: abs(np.log(size * UNITS[u] / ref)))
     return unit, UNITS[unit]
 
 
-def detect_up_axis(names, positions: np.ndarray) -> str:
-    """'Y', 'Z', '-Y', '-Z', 'X' or '-X': the world axis pointing up in these positions (T,J,3)."""
-    pos = _sample(positions)
-    j = _smpl22(names, pos)
-    if j is not None:
-        v = np.median(j[:, 15] - 0.5 * (j[:, 7] + j[:, 8]), axis=0)
-        if not np.all(np.isfinite(v)) or not np.any(v):
-            return "Y"
-        k = int(np.argmax(np.abs(v)))
-        return ("-" if v[k] < 0 else "") + "XYZ"[k]
-    ext = np.median(np.ptp(pos, axis=1), axis=0)
-    return "XYZ"[int(np.argmax(ext))] if np.all(np.isfinite(ext)) else "Y"
+def _axis_of(v) -> str:
+    k = int(np.argmax(np.abs(v)))
+    return ("-" if v[k] < 0 else "") + "XYZ"[k]
+
+
+def _upright(j: np.ndarray) -> np.ndarray:
+    """(T,22,3) -> (T,) bool: head above the ankles along one world axis, both legs along it."""
+    up = j[:, 15] - 0.5 * (j[:, 7] + j[:, 8])
+    n = np.maximum(np.linalg.norm(up, axis=-1), 1e-12)
+    ok = np.abs(up).max(-1) > 0.9 * n
+    for hip, ankle in ((1, 7), (2, 8)):
+        leg = j[:, hip] - j[:, ankle]
+        ok &= np.sum(leg * up, -1) > 0.9 * n * np.maximum(np.linalg.norm(leg, axis=-1), 1e-12)
+    return ok
+
+
+def detect_up_axis(names, positions: np.ndarray, rest: np.ndarray | None = None, smpl22=None) -> str:
+    """'Y', 'Z', '-Y', '-Z', 'X' or '-X': the world axis pointing up in positions (T,J,3).
+
+    The rest skeleton ``rest`` (J,3) decides when it stands upright (ASF and most BVH rigs); else
+    the frames where the subject stands upright vote (a clip that lies on the floor still has some);
+    else the median ankles->head direction."""
+    rig = find_rig(names)
+    if rig is None:
+        ext = np.median(np.ptp(_sample(positions), axis=1), axis=0)
+        return "XYZ"[int(np.argmax(ext))] if np.all(np.isfinite(ext)) else "Y"
+    if rest is not None:
+        r = rest[None]
+        jr = np.matmul(mapping_matrix(rig, names, r), r)
+        if _upright(jr)[0]:
+            return _axis_of(jr[0, 15] - 0.5 * (jr[0, 7] + jr[0, 8]))
+    j = smpl22 if smpl22 is not None else smpl22_or_none(names, positions)
+    up = j[:, 15] - 0.5 * (j[:, 7] + j[:, 8])
+    ok = _upright(j)
+    if ok.any():
+        u = up[ok]
+        k = np.abs(u).argmax(-1)
+        votes = k * 2 + (np.take_along_axis(u, k[:, None], -1)[:, 0] < 0)   # (axis, sign) codes
+        best = int(np.bincount(votes, minlength=6).argmax())
+        return ("-" if best % 2 else "") + "XYZ"[best // 2]
+    v = np.median(up, axis=0)
+    return _axis_of(v) if np.all(np.isfinite(v)) and np.any(v) else "Y"
 
 
 def to_y_up(axis: str) -> np.ndarray:

@@ -80,9 +80,19 @@ class MotionEncoder(nn.Module):
     def forward(self, feats: torch.Tensor, lengths: torch.Tensor) -> torch.Tensor:
         """feats (B,T,263) normalised, zero-padded; lengths (B,) valid frames."""
         feats = feats[:, : self.max_frames]
-        x = self.stem(feats.transpose(1, 2)).transpose(1, 2)
+        lengths = lengths.to(feats.device).clamp(max=self.max_frames)
+        x = F.pad(feats, (0, 0, 0, -feats.shape[1] % 4)).transpose(1, 2)  # whole 4-frame steps
+        # padding is zeroed after every layer, so an embedding does not depend on the batch's padding
+        valid = lengths
+        for layer in self.stem:
+            if isinstance(layer, nn.Conv1d) and layer.stride[0] == 2 and layer is not self.stem[-1]:
+                valid = (valid + 1) // 2
+            x = layer(x)
+            if isinstance(layer, nn.GELU):
+                x = x * (torch.arange(x.shape[-1], device=x.device)[None] < valid[:, None])[:, None]
+        x = x.transpose(1, 2)
         n = x.shape[1]
-        keep = torch.arange(n)[None] < (lengths.clamp(max=self.max_frames)[:, None] + 3) // 4
+        keep = torch.arange(n, device=x.device)[None] < (lengths[:, None] + 3) // 4
         x = self.encoder(x + self.pos[:n], src_key_padding_mask=~keep)
         return F.normalize(self.out(_pool(x, keep)), dim=-1)
 
@@ -98,10 +108,10 @@ class TMA(nn.Module):
         """Symmetric InfoNCE; pairs whose captions are identical are masked out as negatives."""
         logits = t @ m.T / self.cfg.temperature
         if text_keys is not None:
-            same = torch.tensor([[a == b for b in text_keys] for a in text_keys])
+            same = torch.tensor([[a == b for b in text_keys] for a in text_keys], device=logits.device)
             same.fill_diagonal_(False)
             logits = logits.masked_fill(same, float("-inf"))
-        target = torch.arange(t.shape[0])
+        target = torch.arange(t.shape[0], device=logits.device)
         return (F.cross_entropy(logits, target) + F.cross_entropy(logits.T, target)) / 2
 
     def config_dict(self) -> dict:

@@ -7,8 +7,10 @@ from ..errors import ShapeMoveError
 def load_body(name: str, model_file=None):
     """"openbody-*" -> the bundled OpenBody; "capsule-v1" -> the procedural capsule body;
     an SMPL-family id ("smplx-male", ...) needs ``model_file`` (the user's own model file)."""
-    from ..body.load import load_body_model
-
+    try:
+        from ..body.load import load_body_model
+    except ImportError as exc:
+        raise ShapeMoveError(f"body models need {exc.name or 'torch'}: install it into Blender's Python") from None
     if name == "capsule-v1":
         from .capsule_body import capsule_body
 

@@ -11,6 +11,19 @@ from __future__ import annotations
 import numpy as np
 
 
+def axis_angle_to_matrix(aa) -> np.ndarray:
+    """(..., 3) axis-angle -> (..., 3, 3) rotation matrices (Rodrigues; numpy twin of
+    ``core.body.kinematics.axis_angle_to_matrix`` so the Blender side can register without torch)."""
+    aa = np.asarray(aa, dtype=np.float64)
+    angle = np.linalg.norm(aa, axis=-1, keepdims=True)
+    axis = aa / np.where(angle < 1e-12, 1.0, angle)
+    x, y, z = np.moveaxis(axis, -1, 0)
+    zero = np.zeros_like(x)
+    k = np.stack([zero, -z, y, z, zero, -x, -y, x, zero], -1).reshape(aa.shape[:-1] + (3, 3))
+    s, c = np.sin(angle)[..., None], np.cos(angle)[..., None]
+    return np.eye(3) + s * k + (1 - c) * (k @ k)
+
+
 def matrix_to_quaternion(rot) -> np.ndarray:
     """(..., 3, 3) rotation matrices -> (..., 4) unit quaternions (w, x, y, z), w >= 0."""
     r = np.asarray(rot, dtype=np.float64)

@@ -8,11 +8,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..body.kinematics import axis_angle_to_matrix
 from ..body.skeleton import JOINT_NAMES, PARENTS
 from ..errors import ShapeMoveError
 from .axes import Y_UP_TO_Z_UP, points_to_z_up, rotations_to_z_up
 from .bones import BoneLayout, bone_layout
+from .pose import axis_angle_to_matrix
 from .shape_keys import rest_joints_for, shape_key_coords
 
 
@@ -58,11 +58,9 @@ def rig_data(body, betas) -> RigData:
 def motion_channels_z_up(poses, transl) -> tuple[np.ndarray, np.ndarray]:
     """poses (T,24,3) axis-angle (or (T,24,3,3)) Y-up, transl (T,3) Y-up ->
     local rotation matrices (T,24,3,3) and root offsets (T,3) in Z-up armature axes."""
-    import torch
-
     p = np.asarray(poses, dtype=np.float64)
     if p.ndim == 3 and p.shape[-1] == 3:
-        rot = axis_angle_to_matrix(torch.as_tensor(p)).numpy()
+        rot = axis_angle_to_matrix(p)
     elif p.ndim == 4 and p.shape[-2:] == (3, 3):
         rot = p
     else:

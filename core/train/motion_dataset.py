@@ -70,7 +70,7 @@ class MotionClips(Dataset):
 
     def _load(self, sub: str, cid: str, start: int | None = None) -> np.ndarray:
         a = np.load(self.root / sub / f"{cid}.npy", mmap_mode="r")
-        return np.asarray(a if start is None else a[start:start + self.window], dtype=np.float32)
+        return np.array(a if start is None else a[start:start + self.window], dtype=np.float32)
 
     def __getitem__(self, key) -> dict:
         index, epoch = key if isinstance(key, tuple) else (key, 0)

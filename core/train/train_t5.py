@@ -153,7 +153,7 @@ def _train(data, vae_path, out, c, base_model, resume, dist, progress, cancel, v
     if dist.enabled:
         model = DDP(model, find_unused_parameters=True)
     train_set = T2MExamples(data, "train", tokens, c.max_codes, c.m2t_share)
-    meta = {"vae": str(vae_path), "vae_body": getattr(vae, "body_name", None), "config": asdict(c),
+    meta = {"vae": str(vae_path), "vae_body": vae.metadata.get("body"), "config": asdict(c),
             "downsample": vae.cfg.downsample, "max_codes": c.max_codes, "data": str(data)}
 
     def save(final: bool = False):

@@ -199,7 +199,7 @@ def _train(data, out, cfg, t, resume, body, dist, progress, cancel, verbose) -> 
         bar.update(1)
         done = step == t.steps
         if done or step % t.log_every == 0 or step % t.val_every == 0:
-            train_metrics = distributed.mean_over_ranks({k: float(v) for k, v in losses.items()}, dist)
+            train_metrics = distributed.mean_over_ranks({k: float(v.detach()) for k, v in losses.items()}, dist)
             metrics = {"step": step, "lr": scheduler.get_last_lr()[0], "train": train_metrics,
                        "sec_per_step": (time.time() - t0) / (step - t0_step)}
             if dist.is_main and (done or step % t.val_every == 0) and len(val_set):

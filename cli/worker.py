@@ -1,0 +1,24 @@
+"""`python -m shapemove worker`: serve jobs over stdin/stdout (JSON lines) for the Blender extension.
+
+The protocol is described in core/worker/protocol.py; the ops in core/worker/ops.py.
+``--list`` prints the ops and exits (without serving).
+"""
+from __future__ import annotations
+
+
+def add_arguments(p):
+    p.add_argument("--list", action="store_true", help="print the available ops and exit")
+
+
+def run(args) -> int:
+    from ..core.worker.protocol import CONTROL_OPS
+
+    if args.list:
+        from ..core.worker.ops import JOBS
+
+        for name in [*CONTROL_OPS, *sorted(JOBS)]:
+            print(name)
+        return 0
+    from ..core.worker.server import main
+
+    return main()

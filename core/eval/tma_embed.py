@@ -1,0 +1,180 @@
+"""Using a trained TMA: load it, embed texts and motions, and score the real data (the ceiling
+that generated motions are compared against).
+
+A TMA run folder holds ``tma.pt`` (weights + metadata with the data's Mean/Std) and
+``tokenizer/`` beside it. Motions are raw (T,263) HumanML3D features; they are normalized with the
+TMA's own Mean/Std. A motion longer than the model's ``max_frames`` is embedded as the mean of
+evenly spaced ``max_frames`` windows (re-normalized), the same crops the model was trained on.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import torch
+
+from ..errors import ShapeMoveError
+from ..models.tma import TMA, TMAConfig
+
+KIND = "tma"
+FEATURE_DIM = 263
+
+
+def tma_path(path) -> Path:
+    """``tma.pt`` itself, or a folder holding it (a run folder, a model folder's ``tma/``)."""
+    p = Path(path)
+    if p.is_dir():
+        for cand in (p / "tma.pt", p / "tma" / "tma.pt"):
+            if cand.is_file():
+                return cand
+        raise ShapeMoveError(f"{p}: no tma.pt in this folder (train one with `python -m shapemove train tma`)")
+    return p
+
+
+def load_tma(path):
+    """(model in eval mode, tokenizer, mean (263,), std (263,)) from ``tma.pt`` (or its folder).
+    A checkpoint of another kind, or one without its ``tokenizer/`` folder, is a ShapeMoveError."""
+    from ..models.tokenizer import load_tokenizer
+    from ..train.checkpoint import load_checkpoint
+
+    path = tma_path(path)
+    ckpt = load_checkpoint(path, kind=KIND)
+    meta = ckpt["metadata"]
+    try:
+        cfg = TMAConfig(**meta["config"]["model"])
+    except (KeyError, TypeError) as exc:
+        raise ShapeMoveError(f"{path}: TMA checkpoint without a valid model config ({exc})") from exc
+    tok_dir = path.parent / "tokenizer"
+    if not tok_dir.is_dir():
+        raise ShapeMoveError(f"{path}: its tokenizer folder is missing ({tok_dir}); keep tokenizer/ beside tma.pt")
+    tok = load_tokenizer(tok_dir)
+    if len(tok) != cfg.vocab_size:
+        raise ShapeMoveError(f"{path}: tokenizer in {tok_dir} has {len(tok)} tokens, the model expects {cfg.vocab_size}")
+    model = TMA(cfg)
+    model.load_state_dict(ckpt["model"])
+    model.eval()
+    mean = np.asarray(meta["mean"], np.float32)
+    std = np.asarray(meta["std"], np.float32)
+    return model, tok, mean, std
+
+
+def _device(model) -> torch.device:
+    return next(model.parameters()).device
+
+
+@torch.no_grad()
+def embed_texts(model: TMA, tok, texts: list[str], batch: int = 128) -> np.ndarray:
+    """(N, E) unit vectors for ``texts`` (float32)."""
+    texts = [str(t) for t in texts]
+    if not texts:
+        return np.zeros((0, model.cfg.embed), np.float32)
+    was_training = model.training
+    model.eval()
+    out = []
+    for s in range(0, len(texts), batch):
+        enc = tok(texts[s:s + batch], return_tensors="pt", padding=True, truncation=True, max_length=model.cfg.max_text)
+        out.append(model.text(enc.input_ids.to(_device(model)), enc.attention_mask.to(_device(model))).cpu())
+    model.train(was_training)
+    return torch.cat(out).numpy().astype(np.float32)
+
+
+def windows(length: int, max_frames: int) -> list[tuple[int, int]]:
+    """(start, stop) of the evenly spaced ``max_frames`` windows covering ``length`` frames."""
+    if length <= max_frames:
+        return [(0, length)]
+    n = -(-length // max_frames)
+    starts = np.linspace(0, length - max_frames, n).round().astype(int)
+    return [(int(s), int(s) + max_frames) for s in starts]
+
+
+def check_features(feats, name: str = "motion") -> np.ndarray:
+    f = np.asarray(feats, dtype=np.float32)
+    if f.ndim != 2 or f.shape[1] != FEATURE_DIM:
+        raise ShapeMoveError(f"{name}: features must be (frames, {FEATURE_DIM}), got shape {f.shape}")
+    if len(f) < 4:
+        raise ShapeMoveError(f"{name}: too short to embed ({len(f)} frames, need at least 4)")
+    if not np.isfinite(f).all():
+        raise ShapeMoveError(f"{name}: features contain NaN or inf")
+    return f
+
+
+@torch.no_grad()
+def embed_motions(model: TMA, feats: list, mean, std, batch: int = 64) -> np.ndarray:
+    """(N, E) unit vectors for a list of raw (T_i, 263) feature arrays (float32)."""
+    if not len(feats):
+        return np.zeros((0, model.cfg.embed), np.float32)
+    mean, std = np.asarray(mean, np.float32), np.asarray(std, np.float32)
+    crops, owner = [], []
+    for i, f in enumerate(feats):
+        f = (check_features(f, f"motion {i}") - mean) / std
+        for a, b in windows(len(f), model.cfg.max_frames):
+            crops.append(f[a:b])
+            owner.append(i)
+    was_training = model.training
+    model.eval()
+    dev = _device(model)
+    order = np.argsort([len(c) for c in crops], kind="stable")  # similar lengths together: less padding
+    emb = np.zeros((len(crops), model.cfg.embed), np.float32)
+    for s in range(0, len(order), batch):
+        idx = order[s:s + batch]
+        x, lengths = pad_batch([crops[k] for k in idx])
+        emb[idx] = model.motion(x.to(dev), lengths.to(dev)).cpu().numpy()
+    model.train(was_training)
+    out = np.zeros((len(feats), model.cfg.embed), np.float32)
+    np.add.at(out, np.asarray(owner), emb)
+    return out / np.linalg.norm(out, axis=1, keepdims=True).clip(1e-8)
+
+
+def pad_batch(crops: list[np.ndarray]) -> tuple[torch.Tensor, torch.Tensor]:
+    """Zero-padded (B, T_max, D) float32 tensor and the (B,) lengths."""
+    lengths = torch.tensor([len(c) for c in crops])
+    x = torch.zeros(len(crops), int(lengths.max()), crops[0].shape[1])
+    for k, c in enumerate(crops):
+        x[k, : len(c)] = torch.as_tensor(c)
+    return x, lengths
+
+
+def eval_pairs(root, ids: list[str], kind: str = "new_joint_vecs", seed: int = 0) -> tuple[list, list[str]]:
+    """Features and one caption per clip (chosen with a fixed seed) of the clips ``ids``."""
+    from ..train.t5_dataset import read_lines
+
+    root = Path(root)
+    rng = np.random.default_rng(seed)
+    feats, texts = [], []
+    for cid in ids:
+        caps = read_lines(root / "texts" / f"{cid}.txt")
+        f = root / kind / f"{cid}.npy"
+        if not caps or not f.is_file():
+            continue
+        feats.append(np.load(f).astype(np.float32))
+        texts.append(caps[int(rng.integers(len(caps)))])
+    return feats, texts
+
+
+def score_pairs(model, tok, mean, std, feats: list, texts: list[str]) -> dict:
+    """R-precision top1/top3 (groups of 32) and matching score of paired motions/texts."""
+    from .retrieval import matching_score, r_precision
+
+    t = embed_texts(model, tok, texts)
+    m = embed_motions(model, feats, mean, std)
+    r = r_precision(t, m, top_k=(1, 3))
+    return {"r_precision_top1": r["top1"], "r_precision_top3": r["top3"], "matching_score": matching_score(t, m),
+            "clips": len(feats)}
+
+
+def real_motion_scores(data, split: str = "test", tma=None, kind: str = "new_joint_vecs") -> dict:
+    """R-precision/matching score of the real clips of ``split`` against their own captions:
+    the ceiling for generated motions. ``tma``: a path or a ``load_tma`` tuple."""
+    from ..train.motion_dataset import read_split
+
+    if tma is None:
+        raise ShapeMoveError("real_motion_scores needs a TMA (path to tma.pt or a load_tma() result)")
+    model, tok, mean, std = load_tma(tma) if isinstance(tma, (str, Path)) else tma
+    data = Path(data)
+    if not data.is_dir():
+        raise ShapeMoveError(f"dataset folder not found: {data}")
+    ids = read_split(data, split)
+    feats, texts = eval_pairs(data, ids, kind)
+    if len(feats) < 2:
+        raise ShapeMoveError(f"{data}: split '{split}' has {len(feats)} clip(s) with features and captions; need 2")
+    return score_pairs(model, tok, mean, std, feats, texts)

@@ -1,0 +1,144 @@
+"""Text -> body shape + motion, the whole pipeline.
+
+    gen = Generator()                                # default models, OpenBody
+    motion = gen.generate("a person jogs forward and waves", shape_text="a tall, heavy-set man")
+    save_motion("out.npz", motion)
+
+Steps: prompt checks -> T5 writes [BETA] + motion tokens (constrained decoding, length control)
+-> betas from the [BETA] head unless given -> SA-VAE decodes the tokens for those betas ->
+joints from the HumanML3D features -> IK onto the body with those betas -> ``Motion``.
+``redecode(motion, betas)`` re-decodes the same tokens for another body (the shape sliders).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import torch
+
+from ..errors import ShapeMoveError
+from ..scene.motion_file import Motion
+from .prompts import check_prompt
+
+FPS = 20
+
+
+@dataclass
+class Request:
+    prompt: str
+    shape_text: str | None = None
+    betas: np.ndarray | None = None
+    seconds: float | None = None
+    seed: int = 0
+    temperature: float = 1.0
+    top_k: int | None = 50
+
+
+def parse_betas(text: str) -> np.ndarray:
+    """'b0,b1,…' (up to 10 numbers; missing ones are 0) -> (10,)"""
+    try:
+        vals = [float(v) for v in str(text).replace(" ", "").split(",") if v != ""]
+    except ValueError:
+        raise ShapeMoveError(f"--betas must be comma-separated numbers, got {text!r}") from None
+    if not 1 <= len(vals) <= 10 or not np.isfinite(vals).all():
+        raise ShapeMoveError(f"--betas takes 1 to 10 finite numbers, got {len(vals)}")
+    if max(abs(v) for v in vals) > 5:
+        raise ShapeMoveError("--betas values must lie in [-5, 5] (the shape space is ~N(0,1))")
+    return np.array(vals + [0.0] * (10 - len(vals)), dtype=np.float32)
+
+
+class Generator:
+    def __init__(self, model_dir=None, body=None, ik_refine_iters: int = 10):
+        from ..body.load import load_body_model
+        from ..models.savae import load_savae
+        from ..models.shapemove_t5 import ShapeMoveT5
+        from .model_bundle import model_files, resolve_model_dir
+
+        self.model_dir = resolve_model_dir(model_dir)
+        files = model_files(self.model_dir)
+        self.body = body if body is not None and not isinstance(body, str) else load_body_model(body)
+        self.vae = load_savae(files["savae"], body=self.body)
+        self.t5, self.tok = (ShapeMoveT5.load(files["t5"]) if files["t5"].is_dir() else (None, None))
+        self.ik_refine_iters = ik_refine_iters
+        self.max_codes = int(getattr(self.t5, "info", {}).get("max_codes", 50)) if self.t5 else 50
+
+    # -- tokens ------------------------------------------------------------------------------
+    def _length(self, seconds: float | None) -> tuple[int, int]:
+        down = self.vae.cfg.downsample
+        if seconds is None:
+            return 4, self.max_codes
+        if not (0.4 <= seconds <= 60):
+            raise ShapeMoveError(f"--seconds must be between 0.4 and 60, got {seconds}")
+        n = max(1, int(round(seconds * FPS / down)))
+        return n, n
+
+    @torch.no_grad()
+    def tokens_for(self, reqs: list[Request]) -> tuple[list[list[int]], torch.Tensor]:
+        from ..models.constrained_decoding import decode
+        from ..models.shapemove_t5 import shapemove_prompt
+
+        if self.t5 is None:
+            raise ShapeMoveError(f"{self.model_dir} has no t5/ model: text-to-motion needs one (train t5)")
+        codes, betas = [], []
+        for r in reqs:  # one at a time: each has its own seed, length and temperature
+            g = torch.Generator().manual_seed(int(r.seed))
+            lo, hi = self._length(r.seconds)
+            enc = self.tok([shapemove_prompt(r.prompt, r.shape_text)], return_tensors="pt", truncation=True,
+                           max_length=256)
+            out = decode(self.t5, enc.input_ids, enc.attention_mask, lo, hi, temperature=r.temperature,
+                         top_k=r.top_k, generator=g)
+            codes.append(out.codes[0])
+            betas.append(out.betas[0])
+        return codes, torch.stack(betas)
+
+    # -- motion ------------------------------------------------------------------------------
+    @torch.no_grad()
+    def decode_motion(self, codes: list[int], betas: np.ndarray, prompt: str | None = None) -> Motion:
+        """Tokens + body shape -> Motion on the body model (SA-VAE decode, joints, IK)."""
+        from ..body.ik import solve_ik
+        from ..body.kinematics import matrix_to_axis_angle
+        from ..motion.features import joints_from_features
+
+        if not codes:
+            raise ShapeMoveError("no motion tokens to decode")
+        b = torch.as_tensor(np.asarray(betas, np.float32)).reshape(1, 10)
+        idx = torch.as_tensor(codes, dtype=torch.long)[None]
+        feats = self.vae.denormalize(self.vae.decode_long(self.vae.quantizer.indices_to_codes(idx), b))[0]
+        joints = joints_from_features(feats).numpy()
+        joints[..., 1] -= joints[:, [7, 8, 10, 11], 1].min()
+        rest = self.body.rest_joints(b)[0].numpy()
+        ik = solve_ik(joints, rest, refine_iters=self.ik_refine_iters)
+        rot = torch.as_tensor(np.asarray(ik.rotations, np.float32))
+        poses = matrix_to_axis_angle(rot).numpy().astype(np.float32)
+        m = Motion(joints=joints.astype(np.float32), betas=b[0].numpy(), poses=poses,
+                   transl=np.asarray(ik.transl, np.float32), fps=float(FPS), body_model=self.body.name,
+                   prompt=prompt, tokens=np.asarray(codes, np.int16), features=feats.numpy().astype(np.float32))
+        m.ik_error_cm = float(ik.mean_error_cm)
+        return m
+
+    def generate(self, prompt: str, shape_text: str | None = None, betas=None, seconds: float | None = None,
+                 seed: int = 0, temperature: float = 1.0, top_k: int | None = 50) -> Motion:
+        return self.generate_batch([Request(prompt, shape_text, betas, seconds, seed, temperature, top_k)])[0]
+
+    def generate_batch(self, reqs: list[Request], progress=None, cancel=None) -> list[Motion]:
+        for r in reqs:
+            r.prompt = check_prompt(r.prompt)
+            r.shape_text = check_prompt(r.shape_text, "shape text", allow_empty=True) or None
+            if r.temperature < 0:
+                raise ShapeMoveError("temperature must be >= 0 (0 = greedy)")
+        out = []
+        for i, r in enumerate(reqs):
+            if cancel is not None and cancel():
+                break
+            codes, pred = self.tokens_for([r])
+            betas = np.asarray(r.betas, np.float32) if r.betas is not None else pred[0].numpy()
+            out.append(self.decode_motion(codes[0], betas, prompt=r.prompt))
+            if progress is not None:
+                progress((i + 1) / len(reqs), r.prompt)
+        return out
+
+    def redecode(self, motion: Motion, betas) -> Motion:
+        """The same tokens on another body: feet stay planted and bones keep the new lengths."""
+        if motion.tokens is None or len(motion.tokens) == 0:
+            raise ShapeMoveError("this motion has no tokens to re-decode (it was not generated or retargeted)")
+        return self.decode_motion([int(t) for t in motion.tokens], betas, motion.prompt)

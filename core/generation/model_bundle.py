@@ -1,0 +1,32 @@
+"""Where trained models live and how a set of them is loaded together.
+
+A model folder holds ``savae.pt`` (SA-VAE), ``t5/`` (ShapeMove T5: save_pretrained + tokenizer +
+[BETA] head) and optionally ``tma/tma.pt`` (text-motion alignment). The embedded default is
+``weights/default`` in the package; a user's own models are any folder of the same layout
+(inside Blender: under ``bpy.utils.extension_path_user``).
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+from ..errors import ShapeMoveError
+
+PACKAGE_ROOT = Path(__file__).resolve().parents[2]
+DEFAULT_MODEL_DIR = PACKAGE_ROOT / "weights" / "default"
+
+
+def resolve_model_dir(path=None) -> Path:
+    d = Path(path) if path else DEFAULT_MODEL_DIR
+    if not d.is_dir():
+        if path is None:
+            raise ShapeMoveError(f"the default model is missing ({d}); rebuild it with `make train-default` "
+                                 "or pass --model DIR")
+        raise ShapeMoveError(f"model folder not found: {d}")
+    return d
+
+
+def model_files(d: Path) -> dict:
+    files = {"savae": d / "savae.pt", "t5": d / "t5", "tma": d / "tma" / "tma.pt"}
+    if not files["savae"].is_file():
+        raise ShapeMoveError(f"{d} has no savae.pt (the SA-VAE): train one with `python -m shapemove train vae`")
+    return files

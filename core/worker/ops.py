@@ -1,0 +1,172 @@
+"""The job ops the worker serves: ``JOBS[name](params, progress, cancel) -> dict`` (JSON-able).
+
+``progress(fraction, message)`` reports 0..1; ``cancel()`` is true once the caller cancelled (stop
+soon and return what you have). Bad params -> ShapeMoveError naming the op and the parameter.
+Heavy imports (torch, the models) happen inside each op, so the worker starts fast.
+To add an op: write ``def my_op(params, progress, cancel) -> dict`` next to the code it runs and add
+one line to ``JOBS`` below (or call ``register("name", func)`` before the worker serves).
+"""
+from __future__ import annotations
+
+import io
+import sys
+from collections import deque
+from contextlib import redirect_stderr
+from pathlib import Path
+
+from ..errors import ShapeMoveError
+
+_REQUIRED = object()
+
+
+def param(params: dict, op: str, name: str, types, default=_REQUIRED):
+    """params[name] checked against ``types`` (a type or tuple); missing -> default or an error."""
+    if name not in params or params[name] is None:
+        if default is _REQUIRED:
+            raise ShapeMoveError(f"op {op!r}: missing parameter {name!r}")
+        return default
+    value = params[name]
+    types = types if isinstance(types, tuple) else (types,)
+    if isinstance(value, bool) and bool not in types or not isinstance(value, types):
+        want = " or ".join(t.__name__ for t in types)
+        raise ShapeMoveError(f"op {op!r}: parameter {name!r} must be {want}, got {type(value).__name__}")
+    return value
+
+
+def _str_list(params, op, name, default=_REQUIRED):
+    value = param(params, op, name, list, default)
+    if value is not None and not all(isinstance(v, str) for v in value):
+        raise ShapeMoveError(f"op {op!r}: parameter {name!r} must be a list of strings")
+    return value
+
+
+# -- ops ---------------------------------------------------------------------------------------
+def env_info(params, progress, cancel) -> dict:
+    """Facts about the Python that runs the jobs (torch version, CUDA) - the UI's environment check."""
+    import platform
+
+    import numpy
+    import torch
+
+    from ... import __version__
+
+    return {"executable": sys.executable, "python": platform.python_version(), "platform": platform.platform(),
+            "shapemove": __version__, "numpy": numpy.__version__, "torch": torch.__version__,
+            "cuda": bool(torch.cuda.is_available()), "threads": torch.get_num_threads()}
+
+
+def body_info(params, progress, cancel) -> dict:
+    """params {"body": "openbody" | path to an SMPL-family file (default openbody)} -> model facts;
+    height_m is the rest-pose height at betas 0 (top minus lowest vertex, metres)."""
+    from ..body.load import load_body_model
+
+    body = load_body_model(param(params, "body_info", "body", str, None))
+    verts = body.rest_vertices(None)[0].numpy()
+    out = {"name": body.name, "num_vertices": body.num_vertices, "num_faces": int(len(body.faces)),
+           "num_joints": len(body.parents), "num_betas": body.num_betas, "joint_names": list(body.joint_names),
+           "height_m": float(verts[:, 1].max() - verts[:, 1].min())}
+    if hasattr(body, "phenotype_names"):
+        out["phenotype_names"] = list(body.phenotype_names)
+    return out
+
+
+def measure(params, progress, cancel) -> dict:
+    """params {"betas": 10 numbers (default zeros), "body"} -> measurements in cm (core.body.measure)."""
+    from ..body.load import load_body_model
+    from ..body.measure import measure as _measure
+
+    betas = param(params, "measure", "betas", list, None)
+    body = load_body_model(param(params, "measure", "body", str, None))
+    m = _measure(body, betas)
+    return {k: float(v) for k, v in m.items()}
+
+
+def build_dataset(params, progress, cancel) -> dict:
+    """params {"sources": [paths], "out": path, "body", "augment_share", "limit", "only": [ids]}
+    -> the build report (core.data.build). Cancel stops after the current clip (resumable)."""
+    import dataclasses
+
+    from ..body.load import load_body_model
+    from ..data.build import AUGMENT_SHARE, build_dataset as _build
+
+    op = "build_dataset"
+    sources = [Path(s) for s in _str_list(params, op, "sources")]
+    body = load_body_model(param(params, op, "body", str, None))
+    report = _build(sources, Path(param(params, op, "out", str)), body=body,
+                    augment_share=float(param(params, op, "augment_share", (int, float), AUGMENT_SHARE)),
+                    limit=param(params, op, "limit", int, None), only=_str_list(params, op, "only", None),
+                    progress=progress, cancel=cancel, verbose=False)
+    return {**dataclasses.asdict(report), "summary": report.summary()}
+
+
+def train_vae(params, progress, cancel) -> dict:
+    """params {"data": dataset folder, "out": run folder, "config": "small" | "paper" | JSON path |
+    object of overrides (with "base"), "steps", "resume", "body", "device"} -> last metrics.
+    Cancel stops after saving last.pt (resume with "resume": true)."""
+    from ..models.savae import SAVAEConfig
+    from ..train.train_vae import train_vae as _train
+
+    op = "train_vae"
+    cfg = param(params, op, "config", (str, dict), "small")
+    cfg = SAVAEConfig.from_dict(cfg) if isinstance(cfg, dict) else SAVAEConfig.load(cfg)
+    metrics = _train(param(params, op, "data", str), param(params, op, "out", str), cfg,
+                     steps=param(params, op, "steps", int, None), resume=param(params, op, "resume", bool, False),
+                     body=param(params, op, "body", str, None), device=param(params, op, "device", str, None),
+                     progress=progress, cancel=cancel, verbose=False)
+    return {"metrics": metrics, "out": param(params, op, "out", str)}
+
+
+class _Tail(io.TextIOBase):
+    """Forwards writes to ``target`` and keeps the last lines (for the error message)."""
+
+    def __init__(self, target, lines: int = 20):
+        self.target, self.lines = target, deque(maxlen=lines)
+
+    def write(self, s: str) -> int:
+        self.target.write(s)
+        self.lines.extend(line for line in s.replace("\r", "\n").split("\n") if line.strip())
+        return len(s)
+
+    def flush(self) -> None:
+        self.target.flush()
+
+
+def cli(params, progress, cancel) -> dict:
+    """params {"argv": ["data", "build", ...]}: run a `python -m shapemove` command in this process.
+    Its printed output arrives as log messages; a failure -> error with its last stderr lines.
+    Commands have no cancel hook: a cancelled cli job still runs to its end."""
+    from ...cli import COMMANDS, main
+
+    argv = _str_list(params, "cli", "argv")
+    if not argv or argv[0] not in COMMANDS or argv[0] == "worker":
+        known = ", ".join(c for c in COMMANDS if c != "worker")
+        raise ShapeMoveError(f"op 'cli': argv must start with a command ({known}), got {argv[:1]}")
+    tail = _Tail(sys.stderr)
+    with redirect_stderr(tail):
+        try:
+            code = main(argv)
+        except SystemExit as exc:  # argparse errors
+            code = exc.code if isinstance(exc.code, int) else 2
+    if code:
+        why = "; ".join(list(tail.lines)[-3:]) or "no message"
+        raise ShapeMoveError(f"`shapemove {' '.join(argv)}` failed (exit code {code}): {why}")
+    return {"exit_code": 0}
+
+
+JOBS: dict = {
+    "env_info": env_info,
+    "body_info": body_info,
+    "measure": measure,
+    "build_dataset": build_dataset,
+    "train_vae": train_vae,
+    "cli": cli,
+}
+
+
+def register(name: str, func) -> None:
+    """Add a job op (``func(params, progress, cancel) -> dict``); control op names are reserved."""
+    from .protocol import CONTROL_OPS
+
+    if name in CONTROL_OPS:
+        raise ShapeMoveError(f"{name!r} is a control op of the worker and cannot be a job")
+    JOBS[name] = func

@@ -1,0 +1,83 @@
+"""A small stage for previews: camera framing the whole motion, ground plane, Workbench render.
+
+Used by ``python -m shapemove blend --render`` and the render command; adds its own objects
+(camera "<rig>_camera", plane "<rig>_ground") and sets the scene camera and render settings.
+"""
+from __future__ import annotations
+
+import math
+
+import bpy
+import numpy as np
+from mathutils import Vector
+
+from .shape_sync import body_of
+
+BODY_COLOR = (0.85, 0.35, 0.25, 1.0)
+GROUND_COLOR = (0.55, 0.55, 0.55, 1.0)
+
+
+def motion_bounds(scene, rig, samples: int = 12) -> tuple[np.ndarray, np.ndarray]:
+    """(min, max) corners (3,) of the evaluated body mesh over ``samples`` frames of the scene range."""
+    body = body_of(rig)
+    keep = scene.frame_current
+    lo, hi = np.full(3, np.inf), np.full(3, -np.inf)
+    for f in np.unique(np.linspace(scene.frame_start, scene.frame_end, samples).round().astype(int)):
+        scene.frame_set(int(f))
+        ev = body.evaluated_get(bpy.context.evaluated_depsgraph_get())
+        co = np.empty(len(ev.data.vertices) * 3, dtype=np.float32)
+        ev.data.vertices.foreach_get("co", co)
+        co = co.reshape(-1, 3) @ np.array(body.matrix_world)[:3, :3].T + np.array(body.matrix_world)[:3, 3]
+        lo, hi = np.minimum(lo, co.min(0)), np.maximum(hi, co.max(0))
+    scene.frame_set(keep)
+    return lo, hi
+
+
+def add_preview_stage(context, rig, resolution=(320, 240), lens: float = 50.0):
+    """Camera in front of the body (it faces -Y) framing the motion's bounds, a ground plane under
+    the lowest vertex, Workbench with the body and ground in flat distinct colours. Returns the camera."""
+    scene = context.scene
+    lo, hi = motion_bounds(scene, rig)
+    centre = (lo + hi) / 2
+    size = hi - lo
+    ground_mesh = bpy.data.meshes.new(f"{rig.name}_ground")
+    half = max(size[0], size[1]) / 2 + 1.5
+    ground_mesh.from_pydata([(-half, -half, 0), (half, -half, 0), (half, half, 0), (-half, half, 0)], [], [(0, 1, 2, 3)])
+    ground = bpy.data.objects.new(f"{rig.name}_ground", ground_mesh)
+    ground.location = (centre[0], centre[1], lo[2])
+    ground.color = GROUND_COLOR
+    scene.collection.objects.link(ground)
+    body_of(rig).color = BODY_COLOR
+
+    cam_data = bpy.data.cameras.new(f"{rig.name}_camera")
+    cam_data.lens = lens
+    cam = bpy.data.objects.new(f"{rig.name}_camera", cam_data)
+    scene.collection.objects.link(cam)
+    scene.render.resolution_x, scene.render.resolution_y = resolution
+    scene.render.resolution_percentage = 100
+    # distance so the bounds (with 15 % margin) fit both field-of-view directions
+    # sensor fit AUTO: the sensor width spans the longer image side
+    aspect = resolution[0] / resolution[1]
+    half_long = cam_data.sensor_width / (2 * lens)  # tan(half field of view) along the longer side
+    tan_w, tan_h = (half_long, half_long / aspect) if aspect >= 1 else (half_long * aspect, half_long)
+    need_w, need_h = 1.15 * max(size[0], 0.5), 1.15 * max(size[2], 0.5)
+    dist = max(need_w / 2 / tan_w, need_h / 2 / tan_h) + size[1] / 2
+    elevation = math.radians(10)
+    cam.location = Vector((centre[0], centre[1] - dist * math.cos(elevation), centre[2] + dist * math.sin(elevation)))
+    cam.rotation_euler = (Vector(centre.tolist()) - cam.location).to_track_quat("-Z", "Y").to_euler()
+    scene.camera = cam
+
+    scene.render.engine = "BLENDER_WORKBENCH"
+    shading = scene.display.shading
+    shading.light = "STUDIO"
+    shading.color_type = "OBJECT"
+    return cam
+
+
+def render_frame(scene, frame: int, path) -> str:
+    """Render ``frame`` of ``scene`` to the PNG ``path`` (headless is fine)."""
+    scene.frame_set(int(frame))
+    scene.render.image_settings.file_format = "PNG"
+    scene.render.filepath = str(path)
+    bpy.ops.render.render(write_still=True)
+    return str(path)

@@ -1,0 +1,234 @@
+"""SA-VAE training: dataset crops, schedule, checkpoints, exact resume, DDP under torchrun, CLI."""
+import importlib.util
+import json
+import os
+import shutil
+import subprocess
+import sys
+import time
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+import torch
+
+from shapemove.core.errors import ShapeMoveError
+from shapemove.core.models.savae import SAVAE, SAVAEConfig, TrainSettings, load_savae
+from shapemove.core.train.checkpoint import load_checkpoint, make_metadata, save_checkpoint
+from shapemove.core.train.motion_dataset import BatchStream, MotionClips
+from shapemove.core.train.train_vae import lr_factor, train_vae
+
+# Real Bandai clips of 83-170 frames at 20 fps: 4 for training, 2 for validation.
+CLIPS = {"train": ["dataset-2_walk-turn-left_active_001", "dataset-2_walk-turn-left_active_002",
+                   "dataset-1_walk-back_active_001", "dataset-1_walk-back_angry_001"],
+         "val": ["dataset-2_walk-turn-left_active_003", "dataset-1_walk-back_childish_001"]}
+# The full dataset builder (core/data/build.py: fit, IK, shape-aware retarget) is used when all of
+# its pieces exist and it builds these clips; otherwise the clips are written on the canonical body
+# (betas 0, new == norm features), with a warning.
+USE_BUILDER = all(importlib.util.find_spec(f"shapemove.core.body.{m}") for m in ("fit", "ik", "measure", "openbody"))
+
+
+def _write_split_lists(out: Path) -> None:
+    for split, ids in CLIPS.items():
+        (out / f"{split}.txt").write_text("\n".join(ids) + "\n")
+    (out / "test.txt").write_text("")
+
+
+def build_tiny_dataset(mocap_root: Path, out: Path) -> Path:
+    if USE_BUILDER:
+        from shapemove.core.data.build import build_dataset
+
+        report = build_dataset([mocap_root / "bandai"], out / "built", augment_share=0.0, verbose=False,
+                               only=CLIPS["train"] + CLIPS["val"])
+        if not report.failures:
+            _write_split_lists(out / "built")
+            return out / "built"
+        warnings.warn(f"dataset builder failed ({report.failures[0][1]}); using canonical-body clips")
+    from shapemove.core.io.mocap import load_smpl22
+    from shapemove.core.motion.features import features_from_joints, mean_std
+
+    for d in ("norm_joint_vecs", "new_joint_vecs", "betas"):
+        (out / d).mkdir(parents=True)
+    feats = {}
+    for cid in CLIPS["train"] + CLIPS["val"]:
+        ds = cid.split("_")[0]
+        f = features_from_joints(load_smpl22(mocap_root / "bandai" / ds / "data" / f"{cid}.bvh").joints)
+        feats[cid] = f
+        np.save(out / "norm_joint_vecs" / f"{cid}.npy", f)
+        np.save(out / "new_joint_vecs" / f"{cid}.npy", f)
+        np.save(out / "betas" / f"{cid}.npy", np.zeros(10, np.float32))
+    mean, std = mean_std([feats[c] for c in CLIPS["train"]])
+    np.save(out / "Mean.npy", mean)
+    np.save(out / "Std.npy", std)
+    _write_split_lists(out)
+    return out
+
+
+@pytest.fixture(scope="module")
+def data_dir(mocap_root, tmp_path_factory):
+    return build_tiny_dataset(mocap_root, tmp_path_factory.mktemp("vae_data"))
+
+
+@pytest.fixture(scope="module")
+def body():
+    from shapemove.core.body.load import load_body_model
+
+    return load_body_model(None)
+
+
+def tiny_config(**train) -> SAVAEConfig:
+    settings = dict(steps=6, batch_size=4, warmup_steps=2, log_every=1, val_every=3, val_batches=1, ckpt_every=2)
+    return SAVAEConfig(width=16, depth=1, shape_hidden=16, train=TrainSettings(**{**settings, **train}))
+
+
+# -- data --------------------------------------------------------------------------------------------
+
+def test_dataset_crops(data_dir):
+    ds = MotionClips(data_dir, "train", window=64, seed=0)
+    assert len(ds) == 4 and ds.skipped == []
+    item = ds[(2, 5)]
+    assert item["x"].shape == (64, 263) and item["y"].shape == (64, 263) and item["betas"].shape == (10,)
+    assert torch.equal(ds[(2, 5)]["x"], item["x"])                     # deterministic per (index, epoch)
+    raw = np.load(data_dir / "norm_joint_vecs" / f"{ds.ids[2]}.npy")
+    x = item["x"].numpy() * ds.std + ds.mean                            # undo the normalization
+    starts = [s for s in range(len(raw) - 63) if np.allclose(raw[s:s + 64], x, atol=1e-4)]
+    assert len(starts) == 1                                             # a real 64-frame window of the clip
+    starts_y = [s for s in range(len(raw) - 63)
+                if np.allclose(np.load(data_dir / "new_joint_vecs" / f"{ds.ids[2]}.npy")[s:s + 64],
+                               item["y"].numpy() * ds.std + ds.mean, atol=1e-4)]
+    assert starts_y == starts                                           # same crop for input and target
+    assert len(MotionClips(data_dir, "train", window=100).skipped) >= 1  # 83-93 frame clips left out
+
+
+def test_batch_stream_is_a_function_of_the_step(data_dir):
+    ds = MotionClips(data_dir, "train", window=64)
+    full = BatchStream(ds, batch=3, seed=7)
+    it = iter(full)
+    first = [next(it) for _ in range(6)]                                 # 18 items: crosses 4 epochs
+    it2 = iter(BatchStream(ds, batch=3, seed=7, start_step=4))
+    assert [next(it2) for _ in range(2)] == first[4:]
+    assert sorted(k[0] for b in first for k in b if k[1] == 0) == [0, 1, 2, 3]  # each epoch a permutation
+    r0 = [k for b in [next(iter(BatchStream(ds, 2, rank=0, world_size=2)))] for k in b]
+    r1 = [k for b in [next(iter(BatchStream(ds, 2, rank=1, world_size=2)))] for k in b]
+    assert sorted(k[0] for k in r0 + r1) == [0, 1, 2, 3]                # ranks split an epoch
+
+
+def test_lr_schedule():
+    t = TrainSettings(warmup_steps=100, decay="step", milestones=(0.5, 0.8), gamma=0.1)
+    assert lr_factor(0, t, 1000) == pytest.approx(0.01) and lr_factor(99, t, 1000) == 1.0
+    assert lr_factor(499, t, 1000) == 1.0 and lr_factor(500, t, 1000) == pytest.approx(0.1)
+    assert lr_factor(800, t, 1000) == pytest.approx(0.01)
+    c = TrainSettings(warmup_steps=10, decay="cosine", min_lr_ratio=0.1)
+    assert lr_factor(10, c, 110) == pytest.approx(1.0) and lr_factor(60, c, 110) == pytest.approx(0.55)
+    assert lr_factor(110, c, 110) == pytest.approx(0.1)
+
+
+# -- checkpoints ---------------------------------------------------------------------------------------
+
+def test_checkpoint_round_trip_and_mismatches(tmp_path):
+    cfg = tiny_config()
+    m = SAVAE(cfg, torch.randn(263), torch.rand(263) + 0.5)
+    meta = make_metadata("savae", cfg.to_dict(), "openbody-v1", m.mean, m.std, step=3)
+    path = save_checkpoint(tmp_path / "savae.pt", {"model": m.state_dict()}, meta)
+    assert not list(tmp_path.glob("*.tmp"))
+    loaded = load_savae(path, body="openbody-v1")
+    for k, v in m.state_dict().items():
+        assert torch.equal(loaded.state_dict()[k], v)
+    assert loaded.metadata["step"] == 3 and loaded.metadata["config"] == cfg.to_dict()
+    with pytest.raises(ShapeMoveError, match="body model 'openbody-v1', not 'smplx'"):
+        load_savae(path, body="smplx")
+    other = cfg.to_dict()
+    other["width"] = 32
+    with pytest.raises(ShapeMoveError, match="width"):
+        load_checkpoint(path, config=other)
+    with pytest.raises(ShapeMoveError, match="normalization"):
+        load_checkpoint(path, stats_hash_="0" * 64)
+    with pytest.raises(ShapeMoveError, match="expected 't5'"):
+        load_checkpoint(path, kind="t5")
+    (tmp_path / "bad.pt").write_bytes(b"not a checkpoint")
+    with pytest.raises(ShapeMoveError, match="cannot read"):
+        load_checkpoint(tmp_path / "bad.pt")
+    with pytest.raises(ShapeMoveError, match="not found"):
+        load_checkpoint(tmp_path / "missing.pt")
+
+
+# -- training -----------------------------------------------------------------------------------------
+
+def test_resume_equals_uninterrupted(data_dir, body, tmp_path):
+    torch.set_num_threads(1)
+    full = train_vae(data_dir, tmp_path / "full", tiny_config(), body=body, device="cpu", verbose=False)
+    assert full["step"] == 6 and "val" in full and np.isfinite(full["val"]["total"])
+    calls = []
+
+    def cancel_after_3():
+        calls.append(1)
+        return len(calls) > 3
+
+    part = tmp_path / "part"
+    assert train_vae(data_dir, part, tiny_config(), body=body, device="cpu", verbose=False,
+                     cancel=cancel_after_3)["step"] == 3
+    assert load_checkpoint(part / "last.pt")["step"] == 3 and not (part / "savae.pt").exists()
+    progress = []
+    train_vae(data_dir, part, tiny_config(), body=body, device="cpu", verbose=False, resume=True,
+              progress=lambda f, msg: progress.append(f))
+    assert progress[0] == pytest.approx(4 / 6) and progress[-1] == 1.0
+    a = load_checkpoint(tmp_path / "full" / "last.pt")
+    b = load_checkpoint(part / "last.pt")
+    assert a["step"] == b["step"] == 6
+    for k, v in a["model"].items():
+        assert torch.equal(v, b["model"][k]), k
+    for s_a, s_b in zip(a["optimizer"]["state"].values(), b["optimizer"]["state"].values()):
+        assert torch.equal(s_a["exp_avg_sq"], s_b["exp_avg_sq"])
+    assert a["scheduler"]["last_epoch"] == b["scheduler"]["last_epoch"] == 6
+    model = load_savae(tmp_path / "full" / "savae.pt", body=body)
+    assert model.metadata["body"] == body.name
+    log = [json.loads(line) for line in (tmp_path / "full" / "log.jsonl").read_text().splitlines()]
+    assert [r["step"] for r in log] == [1, 2, 3, 4, 5, 6] and "val" in log[2]
+    # resuming with another architecture is refused
+    with pytest.raises(ShapeMoveError, match="width"):
+        train_vae(data_dir, part, SAVAEConfig(width=24, depth=1, shape_hidden=16, train=tiny_config().train),
+                  body=body, device="cpu", verbose=False, resume=True, steps=8)
+
+
+def test_training_reduces_loss(data_dir, body, tmp_path):
+    torch.set_num_threads(1)
+    cfg = tiny_config(steps=40, lr=1e-2, warmup_steps=1, log_every=1, val_every=40, ckpt_every=1000)
+    train_vae(data_dir, tmp_path / "r", cfg, body=body, device="cpu", verbose=False)
+    recon = [json.loads(line)["train"]["recon"] for line in (tmp_path / "r" / "log.jsonl").read_text().splitlines()]
+    assert len(recon) == 40 and np.mean(recon[-5:]) < 0.9 * np.mean(recon[:5])
+
+
+def test_cli_train_vae(data_dir, tmp_path):
+    from shapemove.cli import main
+
+    cfg_path = tmp_path / "cfg.json"
+    cfg_path.write_text(json.dumps({"base": "small", "width": 16, "depth": 1, "shape_hidden": 16,
+                                    "train": {"batch_size": 2, "warmup_steps": 1, "log_every": 1}}))
+    assert main(["train", "vae", "--data", str(data_dir), "--config", str(cfg_path), "--out", str(tmp_path / "run"),
+                 "--steps", "2", "--device", "cpu", "--quiet"]) == 0
+    assert load_savae(tmp_path / "run" / "savae.pt").cfg.width == 16
+    assert main(["train", "vae", "--data", str(tmp_path / "nowhere"), "--out", str(tmp_path / "x"), "--quiet"]) == 2
+
+
+def test_torchrun_two_processes(data_dir, tmp_path):
+    torchrun = Path(sys.executable).with_name("torchrun")
+    if not torchrun.exists():
+        pytest.skip("torchrun not installed next to the Python interpreter")
+    cfg_path = tmp_path / "cfg.json"
+    cfg_path.write_text(json.dumps({"width": 16, "depth": 1, "shape_hidden": 16,
+                                    "train": {"batch_size": 4, "warmup_steps": 1, "log_every": 1, "val_every": 3,
+                                              "val_batches": 1, "ckpt_every": 2}}))
+    env = {**os.environ, "OMP_NUM_THREADS": "1"}
+    t0 = time.time()
+    proc = subprocess.run([str(torchrun), "--nproc_per_node", "2", "--master_port", "0", "-m", "shapemove", "train", "vae",
+                           "--data", str(data_dir), "--config", str(cfg_path), "--out", str(tmp_path / "ddp"),
+                           "--steps", "3", "--device", "cpu", "--quiet"],
+                          env=env, capture_output=True, text=True, timeout=300, cwd=tmp_path)
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    ckpt = load_checkpoint(tmp_path / "ddp" / "last.pt")
+    assert ckpt["step"] == 3 and ckpt["metadata"]["body"]
+    assert all(torch.isfinite(v).all() for v in ckpt["model"].values() if v.is_floating_point())
+    log = [json.loads(line) for line in (tmp_path / "ddp" / "log.jsonl").read_text().splitlines()]
+    assert [r["step"] for r in log] == [1, 2, 3]                        # rank 0 alone writes the log
+    print(f"torchrun 2 processes, 3 steps: {time.time() - t0:.1f} s")
