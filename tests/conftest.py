@@ -6,6 +6,13 @@ import os
 
 import pytest
 
+try:  # small tensors: one thread is faster and keeps parallel test processes from oversubscribing 2 cores
+    import torch
+
+    torch.set_num_threads(1)
+except ImportError:  # pragma: no cover
+    pass
+
 REQUIRE_DATA = os.environ.get("SHAPEMOVE_REQUIRE_DATA") == "1"
 
 

@@ -1,12 +1,9 @@
 """SA-VAE training: dataset crops, schedule, checkpoints, exact resume, DDP under torchrun, CLI."""
-import importlib.util
 import json
 import os
-import shutil
 import subprocess
 import sys
 import time
-import warnings
 from pathlib import Path
 
 import numpy as np
@@ -19,49 +16,43 @@ from shapemove.core.train.checkpoint import load_checkpoint, make_metadata, save
 from shapemove.core.train.motion_dataset import BatchStream, MotionClips
 from shapemove.core.train.train_vae import lr_factor, train_vae
 
-# Real Bandai clips of 83-170 frames at 20 fps: 4 for training, 2 for validation.
+# Real Bandai clips of 83-138 frames at 20 fps: 3 for training (the first also retargeted onto a
+# sampled body, as the builder's augmentation does), 1 for validation.
 CLIPS = {"train": ["dataset-2_walk-turn-left_active_001", "dataset-2_walk-turn-left_active_002",
-                   "dataset-1_walk-back_active_001", "dataset-1_walk-back_angry_001"],
-         "val": ["dataset-2_walk-turn-left_active_003", "dataset-1_walk-back_childish_001"]}
-# The full dataset builder (core/data/build.py: fit, IK, shape-aware retarget) is used when all of
-# its pieces exist and it builds these clips; otherwise the clips are written on the canonical body
-# (betas 0, new == norm features), with a warning.
-USE_BUILDER = all(importlib.util.find_spec(f"shapemove.core.body.{m}") for m in ("fit", "ik", "measure", "openbody"))
-
-
-def _write_split_lists(out: Path) -> None:
-    for split, ids in CLIPS.items():
-        (out / f"{split}.txt").write_text("\n".join(ids) + "\n")
-    (out / "test.txt").write_text("")
+                   "dataset-1_walk-back_active_001"],
+         "val": ["dataset-2_walk-turn-left_active_003"]}
+AUG_BETAS = np.array([1.5, -1.0, 0.5, 0, 0, 0, 0, 0, 0, 0], np.float32)
 
 
 def build_tiny_dataset(mocap_root: Path, out: Path) -> Path:
-    if USE_BUILDER:
-        from shapemove.core.data.build import build_dataset
+    """The dataset builder's per-clip pipeline (load, fit betas, IK, shape-aware and canonical FK,
+    features; ``core/data/build.py``) on a few clips, with IK refinement off to stay fast."""
+    from shapemove.core.data.build import ClipProcessor
+    from shapemove.core.data.sources import discover, open_source
+    from shapemove.core.motion.features import mean_std
 
-        report = build_dataset([mocap_root / "bandai"], out / "built", augment_share=0.0, verbose=False,
-                               only=CLIPS["train"] + CLIPS["val"])
-        if not report.failures:
-            _write_split_lists(out / "built")
-            return out / "built"
-        warnings.warn(f"dataset builder failed ({report.failures[0][1]}); using canonical-body clips")
-    from shapemove.core.io.mocap import load_smpl22
-    from shapemove.core.motion.features import features_from_joints, mean_std
-
+    wanted = CLIPS["train"] + CLIPS["val"]
+    clips = {c.id: c for c in discover(open_source(mocap_root / "bandai")) if c.id in wanted}
+    proc = ClipProcessor(ik_refine_iters=0)
     for d in ("norm_joint_vecs", "new_joint_vecs", "betas"):
         (out / d).mkdir(parents=True)
-    feats = {}
-    for cid in CLIPS["train"] + CLIPS["val"]:
-        ds = cid.split("_")[0]
-        f = features_from_joints(load_smpl22(mocap_root / "bandai" / ds / "data" / f"{cid}.bvh").joints)
-        feats[cid] = f
-        np.save(out / "norm_joint_vecs" / f"{cid}.npy", f)
-        np.save(out / "new_joint_vecs" / f"{cid}.npy", f)
-        np.save(out / "betas" / f"{cid}.npy", np.zeros(10, np.float32))
-    mean, std = mean_std([feats[c] for c in CLIPS["train"]])
+    splits = {"train": [], "val": []}
+    for split, ids in CLIPS.items():
+        for cid in ids:
+            joints = proc.load(clips[cid])
+            todo = [(cid, None)] + ([(cid + "_aug", AUG_BETAS)] if cid == CLIPS["train"][0] else [])
+            for name, betas in todo:
+                arrays = proc.process(clips[cid], joints, betas)
+                for key in ("norm_joint_vecs", "new_joint_vecs", "betas"):
+                    np.save(out / key / f"{name}.npy", np.asarray(arrays[key], np.float32))
+                splits[split].append(name)
+    for split, ids in splits.items():
+        (out / f"{split}.txt").write_text("\n".join(ids) + "\n")
+    (out / "test.txt").write_text("")
+    train = [np.load(out / k / f"{i}.npy") for i in splits["train"] for k in ("new_joint_vecs", "norm_joint_vecs")]
+    mean, std = mean_std(train)
     np.save(out / "Mean.npy", mean)
     np.save(out / "Std.npy", std)
-    _write_split_lists(out)
     return out
 
 
@@ -98,6 +89,9 @@ def test_dataset_crops(data_dir):
                 if np.allclose(np.load(data_dir / "new_joint_vecs" / f"{ds.ids[2]}.npy")[s:s + 64],
                                item["y"].numpy() * ds.std + ds.mean, atol=1e-4)]
     assert starts_y == starts                                           # same crop for input and target
+    aug = ds[ds.ids.index(CLIPS["train"][0] + "_aug")]
+    assert np.allclose(aug["betas"].numpy(), AUG_BETAS)
+    assert (aug["x"] - aug["y"]).abs().max() > 0.1                      # shape-aware target differs from input
     assert len(MotionClips(data_dir, "train", window=100).skipped) >= 1  # 83-93 frame clips left out
 
 
@@ -108,9 +102,10 @@ def test_batch_stream_is_a_function_of_the_step(data_dir):
     first = [next(it) for _ in range(6)]                                 # 18 items: crosses 4 epochs
     it2 = iter(BatchStream(ds, batch=3, seed=7, start_step=4))
     assert [next(it2) for _ in range(2)] == first[4:]
-    assert sorted(k[0] for b in first for k in b if k[1] == 0) == [0, 1, 2, 3]  # each epoch a permutation
-    r0 = [k for b in [next(iter(BatchStream(ds, 2, rank=0, world_size=2)))] for k in b]
-    r1 = [k for b in [next(iter(BatchStream(ds, 2, rank=1, world_size=2)))] for k in b]
+    for e in range(4):                                                  # each epoch is a permutation
+        assert sorted(k[0] for b in first for k in b if k[1] == e) == [0, 1, 2, 3]
+    r0 = next(iter(BatchStream(ds, 2, rank=0, world_size=2)))
+    r1 = next(iter(BatchStream(ds, 2, rank=1, world_size=2)))
     assert sorted(k[0] for k in r0 + r1) == [0, 1, 2, 3]                # ranks split an epoch
 
 
@@ -156,7 +151,6 @@ def test_checkpoint_round_trip_and_mismatches(tmp_path):
 # -- training -----------------------------------------------------------------------------------------
 
 def test_resume_equals_uninterrupted(data_dir, body, tmp_path):
-    torch.set_num_threads(1)
     full = train_vae(data_dir, tmp_path / "full", tiny_config(), body=body, device="cpu", verbose=False)
     assert full["step"] == 6 and "val" in full and np.isfinite(full["val"]["total"])
     calls = []
@@ -192,7 +186,6 @@ def test_resume_equals_uninterrupted(data_dir, body, tmp_path):
 
 
 def test_training_reduces_loss(data_dir, body, tmp_path):
-    torch.set_num_threads(1)
     cfg = tiny_config(steps=40, lr=1e-2, warmup_steps=1, log_every=1, val_every=40, ckpt_every=1000)
     train_vae(data_dir, tmp_path / "r", cfg, body=body, device="cpu", verbose=False)
     recon = [json.loads(line)["train"]["recon"] for line in (tmp_path / "r" / "log.jsonl").read_text().splitlines()]
@@ -211,6 +204,7 @@ def test_cli_train_vae(data_dir, tmp_path):
     assert main(["train", "vae", "--data", str(tmp_path / "nowhere"), "--out", str(tmp_path / "x"), "--quiet"]) == 2
 
 
+@pytest.mark.slow  # ~16 s on 2 shared cores: two fresh Python processes importing torch
 def test_torchrun_two_processes(data_dir, tmp_path):
     torchrun = Path(sys.executable).with_name("torchrun")
     if not torchrun.exists():
@@ -221,7 +215,7 @@ def test_torchrun_two_processes(data_dir, tmp_path):
                                               "val_batches": 1, "ckpt_every": 2}}))
     env = {**os.environ, "OMP_NUM_THREADS": "1"}
     t0 = time.time()
-    proc = subprocess.run([str(torchrun), "--nproc_per_node", "2", "--master_port", "0", "-m", "shapemove", "train", "vae",
+    proc = subprocess.run([str(torchrun), "--standalone", "--nproc_per_node", "2", "-m", "shapemove", "train", "vae",
                            "--data", str(data_dir), "--config", str(cfg_path), "--out", str(tmp_path / "ddp"),
                            "--steps", "3", "--device", "cpu", "--quiet"],
                           env=env, capture_output=True, text=True, timeout=300, cwd=tmp_path)

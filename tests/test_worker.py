@@ -21,13 +21,22 @@ from shapemove.core.worker.client import InProcessRunner, WorkerClient, resolve_
 
 PY = sys.executable  # the test venv's Python (has torch and shapemove)
 CMD = [PY, "-m", "shapemove", "worker"]
-# Bandai clips of the shared tiny set; the builder takes ~0.3-2 s per clip
-CLIPS = ["dataset-1_walk_normal_002", "dataset-1_run_happy_001", "dataset-2_wave-left-hand_elderly_001",
-         "dataset-2_walk_masculine_003", "dataset-1_kick_normal_001", "dataset-2_raise-up-both-hands_normal_001"]
+# Short real Bandai clips (65-82 frames at 30 fps: 2.2-2.7 s), so a build step takes a second or so
+CLIPS = [f"dataset-2_raise-up-both-hands_{c}" for c in
+         ("exhausted_006", "feminine_007", "feminine_011", "masculine_012", "youthful_007", "youthful_039")]
 
 
 @pytest.fixture
 def client():
+    """A worker of its own (for tests that kill or stop it)."""
+    c = WorkerClient(PY, command=CMD)
+    yield c
+    c.stop()
+
+
+@pytest.fixture(scope="module")
+def shared():
+    """One worker for the tests that leave it serving (saves a torch import per test)."""
     c = WorkerClient(PY, command=CMD)
     yield c
     c.stop()
@@ -125,50 +134,50 @@ def test_resolve_python(tmp_path):
 
 
 # -- the worker process ------------------------------------------------------------------------
-def test_ping_round_trip(client):
+def test_ping_round_trip(shared):
     t0 = time.monotonic()
-    res = client.call("ping", timeout=30)
-    assert res["pong"] is True and res["pid"] == client.pid != os.getpid()
+    res = shared.call("ping", timeout=30)
+    assert res["pong"] is True and res["pid"] == shared.pid != os.getpid()
     assert res["protocol"] == P.PROTOCOL_VERSION
     assert {"body_info", "measure", "build_dataset", "train_vae"} <= set(res["ops"])
-    assert client.alive() and not client.pending
+    assert shared.alive() and not shared.pending
     assert time.monotonic() - t0 < 20
 
 
-def test_body_info_real_facts(client, tmp_path):
+def test_body_info_real_facts(shared, tmp_path):
     from shapemove.core.body.openbody import DEFAULT_PATH
 
     if DEFAULT_PATH.is_file():
         with np.load(DEFAULT_PATH) as npz:
             v, f = npz["v_template"], npz["faces"]
-        info = client.call("body_info", timeout=60)
+        info = shared.call("body_info", timeout=60)
         assert info["name"] == "openbody-v1" and info["num_vertices"] == len(v) and info["num_faces"] == len(f)
         assert info["height_m"] == pytest.approx(float(v[:, 1].max() - v[:, 1].min()), abs=1e-5)
         assert len(info["phenotype_names"]) == 6
     arrays = write_model(tmp_path / "SMPL_NEUTRAL.npz", "smpl")
-    info = client.call("body_info", {"body": str(tmp_path / "SMPL_NEUTRAL.npz")}, timeout=60)
+    info = shared.call("body_info", {"body": str(tmp_path / "SMPL_NEUTRAL.npz")}, timeout=60)
     vt = arrays["v_template"]
     assert info["num_vertices"] == len(vt) and info["num_faces"] == len(arrays["f"])
     assert info["num_joints"] == 24 and info["num_betas"] == 10 and info["joint_names"][0] == "pelvis"
     assert info["height_m"] == pytest.approx(float(vt[:, 1].max() - vt[:, 1].min()), abs=1e-5)
 
 
-def test_measure_equals_in_process(client):
+def test_measure_equals_in_process(shared):
     from shapemove.core.body.load import load_body_model
     from shapemove.core.body.measure import measure
 
     betas = [1.5, -0.5, 0, 0, 0.3, 0, 0, 0, 0, -1.0]
-    got = client.call("measure", {"betas": betas}, timeout=90)
+    got = shared.call("measure", {"betas": betas}, timeout=90)
     want = measure(load_body_model(None), np.array(betas))
     assert got.keys() == want.keys() and all(got[k] == pytest.approx(float(want[k]), abs=1e-9) for k in want)
 
 
-def test_errors_unknown_op_and_bad_input(client):
-    j1 = client.submit("teleport", {})
-    j2 = client.submit("body_info", {"body": "/no/such/model.npz"})
-    j3 = client.submit("measure", {"betas": [1, 2, 3]})
-    j4 = client.submit("build_dataset", {"out": "/tmp/x"})
-    msgs = wait_for(client, lambda m: all(ended(j)(m) for j in (j1, j2, j3, j4)), timeout=90)
+def test_errors_unknown_op_and_bad_input(shared):
+    j1 = shared.submit("teleport", {})
+    j2 = shared.submit("body_info", {"body": "/no/such/model.npz"})
+    j3 = shared.submit("measure", {"betas": [1, 2, 3]})
+    j4 = shared.submit("build_dataset", {"out": "/tmp/x"})
+    msgs = wait_for(shared, lambda m: all(ended(j)(m) for j in (j1, j2, j3, j4)), timeout=90)
     e1 = final(msgs, j1)
     assert e1["type"] == "error" and "unknown op 'teleport'" in e1["message"]
     assert all(op in e1["message"] for op in ("body_info", "train_vae", "ping", "cancel"))
@@ -178,7 +187,9 @@ def test_errors_unknown_op_and_bad_input(client):
     assert e3["error_type"] == "ShapeMoveError" and "betas must be" in e3["message"]
     e4 = final(msgs, j4)
     assert e4["message"] == "op 'build_dataset': missing parameter 'sources'"
-    assert client.call("ping")["pong"]  # still serving
+    with pytest.raises(ShapeMoveError, match="'betas' must be a list of numbers"):
+        shared.call("measure", {"betas": ["tall"] * 10})
+    assert shared.call("ping")["pong"]  # still serving
 
 
 def test_malformed_lines_get_errors_and_worker_keeps_serving():
@@ -218,11 +229,11 @@ def test_stdout_has_only_protocol_lines_when_a_job_prints():
         w.close()
 
 
-def test_queued_job_cancels_at_once(client):
-    j1 = client.submit("measure", {"betas": [0.0] * 10})
-    j2 = client.submit("body_info", {})
-    assert client.cancel(j2)
-    msgs = wait_for(client, ended(j1), timeout=90)
+def test_queued_job_cancels_at_once(shared):
+    j1 = shared.submit("measure", {"betas": [0.0] * 10})
+    j2 = shared.submit("body_info", {})
+    assert shared.cancel(j2)
+    msgs = wait_for(shared, ended(j1), timeout=90)
     order = [m["id"] for m in msgs if m["type"] in ("result", "error")]
     assert order == [j2, j1]  # j2 left the queue before j1 finished
     assert final(msgs, j2) == P.result(j2, {}, cancelled=True)
@@ -233,35 +244,35 @@ def build_params(mocap_root, out, clips):
     return {"sources": [str(mocap_root / "bandai")], "out": str(out), "only": clips, "augment_share": 0.0}
 
 
-def test_build_dataset_streams_progress(client, mocap_root, tmp_path):
-    jid = client.submit("build_dataset", build_params(mocap_root, tmp_path / "ds", CLIPS[:2]))
-    msgs = wait_for(client, ended(jid), timeout=120)
-    res = final(msgs, jid)
-    assert res["type"] == "result" and not res["cancelled"], res
-    report = res["result"]
-    assert report["built"] + report["skipped_done"] + len(report["failures"]) == 2
-    fractions = [m["fraction"] for m in msgs if m["type"] == "progress"]
-    assert fractions[-1] == 1.0 and fractions == sorted(fractions) and set(fractions) <= {0.5, 1.0}
-    assert (tmp_path / "ds" / "build_report.txt").read_text().startswith("clips built: ")
+def wait_running(client, jid, timeout=60.0) -> None:
+    """Until the worker says ``jid`` is its running job (ping is answered while a job runs)."""
+    end = time.monotonic() + timeout
+    while client.call("ping")["running"] != jid:
+        assert time.monotonic() < end
+        time.sleep(0.05)
 
 
-def test_cancel_running_build(client, mocap_root, tmp_path):
-    jid = client.submit("build_dataset", build_params(mocap_root, tmp_path / "ds", CLIPS))
-    wait_for(client, lambda m: any(x["type"] == "progress" for x in m), timeout=120)
-    assert client.cancel(jid)
-    msgs = wait_for(client, ended(jid), timeout=60)
+def test_build_dataset_streams_progress_and_cancels(shared, mocap_root, tmp_path):
+    jid = shared.submit("build_dataset", build_params(mocap_root, tmp_path / "ds", CLIPS))
+    msgs = wait_for(shared, lambda m: any(x["type"] == "progress" for x in m), timeout=120)
+    assert shared.cancel(jid)
+    msgs += wait_for(shared, ended(jid), timeout=60)
     res = final(msgs, jid)
     assert res["type"] == "result" and res["cancelled"] is True
     r = res["result"]
     done = r["built"] + r["skipped_done"] + len(r["failures"])
     assert 1 <= done < len(CLIPS)  # stopped after the clip in progress
-    assert client.call("ping")["running"] is None
+    fractions = [m["fraction"] for m in msgs if m["type"] == "progress"]
+    assert fractions == [pytest.approx(k / len(CLIPS)) for k in range(1, done + 1)]
+    assert [m["message"] for m in msgs if m["type"] == "progress"][0] in CLIPS
+    assert (tmp_path / "ds" / "build_report.txt").read_text().startswith("clips built: ")
+    assert shared.call("ping")["running"] is None
 
 
 def test_killed_worker_is_reported_and_restarted(client, mocap_root, tmp_path):
     jid = client.submit("build_dataset", build_params(mocap_root, tmp_path / "ds", CLIPS))
     queued = client.submit("body_info", {})
-    wait_for(client, lambda m: any(x["type"] == "progress" for x in m), timeout=120)
+    wait_running(client, jid)
     old_pid = client.pid
     os.kill(old_pid, signal.SIGKILL)
     msgs = wait_for(client, lambda m: ended(jid)(m) and ended(queued)(m), timeout=30)
@@ -274,13 +285,13 @@ def test_killed_worker_is_reported_and_restarted(client, mocap_root, tmp_path):
     assert client.alive() and res["pid"] == client.pid != old_pid and client.starts == 2
 
 
-def test_stop_fails_unfinished_jobs_once(client, mocap_root, tmp_path):
+def test_stop_ends_running_job_once(client, mocap_root, tmp_path):
     jid = client.submit("build_dataset", build_params(mocap_root, tmp_path / "ds", CLIPS))
-    wait_for(client, lambda m: any(x["type"] == "progress" for x in m), timeout=120)
-    client.stop(timeout=30)
+    wait_running(client, jid)
+    client.stop(timeout=60)
     msgs = wait_for(client, ended(jid), timeout=5)
     assert [m["type"] for m in msgs if m["id"] == jid and m["type"] in ("result", "error")] == ["result"]
-    assert final(msgs, jid)["cancelled"] is True  # shutdown cancels, the job ended cleanly
+    assert final(msgs, jid)["cancelled"] is True  # shutdown cancels; the job ended cleanly
     assert not client.alive() and client.exit_code == 0
 
 
@@ -294,12 +305,27 @@ def test_default_launcher_runs_this_package():
         c.stop()
 
 
+def test_python_without_requirements_says_what_is_missing():
+    """A Python without numpy/torch (e.g. a wrong preference): the worker starts, jobs say why they fail."""
+    bare = next((p for p in ("/usr/bin/python3", "/usr/local/bin/python3") if os.path.isfile(p) and subprocess.run(
+        [p, "-c", "import numpy"], capture_output=True).returncode), None)
+    if bare is None:
+        pytest.skip("no Python without numpy on this machine")
+    c = WorkerClient(bare)
+    try:
+        assert c.call("ping", timeout=30)["pong"]
+        with pytest.raises(ShapeMoveError, match=f"needs the Python package 'numpy', which is not installed in {bare}"):
+            c.call("body_info", timeout=30)
+    finally:
+        c.stop()
+
+
 # -- in-process --------------------------------------------------------------------------------
-def test_in_process_runner_matches_worker(client):
+def test_in_process_runner_matches_worker(shared):
     r = InProcessRunner()
     try:
         a = r.call("measure", {"betas": [0.5] + [0.0] * 9}, timeout=90)
-        b = client.call("measure", {"betas": [0.5] + [0.0] * 9}, timeout=90)
+        b = shared.call("measure", {"betas": [0.5] + [0.0] * 9}, timeout=90)
         assert a == b
         assert r.call("ping")["pid"] == os.getpid()
         with pytest.raises(ShapeMoveError, match="unknown op 'nope'"):
@@ -312,15 +338,15 @@ def test_in_process_runner_matches_worker(client):
 
 
 @pytest.mark.slow
-def test_train_vae_streams_progress_and_cancels(client, tiny_dataset, tmp_path):
+def test_train_vae_streams_progress_and_cancels(shared, tiny_dataset, tmp_path):
     cfg = {"base": "small", "width": 32, "shape_hidden": 32, "depth": 1,
            "train": {"steps": 400, "batch_size": 4, "window": 16, "log_every": 1, "val_every": 10_000,
                      "ckpt_every": 10_000, "warmup_steps": 1}}
-    jid = client.submit("train_vae", {"data": str(tiny_dataset), "out": str(tmp_path / "run"), "config": cfg})
-    msgs = wait_for(client, lambda m: sum(x["type"] == "progress" for x in m) >= 3, timeout=120)
+    jid = shared.submit("train_vae", {"data": str(tiny_dataset), "out": str(tmp_path / "run"), "config": cfg})
+    msgs = wait_for(shared, lambda m: sum(x["type"] == "progress" for x in m) >= 3, timeout=120)
     assert [m["message"].split(" loss")[0] for m in msgs if m["type"] == "progress"][:2] == ["step 1/400", "step 2/400"]
-    client.cancel(jid)
-    msgs = wait_for(client, ended(jid), timeout=60)
+    shared.cancel(jid)
+    msgs = wait_for(shared, ended(jid), timeout=60)
     res = final(msgs, jid)
     assert res["type"] == "result" and res["cancelled"] is True
     assert 3 <= res["result"]["metrics"]["step"] < 400

@@ -48,10 +48,6 @@ ANNY_TO_SM = np.array([[1.0, 0, 0], [0, 0, 1.0], [0, -1.0, 0]])
 PHENOTYPES = ["gender", "age", "muscle", "weight", "height", "proportions"]
 
 
-def _side(name: str, s: str) -> str:
-    return name.replace("left", s)
-
-
 def joint_definitions(labels: list[str]) -> tuple[dict, dict]:
     """For each SMPL joint: the Anny bones whose heads are averaged for its position, and the
     Anny bones whose skin weights it takes. Returns ({joint: [bone idx]}, {bone idx: joint idx})."""
@@ -217,7 +213,7 @@ def pca(X: np.ndarray, k: int):
     return mean, comps, std, evals[:k] / evals.sum()
 
 
-def fit_regressor(verts, joints, ref_verts, ref_joints, k_near=160, ridge=1e-3):
+def fit_regressor(verts, joints, ref_verts, ref_joints, k_near=500, ridge=1e-4):
     """Joint regressor (24,V): joint j = sum_v w_jv vertex_v with sum_v w_jv = 1, over the
     k_near vertices nearest to the joint in the reference body; ridge pulls w towards the
     uniform average. verts (n,V,3), joints (n,24,3)."""
@@ -225,10 +221,10 @@ def fit_regressor(verts, joints, ref_verts, ref_joints, k_near=160, ridge=1e-3):
     for j in range(joints.shape[1]):
         d = np.linalg.norm(ref_verts - ref_joints[j], axis=1)
         cand = np.argsort(d)[:k_near]
-        X = verts[:, cand] - ref_joints[j]  # (n,K,3)
-        y = joints[:, j] - ref_joints[j]    # (n,3)
-        A = np.einsum("nkc,nlc->kl", X, X)
-        b = np.einsum("nkc,nc->k", X, y)
+        X = (verts[:, cand] - ref_joints[j]).transpose(0, 2, 1).reshape(-1, len(cand))  # (n*3,K)
+        y = (joints[:, j] - ref_joints[j]).reshape(-1)                                   # (n*3,)
+        A = X.T @ X
+        b = X.T @ y
         lam = ridge * np.trace(A) / len(cand)
         u = np.full(len(cand), 1.0 / len(cand))
         K = len(cand)
@@ -318,9 +314,10 @@ def main(argv=None) -> int:
     coef, *_ = np.linalg.lstsq(F, betas, rcond=None)
     r2 = 1 - ((F @ coef - betas) ** 2).sum(0) / ((betas - betas.mean(0)) ** 2).sum(0)
     print(f"phenotype->betas R^2 per beta: {np.round(r2, 3).tolist()}")
-    ranges = np.stack([sliders.min(0), sliders.max(0)], 1)
-    ranges[[0, 2, 3, 4, 5]] = [0.0, 1.0]  # Anny's own [0,1] sliders
-    ranges[1] = [14.0, 80.0]
+    # slider ranges: 1st-99th percentiles of the samples (Anny's extremes are far outside people)
+    ranges = np.round(np.percentile(sliders, [1, 99], axis=0).T, 2)
+    ranges[0] = [0.0, 1.0]
+    ranges[1] = [18.0, 80.0]
 
     out = dict(
         format_version=np.int32(FORMAT_VERSION),

@@ -21,6 +21,7 @@ Positions: metres, Y up. Local rotations as in ``kinematics.forward_kinematics``
 """
 from __future__ import annotations
 
+from contextlib import contextmanager
 from dataclasses import dataclass
 
 import numpy as np
@@ -38,6 +39,9 @@ LIMBS = [
     (17, 19, 21, (0.0, 1.0, 0.0)),   # right arm
 ]
 END_JOINTS = [7, 8, 10, 11, 20, 21]  # ankles, feet, wrists
+ROOT_WEIGHTS = (1.0, 1.0, 1.0, 1.0)  # pelvis, left hip, right hip, spine1 in the root fit
+MAX_AIM_TURN = 20.0  # degrees a bone may turn from the target's bone direction to hit a target
+LIMB_END_WEIGHT = 2.0  # an ankle/wrist miss counts double when placing the knee/elbow
 SPINE_BLEND = {3: 1.0 / 3.0, 6: 2.0 / 3.0}  # share of the chest's left-right axis per spine joint
 _EPS = 1e-9
 
@@ -96,8 +100,10 @@ def _swing(a: torch.Tensor, b: torch.Tensor) -> torch.Tensor:
     return rot
 
 
-def _kabsch(src: torch.Tensor, dst: torch.Tensor) -> torch.Tensor:
-    """Rotation (T,3,3) best mapping the vectors src (n,3) onto dst (T,n,3) (least squares)."""
+def _kabsch(src: torch.Tensor, dst: torch.Tensor, weight: torch.Tensor | None = None) -> torch.Tensor:
+    """Rotation (T,3,3) best mapping the vectors src (n,3) onto dst (T,n,3) (weighted least squares)."""
+    if weight is not None:
+        src = src * weight[:, None]
     h = torch.einsum("ni,tnj->tij", src, dst)
     u, _, vt = torch.linalg.svd(h)
     d = torch.sign(torch.linalg.det(vt.transpose(-1, -2) @ u.transpose(-1, -2)))
@@ -109,6 +115,18 @@ def _kabsch(src: torch.Tensor, dst: torch.Tensor) -> torch.Tensor:
 def _smoothstep(x: torch.Tensor, lo: float, hi: float) -> torch.Tensor:
     t = ((x - lo) / (hi - lo)).clamp(0, 1)
     return t * t * (3 - 2 * t)
+
+
+@contextmanager
+def _one_thread():
+    """Run torch on one thread: the tensors here are tiny (frames x 24 x 4 x 4), and intra-op
+    threads only add synchronisation (badly so on a busy machine)."""
+    n = torch.get_num_threads()
+    torch.set_num_threads(1)
+    try:
+        yield
+    finally:
+        torch.set_num_threads(n)
 
 
 # -- input checks --------------------------------------------------------------------------------
@@ -138,6 +156,18 @@ def _prepare(joints, rest_joints, parents):
 def _fk(rot: torch.Tensor, rest: torch.Tensor, parents, transl: torch.Tensor) -> torch.Tensor:
     pos, _ = forward_kinematics(rot, rest.expand(rot.shape[0], -1, -1), parents)
     return pos[:, :NUM_BODY_JOINTS] + transl[:, None]
+
+
+def _fk_fast(rot: torch.Tensor, offs: torch.Tensor, parents, transl: torch.Tensor) -> torch.Tensor:
+    """The 22 body joints (T,22,3) of ``forward_kinematics`` + transl, with 3x3 rotations and
+    bone offsets instead of 4x4 transforms (about half the work and autograd graph)."""
+    G = [rot[:, 0]]
+    P = [offs[0].expand(rot.shape[0], 3) + transl]
+    for j in range(1, NUM_BODY_JOINTS):
+        p = parents[j]
+        P.append(P[p] + G[p] @ offs[j])
+        G.append(G[p] @ rot[:, j])
+    return torch.stack(P, 1)
 
 
 def _result(rot, transl, target, rest, parents) -> IKResult:
@@ -196,42 +226,66 @@ def analytic_ik(target: torch.Tensor, rest: torch.Tensor, parents) -> tuple[torc
 
     G = [None] * NUM_JOINTS  # world rotations (T,3,3)
     P = [None] * NUM_JOINTS  # FK positions (T,3)
-    P[0] = target[:, 0]
+    # root: rigid fit (rotation + translation) of the pelvis and its children; with another
+    # body's pelvis layout this shares the mismatch instead of piling it onto the hips
+    group = [0] + kids[0]
+    w = torch.tensor(ROOT_WEIGHTS, dtype=dt)[:, None]
+    c_rest = (rest[group] * w).sum(0) / w.sum()
+    c_tgt = (target[:, group] * w).sum(1) / w.sum()
+    G[0] = _kabsch(rest[group] - c_rest, target[:, group] - c_tgt[:, None], w[:, 0])
+    P[0] = c_tgt + G[0] @ (rest[0] - c_rest)
     for j in range(NUM_JOINTS):
         p = parents[j]
         if j > 0:
             P[j] = P[p] + G[p] @ offs[j]
         ch = kids[j]
+        if j == 0:
+            continue
         if not ch:
             G[j] = G[p]
-        elif len(ch) > 1:
-            G[j] = _kabsch(offs[ch], target[:, ch] - P[j][:, None])
+            continue
+        shift = _aim_shift(target[:, j] - P[j], min(float(torch.linalg.norm(offs[c])) for c in ch))
+        aim = target[:, ch] + shift[:, None]  # child targets, moved along when j is off its own
+        if len(ch) > 1:
+            G[j] = _kabsch(offs[ch], aim - P[j][:, None])
         elif j in SPINE_BLEND:
             s = SPINE_BLEND[j]
             side = (1 - s) * (G[0] @ ex) + s * (chest @ ex)
-            G[j] = _align_two(offs[ch[0]].expand(T, 3), ex.expand(T, 3), target[:, ch[0]] - P[j], side)
+            G[j] = _align_two(offs[ch[0]].expand(T, 3), ex.expand(T, 3), aim[:, 0] - P[j], side)
         elif j in limb_of:
-            G[j] = _limb_root(j, limb_of[j], hinge_axis[j], offs, target, P[j], G[p])
+            end = target[:, limb_of[j][2]] + shift
+            G[j] = _limb_root(limb_of[j], hinge_axis[j], offs, aim[:, 0], end, P[j], G[p])
         elif j in hinge_of:
             h = hinge_axis[hinge_of[j][0]]
-            c = ch[0]
-            G[j] = _align_two(offs[c].expand(T, 3), h.expand(T, 3), target[:, c] - P[j], G[p] @ h)
+            G[j] = _align_two(offs[ch[0]].expand(T, 3), h.expand(T, 3), aim[:, 0] - P[j], G[p] @ h)
         else:
-            G[j] = _swing(G[p] @ offs[ch[0]], target[:, ch[0]] - P[j]) @ G[p]
+            G[j] = _swing(G[p] @ offs[ch[0]], aim[:, 0] - P[j]) @ G[p]
     rot = torch.stack([G[0]] + [G[parents[j]].transpose(-1, -2) @ G[j] for j in range(1, NUM_JOINTS)], 1)
-    return rot, target[:, 0] - rest[0]
+    return rot, P[0] - rest[0]
 
 
-def _limb_root(j, limb, h, offs, target, pj, gp):
-    """World rotation of a hip/shoulder: aim at the knee/elbow, twist so that the knee/elbow
-    bends about its hinge axis ``h``; near-straight limbs keep the minimal swing's twist."""
+def _aim_shift(miss: torch.Tensor, bone: float) -> torch.Tensor:
+    """(T,3) shift for the child targets of a joint that FK put ``miss`` = target - FK position
+    away from its target. Aiming a bone of length ``bone`` straight at its child's target from
+    the wrong place would turn it away from the target bone's direction (a too-long spine
+    folds the neck); the child targets are moved along with the miss as far as needed to keep
+    that turn below MAX_AIM_TURN, so small misses are still corrected and big ones copied."""
+    e = torch.linalg.norm(miss, dim=-1, keepdim=True)
+    beta = (bone * np.sin(np.radians(MAX_AIM_TURN)) / e.clamp_min(_EPS)).clamp(max=1.0)
+    return -(1 - beta) * miss
+
+
+def _limb_root(limb, h, offs, t_mid, t_end, pj, gp):
+    """World rotation of a hip/shoulder: aim at the knee/elbow target ``t_mid``, twist so that
+    the knee/elbow bends about its hinge axis ``h`` towards ``t_end``; near-straight limbs keep
+    the minimal swing's twist."""
     _, mid, end, _ = limb
     a = _unit(offs[mid])
-    bj = _unit(_two_bone_mid(pj, target[:, mid], target[:, end], offs[mid], offs[end]) - pj)
+    bj = _unit(_place_mid(pj, t_mid, t_end, offs[mid], offs[end]) - pj)
     g0 = _swing(gp @ a, bj) @ gp
     u = g0 @ h                                     # hinge axis with the minimal twist
     p_mid = pj + torch.linalg.norm(offs[mid]) * bj  # where FK will put the knee/elbow
-    bk = _unit(target[:, end] - p_mid)
+    bk = _unit(t_end - p_mid)
     dvec = bk - (bk * bj).sum(-1, keepdim=True) * bj
     r = torch.linalg.norm(dvec, dim=-1, keepdim=True)  # sin of the bend angle
     d = dvec / r.clamp_min(_EPS)
@@ -266,53 +320,115 @@ def _two_bone_mid(root, mid, end, off_mid, off_end):
     return torch.where(ok, mid_new, mid)
 
 
+def _place_mid(root, mid, end, off_mid, off_end):
+    """Knee/elbow target (T,3) for the FK hip/shoulder ``root``: aim straight at the target
+    knee, or use the two-bone solution that also lands the ankle - whichever misses less
+    (knee miss + LIMB_END_WEIGHT x ankle miss), frame by frame."""
+    l1, l2 = torch.linalg.norm(off_mid), torch.linalg.norm(off_end)
+
+    def misses(knee):
+        return (torch.linalg.norm(knee - mid, dim=-1)
+                + LIMB_END_WEIGHT * (torch.linalg.norm(end - knee, dim=-1) - l2).abs())
+
+    direct = root + l1 * _unit(mid - root)
+    two = _two_bone_mid(root, mid, end, off_mid, off_end)
+    return torch.where((misses(two) <= misses(direct))[:, None], two, mid)
+
+
 # -- refinement ----------------------------------------------------------------------------------
+def lbfgs(fun, x: torch.Tensor, iters: int, history: int = 8, first_step: float = 0.05) -> torch.Tensor:
+    """Minimise ``fun(x) -> (loss, grad)`` with ``iters`` L-BFGS iterations and an Armijo
+    backtracking line search. Small and dependency-free (``torch.optim`` pulls in torch._dynamo,
+    seconds of import on first use). ``first_step``: largest change of any entry on step one."""
+    loss, g = fun(x)
+    mem: list[tuple[torch.Tensor, torch.Tensor, torch.Tensor]] = []
+    for _ in range(iters):
+        q = g.clone()
+        alphas = []
+        for s, y, rho in reversed(mem):
+            a = rho * (s * q).sum()
+            q -= a * y
+            alphas.append(a)
+        if mem:
+            s, y, _ = mem[-1]
+            q *= (s * y).sum() / (y * y).sum()
+        else:
+            q *= first_step / g.abs().max().clamp_min(1e-30)
+        for (s, y, rho), a in zip(mem, reversed(alphas)):
+            q += s * (a - rho * (y * q).sum())
+        d = -q
+        slope = (g * d).sum()
+        if slope >= 0:  # not a descent direction: restart from the gradient
+            mem.clear()
+            d = -g * first_step / g.abs().max().clamp_min(1e-30)
+            slope = (g * d).sum()
+        step = 1.0
+        for _ in range(12):
+            x_new = x + step * d
+            loss_new, g_new = fun(x_new)
+            if loss_new <= loss + 1e-4 * step * slope:
+                break
+            step *= 0.5
+        else:
+            break  # no decrease along d: converged as far as float precision goes
+        s, y = x_new - x, g_new - g
+        sy = (s * y).sum()
+        if sy > 1e-20:
+            mem.append((s, y, 1.0 / sy))
+            del mem[:-history]
+        x, loss, g = x_new, loss_new, g_new
+    return x
+
+
 def refine(rot0, transl0, target, rest, parents, iters: int = 10, smooth: float = 1e-3, end_weight: float = 3.0):
-    """A few batched LBFGS steps on axis-angle corrections of all frames at once.
-    Loss: mean joint distance (ankles, feet and wrists weighted ``end_weight``: contacts matter
-    most) + ``smooth`` x squared frame-to-frame change of the local
-    rotations + a small pull towards the analytic solution. Returns (rotations, transl)."""
+    """``iters`` L-BFGS iterations on axis-angle corrections (T,22,3) and translation corrections
+    of all frames at once. Loss per frame: sum of joint distances (ankles, feet and wrists weighted
+    ``end_weight``: contacts matter most) + ``smooth`` x squared frame-to-frame change of the local
+    rotations + a tiny pull towards the analytic solution. Returns (rotations, transl)."""
     T = rot0.shape[0]
-    delta = torch.zeros(T, NUM_BODY_JOINTS, 3, dtype=rot0.dtype, requires_grad=True)
-    dtr = torch.zeros(T, 3, dtype=rot0.dtype, requires_grad=True)
     tail = rot0[:, NUM_BODY_JOINTS:]
     weight = torch.ones(NUM_BODY_JOINTS, dtype=rot0.dtype)
     weight[END_JOINTS] = end_weight
-    opt = torch.optim.LBFGS([delta, dtr], lr=1.0, max_iter=iters, line_search_fn="strong_wolfe",
-                            tolerance_grad=1e-12, tolerance_change=1e-15)
+    n_rot = T * NUM_BODY_JOINTS * 3
+    offs = rest.clone()
+    offs[1:] = rest[1:] - rest[parents[1:]]
 
-    def compose():
+    def compose(x):
+        delta = x[:n_rot].reshape(T, NUM_BODY_JOINTS, 3)
         head = rot0[:, :NUM_BODY_JOINTS] @ axis_angle_to_matrix(delta)
-        return torch.cat([head, tail], 1), transl0 + dtr
+        return torch.cat([head, tail], 1), transl0 + x[n_rot:].reshape(T, 3), delta
 
-    def closure():
-        opt.zero_grad()
-        rot, tr = compose()
-        sq = ((_fk(rot, rest, parents, tr) - target) ** 2).sum(-1)
-        loss = (torch.sqrt(sq + 1e-8) * weight).mean() + 1e-6 * (delta ** 2).sum(-1).mean()
+    def fun(x):
+        x = x.detach().requires_grad_(True)
+        rot, tr, delta = compose(x)
+        sq = ((_fk_fast(rot, offs, parents, tr) - target) ** 2).sum(-1)
+        loss = (torch.sqrt(sq + 1e-8) * weight).sum() + 1e-6 * (delta ** 2).sum()
         if T > 1 and smooth > 0:
-            loss = loss + smooth * ((rot[1:] - rot[:-1]) ** 2).sum((-1, -2)).mean()
-        loss.backward()
-        return loss
+            loss = loss + smooth * ((rot[1:] - rot[:-1]) ** 2).sum()
+        (grad,) = torch.autograd.grad(loss, x)
+        return loss.detach(), grad
 
-    opt.step(closure)
+    x = lbfgs(fun, torch.zeros(n_rot + T * 3, dtype=rot0.dtype), iters)
     with torch.no_grad():
-        return compose()
+        rot, tr, _ = compose(x)
+    return rot, tr
 
 
 def solve_ik(joints, rest_joints, parents=PARENTS, refine_iters: int = 10) -> IKResult:
     """joints (T,22,3) metres Y-up; rest_joints (24,3) of the target body (e.g.
     ``BodyModel.rest_joints(betas)[0]``). Analytic IK then ``refine_iters`` LBFGS iterations
-    (0 = analytic only; skipped when the analytic error is already below 0.01 mm).
+    (0 = analytic only; skipped when the analytic error is already below 0.01 mm). Bad input
+    raises ShapeMoveError.
     Returns local rotations (T,24,3,3) and transl (T,3) such that FK + transl ~ joints."""
     target, rest, parents = _prepare(joints, rest_joints, parents)
-    rot, transl = analytic_ik(target, rest, parents)
-    if refine_iters > 0:
-        with torch.no_grad():
-            before = torch.linalg.norm(_fk(rot, rest, parents, transl) - target, dim=-1).max()
-        if before > 1e-5:
-            rot, transl = refine(rot, transl, target, rest, parents, iters=refine_iters)
-    return _result(rot, transl, target, rest, parents)
+    with _one_thread():
+        rot, transl = analytic_ik(target, rest, parents)
+        if refine_iters > 0:
+            with torch.no_grad():
+                before = torch.linalg.norm(_fk(rot, rest, parents, transl) - target, dim=-1).max()
+            if before > 1e-5:
+                rot, transl = refine(rot, transl, target, rest, parents, iters=refine_iters)
+        return _result(rot, transl, target, rest, parents)
 
 
 def ik_lbfgs_baseline(joints, rest_joints, iters: int = 100, parents=PARENTS) -> IKResult:
@@ -332,5 +448,6 @@ def ik_lbfgs_baseline(joints, rest_joints, iters: int = 100, parents=PARENTS) ->
         loss.backward()
         return loss
 
-    opt.step(closure)
-    return _result(axis_angle_to_matrix(aa.detach()), tr.detach(), target, rest, parents)
+    with _one_thread():
+        opt.step(closure)
+        return _result(axis_angle_to_matrix(aa.detach()), tr.detach(), target, rest, parents)

@@ -22,6 +22,12 @@ MODEL_ID = "openbody-v1"
 DEFAULT_PATH = Path(__file__).resolve().parents[2] / "assets" / "openbody.npz"
 REBUILD_HINT = "rebuild it with: python tools/build_openbody.py --out assets/openbody.npz --seed 0"
 
+# what each slider means (the asset stores names, ranges and the map; units are fixed by the build)
+PHENOTYPE_UNITS = {
+    "gender": "0 = male .. 1 = female", "age": "years", "muscle": "Anny 0..1", "weight": "Anny 0..1",
+    "height": "Anny 0..1", "proportions": "Anny 0..1 (ideal .. uncommon)",
+}
+
 _REQUIRED = ["format_version", "model_id", "v_template", "shapedirs", "j_regressor", "skin_weights",
              "faces", "joint_names", "phenotype_names", "phenotype_ranges", "phenotype_defaults",
              "phenotype_intercept", "phenotype_matrix"]

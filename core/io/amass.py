@@ -6,7 +6,7 @@ Z up; the result is Y up (``(x, y, z) -> (x, z, -y)``, a rotation: left stays le
 
 The body joints come from ``body_model`` (a ``core.body.model.BodyModel``; default OpenBody).
 AMASS betas belong to the SMPL family's shape space, so they are applied only when the model is an
-SMPL-family model (name starting with ``smpl``); other models use their mean shape unless
+SMPL-family model (``is_smpl_family``); other models use their mean shape unless
 ``betas=True`` forces them.
 """
 from __future__ import annotations
@@ -28,6 +28,11 @@ def _default_model():
     from ..body.openbody import OpenBody
 
     return OpenBody.load()
+
+
+def is_smpl_family(model) -> bool:
+    """True for SMPL/SMPL-H/SMPL-X models (``SMPLFamilyBody`` has ``family``; names 'smpl*')."""
+    return hasattr(model, "family") or str(getattr(model, "name", "")).lower().startswith("smpl")
 
 
 def read_amass_npz(path) -> dict:
@@ -65,7 +70,7 @@ def load_amass(path, body_model=None, betas="auto") -> Mocap:
     """Read an AMASS ``.npz`` into a Mocap on the 24 SMPL joints (hands unposed), metres, Y up."""
     d = read_amass_npz(path)
     model = body_model if body_model is not None else _default_model()
-    use = betas if isinstance(betas, bool) else str(getattr(model, "name", "")).lower().startswith("smpl")
+    use = betas if isinstance(betas, bool) else is_smpl_family(model)
     shape = d["betas"] if use else np.zeros(10)
     T = len(d["poses"])
     aa = np.zeros((T, 24, 3))

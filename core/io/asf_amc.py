@@ -214,7 +214,7 @@ def parse_amc(text: str, skel: Skeleton, source="AMC"):
             elif key.startswith(":DEGREES"):
                 angle = np.pi / 180
             continue
-        name, _, rest = line.partition(" ")
+        name, rest = (line.split(None, 1) + [""])[:2]
         if name.isdigit():
             frames += 1
             continue
@@ -328,14 +328,19 @@ def amc_fps(amc_path, default: float = 120.0) -> float:
     return float(m.group(1)) if m and 1 <= int(m.group(1)) <= 1000 else default
 
 
-def load_amc(path, asf=None, fps: float | None = None) -> Mocap:
-    """Read an AMC with its ASF into a Mocap (metres, Y up)."""
+def load_amc(path, asf=None, fps: float | None = None, up_axis: str | None = None) -> Mocap:
+    """Read an AMC with its ASF into a Mocap (metres, Y up). The up axis is detected for a
+    humanoid we can map (CMU/HDM05 are Y up) and taken as Acclaim's Y otherwise."""
+    from .rig_map import find_rig
+
     path = Path(path)
     asf_path = Path(asf) if asf else find_asf(path)
     skel = load_asf(asf_path)
     root, values, angle = parse_amc(_read_text(path, "AMC"), skel, path)
     names, parents, offsets, positions, rots = amc_to_positions(skel, root, values, angle)
     subject = asf_path.stem[4:] if asf_path.stem.startswith("HDM_") else asf_path.stem
+    if up_axis is None and find_rig(names) is None:
+        up_axis = "Y"
     return finish_mocap(names, parents, offsets, positions, fps or amc_fps(path), str(path), rotations=rots,
-                        unit=f"asf length {INCH / skel.length_scale:g}", scale=skel.length_scale, subject=subject,
-                        meta={"asf": str(asf_path)})
+                        unit=f"asf length {INCH / skel.length_scale:g}", scale=skel.length_scale,
+                        up_axis=up_axis, subject=subject, meta={"asf": str(asf_path)})

@@ -17,7 +17,7 @@ from .mocap import Mocap, finish_mocap
 
 CHANNELS = {"xposition": ("p", 0), "yposition": ("p", 1), "zposition": ("p", 2),
             "xrotation": ("r", "x"), "yrotation": ("r", "y"), "zrotation": ("r", "z")}
-MAX_JOINTS = 10000
+MAX_JOINTS = 2000
 MAX_VALUE = 1e7  # any channel value beyond this is corrupt (cm, degrees)
 
 
@@ -71,6 +71,7 @@ def parse_hierarchy(text: str, source="BVH"):
     stack = []  # open joints (indices)
     root_name = tk.name_until_brace("ROOT")
     names.append(root_name)
+    taken = {root_name}
     parents.append(-1)
     stack.append(0)
     offsets.append(None)
@@ -109,13 +110,14 @@ def parse_hierarchy(text: str, source="BVH"):
             if key == "END":
                 label = tk.name_until_brace("End Site")
                 name = names[cur] + "_End" if label.lower() in ("site", "") else label
-                while name in names:
-                    name += "_"
+                if name in taken:
+                    name = f"{name}{len(names)}"
             else:
                 name = tk.name_until_brace("JOINT")
             if len(names) >= MAX_JOINTS:
                 raise ShapeMoveError(f"{source}: BVH has more than {MAX_JOINTS} joints")
             names.append(name)
+            taken.add(name)
             parents.append(cur)
             offsets.append(None)
             channels.append([])
@@ -160,7 +162,7 @@ def parse_bvh(text: str, source="BVH"):
     names, parents, offsets, channels = parse_hierarchy(head, source)
     frames, dt, body = _motion_header(motion, source)
     C = sum(len(c) for c in channels)
-    if frames != int(frames) or frames < 1:
+    if not (np.isfinite(frames) and frames == int(frames) and frames >= 1):
         raise ShapeMoveError(f"{source}: BVH says {frames} frames")
     if not (np.isfinite(dt) and dt > 0):
         raise ShapeMoveError(f"{source}: BVH frame time {dt} is not positive")

@@ -23,9 +23,12 @@ class Mocap:
     names (J,) joint names (End Sites are joints named ``<parent>_End``); parents (J,) int, -1 for
     the root, parents[j] < j; offsets (J,3) metres, Y up: each joint's rest position relative to
     its parent (the root's is its rest position); positions (T,J,3) metres, Y up, world;
-    rotations (T,J,3,3) local joint rotations in the same frame (FK of offsets/rotations gives the
-    positions) or None; fps frames per second; unit and up_axis as found in the file
-    (``unit`` in m/cm/mm/inch/asf, ``scale`` metres per file unit, ``up_axis`` Y/Z/...).
+    rotations (T,J,3,3) local joint rotations in the same frame, or None: FK of the offsets with
+    these rotations, the root placed at positions[:, 0], gives the positions (BVH joints with
+    position channels, like Bandai's, translate by their channels instead of their offsets);
+    fps frames per second; ``unit`` (m/cm/mm/inch/asf ...), ``scale`` (metres per file unit) and
+    ``up_axis`` (Y/Z/...) as found in the file; ``subject`` the performer (CMU subject number,
+    HDM05 actor, 'bandai'); ``meta`` reader extras (BVH channels, ASF path, AMASS betas).
     """
 
     names: list
@@ -151,7 +154,7 @@ def mocap_to_smpl22(mocap: Mocap, fps: float = 20.0, drop_tpose: bool = True) ->
     W = mapping_matrix(rig, mocap.names, mocap.positions)
     joints = np.matmul(W, mocap.positions)
     cut = tpose_lead_in(joints, mocap.fps) if drop_tpose else 0
-    if cut >= len(joints) - 1:
+    if cut > 0 and cut >= len(joints) - 1:
         raise ShapeMoveError(f"{mocap.source}: the clip holds nothing but a T-pose")
     joints = resample_positions(joints[cut:], mocap.fps, fps)
     # rest skeleton: FK of the offsets with identity rotations, mapped like the motion

@@ -31,7 +31,7 @@ SPINE_FRACTIONS = {"pelvis": 0.15, "spine1": 0.34, "spine2": 0.56, "spine3": 0.6
 
 
 def _limbs(hip, knee, ankle, foot, collar, shoulder, elbow, wrist):
-    """Rules for both sides from templates containing '{s}' (side letter/word)."""
+    """Rules for both sides from name templates: '{s}' -> l/r, '{S}' -> Left/Right, '{X}' -> L/R."""
     out = {}
     for side, s in (("left", "L"), ("right", "R")):
         for smpl, tmpl in (("hip", hip), ("knee", knee), ("ankle", ankle), ("foot", foot),
@@ -41,8 +41,8 @@ def _limbs(hip, knee, ankle, foot, collar, shoulder, elbow, wrist):
 
 
 def _side(rule, s):
-    sides = {"L": ("l", "Left", "L", "left"), "R": ("r", "Right", "R", "right")}[s]
-    fill = lambda name: name.format(s=sides[0], S=sides[1], X=sides[2], w=sides[3])  # noqa: E731
+    sides = {"L": ("l", "Left", "L"), "R": ("r", "Right", "R")}[s]
+    fill = lambda name: name.format(s=sides[0], S=sides[1], X=sides[2])  # noqa: E731
     if isinstance(rule, str):
         return fill(rule)
     return tuple(fill(x) if isinstance(x, str) else x for x in rule)

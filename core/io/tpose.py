@@ -26,7 +26,8 @@ def is_tpose(joints: np.ndarray) -> np.ndarray:
     for sh, el, wr, sign in ((16, 18, 20, 1.0), (17, 19, 21, -1.0)):
         arm = joints[:, wr] - joints[:, sh]
         n = np.maximum(np.linalg.norm(arm, axis=-1), 1e-9)
-        reach = np.linalg.norm(joints[:, el] - joints[:, sh], axis=-1) + np.linalg.norm(joints[:, wr] - joints[:, el], axis=-1)
+        reach = (np.linalg.norm(joints[:, el] - joints[:, sh], axis=-1)
+                 + np.linalg.norm(joints[:, wr] - joints[:, el], axis=-1))
         elev = np.degrees(np.arcsin(np.clip(arm[:, 1] / n, -1, 1)))
         side = sign * np.sum(arm * across, -1) / n
         ok &= (np.abs(elev) < ARM_ELEVATION_DEG) & (n > STRAIGHT * reach) & (side > SIDEWAYS_COS)
@@ -52,7 +53,7 @@ def tpose_lead_in(joints: np.ndarray, fps: float) -> int:
 
     def skip_blend(k):  # frames far faster than the clip are the converter's blend out of the T-pose
         limit = min(T - 1, k + int(round(0.25 * fps)))
-        while k < limit and speed[k - 1] > threshold:
+        while k < limit and speed[k] > threshold:
             k += 1
         return k
 

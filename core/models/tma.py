@@ -53,7 +53,7 @@ class TextEncoder(nn.Module):
         self.embed = nn.Embedding(cfg.vocab_size, cfg.dim, padding_idx=0)
         self.register_buffer("pos", _sinusoid(cfg.max_text, cfg.dim), persistent=False)
         layer = nn.TransformerEncoderLayer(cfg.dim, cfg.heads, cfg.dim * 2, dropout=0.1, batch_first=True)
-        self.encoder = nn.TransformerEncoder(layer, cfg.layers)
+        self.encoder = nn.TransformerEncoder(layer, cfg.layers, enable_nested_tensor=False)
         self.out = nn.Linear(cfg.dim, cfg.embed)
         self.max_text = cfg.max_text
 
@@ -73,7 +73,7 @@ class MotionEncoder(nn.Module):
                                   nn.Conv1d(d, d, 4, stride=2, padding=1))
         self.register_buffer("pos", _sinusoid(cfg.max_frames // 4 + 2, d), persistent=False)
         layer = nn.TransformerEncoderLayer(d, cfg.heads, d * 2, dropout=0.1, batch_first=True)
-        self.encoder = nn.TransformerEncoder(layer, cfg.layers)
+        self.encoder = nn.TransformerEncoder(layer, cfg.layers, enable_nested_tensor=False)
         self.out = nn.Linear(d, cfg.embed)
         self.max_frames = cfg.max_frames
 

@@ -296,7 +296,7 @@ def _train(data, out, c, resume, body_name, dist, progress, cancel, verbose) -> 
         bar.update(1)
         done = step == c.steps
         if done or step % c.log_every == 0 or step % c.val_every == 0:
-            train_metrics = distributed.mean_over_ranks({"loss": float(loss)}, dist)
+            train_metrics = distributed.mean_over_ranks({"loss": loss.item()}, dist)
             metrics = {"step": step, "lr": scheduler.get_last_lr()[0], "train": train_metrics,
                        "sec_per_step": (time.time() - t0) / max(1, step - s0)}
             if dist.is_main and (done or step % c.val_every == 0):

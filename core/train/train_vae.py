@@ -11,6 +11,7 @@ ends with the same parameters as an uninterrupted one.
 """
 from __future__ import annotations
 
+import copy
 import json
 import math
 import os
@@ -115,7 +116,7 @@ def train_vae(data, out, config: SAVAEConfig | None = None, steps: int | None = 
     progress(fraction, message) is called on rank 0 every ``log_every`` steps; when cancel()
     returns True training stops after saving ``last.pt`` (resume later with resume=True).
     """
-    cfg = config or SAVAEConfig.small()
+    cfg = copy.deepcopy(config) if config is not None else SAVAEConfig.small()
     if steps is not None:
         cfg.train.steps = int(steps)
     cfg.validate()
@@ -147,7 +148,7 @@ def _train(data, out, cfg, t, resume, body, dist, progress, cancel, verbose) -> 
     step = 0
     last = out / "last.pt"
     if resume and last.exists():
-        ckpt = load_checkpoint(last, map_location=dist.device, kind=KIND, body=body_name, config=cfg.to_dict(),
+        ckpt = load_checkpoint(last, map_location="cpu", kind=KIND, body=body_name, config=cfg.to_dict(),
                                ignore=RESUME_IGNORES, stats_hash_=stats_hash(mean, std))
         model.load_state_dict(ckpt["model"])
         optimizer.load_state_dict(ckpt["optimizer"])

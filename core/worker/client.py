@@ -74,7 +74,7 @@ class _Jobs:
     def _init_jobs(self):
         self._messages: queue.Queue = queue.Queue()
         self.pending: dict = {}  # job id -> op, until its result/error was returned by poll()
-        self._finished: set = set()
+        self._finished: set = set()  # jobs that ended, and our own cancel/shutdown requests
         self._count = 0
 
     def _new_id(self, prefix: str = "j") -> str:
@@ -84,7 +84,7 @@ class _Jobs:
     def _take(self, msg: dict, out: list) -> None:
         jid = msg.get("id")
         if jid in self._finished:
-            return  # a job ends once: drop a late answer after its "died"/"stopped" error
+            return  # a job ends once (drop a late answer after its "died"/"stopped" error); acks of ours
         if msg.get("type") in ("result", "error") and jid in self.pending:
             del self.pending[jid]
             self._finished.add(jid)
@@ -247,6 +247,7 @@ class WorkerClient(_Jobs):
 
     # -- pipes --------------------------------------------------------------------------------
     def _send(self, rid, op: str, params: dict) -> None:
+        self._finished.add(rid)  # its answer is not for the caller
         self._write(P.encode_request(rid, op, params))
 
     def _write(self, line: str) -> None:

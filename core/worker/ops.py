@@ -71,14 +71,21 @@ def body_info(params, progress, cancel) -> dict:
 
 
 def measure(params, progress, cancel) -> dict:
-    """params {"betas": 10 numbers (default zeros), "body"} -> measurements in cm (core.body.measure)."""
+    """params {"betas": 10 numbers (default zeros) or B lists of 10, "body"} -> measurements in cm
+    (core.body.measure): numbers, or lists of B numbers."""
     from ..body.load import load_body_model
     from ..body.measure import measure as _measure
 
+    import numpy as np
+
     betas = param(params, "measure", "betas", list, None)
+    if betas is not None:
+        try:
+            betas = np.asarray(betas, np.float64)
+        except (TypeError, ValueError):
+            raise ShapeMoveError("op 'measure': parameter 'betas' must be a list of numbers (or of lists of numbers)") from None
     body = load_body_model(param(params, "measure", "body", str, None))
-    m = _measure(body, betas)
-    return {k: float(v) for k, v in m.items()}
+    return {k: np.asarray(v).tolist() for k, v in _measure(body, betas).items()}
 
 
 def build_dataset(params, progress, cancel) -> dict:

@@ -143,7 +143,11 @@ class JobRunner:
             msg = P.result(job.id, {}, cancelled=True)
         except ShapeMoveError as exc:
             msg = P.error(job.id, str(exc), "ShapeMoveError")
-        except Exception as exc:  # noqa: BLE001  (a job's bug must not kill the worker)
+        except ModuleNotFoundError as exc:  # the chosen Python lacks a requirement
+            traceback.print_exc(file=sys.stderr)
+            msg = P.error(job.id, f"op {job.op!r} needs the Python package {exc.name!r}, which is not installed in "
+                                  f"{sys.executable}", "ModuleNotFoundError")
+        except BaseException as exc:  # noqa: BLE001  (a job's bug, even sys.exit, must not kill the worker)
             traceback.print_exc(file=sys.stderr)
             msg = P.error(job.id, f"{type(exc).__name__}: {exc}", type(exc).__name__)
         self.emit(msg)

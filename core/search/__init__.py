@@ -1,0 +1,1 @@
+"""Text search over a folder of motions with the TMA."""

@@ -1,0 +1,220 @@
+"""Rank a folder of motions by a text query with a trained TMA.
+
+A library folder is one of
+  * a built dataset folder (``new_joint_vecs/ID.npy`` + ``texts/ID.txt``): every clip, any split;
+  * any folder (searched recursively) of ``.npz`` motion files holding ``features`` (T,263) or
+    ``joints`` (T,22,3) at 20 fps, and/or ``.bvh`` / ``.amc`` mocap files (converted with
+    ``io.mocap.load_smpl22`` + ``motion.features.features_from_joints``). A caption is the
+    file's ``prompt`` (npz) or the first line of a same-name ``.txt`` beside it.
+The embeddings are cached in the folder as ``.shapemove_index.npz``, keyed by the files' sizes
+and modification times and by the TMA checkpoint: the next search with the same files and model
+reuses it, any change rebuilds it.
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import ShapeMoveError
+
+INDEX_NAME = ".shapemove_index.npz"
+MOCAP_EXTS = (".bvh", ".amc")
+
+
+@dataclass
+class LibraryIndex:
+    folder: Path
+    ids: list[str]
+    paths: list[str]
+    captions: list[str]
+    embeddings: np.ndarray            # (N, E) unit vectors
+    tma: tuple                        # (model, tokenizer, mean, std)
+    skipped: list[tuple[str, str]] = field(default_factory=list)  # (file, reason)
+    from_cache: bool = False
+
+    def __len__(self) -> int:
+        return len(self.ids)
+
+
+def _first_line(path: Path) -> str:
+    if not path.is_file():
+        return ""
+    lines = [ln.strip() for ln in path.read_text(encoding="utf-8", errors="replace").splitlines() if ln.strip()]
+    return lines[0] if lines else ""
+
+
+def _is_dataset(folder: Path) -> bool:
+    return (folder / "new_joint_vecs").is_dir()
+
+
+def list_library(folder: Path) -> list[tuple[str, Path, list[Path]]]:
+    """(id, motion file, files whose change invalidates the entry) of every motion in ``folder``."""
+    if _is_dataset(folder):
+        out = []
+        for f in sorted((folder / "new_joint_vecs").glob("*.npy")):
+            if f.name.endswith(".tmp.npy"):
+                continue
+            out.append((f.stem, f, [f, folder / "texts" / f"{f.stem}.txt", folder / "Mean.npy", folder / "Std.npy"]))
+        return out
+    out = []
+    for f in sorted(folder.rglob("*")):
+        ext = f.suffix.lower()
+        if not f.is_file() or f.name == INDEX_NAME or ext not in (".npz", *MOCAP_EXTS):
+            continue
+        if any(part.startswith(".") for part in f.relative_to(folder).parts):
+            continue
+        cid = "/".join(f.relative_to(folder).with_suffix("").parts)
+        deps = [f, f.with_suffix(".txt")]
+        if ext == ".amc":
+            deps += sorted(f.parent.glob("*.asf"))
+        out.append((cid, f, deps))
+    return out
+
+
+def _stamp(files: list[Path]) -> list:
+    return [[str(p), p.stat().st_mtime_ns, p.stat().st_size] if p.is_file() else [str(p), None, None] for p in files]
+
+
+def _key(entries, tma_file: Path | None) -> str:
+    h = hashlib.sha256()
+    tma = _stamp([tma_file])[0] if tma_file is not None else None
+    h.update(json.dumps({"tma": tma, "files": [[cid, _stamp(deps)] for cid, _, deps in entries]}).encode())
+    return h.hexdigest()
+
+
+def load_motion_features(path: Path) -> tuple[np.ndarray, str]:
+    """(features (T,263), caption) of one library file (dataset .npy, motion .npz, BVH/AMC)."""
+    from ..motion.features import features_from_joints
+
+    ext = path.suffix.lower()
+    caption = _first_line(path.with_suffix(".txt"))
+    if ext == ".npy":
+        return np.load(path).astype(np.float32), _first_line(path.parent.parent / "texts" / f"{path.stem}.txt")
+    if ext == ".npz":
+        with np.load(path, allow_pickle=False) as z:
+            if "prompt" in z.files and not caption:
+                caption = str(z["prompt"])
+            if "features" in z.files:
+                return np.asarray(z["features"], np.float32), caption
+            if "joints" in z.files:
+                joints = np.asarray(z["joints"], np.float32)
+                fps = float(z["fps"]) if "fps" in z.files else 20.0
+                if joints.ndim != 3 or joints.shape[1] < 22 or joints.shape[2] != 3:
+                    raise ShapeMoveError(f"joints must be (T,22,3), got {joints.shape}")
+                if abs(fps - 20.0) > 1e-3:
+                    from ..io.resample import resample_positions
+
+                    joints = resample_positions(joints[:, :22], fps, 20.0)
+                return features_from_joints(joints[:, :22]), caption
+        from ..io.mocap import load_smpl22  # an AMASS file
+
+        return features_from_joints(np.asarray(load_smpl22(path).joints, np.float32)), caption
+    if ext in MOCAP_EXTS:
+        from ..io.mocap import load_smpl22
+
+        return features_from_joints(np.asarray(load_smpl22(path).joints, np.float32)), caption
+    raise ShapeMoveError(f"{path}: not a motion file (.npz, .bvh, .amc)")
+
+
+def resolve_tma(tma):
+    """(tma tuple, checkpoint file or None) from a path, a load_tma() tuple or None (the default model)."""
+    from ..eval.tma_embed import load_tma, tma_path
+
+    if isinstance(tma, tuple):
+        return tma, None
+    if tma is None:
+        from ..generation.model_bundle import DEFAULT_MODEL_DIR
+
+        tma = DEFAULT_MODEL_DIR / "tma" / "tma.pt"
+        if not tma.is_file():
+            raise ShapeMoveError(f"no TMA given and the default model has none ({tma}); train one with "
+                                 "`python -m shapemove train tma` and pass --tma RUN/tma.pt")
+    path = tma_path(tma)
+    return load_tma(path), path.resolve()
+
+
+def index_library(folder, tma=None, use_cache: bool = True, progress=None) -> LibraryIndex:
+    """Embed every motion of ``folder`` with the TMA (path, load_tma() tuple or None = default).
+    Files that cannot be read are skipped (listed in ``index.skipped``)."""
+    from ..eval.tma_embed import check_features, embed_motions
+
+    folder = Path(folder)
+    if not folder.is_dir():
+        raise ShapeMoveError(f"motion library folder not found: {folder}")
+    tma, tma_file = resolve_tma(tma)
+    entries = list_library(folder)
+    if not entries:
+        raise ShapeMoveError(f"{folder}: no motions found (expected a built dataset folder, or .npz/.bvh/.amc files)")
+    key = _key(entries, tma_file)
+    cache = folder / INDEX_NAME
+    if use_cache and tma_file is not None and cache.is_file():
+        try:
+            with np.load(cache, allow_pickle=False) as z:
+                if str(z["key"]) == key:
+                    return LibraryIndex(folder, z["ids"].tolist(), z["paths"].tolist(), z["captions"].tolist(),
+                                        z["embeddings"].astype(np.float32), tma,
+                                        [tuple(s) for s in json.loads(str(z["skipped"]))], from_cache=True)
+        except (OSError, KeyError, ValueError):
+            pass  # unreadable or old cache: rebuild it
+    ids, paths, captions, feats, skipped = [], [], [], [], []
+    for i, (cid, f, _) in enumerate(entries):
+        try:
+            x, caption = load_motion_features(f)
+            feats.append(check_features(x, str(f)))
+        except ShapeMoveError as exc:
+            skipped.append((str(f), str(exc)))
+            continue
+        except Exception as exc:  # one bad file must not stop the index
+            skipped.append((str(f), f"{type(exc).__name__}: {exc}"))
+            continue
+        ids.append(cid)
+        paths.append(str(f))
+        captions.append(caption)
+        if progress is not None:
+            progress((i + 1) / len(entries), cid)
+    if not ids:
+        raise ShapeMoveError(f"{folder}: none of the {len(entries)} motion files could be read "
+                             f"(first problem: {skipped[0][1]})")
+    model, _, mean, std = tma
+    emb = embed_motions(model, feats, mean, std)
+    index = LibraryIndex(folder, ids, paths, captions, emb, tma, skipped)
+    if use_cache and tma_file is not None:
+        _save_index(cache, key, index)
+    return index
+
+
+def _save_index(cache: Path, key: str, index: LibraryIndex) -> None:
+    tmp = cache.with_name(cache.name + ".tmp.npz")
+    try:
+        np.savez(tmp, key=np.array(key), ids=np.array(index.ids, dtype=str), paths=np.array(index.paths, dtype=str),
+                 captions=np.array(index.captions, dtype=str), embeddings=index.embeddings,
+                 skipped=np.array(json.dumps(index.skipped)))
+        os.replace(tmp, cache)
+    except OSError:  # a read-only library is still searchable, just not cached
+        tmp.unlink(missing_ok=True)
+
+
+def check_query(query, top_k: int = 10) -> str:
+    """The stripped query; ShapeMoveError when it is empty or ``top_k`` < 1."""
+    if not isinstance(query, str) or not query.strip():
+        raise ShapeMoveError("the search query is empty: describe a motion, e.g. 'a person waves with the left hand'")
+    if top_k < 1:
+        raise ShapeMoveError(f"top_k must be at least 1, got {top_k}")
+    return query.strip()
+
+
+def search(index: LibraryIndex, query: str, top_k: int = 10) -> list[tuple[str, float, str, str]]:
+    """The ``top_k`` motions closest to ``query``: (id, cosine similarity, path, caption), best first."""
+    from ..eval.tma_embed import embed_texts
+
+    query = check_query(query, top_k)
+    model, tok, _, _ = index.tma
+    q = embed_texts(model, tok, [query])[0]
+    scores = index.embeddings @ q
+    order = np.argsort(-scores, kind="stable")[:top_k]
+    return [(index.ids[i], float(scores[i]), index.paths[i], index.captions[i]) for i in order]

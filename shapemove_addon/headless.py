@@ -1,0 +1,94 @@
+"""Headless scene files and previews (bpy as a module, no UI): used by the `demo`, `blend` and
+`render` commands. A fresh factory scene per motion; outputs written atomically."""
+from __future__ import annotations
+
+import os
+import tempfile
+from pathlib import Path
+
+import bpy
+import numpy as np
+
+from .preview_render import add_preview_stage, render_frame
+from .scene_build import build_rig
+
+
+def save_blend(path: Path) -> Path:
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(path.stem + ".tmp.blend")
+    bpy.ops.wm.save_as_mainfile(filepath=str(tmp.resolve()), compress=True, copy=True)
+    os.replace(tmp, path)
+    return path
+
+
+def _pixels(png: Path) -> np.ndarray:
+    img = bpy.data.images.load(str(png), check_existing=False)
+    try:
+        w, h = img.size
+        px = np.empty(w * h * 4, dtype=np.float32)
+        img.pixels.foreach_get(px)
+        return px.reshape(h, w, 4)
+    finally:
+        bpy.data.images.remove(img)
+
+
+def write_strip(frames: list[np.ndarray], path: Path) -> Path:
+    """Frames (h,w,4) side by side into one PNG (atomic)."""
+    strip = np.concatenate(frames, axis=1)
+    h, w = strip.shape[:2]
+    img = bpy.data.images.new("shapemove_strip", w, h, alpha=True)
+    try:
+        img.pixels.foreach_set(strip.ravel())
+        path = Path(path)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        tmp = path.with_name(path.stem + ".tmp.png")
+        img.filepath_raw = str(tmp)
+        img.file_format = "PNG"
+        img.save()
+        os.replace(tmp, path)
+    finally:
+        bpy.data.images.remove(img)
+    return path
+
+
+def build_scene_file(motion, body, out_blend: Path, preview: Path | None = None, frames: int = 4,
+                     resolution=(320, 320), name: str = "ShapeMove") -> dict:
+    """New scene with the rig for ``motion``; saves ``out_blend``; with ``preview`` renders
+    ``frames`` evenly spaced frames into one PNG strip. Returns facts about what was built."""
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    rig = build_rig(bpy.context, motion, body, name=name)
+    scene = bpy.context.scene
+    info = {"armature": rig.armature.name, "vertices": len(rig.body.data.vertices),
+            "bones": len(rig.armature.data.bones), "frame_start": scene.frame_start, "frame_end": scene.frame_end}
+    if preview is not None:
+        add_preview_stage(bpy.context, rig.armature, resolution=tuple(resolution))
+        picks = np.unique(np.linspace(scene.frame_start, scene.frame_end, frames).round().astype(int))
+        with tempfile.TemporaryDirectory() as tmp:
+            shots = []
+            for f in picks:
+                png = Path(tmp) / f"f{int(f):05d}.png"
+                render_frame(scene, int(f), png)
+                shots.append(_pixels(png))
+        write_strip(shots, preview)
+        scene.frame_set(scene.frame_start)
+        info["preview_frames"] = [int(f) for f in picks]
+    save_blend(out_blend)
+    return info
+
+
+def render_video(blend: Path, mp4: Path) -> Path:
+    """Every frame of the saved preview scene to an H.264 MP4 (atomic)."""
+    bpy.ops.wm.open_mainfile(filepath=str(Path(blend).resolve()))
+    scene = bpy.context.scene
+    r = scene.render
+    r.image_settings.file_format = "FFMPEG"
+    r.ffmpeg.format = "MPEG4"
+    r.ffmpeg.codec = "H264"
+    mp4 = Path(mp4)
+    tmp = mp4.with_name(mp4.stem + ".tmp.mp4")
+    r.filepath = str(tmp.resolve())
+    r.use_file_extension = False
+    bpy.ops.render.render(animation=True)
+    os.replace(tmp, mp4)
+    return mp4

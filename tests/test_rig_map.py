@@ -1,0 +1,108 @@
+"""Rig mapping to the 22 SMPL body joints: direct joints, spine-chain interpolation, left/right,
+namespaces, unknown rigs."""
+import numpy as np
+import pytest
+
+from mocap_synth import SMPL_REST, mixamo_skeleton
+from shapemove.core.errors import ShapeMoveError
+from shapemove.core.io.rig_map import SPINE_FRACTIONS, detect_rig, map_positions, normalize
+
+
+def _chain_point(points, frac):
+    seg = np.linalg.norm(np.diff(points, axis=0), axis=-1)
+    s = frac * seg.sum()
+    cum = np.concatenate([[0], np.cumsum(seg)])
+    k = min(np.searchsorted(cum, s, side="right") - 1, len(seg) - 1)
+    t = (s - cum[k]) / seg[k]
+    return (1 - t) * points[k] + t * points[k + 1]
+
+
+def test_mixamo_direct_and_chain_joints():
+    names, parents, rest = mixamo_skeleton()
+    j22, rig = map_positions(names, rest[None])
+    assert rig.name == "mixamo"
+    j22 = j22[0]
+    # every limb joint, the neck and the head come straight from the source
+    for i in [1, 2, 4, 5, 7, 8, 10, 11, 12, 13, 14, 15, 16, 17, 18, 19, 20, 21]:
+        np.testing.assert_allclose(j22[i], SMPL_REST[i], atol=1e-12)
+    # pelvis/spine1/2/3 lie on the mid-hips -> Hips -> Spine -> Spine1 -> Spine2 -> Neck polyline
+    chain = np.stack([(SMPL_REST[1] + SMPL_REST[2]) / 2, SMPL_REST[0], SMPL_REST[3], SMPL_REST[6],
+                      SMPL_REST[9], SMPL_REST[12]])
+    for name, idx in (("pelvis", 0), ("spine1", 3), ("spine2", 6), ("spine3", 9)):
+        np.testing.assert_allclose(j22[idx], _chain_point(chain, SPINE_FRACTIONS[name]), atol=1e-12)
+    # the pelvis sits between and above the hips, like SMPL's (~9 cm)
+    assert abs(j22[0, 0]) < 1e-9 and 0.05 < j22[0, 1] - SMPL_REST[1, 1] < 0.13
+
+
+def test_mapping_is_linear_per_frame():
+    """Mapping a moved skeleton equals moving the mapped skeleton (rigid motion commutes)."""
+    names, parents, rest = mixamo_skeleton()
+    a = np.radians(40)
+    R = np.array([[np.cos(a), 0, np.sin(a)], [0, 1, 0], [-np.sin(a), 0, np.cos(a)]])
+    moved = rest @ R.T + np.array([1.0, 0.2, -3.0])
+    both, _ = map_positions(names, np.stack([rest, moved]))
+    np.testing.assert_allclose(both[1], both[0] @ R.T + np.array([1.0, 0.2, -3.0]), atol=1e-12)
+
+
+BANDAI_LIMBS = ("Shoulder", "UpperArm", "LowerArm", "Hand", "UpperLeg", "LowerLeg", "Foot", "Toes")
+ASF_LIMBS = ("hipjoint", "femur", "tibia", "foot", "toes", "clavicle", "humerus", "radius", "wrist")
+CGSPEED_LIMBS = ("UpLeg", "Leg", "Foot", "ToeBase", "Shoulder", "Arm", "ForeArm", "Hand")
+DAZ_LIMBS = ("Collar", "Shldr", "ForeArm", "Hand", "Buttock", "Thigh", "Shin", "Foot", "Foot_End")
+
+
+@pytest.mark.parametrize("names,rig", [
+    (["joint_Root", "Hips", "Spine", "Chest", "Neck", "Head"]
+     + [f"{b}_{s}" for s in "LR" for b in BANDAI_LIMBS],
+     "bandai"),
+    (["root", "lowerback", "upperback", "thorax", "lowerneck", "upperneck", "head"]
+     + [f"{s}{b}" for s in "lr" for b in ASF_LIMBS],
+     "cmu_asf"),
+    (["Hips", "LowerBack", "Spine", "Spine1", "Neck", "Neck1", "Head"]
+     + [f"{s}{b}" for s in ("Left", "Right") for b in CGSPEED_LIMBS],
+     "cmu_cgspeed"),
+    (["hip", "abdomen", "chest", "neck", "head"]
+     + [f"{s}{b}" for s in "lr" for b in DAZ_LIMBS],
+     "daz"),
+])
+def test_known_rigs_detected(names, rig):
+    assert detect_rig(names).name == rig
+
+
+def test_left_right_from_names():
+    """Swapping the source's Left/Right joints swaps SMPL's left/right joints."""
+    names, parents, rest = mixamo_skeleton(prefix="")
+    swapped = [n.replace("Left", "TMP").replace("Right", "Left").replace("TMP", "Right") for n in names]
+    a, _ = map_positions(names, rest[None])
+    b, _ = map_positions(swapped, rest[None])
+    for left, right in ((1, 2), (4, 5), (7, 8), (10, 11), (13, 14), (16, 17), (18, 19), (20, 21)):
+        np.testing.assert_allclose(a[0, left], b[0, right], atol=1e-12)
+    assert a[0, 1, 0] > 0 and a[0, 16, 0] > 0  # SMPL left at +X
+
+
+def test_cmu_clavicle_interpolated():
+    names = ["root", "lowerback", "upperback", "thorax", "lowerneck", "upperneck", "head"] + [
+        f"{s}{b}" for s in "lr" for b in ASF_LIMBS]
+    pos = np.random.default_rng(0).normal(size=(3, len(names), 3))
+    j22, _ = map_positions(names, pos)
+    lc, lh = names.index("lclavicle"), names.index("lhumerus")
+    np.testing.assert_allclose(j22[:, 13], 0.55 * pos[:, lc] + 0.45 * pos[:, lh], atol=1e-12)
+    np.testing.assert_allclose(j22[:, 10], pos[:, names.index("ltoes")], atol=1e-12)
+
+
+def test_namespace_and_case():
+    assert normalize("mixamorig:LeftArm") == "leftarm"
+    assert normalize("Character1|Hips") == "hips"
+    names, _, _ = mixamo_skeleton(prefix="mixamorig1:")
+    assert detect_rig([n.upper() for n in names]).name == "mixamo"
+
+
+def test_unknown_rig_lists_missing_smpl_joints():
+    names, _, _ = mixamo_skeleton()
+    partial = [n for n in names if "LeftHand" not in n and "RightFoot" not in n]
+    with pytest.raises(ShapeMoveError) as err:
+        detect_rig(partial)
+    msg = str(err.value)
+    assert "left_wrist" in msg and "right_ankle" in msg and "mixamo" in msg
+    assert "left_elbow" not in msg
+    with pytest.raises(ShapeMoveError, match="pelvis"):
+        detect_rig(["a", "b", "c"])
