@@ -86,6 +86,53 @@ def _best_time(fn, repeats: int):
     return best, out
 
 
+def _bone_turn_deg(res, rest, joints) -> np.ndarray:
+    """(T, bones) angle between each posed bone and the target's bone, degrees (the pelvis's own
+    child bones are left out: they are the rest layout)."""
+    from ..core.body.kinematics import forward_kinematics
+    from ..core.body.skeleton import PARENTS
+
+    rot = torch.tensor(res.rotations, dtype=torch.float64)
+    pos, _ = forward_kinematics(rot, torch.tensor(rest).expand(len(rot), -1, -1), PARENTS)
+    bones = [j for j in range(1, 22) if PARENTS[j] != 0]
+    a = pos[:, bones].numpy() - pos[:, PARENTS[bones]].numpy()
+    b = joints[:, bones] - joints[:, PARENTS[bones]]
+    cos = (a * b).sum(-1) / np.linalg.norm(a, axis=-1) / np.linalg.norm(b, axis=-1)
+    return np.degrees(np.arccos(np.clip(cos, -1, 1)))
+
+
+def _reachable(res, rest):
+    """FK of an IK result: targets the body reaches exactly (a real motion on a body that fits)."""
+    from ..core.body.kinematics import forward_kinematics
+    from ..core.body.skeleton import PARENTS
+
+    rot = torch.tensor(res.rotations, dtype=torch.float64)
+    pos, _ = forward_kinematics(rot, torch.tensor(rest).expand(len(rot), -1, -1), PARENTS)
+    return pos[:, :22].numpy() + res.transl[:, None]
+
+
+class _Tally:
+    """Time, frame-weighted joint error and bone turns of one method over the clips."""
+
+    def __init__(self):
+        self.time, self.err, self.frames, self.turns = 0.0, 0.0, 0, []
+
+    def add(self, seconds, res, rest, joints):
+        self.time += seconds
+        self.err += float(res.joint_error.mean()) * len(joints)
+        self.frames += len(joints)
+        self.turns.append(_bone_turn_deg(res, rest, joints).ravel())
+        return res
+
+    @property
+    def err_cm(self) -> float:
+        return self.err / max(self.frames, 1) * 100
+
+    @property
+    def turn_p99(self) -> float:
+        return float(np.percentile(np.concatenate(self.turns), 99))
+
+
 def run(quick: bool = False) -> dict:
     from ..core.body.ik import ik_lbfgs_baseline, solve_ik
     from ..core.body.skeleton import JOINT_NAMES
@@ -100,34 +147,38 @@ def run(quick: bool = False) -> dict:
         clips = []
     if not clips:
         clips = _synthetic_clip(rest, max_frames)
-    solve_ik(clips[0][1][:8], rest)  # warm-up (torch lazy init)
+    solve_ik(clips[0][1][:8], rest)  # warm-up
+    ik_lbfgs_baseline(clips[0][1][:8], rest, iters=2)
 
-    t_ours = t_base = t_analytic = 0.0
-    err_ours, err_base, err_analytic, frames = [], [], [], 0
+    ours, analytic, loose, base, ours_fit, base_fit = (_Tally() for _ in range(6))
     for name, joints in clips:
         fitted, fit_rms = _fit_rest(body, rest, joints)
-        ta, ana = _best_time(lambda: solve_ik(joints, fitted, refine_iters=0), 3)
-        to, ours = _best_time(lambda: solve_ik(joints, fitted), 3)
-        tb, base = _best_time(lambda: ik_lbfgs_baseline(joints, fitted, iters=100), 1)
-        T = len(joints)
-        frames += T
-        t_ours, t_base, t_analytic = t_ours + to, t_base + tb, t_analytic + ta
-        err_ours.append(ours.joint_error.mean() * T)
-        err_base.append(base.joint_error.mean() * T)
-        err_analytic.append(ana.joint_error.mean() * T)
-        print(f"  {name}: {T} frames, body fit bone RMS {fit_rms * 100:.2f} cm | solve_ik {to * 1000:.0f} ms "
-              f"(analytic only {ta * 1000:.0f} ms) err {ours.mean_error_cm:.2f} cm "
-              f"(analytic {ana.mean_error_cm:.2f}) | LBFGS-100 baseline {tb * 1000:.0f} ms err {base.mean_error_cm:.2f} cm")
-        per = ours.per_joint_error_cm()
+        r = ours.add(*_best_time(lambda: solve_ik(joints, fitted), 3), fitted, joints)
+        a = analytic.add(*_best_time(lambda: solve_ik(joints, fitted, refine_iters=0), 3), fitted, joints)
+        lo = loose.add(*_best_time(lambda: solve_ik(joints, fitted, max_turn_deg=89), 1), fitted, joints)
+        b = base.add(*_best_time(lambda: ik_lbfgs_baseline(joints, fitted, iters=100), 1), fitted, joints)
+        # the same motion on a body that fits it exactly: IK accuracy without the body-fit error
+        exact = _reachable(r, fitted)
+        rf = ours_fit.add(*_best_time(lambda: solve_ik(exact, fitted), 1), fitted, exact)
+        bf = base_fit.add(*_best_time(lambda: ik_lbfgs_baseline(exact, fitted, iters=100), 1), fitted, exact)
+        per = r.per_joint_error_cm()
         worst = np.argsort(per)[::-1][:4]
-        print("    worst joints (cm): " + ", ".join(f"{JOINT_NAMES[j]} {per[j]:.2f}" for j in worst))
-    e_ours = float(np.sum(err_ours) / frames * 100)
-    e_base = float(np.sum(err_base) / frames * 100)
-    e_ana = float(np.sum(err_analytic) / frames * 100)
-    speedup = t_base / t_ours
-    print(f"  total {frames} frames: solve_ik {t_ours:.3f} s ({frames / t_ours:.0f} frames/s), "
-          f"baseline {t_base:.3f} s -> speedup x{speedup:.1f}; error {e_ours:.3f} cm vs baseline {e_base:.3f} cm "
-          f"(analytic only {e_ana:.3f} cm, x{t_base / t_analytic:.0f} faster)")
-    return {"ik_speedup": speedup, "ik_err_cm": e_ours, "ik_baseline_err_cm": e_base,
-            "ik_analytic_err_cm": e_ana, "ik_analytic_speedup": t_base / t_analytic, "ik_time_s": t_ours,
-            "ik_baseline_time_s": t_base, "ik_frames": frames, "ik_clips": len(clips)}
+        print(f"  {name}: {len(joints)} frames, body fit bone-length RMS {fit_rms * 100:.2f} cm\n"
+              f"    solve_ik err {r.mean_error_cm:.2f} cm (analytic {a.mean_error_cm:.2f}, max_turn 89: "
+              f"{lo.mean_error_cm:.2f}) | LBFGS-100 err {b.mean_error_cm:.2f} cm | reachable targets: "
+              f"solve_ik {rf.mean_error_cm:.3f} cm, LBFGS-100 {bf.mean_error_cm:.3f} cm\n"
+              "    worst joints (cm): " + ", ".join(f"{JOINT_NAMES[j]} {per[j]:.2f}" for j in worst))
+    speedup = base.time / ours.time
+    print(f"  total {ours.frames} frames: solve_ik {ours.time:.3f} s ({ours.frames / ours.time:.0f} frames/s; "
+          f"analytic only {analytic.time:.3f} s), LBFGS-100 baseline {base.time:.3f} s -> speedup x{speedup:.1f} "
+          f"(analytic only x{base.time / analytic.time:.0f})")
+    print(f"  joint error on the fitted body: solve_ik {ours.err_cm:.3f} cm (analytic {analytic.err_cm:.3f}, "
+          f"max_turn 89: {loose.err_cm:.3f}) vs baseline {base.err_cm:.3f} cm; bone-direction turn p99 "
+          f"{ours.turn_p99:.1f} deg vs baseline {base.turn_p99:.1f} deg")
+    print(f"  reachable targets (body fits): solve_ik {ours_fit.err_cm:.4f} cm vs baseline {base_fit.err_cm:.4f} cm")
+    return {"ik_speedup": speedup, "ik_err_cm": ours.err_cm, "ik_baseline_err_cm": base.err_cm,
+            "ik_analytic_err_cm": analytic.err_cm, "ik_analytic_speedup": base.time / analytic.time,
+            "ik_max_turn_89_err_cm": loose.err_cm, "ik_bone_turn_p99_deg": ours.turn_p99,
+            "ik_baseline_bone_turn_p99_deg": base.turn_p99, "ik_reachable_err_cm": ours_fit.err_cm,
+            "ik_baseline_reachable_err_cm": base_fit.err_cm, "ik_time_s": ours.time,
+            "ik_baseline_time_s": base.time, "ik_frames": ours.frames, "ik_clips": len(clips)}

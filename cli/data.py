@@ -15,6 +15,8 @@ def add_arguments(p):
     b.add_argument("--augment-share", type=float, default=None,
                    help="fraction of Bandai clips that get a copy on a sampled body (default 0.5)")
     b.add_argument("--limit", type=int, default=None, help="only the first N clips (for a quick look)")
+    b.add_argument("--ik-refine-iters", type=int, default=10,
+                   help="LBFGS refinement steps after the analytic IK (0 = analytic only, faster)")
     b.add_argument("--only", nargs="*", default=None, help="only clips whose id starts with one of these")
 
 
@@ -25,6 +27,6 @@ def run(args) -> int:
     body = load_body_model(args.body_model)
     report = build_dataset(args.source, args.out, body=body,
                            augment_share=AUGMENT_SHARE if args.augment_share is None else args.augment_share,
-                           limit=args.limit, only=args.only)
+                           limit=args.limit, only=args.only, ik_refine_iters=args.ik_refine_iters)
     print(report.summary())
     return 0 if report.built + report.skipped_done + report.augmented > 0 else 1

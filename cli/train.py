@@ -39,6 +39,10 @@ def add_arguments(p):
         s.add_argument("--device", choices=["cpu", "cuda"], help="default: cuda when available")
         s.add_argument("--body", help="body model: openbody (default) or an SMPL-family file")
         s.add_argument("--quiet", action="store_true", help="no progress bar")
+        if kind == "t5":
+            s.add_argument("--vae", type=Path, required=True, help="trained SA-VAE (savae.pt) that tokenizes the motions")
+            s.add_argument("--base-model", type=Path, default=None,
+                           help="local pretrained T5 folder (e.g. flan-t5-base on disk) instead of a fresh small T5")
 
 
 def run(args) -> int:

@@ -189,20 +189,40 @@ def test_real_clip_with_fitted_skeleton(mocap_root, rest, clip):
         assert step.max() < 45, f"{JOINT_NAMES[j]} jumps by {step.max():.0f} deg between frames"
 
 
+def bone_turn_deg(res, rest, joints):
+    """(T, bones) angle between each posed bone and the target's bone (pelvis->hip/spine1 left out:
+    those are the rest layout), degrees."""
+    rot = torch.tensor(res.rotations, dtype=torch.float64)
+    pos, _ = forward_kinematics(rot, torch.tensor(rest).expand(len(rot), -1, -1), PARENTS)
+    pos = pos[:, :22].numpy()
+    bones = [j for j in range(1, 22) if PARENTS[j] != 0]
+    a = pos[:, bones] - pos[:, PARENTS[bones]]
+    b = joints[:, bones] - joints[:, PARENTS[bones]]
+    cos = (a * b).sum(-1) / np.linalg.norm(a, axis=-1) / np.linalg.norm(b, axis=-1)
+    return np.degrees(np.arccos(np.clip(cos, -1, 1)))
+
+
 def test_real_clip_on_openbody_fitted_to_bone_lengths(mocap_root, openbody):
     """The real path: OpenBody betas fitted to the clip's bone lengths, then IK. The betas cannot
-    reproduce every bone (fit RMS ~2.4 cm) nor the clip's pelvis/chest layout, so a few cm remain
-    (reported per joint); solve_ik still beats 100 LBFGS iterations from identity."""
+    reproduce every bone (the fitted torso is much longer than Bandai's), so cm remain (reported
+    per joint); the bones still follow the clip's bone directions (within max_turn_deg), where the
+    LBFGS baseline folds them to chase positions."""
     from shapemove.core.body.fit import fit_betas_to_bone_lengths
 
-    joints = _load_bandai(mocap_root, BANDAI_CLIPS[0])
+    joints = _load_bandai(mocap_root, BANDAI_CLIPS[0])[:60]
     fit = fit_betas_to_bone_lengths(openbody, bone_lengths(joints))
     rest = openbody.rest_joints(torch.tensor(fit.betas)[None])[0].double().numpy()
     res = solve_ik(joints, rest)
+    loose = solve_ik(joints, rest, max_turn_deg=89)
+    base = ik_lbfgs_baseline(joints, rest, iters=100)
     _report(res, f"OpenBody fitted (bone RMS {fit.residual * 100:.2f} cm)")
-    assert res.mean_error_cm < 3.5
-    base = ik_lbfgs_baseline(joints[:40], rest, iters=100)
-    assert res.joint_error[:40].mean() * 100 < base.mean_error_cm
+    _report(loose, "OpenBody fitted, max_turn_deg=89")
+    _report(base, "OpenBody fitted, LBFGS baseline")
+    turn, turn_base = bone_turn_deg(res, rest, joints), bone_turn_deg(base, rest, joints)
+    print(f"bone turn p99: solve_ik {np.percentile(turn, 99):.1f} deg, baseline {np.percentile(turn_base, 99):.1f} deg")
+    assert res.mean_error_cm < 6.0
+    assert np.percentile(turn, 99) < 32 < np.percentile(turn_base, 99)
+    assert loose.mean_error_cm < res.mean_error_cm
 
 
 def test_real_clip_bone_lengths_only(mocap_root, rest):

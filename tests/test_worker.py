@@ -169,7 +169,8 @@ def test_measure_equals_in_process(shared):
     betas = [1.5, -0.5, 0, 0, 0.3, 0, 0, 0, 0, -1.0]
     got = shared.call("measure", {"betas": betas}, timeout=90)
     want = measure(load_body_model(None), np.array(betas))
-    assert got.keys() == want.keys() and all(got[k] == pytest.approx(float(want[k]), abs=1e-9) for k in want)
+    # float32 mesh maths: two processes may sum in another order (torch threads), so 1e-6 relative
+    assert got.keys() == want.keys() and all(got[k] == pytest.approx(float(want[k]), rel=1e-6) for k in want)
 
 
 def test_errors_unknown_op_and_bad_input(shared):

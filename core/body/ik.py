@@ -2,17 +2,20 @@
 
 ``solve_ik`` is analytic and batched over frames (a Python loop over the 24 joints only):
 
-* the pelvis and spine3 (several children) get a Kabsch fit of all their child bones;
+* the root gets a rigid fit (rotation + translation) of the pelvis, hips and spine1; spine3 a
+  Kabsch fit of its three child bones;
 * spine1/spine2 align their bone and take a left-right axis blended between the pelvis and the
   chest, so a torso twist is spread along the spine;
-* hips and shoulders align their bone and choose the twist so that the knee/elbow bends about a
-  fixed hinge axis (knees about +X, elbows about -/+Y in the rest pose): limbs bend consistently
-  and never flip; the knee/elbow is then a pure hinge rotation when the pose allows it;
+* hips and shoulders place the knee/elbow (straight at its target, or the two-bone solution that
+  also lands the ankle/wrist, whichever misses less) and choose the twist so that the knee/elbow
+  bends about a fixed hinge axis (knees about +X, elbows about -/+Y in the rest pose): limbs bend
+  consistently and never flip; the knee/elbow is then a pure hinge rotation;
 * every other joint with a child takes the minimal rotation (swing) from its parent's frame;
   the leaves of the 22-joint body (head, feet, wrists) and the hands keep the identity.
 
-Each bone is aimed from where forward kinematics actually puts its parent, so bone-length
-mismatches do not accumulate down the chains. An optional short batched LBFGS refinement
+Each bone is aimed from where forward kinematics actually put its parent, so a small miss does
+not accumulate down the chain; a big miss (a body with other proportions) is carried along
+instead of folding the next bone (``max_turn_deg``). A short batched L-BFGS refinement
 (axis-angle corrections on all frames at once + a temporal smoothness term) reduces what is left.
 
 Positions: metres, Y up. Local rotations as in ``kinematics.forward_kinematics``:
@@ -40,7 +43,6 @@ LIMBS = [
 ]
 END_JOINTS = [7, 8, 10, 11, 20, 21]  # ankles, feet, wrists
 ROOT_WEIGHTS = (1.0, 1.0, 1.0, 1.0)  # pelvis, left hip, right hip, spine1 in the root fit
-MAX_AIM_TURN = 20.0  # degrees a bone may turn from the target's bone direction to hit a target
 LIMB_END_WEIGHT = 2.0  # an ankle/wrist miss counts double when placing the knee/elbow
 SPINE_BLEND = {3: 1.0 / 3.0, 6: 2.0 / 3.0}  # share of the chest's left-right axis per spine joint
 _EPS = 1e-9
@@ -209,7 +211,7 @@ def rest_with_bone_lengths(rest_joints, lengths) -> np.ndarray:
 
 
 # -- analytic solve ------------------------------------------------------------------------------
-def analytic_ik(target: torch.Tensor, rest: torch.Tensor, parents) -> tuple[torch.Tensor, torch.Tensor]:
+def analytic_ik(target: torch.Tensor, rest: torch.Tensor, parents, max_turn_deg: float = 30.0):
     """target (T,22,3), rest (24,3) float64 -> local rotations (T,24,3,3), transl (T,3)."""
     T = target.shape[0]
     dt = target.dtype
@@ -244,7 +246,8 @@ def analytic_ik(target: torch.Tensor, rest: torch.Tensor, parents) -> tuple[torc
         if not ch:
             G[j] = G[p]
             continue
-        shift = _aim_shift(target[:, j] - P[j], min(float(torch.linalg.norm(offs[c])) for c in ch))
+        bone = torch.linalg.norm(target[:, ch] - target[:, j:j + 1], dim=-1).min(1, keepdim=True).values
+        shift = _aim_shift(target[:, j] - P[j], bone, max_turn_deg)
         aim = target[:, ch] + shift[:, None]  # child targets, moved along when j is off its own
         if len(ch) > 1:
             G[j] = _kabsch(offs[ch], aim - P[j][:, None])
@@ -264,14 +267,14 @@ def analytic_ik(target: torch.Tensor, rest: torch.Tensor, parents) -> tuple[torc
     return rot, P[0] - rest[0]
 
 
-def _aim_shift(miss: torch.Tensor, bone: float) -> torch.Tensor:
+def _aim_shift(miss: torch.Tensor, bone: torch.Tensor, max_turn_deg: float) -> torch.Tensor:
     """(T,3) shift for the child targets of a joint that FK put ``miss`` = target - FK position
-    away from its target. Aiming a bone of length ``bone`` straight at its child's target from
+    away from its target. Aiming a bone (target length ``bone`` (T,1)) at its child's target from
     the wrong place would turn it away from the target bone's direction (a too-long spine
     folds the neck); the child targets are moved along with the miss as far as needed to keep
-    that turn below MAX_AIM_TURN, so small misses are still corrected and big ones copied."""
+    that turn below ``max_turn_deg``, so small misses are still corrected and big ones copied."""
     e = torch.linalg.norm(miss, dim=-1, keepdim=True)
-    beta = (bone * np.sin(np.radians(MAX_AIM_TURN)) / e.clamp_min(_EPS)).clamp(max=1.0)
+    beta = (bone * np.sin(np.radians(min(max_turn_deg, 90.0))) / e.clamp_min(_EPS)).clamp(max=1.0)
     return -(1 - beta) * miss
 
 
@@ -414,15 +417,18 @@ def refine(rot0, transl0, target, rest, parents, iters: int = 10, smooth: float 
     return rot, tr
 
 
-def solve_ik(joints, rest_joints, parents=PARENTS, refine_iters: int = 10) -> IKResult:
+def solve_ik(joints, rest_joints, parents=PARENTS, refine_iters: int = 10, max_turn_deg: float = 30.0) -> IKResult:
     """joints (T,22,3) metres Y-up; rest_joints (24,3) of the target body (e.g.
     ``BodyModel.rest_joints(betas)[0]``). Analytic IK then ``refine_iters`` LBFGS iterations
-    (0 = analytic only; skipped when the analytic error is already below 0.01 mm). Bad input
-    raises ShapeMoveError.
+    (0 = analytic only; skipped when the analytic error is already below 0.01 mm).
+    ``max_turn_deg``: when the body's proportions differ from the targets', how far (degrees) a
+    bone may turn away from the target bone's direction to reach a target joint; larger trades
+    natural poses (a too-long spine would fold the neck) for lower joint error. Irrelevant when
+    the body fits. Bad input raises ShapeMoveError.
     Returns local rotations (T,24,3,3) and transl (T,3) such that FK + transl ~ joints."""
     target, rest, parents = _prepare(joints, rest_joints, parents)
     with _one_thread():
-        rot, transl = analytic_ik(target, rest, parents)
+        rot, transl = analytic_ik(target, rest, parents, max_turn_deg)
         if refine_iters > 0:
             with torch.no_grad():
                 before = torch.linalg.norm(_fk(rot, rest, parents, transl) - target, dim=-1).max()

@@ -171,7 +171,7 @@ def _wants_augment(clip: ClipSource, share: float) -> bool:
 
 def build_dataset(sources: list[Path], out: Path, body=None, augment_share: float = AUGMENT_SHARE,
                   limit: int | None = None, only: list[str] | None = None, progress=None, cancel=None,
-                  verbose: bool = True) -> BuildReport:
+                  verbose: bool = True, ik_refine_iters: int = 10) -> BuildReport:
     """Build (or resume building) a dataset folder from mocap sources. See the module docstring."""
     from tqdm import tqdm
 
@@ -188,7 +188,7 @@ def build_dataset(sources: list[Path], out: Path, body=None, augment_share: floa
         clips = clips[:limit]
     if not clips:
         raise ShapeMoveError(f"no motion clips found in {', '.join(map(str, sources))}")
-    proc = ClipProcessor(body)
+    proc = ClipProcessor(body, ik_refine_iters=ik_refine_iters)
     report = BuildReport()
     bar = tqdm(clips, desc="building", unit="clip", disable=not verbose)
     for i, clip in enumerate(bar):

@@ -92,7 +92,6 @@ class Generator:
         return codes, torch.stack(betas)
 
     # -- motion ------------------------------------------------------------------------------
-    @torch.no_grad()
     def decode_motion(self, codes: list[int], betas: np.ndarray, prompt: str | None = None) -> Motion:
         """Tokens + body shape -> Motion on the body model (SA-VAE decode, joints, IK)."""
         from ..body.ik import solve_ik
@@ -103,10 +102,12 @@ class Generator:
             raise ShapeMoveError("no motion tokens to decode")
         b = torch.as_tensor(np.asarray(betas, np.float32)).reshape(1, 10)
         idx = torch.as_tensor(codes, dtype=torch.long)[None]
-        feats = self.vae.denormalize(self.vae.decode_long(self.vae.quantizer.indices_to_codes(idx), b))[0]
-        joints = joints_from_features(feats).numpy()
+        with torch.no_grad():
+            feats = self.vae.denormalize(self.vae.decode_long(self.vae.quantizer.indices_to_codes(idx), b))[0]
+            joints = joints_from_features(feats).numpy()
         joints[..., 1] -= joints[:, [7, 8, 10, 11], 1].min()
-        rest = self.body.rest_joints(b)[0].numpy()
+        with torch.no_grad():
+            rest = self.body.rest_joints(b)[0].numpy()
         ik = solve_ik(joints, rest, refine_iters=self.ik_refine_iters)
         rot = torch.as_tensor(np.asarray(ik.rotations, np.float32))
         poses = matrix_to_axis_angle(rot).numpy().astype(np.float32)

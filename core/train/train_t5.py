@@ -204,6 +204,6 @@ def _train(data, vae_path, out, c, base_model, resume, dist, progress, cancel, v
 
 
 def from_cli(args) -> dict:
-    c = T5TrainConfig.load(args.config)
+    c = T5TrainConfig.load(None if args.config == "small" else args.config)
     return train_t5(args.data, args.vae, args.out, c, base_model=args.base_model, resume=args.resume,
                     steps=args.steps, device=args.device, verbose=not args.quiet)
