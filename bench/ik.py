@@ -12,6 +12,8 @@ import time
 import numpy as np
 import torch
 
+from ..core.body.ik import bone_turn_deg, ik_lbfgs_baseline, solve_ik
+
 CLIPS = [  # (archive folder, glob) - the first match of each
     ("bandai", "dataset-1/data/dataset-1_walk-back_active_001.bvh"),
     ("bandai", "dataset-1/data/dataset-1_dash_active_001.bvh"),
@@ -30,20 +32,15 @@ def _body_rest():
     return body, body.rest_joints()[0].double().numpy()
 
 
-def _fit_rest(body, rest, joints):
-    """Rest joints of the body fitted to the clip's bone lengths; the fit's bone-length RMS (m)."""
+def _fit_rest(body, joints):
+    """Rest joints (24,3) of the body with betas fitted to the clip's bone lengths, and the fit's
+    bone-length RMS (m)."""
+    from ..core.body.fit import fit_betas_to_bone_lengths
     from ..core.body.skeleton import PARENTS
 
     lengths = np.median(np.linalg.norm(joints[:, 1:] - joints[:, PARENTS[1:22]], axis=-1), 0)
-    try:
-        from ..core.body.fit import fit_betas_to_bone_lengths
-
-        fit = fit_betas_to_bone_lengths(body, lengths)
-        return body.rest_joints(torch.tensor(fit.betas)[None])[0].double().numpy(), fit.residual
-    except ImportError:
-        from ..core.body.ik import rest_with_bone_lengths
-
-        return rest_with_bone_lengths(rest, lengths), 0.0
+    fit = fit_betas_to_bone_lengths(body, lengths)
+    return body.rest_joints(torch.tensor(fit.betas)[None])[0].double().numpy(), fit.residual
 
 
 def _real_clips(n: int, max_frames: int):
@@ -86,21 +83,6 @@ def _best_time(fn, repeats: int):
     return best, out
 
 
-def _bone_turn_deg(res, rest, joints) -> np.ndarray:
-    """(T, bones) angle between each posed bone and the target's bone, degrees (the pelvis's own
-    child bones are left out: they are the rest layout)."""
-    from ..core.body.kinematics import forward_kinematics
-    from ..core.body.skeleton import PARENTS
-
-    rot = torch.tensor(res.rotations, dtype=torch.float64)
-    pos, _ = forward_kinematics(rot, torch.tensor(rest).expand(len(rot), -1, -1), PARENTS)
-    bones = [j for j in range(1, 22) if PARENTS[j] != 0]
-    a = pos[:, bones].numpy() - pos[:, PARENTS[bones]].numpy()
-    b = joints[:, bones] - joints[:, PARENTS[bones]]
-    cos = (a * b).sum(-1) / np.linalg.norm(a, axis=-1) / np.linalg.norm(b, axis=-1)
-    return np.degrees(np.arccos(np.clip(cos, -1, 1)))
-
-
 def _reachable(res, rest):
     """FK of an IK result: targets the body reaches exactly (a real motion on a body that fits)."""
     from ..core.body.kinematics import forward_kinematics
@@ -121,7 +103,7 @@ class _Tally:
         self.time += seconds
         self.err += float(res.joint_error.mean()) * len(joints)
         self.frames += len(joints)
-        self.turns.append(_bone_turn_deg(res, rest, joints).ravel())
+        self.turns.append(bone_turn_deg(res.rotations, res.transl, rest, joints).ravel())
         return res
 
     @property
@@ -134,7 +116,6 @@ class _Tally:
 
 
 def run(quick: bool = False) -> dict:
-    from ..core.body.ik import ik_lbfgs_baseline, solve_ik
     from ..core.body.skeleton import JOINT_NAMES
 
     torch.set_num_threads(1)
@@ -152,7 +133,7 @@ def run(quick: bool = False) -> dict:
 
     ours, analytic, loose, base, ours_fit, base_fit = (_Tally() for _ in range(6))
     for name, joints in clips:
-        fitted, fit_rms = _fit_rest(body, rest, joints)
+        fitted, fit_rms = _fit_rest(body, joints)
         r = ours.add(*_best_time(lambda: solve_ik(joints, fitted), 3), fitted, joints)
         a = analytic.add(*_best_time(lambda: solve_ik(joints, fitted, refine_iters=0), 3), fitted, joints)
         lo = loose.add(*_best_time(lambda: solve_ik(joints, fitted, max_turn_deg=89), 1), fitted, joints)

@@ -17,6 +17,7 @@ def add_arguments(p):
     b.add_argument("--limit", type=int, default=None, help="only the first N clips (for a quick look)")
     b.add_argument("--ik-refine-iters", type=int, default=10,
                    help="LBFGS refinement steps after the analytic IK (0 = analytic only, faster)")
+    b.add_argument("--shard", default="0/1", help="i/n: build every n-th clip starting at i (run n processes on one --out)")
     b.add_argument("--only", nargs="*", default=None, help="only clips whose id starts with one of these")
 
 
@@ -24,9 +25,16 @@ def run(args) -> int:
     from ..core.body.load import load_body_model
     from ..core.data.build import AUGMENT_SHARE, build_dataset
 
+    from ..core.errors import ShapeMoveError
+
+    try:
+        shard = tuple(int(v) for v in args.shard.split("/"))
+        assert len(shard) == 2
+    except (ValueError, AssertionError):
+        raise ShapeMoveError(f"--shard must look like 0/2, got {args.shard!r}") from None
     body = load_body_model(args.body_model)
     report = build_dataset(args.source, args.out, body=body,
                            augment_share=AUGMENT_SHARE if args.augment_share is None else args.augment_share,
-                           limit=args.limit, only=args.only, ik_refine_iters=args.ik_refine_iters)
+                           limit=args.limit, only=args.only, ik_refine_iters=args.ik_refine_iters, shard=shard)
     print(report.summary())
     return 0 if report.built + report.skipped_done + report.augmented > 0 else 1

@@ -150,8 +150,8 @@ def _prepare(joints, rest_joints, parents):
     if not (torch.isfinite(j).all() and torch.isfinite(r).all()):
         raise ShapeMoveError("IK input contains NaN or infinite values")
     parents = np.asarray(parents, dtype=np.int64)
-    if parents.shape != (NUM_JOINTS,) or parents[0] != -1 or np.any(parents[1:] >= np.arange(1, NUM_JOINTS)):
-        raise ShapeMoveError("parents must be the 24-joint SMPL tree (parents[0] = -1, parents[j] < j)")
+    if not np.array_equal(parents, PARENTS):
+        raise ShapeMoveError("IK supports the SMPL 24-joint tree only (parents = skeleton.PARENTS)")
     return j[:, :NUM_BODY_JOINTS], r, parents
 
 
@@ -208,6 +208,21 @@ def rest_with_bone_lengths(rest_joints, lengths) -> np.ndarray:
         scale = lengths[bone - 1] / max(np.linalg.norm(rest[bone] - rest[PARENTS[bone]]), 1e-9)
         out[j] = out[PARENTS[j]] + offs[j] * scale
     return out
+
+
+def bone_turn_deg(rotations, transl, rest_joints, joints, parents=PARENTS) -> np.ndarray:
+    """(T,19) angle in degrees between each posed bone and the target's bone for the 22-joint
+    body, leaving out the pelvis's own child bones (those are the body's rest layout). A pose
+    quality measure next to the joint error: 0 means every bone points as in the targets."""
+    rot = torch.as_tensor(np.asarray(rotations), dtype=torch.float64)
+    rest = torch.as_tensor(np.asarray(rest_joints, dtype=np.float64)).reshape(NUM_JOINTS, 3)
+    pos = _fk(rot, rest, parents, torch.as_tensor(np.asarray(transl), dtype=torch.float64)).numpy()
+    tgt = np.asarray(joints, dtype=np.float64)[:, :NUM_BODY_JOINTS]
+    bones = np.array([j for j in range(1, NUM_BODY_JOINTS) if parents[j] != 0])
+    a = pos[:, bones] - pos[:, parents[bones]]
+    b = tgt[:, bones] - tgt[:, parents[bones]]
+    cos = (a * b).sum(-1) / np.maximum(np.linalg.norm(a, axis=-1) * np.linalg.norm(b, axis=-1), 1e-12)
+    return np.degrees(np.arccos(np.clip(cos, -1, 1)))
 
 
 # -- analytic solve ------------------------------------------------------------------------------

@@ -76,6 +76,15 @@ class ClipProcessor:
         self.body = body if body is not None else load_body_model(None)
         self.ik_refine_iters = ik_refine_iters
         self.rest0 = self.body.rest_joints(None)[0].numpy()
+        self._measured: dict[bytes, dict] = {}  # clips of one subject share betas: measure once
+
+    def measure(self, betas: np.ndarray) -> dict:
+        from ..body.measure import measure
+
+        key = np.asarray(betas, np.float32).tobytes()
+        if key not in self._measured:
+            self._measured[key] = {k: float(v) for k, v in measure(self.body, betas).items()}
+        return self._measured[key]
 
     def load(self, clip: ClipSource):
         from ..io.mocap import load_smpl22
@@ -114,7 +123,6 @@ class ClipProcessor:
         import torch
 
         from ..body.ik import solve_ik
-        from ..body.measure import measure
         from ..motion.features import features_from_joints
 
         fitted = self.fit(joints)
@@ -132,7 +140,7 @@ class ClipProcessor:
         local22 = rot[:, :22]
         from ..body.kinematics import matrix_to_axis_angle
 
-        m = measure(self.body, target)
+        m = self.measure(target)
         return {
             "new_joints": shaped, "new_joint_vecs": features_from_joints(shaped, local22),
             "norm_joints": normal, "norm_joint_vecs": features_from_joints(normal, local22),
@@ -140,7 +148,7 @@ class ClipProcessor:
             "poses": matrix_to_axis_angle(torch.as_tensor(rot)).numpy().astype(np.float32),
             "transl": shaped[:, 0] - rest_t[0],  # BodyModel.forward(target, poses, transl) -> shaped
             "ik_error_cm": float(ik.mean_error_cm),
-            "measure": {k: float(v) for k, v in m.items()},
+            "measure": m,
         }
 
 
@@ -171,7 +179,7 @@ def _wants_augment(clip: ClipSource, share: float) -> bool:
 
 def build_dataset(sources: list[Path], out: Path, body=None, augment_share: float = AUGMENT_SHARE,
                   limit: int | None = None, only: list[str] | None = None, progress=None, cancel=None,
-                  verbose: bool = True, ik_refine_iters: int = 10) -> BuildReport:
+                  verbose: bool = True, ik_refine_iters: int = 10, shard: tuple[int, int] = (0, 1)) -> BuildReport:
     """Build (or resume building) a dataset folder from mocap sources. See the module docstring."""
     from tqdm import tqdm
 
@@ -186,6 +194,10 @@ def build_dataset(sources: list[Path], out: Path, body=None, augment_share: floa
         clips = [c for c in clips if any(c.id.startswith(o) for o in only)]
     if limit:
         clips = clips[:limit]
+    index, count = shard
+    if not 0 <= index < count:
+        raise ShapeMoveError(f"shard must be i/n with 0 <= i < n, got {index}/{count}")
+    clips = clips[index::count]  # several processes can build one folder: each takes every n-th clip
     if not clips:
         raise ShapeMoveError(f"no motion clips found in {', '.join(map(str, sources))}")
     proc = ClipProcessor(body, ik_refine_iters=ik_refine_iters)

@@ -83,7 +83,8 @@ def measure(params, progress, cancel) -> dict:
         try:
             betas = np.asarray(betas, np.float64)
         except (TypeError, ValueError):
-            raise ShapeMoveError("op 'measure': parameter 'betas' must be a list of numbers (or of lists of numbers)") from None
+            raise ShapeMoveError("op 'measure': parameter 'betas' must be a list of numbers "
+                                 "(or of lists of numbers)") from None
     body = load_body_model(param(params, "measure", "body", str, None))
     return {k: np.asarray(v).tolist() for k, v in _measure(body, betas).items()}
 

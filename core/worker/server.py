@@ -29,7 +29,8 @@ class _Writer:
         try:
             line = P.encode_response(msg)
         except P.ProtocolError as exc:  # a bug of ours: say so instead of dying
-            line = P.encode_response(P.error(msg.get("id") if isinstance(msg, dict) else None, str(exc), "ProtocolError"))
+            rid = msg.get("id") if isinstance(msg, dict) else None
+            line = P.encode_response(P.error(rid if isinstance(rid, (str, int)) else None, str(exc), "ProtocolError"))
         with self.lock:
             try:
                 self.stream.write(line + "\n")

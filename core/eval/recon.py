@@ -1,0 +1,113 @@
+"""SA-VAE reconstruction quality on a built dataset split, beside the ground truth.
+
+For each clip: the canonical features (``norm_joint_vecs``) are normalized, encoded to tokens and
+decoded with the clip's own betas (``decode_long``, as generation does) -> shape-aware features
+-> joints (``joints_from_features``; NOT re-grounded, so the model's floor errors count) -> IK
+onto the body with those betas -> mesh metrics (``evaluate_motion``; bone metrics on the decoded
+joints). MPJPE is against the ground-truth shape-aware joints recovered from ``new_joint_vecs``
+(same canonical frame, same frames). The ground truth column is the dataset's shape-aware motion
+itself: ``poses``/``transl`` on the body with the clip's betas (its MPJPE is 0 by definition).
+Frames: the (T-1) feature rows cut to a multiple of the VAE's downsampling.
+
+Result (also the JSON of ``eval recon``)::
+
+    {"mpjpe_mm", "bone_err_mm", "penetrate_cm", "float_cm", "skate_pct", "dyn_stable_pct",
+     "code_usage_pct", "clips",                       # the reconstruction
+     "ground_truth": {same keys; code_usage_pct None}}
+
+Metrics are frame-weighted over all clips (``report.aggregate``); code usage is the share of the
+codebook used by all tokens of the split.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import torch
+
+from ..errors import ShapeMoveError
+from .bones import mpjpe_mm
+from .evaluate import evaluate_motion
+from .report import aggregate
+
+KEYS = ("mpjpe_mm", "bone_err_mm", "penetrate_cm", "float_cm", "skate_pct", "dyn_stable_pct")
+
+
+def _body(body):
+    if body is not None and not isinstance(body, str):
+        return body
+    from ..body.load import load_body_model
+
+    return load_body_model(body)
+
+
+def _load(root: Path, sub: str, cid: str) -> np.ndarray:
+    p = root / sub / f"{cid}.npy"
+    try:
+        return np.load(p).astype(np.float32)
+    except FileNotFoundError:
+        raise ShapeMoveError(f"{root}: clip '{cid}' has no {sub}/ file; is this a dataset from `data build`?") from None
+
+
+def _pick(agg: dict) -> dict:
+    return {k: float(agg[k]) for k in KEYS}
+
+
+def recon_clip(vae, body, norm_feats: np.ndarray, betas: np.ndarray, ik_refine_iters: int = 10):
+    """(T-1,263) canonical features + betas -> (joints (n,22,3), rotations (n,24,3,3), transl (n,3),
+    token indices (n/4,)) of the reconstruction, n = (T-1) cut to a multiple of the downsampling."""
+    from ..body.ik import solve_ik
+    from ..motion.features import joints_from_features
+
+    n = len(norm_feats) // vae.cfg.downsample * vae.cfg.downsample
+    if n == 0:
+        raise ShapeMoveError(f"clip too short for the SA-VAE ({len(norm_feats)} feature rows)")
+    b = torch.as_tensor(betas, dtype=torch.float32).reshape(1, 10)
+    with torch.no_grad():  # (not around the IK: its refinement takes gradients)
+        codes, indices = vae.encode(vae.normalize(torch.as_tensor(norm_feats[:n]))[None])
+        feats = vae.denormalize(vae.decode_long(codes, b))[0]
+        joints = joints_from_features(feats.double()).float().numpy()
+    ik = solve_ik(joints, body.rest_joints(b)[0].numpy(), refine_iters=ik_refine_iters)
+    return joints, ik.rotations, ik.transl, indices[0]
+
+
+def eval_recon(data, checkpoint, split: str = "test", body=None, max_clips: int | None = None, progress=None,
+               ik_refine_iters: int = 10) -> dict:
+    """Reconstruction metrics of the SA-VAE ``checkpoint`` (run folder or .pt) on the ``split``
+    clips of the dataset folder ``data``, with the ground truth's beside (see the module doc).
+    progress(fraction, clip id) after each clip."""
+    from ..body.kinematics import axis_angle_to_matrix
+    from ..generation.retarget import load_vae
+    from ..models.fsq import codebook_usage
+    from ..motion.features import joints_from_features
+    from ..train.motion_dataset import read_split
+
+    root = Path(data)
+    if not root.is_dir():
+        raise ShapeMoveError(f"dataset folder not found: {root}")
+    if split not in ("train", "val", "test"):
+        raise ShapeMoveError(f"split must be train, val or test, got {split!r}")
+    body = _body(body)
+    vae = load_vae(checkpoint, body)
+    ids = read_split(root, split)[:max_clips] if max_clips else read_split(root, split)
+    if not ids:
+        raise ShapeMoveError(f"{root}: the {split} split has no clips ({split}.txt missing or empty)")
+    model_rows, gt_rows, all_indices = [], [], []
+    for i, cid in enumerate(ids):
+        betas = _load(root, "betas", cid).reshape(-1)
+        joints, rot, transl, idx = recon_clip(vae, body, _load(root, "norm_joint_vecs", cid), betas, ik_refine_iters)
+        n = len(joints)
+        gt_joints = joints_from_features(_load(root, "new_joint_vecs", cid)[:n].astype(np.float64))
+        m = evaluate_motion(body, betas, rot, transl, joints=joints)
+        m["mpjpe_mm"] = mpjpe_mm(joints, gt_joints)
+        gt_rot = axis_angle_to_matrix(torch.as_tensor(_load(root, "poses", cid)[:n])).numpy()
+        g = evaluate_motion(body, betas, gt_rot, _load(root, "transl", cid)[:n])
+        g["mpjpe_mm"] = mpjpe_mm(gt_joints, gt_joints)
+        model_rows.append(m)
+        gt_rows.append(g)
+        all_indices.append(idx)
+        if progress is not None:
+            progress((i + 1) / len(ids), cid)
+    usage = codebook_usage(torch.cat(all_indices), vae.quantizer.codebook_size)["used_fraction"] * 100.0
+    return {**_pick(aggregate(model_rows)), "code_usage_pct": float(usage), "clips": len(ids),
+            "ground_truth": {**_pick(aggregate(gt_rows)), "code_usage_pct": None, "clips": len(ids)}}

@@ -1,0 +1,154 @@
+"""Move a captured motion onto another body: through the SA-VAE (HUMOS-style) or naively.
+
+``retarget(motion, vae, body, betas)``:
+  1. read the clip as 22 SMPL joints at 20 fps (BVH, ASF/AMC, AMASS .npz; ``io.mocap.load_smpl22``)
+     or take a ``Motion22``;
+  2. the dataset builder's per-clip steps (``data.build.ClipProcessor``): fit the subject's betas
+     to its bone lengths, IK onto that body, the same rotations on the canonical body (betas = 0,
+     stride scaled by the pelvis height) -> canonical HumanML3D features;
+  3. SA-VAE encode -> motion tokens; decode them with the NEW betas -> shape-aware features ->
+     joints -> IK onto the new body (``decode_tokens``, the generator's decoding), so feet stay planted and bones
+     take the new body's lengths. The Motion keeps its tokens: ``Generator.redecode`` moves it
+     to yet another body.
+``naive_retarget(motion, body, betas)``: the subject's local rotations copied onto the new body,
+the root trajectory scaled by the leg-length (pelvis height) ratio, lowest foot put back on the
+floor (exactly the builder's augmentation). Bones are the new body's, but feet slide and float
+wherever the proportions differ.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import torch
+
+from ..errors import ShapeMoveError
+from ..io.mocap import Motion22
+from ..scene.motion_file import Motion, validate
+
+FPS = 20
+
+
+def savae_checkpoint(path=None) -> Path:
+    """A run folder (``savae.pt``, else ``last.pt``), a model folder or a ``.pt`` file -> the
+    SA-VAE checkpoint file; None -> the embedded default model's ``savae.pt``."""
+    from .model_bundle import DEFAULT_MODEL_DIR
+
+    p = Path(path) if path is not None else DEFAULT_MODEL_DIR / "savae.pt"
+    if p.is_dir():
+        for name in ("savae.pt", "last.pt"):
+            if (p / name).is_file():
+                return p / name
+        raise ShapeMoveError(f"{p} holds no savae.pt or last.pt: train one with `python -m shapemove train vae`")
+    if not p.is_file():
+        if path is None:
+            raise ShapeMoveError(f"the default model is missing ({p}); pass --checkpoint RUN or rebuild it")
+        raise ShapeMoveError(f"checkpoint not found: {p}")
+    return p
+
+
+def load_vae(checkpoint, body):
+    """The SA-VAE of ``checkpoint`` (see ``savae_checkpoint``), checked against ``body``."""
+    from ..models.savae import load_savae
+
+    return load_savae(savae_checkpoint(checkpoint), body=body)
+
+
+def source_joints(motion, body=None) -> tuple[np.ndarray, str]:
+    """A mocap file path or a ``Motion22`` -> (T,22,3) joints at 20 fps (metres, Y up), name."""
+    from ..data.build import MIN_FRAMES
+    from ..io.mocap import load_smpl22
+    from ..io.resample import resample_positions
+
+    if isinstance(motion, (str, Path)):
+        path = Path(motion)
+        if not path.is_file():
+            raise ShapeMoveError(f"motion file not found: {path}")
+        motion = load_smpl22(path, fps=FPS, body_model=body)
+    if not isinstance(motion, Motion22):
+        raise ShapeMoveError(f"retarget needs a motion file (.bvh, .amc, AMASS .npz) or a Motion22, got {type(motion).__name__}")
+    joints = np.asarray(motion.joints, dtype=np.float64)
+    if joints.ndim != 3 or joints.shape[1:] != (22, 3):
+        raise ShapeMoveError(f"{motion.source}: joints must be (T,22,3), got {joints.shape}")
+    if abs(motion.fps - FPS) > 1e-6:
+        joints = resample_positions(joints, motion.fps, FPS)
+    if len(joints) < MIN_FRAMES:
+        raise ShapeMoveError(f"{motion.source}: too short to retarget ({len(joints)} frames at {FPS} fps, need {MIN_FRAMES})")
+    if not np.isfinite(joints).all():
+        raise ShapeMoveError(f"{motion.source}: non-finite joint positions")
+    return joints.astype(np.float32), str(motion.source)
+
+
+def check_betas(betas) -> np.ndarray:
+    b = np.asarray(betas, dtype=np.float32).reshape(-1)
+    if b.shape != (10,) or not np.isfinite(b).all():
+        raise ShapeMoveError(f"betas must be 10 finite values, got shape {b.shape}")
+    return b
+
+
+def processor(body, ik_refine_iters: int = 10):
+    from ..data.build import ClipProcessor
+
+    return ClipProcessor(body, ik_refine_iters=ik_refine_iters)
+
+
+def encode_source(joints: np.ndarray, vae, body, ik_refine_iters: int = 10) -> list[int]:
+    """(T,22,3) source joints -> motion tokens: the builder's canonical features, SA-VAE encoded.
+    T-1 feature rows are cut to a multiple of the VAE's downsampling (4): (T-1)//4 tokens."""
+    feats = processor(body, ik_refine_iters).process(None, joints)["norm_joint_vecs"]
+    n = len(feats) // vae.cfg.downsample * vae.cfg.downsample
+    x = vae.normalize(torch.as_tensor(feats[:n], dtype=torch.float32))[None]
+    with torch.no_grad():
+        _, indices = vae.encode(x)
+    return [int(i) for i in indices[0]]
+
+
+def decode_tokens(codes: list[int], vae, body, betas, ik_refine_iters: int = 10, prompt: str | None = None) -> Motion:
+    """Tokens + betas (10,) -> Motion on ``body``, as ``Generator.decode_motion`` does it (SA-VAE
+    ``decode_long``, joints from the features, lowest foot on the floor, IK) without a T5.
+    (Not delegated: ``decode_motion`` runs the IK under ``no_grad``, where the IK's LBFGS
+    refinement cannot take gradients.)"""
+    from ..body.ik import solve_ik
+    from ..body.kinematics import matrix_to_axis_angle
+    from ..motion.features import joints_from_features
+
+    if not codes:
+        raise ShapeMoveError("no motion tokens to decode")
+    b = torch.as_tensor(check_betas(betas))[None]
+    with torch.no_grad():
+        idx = torch.as_tensor(codes, dtype=torch.long)[None]
+        feats = vae.denormalize(vae.decode_long(vae.quantizer.indices_to_codes(idx), b))[0]
+        joints = joints_from_features(feats.double()).float().numpy()
+        rest = body.rest_joints(b)[0].numpy()
+    joints[..., 1] -= joints[:, [7, 8, 10, 11], 1].min()
+    ik = solve_ik(joints, rest, refine_iters=ik_refine_iters)
+    poses = matrix_to_axis_angle(torch.as_tensor(ik.rotations)).numpy().astype(np.float32)
+    m = Motion(joints=joints, betas=b[0].numpy(), poses=poses, transl=np.asarray(ik.transl, np.float32),
+               fps=float(FPS), body_model=body.name, prompt=prompt, tokens=np.asarray(codes, np.int16),
+               features=feats.numpy().astype(np.float32))
+    m.ik_error_cm = float(ik.mean_error_cm)
+    return m
+
+
+def retarget(motion, vae, body, betas, ik_refine_iters: int = 10) -> Motion:
+    """``motion`` (mocap file path or Motion22) performed by the body ``betas`` (10,), through the
+    SA-VAE ``vae`` (trained for ``body``). Returns a validated Motion with tokens: 4*((T-1)//4)
+    frames at 20 fps."""
+    betas = check_betas(betas)
+    joints, _ = source_joints(motion, body)
+    codes = encode_source(joints, vae, body, ik_refine_iters)
+    out = decode_tokens(codes, vae, body, betas, ik_refine_iters)
+    validate(out)
+    return out
+
+
+def naive_retarget(motion, body, betas, ik_refine_iters: int = 10) -> Motion:
+    """Local rotations copied from the subject's IK onto the body ``betas``; root trajectory
+    scaled by the pelvis-height (leg length) ratio; lowest foot joint on the floor. T frames."""
+    betas = check_betas(betas)
+    joints, _ = source_joints(motion, body)
+    a = processor(body, ik_refine_iters).process(None, joints, betas)
+    out = Motion(joints=a["new_joints"], betas=betas, poses=a["poses"], transl=np.asarray(a["transl"], np.float32),
+                 fps=float(FPS), body_model=body.name)
+    validate(out)
+    return out

@@ -1,0 +1,248 @@
+"""The job ops behind the Blender panels (pure core code, no bpy): generate, redecode, retarget,
+search, train, betas_from_text (and measure, which ``ops`` already serves).
+
+Each op is ``op(params, progress, cancel) -> dict`` (JSON-able); files are handed over by path:
+the UI passes an ``out`` path (.npz) under its data folder and builds the rig from the file the
+op wrote (atomically). ``register(JOBS)`` adds the ops to a registry (core/worker/ops.py's JOBS).
+Loaded generators are kept per (model folder, body) so a long-lived worker answers fast.
+"""
+from __future__ import annotations
+
+import os
+import shutil
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import ShapeMoveError
+from .ops import param
+
+TRAIN_KINDS = ("vae", "t5", "tma")
+_GENERATORS: dict = {}
+
+
+# -- helpers -----------------------------------------------------------------------------------
+def _out_path(params: dict, op: str) -> Path:
+    out = Path(param(params, op, "out", str))
+    if out.suffix.lower() != ".npz":
+        raise ShapeMoveError(f"op {op!r}: 'out' must be a .npz path, got {out}")
+    return out
+
+
+def _betas(params: dict, op: str, name: str = "betas", default=None):
+    value = param(params, op, name, list, default)
+    if value is None:
+        return None
+    try:
+        b = np.asarray(value, dtype=np.float32).reshape(-1)
+    except (TypeError, ValueError):
+        raise ShapeMoveError(f"op {op!r}: {name!r} must be a list of 10 numbers") from None
+    if b.shape != (10,) or not np.isfinite(b).all():
+        raise ShapeMoveError(f"op {op!r}: {name!r} must be 10 finite numbers, got {b.shape[0]}")
+    return b
+
+
+def _generator(model, body):
+    """A cached Generator for (model folder or None = default, body spec)."""
+    from ..generation.generate import Generator
+    from ..generation.model_bundle import resolve_model_dir
+
+    d = resolve_model_dir(model or None)
+    stamp = max((p.stat().st_mtime_ns for p in d.rglob("*") if p.is_file()), default=0)
+    key = (str(d.resolve()), body or "openbody", stamp)
+    if key not in _GENERATORS:
+        _GENERATORS.clear()  # one loaded model set at a time
+        _GENERATORS[key] = Generator(d, body=body or None)
+    return _GENERATORS[key]
+
+
+def _measurements(body, betas) -> dict:
+    from ..body.measure import measure
+
+    try:
+        return {k: round(float(v), 1) for k, v in measure(body, betas).items()}
+    except ShapeMoveError:
+        return {}
+
+
+def _motion_facts(path: Path, motion) -> dict:
+    return {"path": str(path), "frames": motion.num_frames, "fps": float(motion.fps),
+            "betas": [float(b) for b in motion.betas], "body_model": motion.body_model,
+            "tokens": 0 if motion.tokens is None else int(len(motion.tokens))}
+
+
+# -- ops ---------------------------------------------------------------------------------------
+def generate(params, progress, cancel) -> dict:
+    """params {"prompt", "shape_text", "betas" (10, optional), "seconds" (optional), "seed",
+    "temperature", "top_k", "model" (folder, optional), "body", "out" (.npz)} -> the motion file
+    written, its facts and the body's measurements (cm)."""
+    from ..generation.generate import Request
+    from ..runner import JobCancelled
+    from ..scene.motion_file import save_motion
+
+    op = "generate"
+    out = _out_path(params, op)
+    req = Request(prompt=param(params, op, "prompt", str), shape_text=param(params, op, "shape_text", str, None) or None,
+                  betas=_betas(params, op), seconds=param(params, op, "seconds", (int, float), None),
+                  seed=int(param(params, op, "seed", int, 0)),
+                  temperature=float(param(params, op, "temperature", (int, float), 1.0)),
+                  top_k=param(params, op, "top_k", int, 50))
+    progress(0.05, "loading models")
+    gen = _generator(param(params, op, "model", str, None), param(params, op, "body", str, None))
+    if cancel():
+        raise JobCancelled
+    progress(0.2, "writing motion tokens")
+    motions = gen.generate_batch([req], cancel=cancel)
+    if not motions:
+        raise JobCancelled
+    save_motion(out, motions[0])
+    progress(1.0, "done")
+    return {**_motion_facts(out, motions[0]), "measurements": _measurements(gen.body, motions[0].betas),
+            "ik_error_cm": float(getattr(motions[0], "ik_error_cm", 0.0))}
+
+
+def redecode(params, progress, cancel) -> dict:
+    """params {"motion" (.npz with tokens), "betas" (10), "model", "body", "out"} -> the same tokens
+    decoded for the new body, written to ``out``."""
+    from ..scene.motion_file import load_motion, save_motion
+
+    op = "redecode"
+    out = _out_path(params, op)
+    betas = _betas(params, op)
+    if betas is None:
+        raise ShapeMoveError("op 'redecode': missing parameter 'betas'")
+    motion = load_motion(param(params, op, "motion", str))
+    gen = _generator(param(params, op, "model", str, None), param(params, op, "body", str, None))
+    progress(0.3, "decoding")
+    new = gen.redecode(motion, betas)
+    save_motion(out, new)
+    return _motion_facts(out, new)
+
+
+def retarget(params, progress, cancel) -> dict:
+    """params {"source" (BVH / ASF+AMC / AMASS .npz), "body", "betas" (10, optional: else fitted to
+    the source skeleton), "out"} -> the motion on the body, written to ``out``."""
+    from ..generation.retarget import retarget as _retarget
+    from ..scene.motion_file import save_motion
+
+    op = "retarget"
+    out = _out_path(params, op)
+    source = Path(param(params, op, "source", str))
+    if not source.is_file():
+        raise ShapeMoveError(f"op 'retarget': source file not found: {source}")
+    progress(0.1, f"reading {source.name}")
+    motion = _retarget(source, body=param(params, op, "body", str, None), betas=_betas(params, op))
+    save_motion(out, motion)
+    return _motion_facts(out, motion)
+
+
+def search(params, progress, cancel) -> dict:
+    """params {"folder", "query", "top_k", "tma" (tma.pt or a folder holding it, optional)} ->
+    {"results": [{"id", "score", "path", "caption"}], "count", "skipped", "from_cache"}."""
+    from ..search.motion_search import check_query, index_library, search as _search
+
+    op = "search"
+    query = check_query(param(params, op, "query", str), int(param(params, op, "top_k", int, 10)))
+    index = index_library(param(params, op, "folder", str), tma=param(params, op, "tma", str, None) or None,
+                          progress=lambda f, m="": progress(0.9 * f, m))
+    hits = _search(index, query, int(param(params, op, "top_k", int, 10)))
+    return {"results": [{"id": i, "score": s, "path": p, "caption": c} for i, s, p, c in hits],
+            "count": len(index), "skipped": len(index.skipped), "from_cache": index.from_cache}
+
+
+def _publish(src: Path, dst: Path) -> None:
+    """Copy a file or folder to ``dst`` (replacing it) via a temporary name beside it."""
+    tmp = dst.with_name(dst.name + ".tmp")
+    if tmp.exists():
+        shutil.rmtree(tmp) if tmp.is_dir() else tmp.unlink()
+    dst.parent.mkdir(parents=True, exist_ok=True)
+    if src.is_dir():
+        shutil.copytree(src, tmp)
+        if dst.exists():
+            shutil.rmtree(dst)
+        os.replace(tmp, dst)
+    else:
+        shutil.copy2(src, tmp)
+        os.replace(tmp, dst)
+
+
+def train(params, progress, cancel) -> dict:
+    """params {"kind": "vae" | "t5" | "tma", "data" (dataset folder), "model_dir" (the model folder
+    being built: savae.pt, t5/, tma/), "steps", "resume", "device", "config" ("small" | "paper" |
+    "tiny" | JSON path), "body"}. Trains in ``model_dir/runs/<kind>``; a run that finished (not
+    cancelled) is copied into the model folder's layout. Cancel stops after saving last.pt."""
+    op = "train"
+    kind = param(params, op, "kind", str)
+    if kind not in TRAIN_KINDS:
+        raise ShapeMoveError(f"op 'train': kind must be one of {', '.join(TRAIN_KINDS)}, got {kind!r}")
+    data = Path(param(params, op, "data", str))
+    if not data.is_dir():
+        raise ShapeMoveError(f"op 'train': dataset folder not found: {data} (build one with `python -m shapemove data build`)")
+    model_dir = Path(param(params, op, "model_dir", str))
+    run = model_dir / "runs" / kind
+    steps = param(params, op, "steps", int, None)
+    resume = bool(param(params, op, "resume", bool, False)) and (run / "last.pt").is_file()
+    device = param(params, op, "device", str, None)
+    config = param(params, op, "config", str, "small")
+    body = param(params, op, "body", str, None)
+    kw = dict(steps=steps, resume=resume, device=device, progress=progress, cancel=cancel, verbose=False)
+    if kind == "vae":
+        from ..models.savae import SAVAEConfig
+        from ..train.train_vae import train_vae
+
+        metrics = train_vae(data, run, SAVAEConfig.load(config), body=body, **kw)
+        product, target = run / "savae.pt", model_dir / "savae.pt"
+    elif kind == "t5":
+        from ..train.train_t5 import T5TrainConfig, train_t5
+
+        vae = model_dir / "savae.pt"
+        if not vae.is_file():
+            raise ShapeMoveError(f"op 'train': T5 training needs the SA-VAE first ({vae}): train kind 'vae' into this model")
+        metrics = train_t5(data, vae, run, T5TrainConfig.load(config), **kw)
+        product, target = run / "t5", model_dir / "t5"
+    else:
+        from ..train.train_tma import train_tma
+
+        metrics = train_tma(data, run, config, body=body, **kw)
+        product, target = run, model_dir / "tma"
+    published = False
+    if not cancel() and product.exists():
+        if kind == "tma":  # tma.pt needs its tokenizer/ beside it
+            target.mkdir(parents=True, exist_ok=True)
+            _publish(run / "tma.pt", target / "tma.pt")
+            _publish(run / "tokenizer", target / "tokenizer")
+        else:
+            _publish(product, target)
+        published = True
+    return {"kind": kind, "run": str(run), "model_dir": str(model_dir), "published": published,
+            "metrics": metrics, "resumable": (run / "last.pt").is_file()}
+
+
+def betas_from_text(params, progress, cancel) -> dict:
+    """params {"text": shape sentence ("a tall man, chest circumference of 104 cm"), "body"} ->
+    {"betas": 10 numbers, "measurements": wanted (cm), "achieved": measured on the result (cm)}."""
+    from ..body.load import load_body_model
+    from ..body.shape_from_measurements import betas_for_measurements
+    from ..data.shape_text import parse_shape_sentence
+
+    op = "betas_from_text"
+    text = param(params, op, "text", str).strip()
+    if not text:
+        raise ShapeMoveError("op 'betas_from_text': the shape text is empty (e.g. 'a man with a height of 185 cm')")
+    wanted = parse_shape_sentence(text)
+    if not wanted:
+        raise ShapeMoveError(f"no measurements found in {text!r}: write e.g. 'a height of 180 cm, "
+                             "waist circumference of 85 cm'")
+    body = load_body_model(param(params, op, "body", str, None))
+    betas = np.asarray(betas_for_measurements(body, wanted), dtype=np.float64).reshape(-1)
+    return {"betas": betas.tolist(), "measurements": wanted, "achieved": _measurements(body, betas.astype(np.float32))}
+
+
+OPS = {"generate": generate, "redecode": redecode, "retarget": retarget, "search": search, "train": train,
+       "betas_from_text": betas_from_text}
+
+
+def register(jobs: dict) -> dict:
+    """Add these ops to the ``jobs`` registry (existing entries of other names are kept)."""
+    jobs.update(OPS)
+    return jobs
