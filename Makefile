@@ -2,9 +2,15 @@
 PYTHON ?= python3
 VENV   := .venv
 PY     := $(VENV)/bin/python
-PROMPT ?= a tall, heavy man jogs forward and waves
+PROMPT ?= a person jogs forward and waves
+SHAPE  ?= a tall, heavy-set man
+DATA   ?= ../shared/data
+BUILT  ?= data/built
+RUNS   ?= runs/default
+# a local pretrained T5 folder (e.g. flan-t5-base on disk): make train-default BASE_T5=/path
+BASE_T5 ?=
 
-.PHONY: setup test test-fast demo bench extension clean-venv
+.PHONY: setup test test-fast demo bench extension eval train-default clean-venv
 
 setup: $(VENV)/.installed
 
@@ -22,8 +28,24 @@ test: setup
 test-fast: setup
 	$(PY) -m pytest -q -m "not slow"
 
+demo: setup
+	$(PY) -m shapemove demo --prompt "$(PROMPT)" --shape-text "$(SHAPE)" --out out/demo
+
 bench: setup
 	$(PY) -m shapemove bench all --json out/bench.json
+
+# The default model, from the shared mocap archives, on this CPU (seeded; resumes if interrupted).
+train-default: setup
+	$(PY) -m shapemove data build --source $(DATA)/bandai.tar.xz $(DATA)/hdm05.tar.xz $(DATA)/cmu.tar.xz --out $(BUILT)
+	$(PY) -m shapemove train vae --data $(BUILT) --config configs/default_vae.json --out $(RUNS)/vae --resume
+	$(PY) -m shapemove train tma --data $(BUILT) --config configs/default_tma.json --out $(RUNS)/tma --resume
+	$(PY) -m shapemove train t5 --data $(BUILT) --config configs/default_t5.json --vae $(RUNS)/vae/savae.pt \
+		--out $(RUNS)/t5 --resume $(if $(BASE_T5),--base-model $(BASE_T5),)
+	$(PY) tools/export_default.py --vae $(RUNS)/vae --t5 $(RUNS)/t5 --tma $(RUNS)/tma --out weights/default
+
+eval: setup
+	$(PY) -m shapemove eval recon --data $(BUILT) --split test --checkpoint weights/default/savae.pt --json out/eval_recon.json
+	$(PY) -m shapemove eval generate --data $(BUILT) --split test --model weights/default --json out/eval_generate.json
 
 extension: setup
 	$(PY) tools/build_extension.py --out dist

@@ -7,9 +7,11 @@ ground truth and writing the numbers as JSON (atomically).
 flat keys (mpjpe_mm, bone_err_mm, penetrate_cm, float_cm, skate_pct, dyn_stable_pct,
 code_usage_pct, clips) plus "ground_truth": {the same keys} (NaN -> null).
 
-Adding a kind: write ``add_KIND(subparsers)`` below and an entry in ``KINDS``. ``generate`` is
-wired already: it appears as soon as ``core/eval/generate_eval.py`` exists and defines
-``add_arguments(parser)`` (optional) and ``from_cli(args) -> int``.
+``generate``: text-to-motion metrics (``core/eval/generate_eval.py``, ``from_cli(args)``; the
+kind is listed only when that module exists; its own ``add_arguments(parser)`` replaces the
+arguments defined here if it has one).
+
+Adding a kind: write ``add_KIND(subparsers)`` (setting ``_run``) and list it in ``KINDS``.
 """
 from __future__ import annotations
 
@@ -66,15 +68,15 @@ def run_recon(args) -> int:
         bar.update(round(100 * fraction) - bar.n)
         bar.set_postfix_str(clip_id)
 
+    clips: list = []
     try:
         result = eval_recon(args.data, args.checkpoint, split=args.split, body=args.body_model,
-                            max_clips=args.max_clips, progress=progress)
+                            max_clips=args.max_clips, progress=progress, per_clip=clips)
     finally:
         bar.close()
     write_json(args.json, result)
-    gt = result["ground_truth"]
-    print_table({**result, "frames": "?"} if False else result, gt, title=f"SA-VAE reconstruction, {args.split} split",
-                name="reconstruction")
+    print_table({**result, "frames": sum(c["frames"] for c in clips)}, result["ground_truth"],
+                title=f"SA-VAE reconstruction, {args.split} split", name="reconstruction")
     print(f"codebook usage: {result['code_usage_pct']:.1f}%   wrote {args.json}")
     return 0
 
@@ -93,10 +95,25 @@ def add_generate(sub):
     mod = _generate_module()
     if mod is None:
         return
-    p = sub.add_parser("generate", help="text-to-motion metrics (generated motions vs ground truth)")
+    p = sub.add_parser("generate", help="text-to-motion metrics (generated motions beside the real clips)",
+                       description="text-to-motion metrics (generated motions beside the real clips)")
     if hasattr(mod, "add_arguments"):
         mod.add_arguments(p)
-    p.set_defaults(_run=mod.from_cli)
+    else:  # the arguments ``generate_eval.from_cli`` reads
+        p.add_argument("--data", type=Path, required=True, help="dataset folder from `data build`")
+        p.add_argument("--split", default="test", choices=["train", "val", "test"])
+        p.add_argument("--model", type=Path, default=None, help="model folder (default: the embedded default model)")
+        p.add_argument("--tma", type=Path, default=None, help="tma.pt or its folder (default: MODEL/tma)")
+        p.add_argument("--json", type=Path, default=None, help="write the metrics here")
+        p.add_argument("--max-clips", type=int, default=None, help="evaluate only N clips")
+        p.add_argument("--seed", type=int, default=0, help="caption choice and sampling seed")
+        p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.set_defaults(_run=lambda args: _exit_code(mod.from_cli(args)))
+
+
+def _exit_code(result) -> int:
+    """An int result is the exit code; anything else (e.g. the metrics dict) means success."""
+    return result if isinstance(result, int) and not isinstance(result, bool) else 0
 
 
 KINDS = [add_recon, add_generate]
@@ -109,4 +126,4 @@ def add_arguments(p):
 
 
 def run(args) -> int:
-    return int(args._run(args) or 0)
+    return _exit_code(args._run(args))

@@ -14,9 +14,9 @@ def run(args) -> int:
     from ..core.worker.protocol import CONTROL_OPS
 
     if args.list:
-        from ..core.worker.ops import JOBS
+        from ..core.worker.ops import default_jobs
 
-        for name in [*CONTROL_OPS, *sorted(JOBS)]:
+        for name in [*CONTROL_OPS, *sorted(default_jobs())]:
             print(name)
         return 0
     from ..core.worker.server import main

@@ -6,9 +6,9 @@ from __future__ import annotations
 
 import bpy
 
-from . import operators, panels, preferences, properties, shape_sync
+from . import jobs, operators, panels, preferences, properties, shape_sync
 
-classes = (*properties.classes, *preferences.classes, *operators.classes, *panels.classes)
+classes = (*properties.classes, *preferences.classes, *jobs.classes, *operators.classes, *panels.classes)
 
 
 def register():
@@ -16,9 +16,11 @@ def register():
         bpy.utils.register_class(cls)
     properties.register()
     shape_sync.register()
+    jobs.register()
 
 
 def unregister():
+    jobs.unregister()
     shape_sync.unregister()
     properties.unregister()
     for cls in reversed(classes):

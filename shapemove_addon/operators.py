@@ -1,16 +1,78 @@
-"""Operators: build the rig from a motion file (.npz)."""
+"""Operators of the ShapeMove panels.
+
+Quick ones (build, shape, export) change the scene directly, undoably. Heavy ones (generate,
+retarget, search, train, measure, shape from text) start a job (``job_submit``) and return at once;
+the job's callback changes the scene when it answers (a rig is built through the build operator,
+so it is one undo step). Every ShapeMoveError becomes an ERROR report and leaves the scene as it was.
+"""
 from __future__ import annotations
 
+import os
+from pathlib import Path
+
 import bpy
-from bpy.props import StringProperty
-from bpy_extras.io_utils import ImportHelper
+import numpy as np
+from bpy.props import BoolProperty, EnumProperty, IntProperty, StringProperty
+from bpy_extras.io_utils import ExportHelper, ImportHelper
 
 from ..core.errors import ShapeMoveError
 from ..core.scene.bodies import load_body
 from ..core.scene.motion_file import load_motion
-from .scene_build import build_rig
+from . import job_submit, paths, semantic_shape, shape_sync
+from .export import FORMATS, export_rig
+from .preferences import body_spec, preferences, setting
+from .redecode import HAS_TOKENS_KEY, MOTION_FILE_KEY
+from .scene_build import SLIDER_RANGE, build_rig
+
+MEASUREMENT_PROPS = ("height_cm", "chest_cm", "waist_cm", "hip_cm")
 
 
+def active_rig(context):
+    return shape_sync.rig_of(context.active_object)
+
+
+def rig_body_spec(rig) -> str:
+    """The worker's "body" for a rig: openbody, or the SMPL file of the preferences."""
+    return "openbody" if rig is None or str(rig.get("shapemove_body_model", "")).startswith("openbody") else body_spec()
+
+
+def store_measurements(rig, measurements: dict) -> None:
+    for prop in MEASUREMENT_PROPS:
+        value = measurements.get(prop)
+        if isinstance(value, (int, float)):
+            setattr(rig.shapemove, prop, float(value))
+
+
+def build_rig_from_file(path: str, name: str = "ShapeMove", measurements: dict | None = None):
+    """From a job callback: build the rig through the (undoable) build operator; errors -> popup."""
+    from .jobs import report_error
+
+    try:
+        bpy.ops.shapemove.build_from_motion(filepath=str(path), rig_name=name)
+    except RuntimeError as exc:  # the operator's ERROR report
+        report_error(str(exc).replace("Error: ", "").strip())
+        return None
+    rig = active_rig(bpy.context)
+    if rig is not None and measurements:
+        store_measurements(rig, measurements)
+    return rig
+
+
+class _JobOperator:
+    """execute -> self.start(context) (returns a message); ShapeMoveError -> ERROR report."""
+
+    def execute(self, context):
+        try:
+            message = self.start(context)
+        except ShapeMoveError as exc:
+            self.report({"ERROR"}, str(exc))
+            return {"CANCELLED"}
+        if message:
+            self.report({"INFO"}, message)
+        return {"FINISHED"}
+
+
+# -- build ---------------------------------------------------------------------------------------
 class SHAPEMOVE_OT_build_from_motion(bpy.types.Operator, ImportHelper):
     """Build a shaped, rigged and keyframed body from a ShapeMove motion file (.npz)"""
 
@@ -33,11 +95,16 @@ class SHAPEMOVE_OT_build_from_motion(bpy.types.Operator, ImportHelper):
     def execute(self, context):
         try:
             motion = load_motion(self.filepath)
-            rig = build_rig(context, motion, load_body(motion.body_model, self.body_model_file or None), name=self.rig_name,
+            model_file = self.body_model_file or (body_spec(context) if not motion.body_model.startswith("openbody") else None)
+            if model_file == "openbody":
+                model_file = None
+            rig = build_rig(context, motion, load_body(motion.body_model, model_file), name=self.rig_name,
                             collection=context.collection)
         except ShapeMoveError as exc:
             self.report({"ERROR"}, str(exc))
             return {"CANCELLED"}
+        rig.armature[MOTION_FILE_KEY] = os.path.abspath(self.filepath)
+        rig.armature[HAS_TOKENS_KEY] = motion.tokens is not None and len(motion.tokens) > 0
         for obj in context.view_layer.objects:
             obj.select_set(False)
         rig.armature.select_set(True)
@@ -46,4 +113,415 @@ class SHAPEMOVE_OT_build_from_motion(bpy.types.Operator, ImportHelper):
         return {"FINISHED"}
 
 
-classes = (SHAPEMOVE_OT_build_from_motion,)
+# -- generate ------------------------------------------------------------------------------------
+class SHAPEMOVE_OT_generate(_JobOperator, bpy.types.Operator):
+    """Generate a body shape and a motion from the prompt (runs in the background)"""
+
+    bl_idname = "shapemove.generate"
+    bl_label = "Generate"
+
+    @classmethod
+    def poll(cls, context):
+        return not job_submit.running("generate")
+
+    def start(self, context):
+        s = context.scene.shapemove
+        prompt = s.prompt.strip()
+        if not prompt:
+            raise ShapeMoveError("the prompt is empty: describe a motion, e.g. 'a person jogs forward and waves'")
+        params = {"prompt": prompt, "shape_text": s.shape_text.strip() or None, "seed": s.seed,
+                  "temperature": s.temperature, "seconds": s.seconds if s.use_seconds else None,
+                  "model": setting("active_model") or None, "body": body_spec(context),
+                  "out": str(paths.new_motion_path(prompt))}
+        name = paths.slug(prompt, 24)
+
+        def done(msg):
+            if not msg.get("cancelled"):
+                r = msg["result"]
+                build_rig_from_file(r["path"], name, r.get("measurements"))
+
+        job_submit.submit_job("generate", params, kind="generate", label="generate", on_result=done)
+        return "generating..."
+
+
+class SHAPEMOVE_OT_cancel_job(bpy.types.Operator):
+    """Cancel this panel's running job (training stops after saving a checkpoint)"""
+
+    bl_idname = "shapemove.cancel_job"
+    bl_label = "Cancel"
+
+    kind: StringProperty(name="Job", default="generate")
+
+    def execute(self, context):
+        if not job_submit.cancel(self.kind):
+            self.report({"WARNING"}, f"no {self.kind} job is running")
+            return {"CANCELLED"}
+        return {"FINISHED"}
+
+
+# -- shape ---------------------------------------------------------------------------------------
+class _RigOperator:
+    bl_options = {"REGISTER", "UNDO"}
+
+    @classmethod
+    def poll(cls, context):
+        return context.mode in ("OBJECT", "POSE") and active_rig(context) is not None
+
+
+class SHAPEMOVE_OT_random_shape(_RigOperator, bpy.types.Operator):
+    """Give the active rig a random body shape (betas ~ N(0, spread))"""
+
+    bl_idname = "shapemove.random_shape"
+    bl_label = "Random Shape"
+
+    seed: IntProperty(name="Seed", default=-1, min=-1, description="-1: a new random shape every time")
+
+    def execute(self, context):
+        rig = active_rig(context)
+        rng = np.random.default_rng(None if self.seed < 0 else self.seed)
+        betas = np.clip(rng.normal(0.0, context.scene.shapemove.random_scale, shape_sync.NUM_BETAS),
+                        -SLIDER_RANGE, SLIDER_RANGE)
+        try:
+            semantic_shape.forget_phenotype(rig)
+            shape_sync.set_betas(rig, betas, context)
+        except ShapeMoveError as exc:
+            self.report({"ERROR"}, str(exc))
+            return {"CANCELLED"}
+        return {"FINISHED"}
+
+
+class SHAPEMOVE_OT_reset_shape(_RigOperator, bpy.types.Operator):
+    """Reset the active rig to the average body (all betas 0)"""
+
+    bl_idname = "shapemove.reset_shape"
+    bl_label = "Reset Shape"
+
+    def execute(self, context):
+        rig = active_rig(context)
+        try:
+            semantic_shape.forget_phenotype(rig)
+            shape_sync.set_betas(rig, np.zeros(shape_sync.NUM_BETAS), context)
+        except ShapeMoveError as exc:
+            self.report({"ERROR"}, str(exc))
+            return {"CANCELLED"}
+        return {"FINISHED"}
+
+
+class SHAPEMOVE_OT_shape_from_text(_JobOperator, _RigOperator, bpy.types.Operator):
+    """Set the active rig's shape from a sentence with measurements (height, chest, waist, ...)"""
+
+    bl_idname = "shapemove.shape_from_text"
+    bl_label = "Apply Shape from Text"
+    bl_options = {"REGISTER"}
+
+    def start(self, context):
+        rig = active_rig(context)
+        text = context.scene.shapemove.shape_from_text.strip()
+        if not text:
+            raise ShapeMoveError("write a shape sentence first, e.g. 'a man with a height of 185 cm'")
+        name = rig.name
+
+        def done(msg):
+            target = bpy.data.objects.get(name)
+            if target is None or msg.get("cancelled"):
+                return
+            semantic_shape.forget_phenotype(target)
+            shape_sync.set_betas(target, msg["result"]["betas"], bpy.context)
+            store_measurements(target, msg["result"].get("achieved", {}))
+
+        job_submit.submit_job("betas_from_text", {"text": text, "body": rig_body_spec(rig)}, kind="shape",
+                              label="shape from text", on_result=done)
+        return "fitting the shape..."
+
+
+class SHAPEMOVE_OT_measure(_JobOperator, _RigOperator, bpy.types.Operator):
+    """Measure the active rig's body (height, chest, waist, hip in cm)"""
+
+    bl_idname = "shapemove.measure"
+    bl_label = "Measure"
+    bl_options = {"REGISTER"}
+
+    def start(self, context):
+        rig = active_rig(context)
+        name = rig.name
+
+        def done(msg):
+            target = bpy.data.objects.get(name)
+            if target is not None and not msg.get("cancelled"):
+                store_measurements(target, msg["result"])
+
+        params = {"betas": shape_sync.current_betas(rig).tolist(), "body": rig_body_spec(rig)}
+        job_submit.submit_job("measure", params, kind="measure", label="measure", on_result=done)
+        return ""
+
+
+class SHAPEMOVE_OT_redecode(_JobOperator, _RigOperator, bpy.types.Operator):
+    """Decode the rig's motion tokens again for its current body"""
+
+    bl_idname = "shapemove.redecode"
+    bl_label = "Re-decode Motion for This Body"
+    bl_options = {"REGISTER"}
+
+    @classmethod
+    def poll(cls, context):
+        rig = active_rig(context)
+        return rig is not None and bool(rig.get(HAS_TOKENS_KEY))
+
+    def start(self, context):
+        from . import redecode
+
+        redecode.submit(active_rig(context))
+        return "re-decoding..."
+
+
+# -- retarget ------------------------------------------------------------------------------------
+def _retarget_job(context, source: str, target_rig, name: str) -> None:
+    params = {"source": source, "body": rig_body_spec(target_rig), "out": str(paths.new_motion_path(name))}
+    if target_rig is not None:
+        params["betas"] = shape_sync.current_betas(target_rig).tolist()
+
+    def done(msg):
+        if not msg.get("cancelled"):
+            build_rig_from_file(msg["result"]["path"], name)
+
+    job_submit.submit_job("retarget", params, kind="retarget", label=f"retarget {Path(source).name}", on_result=done)
+
+
+class SHAPEMOVE_OT_retarget(_JobOperator, bpy.types.Operator):
+    """Put a mocap clip (BVH, ASF/AMC, AMASS) or the active armature's action on a ShapeMove body"""
+
+    bl_idname = "shapemove.retarget"
+    bl_label = "Retarget"
+
+    @classmethod
+    def poll(cls, context):
+        return context.mode == "OBJECT" and not job_submit.running("retarget")
+
+    def start(self, context):
+        s = context.scene.shapemove
+        target = s.retarget_target or active_rig(context)
+        if s.retarget_source == "FILE":
+            source = bpy.path.abspath(s.retarget_path)
+            if not s.retarget_path or not os.path.isfile(source):
+                raise ShapeMoveError(f"motion file not found: {source or '(none given)'}")
+            name = Path(source).stem
+        else:
+            arm = context.active_object
+            if arm is None or arm.type != "ARMATURE" or shape_sync.rig_of(arm) is arm:
+                raise ShapeMoveError("make the armature whose action you want to retarget active (not a ShapeMove rig)")
+            if arm.animation_data is None or arm.animation_data.action is None:
+                raise ShapeMoveError(f"{arm.name!r} has no action to retarget")
+            source = str(paths.new_motion_path(arm.name).with_suffix(".bvh"))
+            _export_plain_bvh(context, arm, source)
+            name = arm.name
+            target = s.retarget_target
+        _retarget_job(context, source, target, name)
+        return f"retargeting {Path(source).name}..."
+
+
+def _export_plain_bvh(context, arm, path: str) -> None:
+    lo, hi = arm.animation_data.action.frame_range
+    with context.temp_override(active_object=arm, object=arm, selected_objects=[arm]):
+        try:
+            bpy.ops.export_anim.bvh(filepath=path, frame_start=int(lo), frame_end=int(hi), root_transform_only=True)
+        except RuntimeError as exc:
+            raise ShapeMoveError(f"could not write {arm.name!r} as BVH: {exc}") from None
+
+
+# -- library -------------------------------------------------------------------------------------
+class SHAPEMOVE_OT_library_search(_JobOperator, bpy.types.Operator):
+    """Rank the motions of the library folder by the query (text-motion alignment model)"""
+
+    bl_idname = "shapemove.library_search"
+    bl_label = "Search"
+
+    @classmethod
+    def poll(cls, context):
+        return not job_submit.running("search")
+
+    def start(self, context):
+        s = context.scene.shapemove
+        folder = bpy.path.abspath(s.library_folder)
+        if not s.library_folder or not os.path.isdir(folder):
+            raise ShapeMoveError(f"library folder not found: {folder or '(none given)'}")
+        if not s.library_query.strip():
+            raise ShapeMoveError("the query is empty: describe a motion, e.g. 'a person waves'")
+        scene_name = context.scene.name
+
+        def done(msg):
+            scene = bpy.data.scenes.get(scene_name)
+            if scene is None or msg.get("cancelled"):
+                return
+            results = scene.shapemove.library_results
+            results.clear()
+            for r in msg["result"]["results"]:
+                item = results.add()
+                item.name, item.score, item.path, item.caption = r["id"], r["score"], r["path"], r["caption"]
+            scene.shapemove.library_index = 0
+
+        params = {"folder": folder, "query": s.library_query.strip(), "top_k": s.library_top_k,
+                  "tma": setting("active_model") or None}
+        job_submit.submit_job("search", params, kind="search", label="search", on_result=done)
+        return "searching..."
+
+
+class SHAPEMOVE_OT_library_import(bpy.types.Operator):
+    """Build a rig from this library motion (mocap files are retargeted first)"""
+
+    bl_idname = "shapemove.library_import"
+    bl_label = "Import Motion"
+    bl_options = {"REGISTER", "UNDO"}
+
+    index: IntProperty(name="Result", default=-1, description="-1: the selected result")
+
+    @classmethod
+    def poll(cls, context):
+        return context.mode == "OBJECT"
+
+    def execute(self, context):
+        s = context.scene.shapemove
+        i = s.library_index if self.index < 0 else self.index
+        if not 0 <= i < len(s.library_results):
+            self.report({"ERROR"}, "no search result selected")
+            return {"CANCELLED"}
+        item = s.library_results[i]
+        path = Path(item.path)
+        try:
+            if path.suffix.lower() == ".npz":
+                try:
+                    load_motion(path)  # a ShapeMove motion file: build it directly
+                except ShapeMoveError:
+                    pass
+                else:
+                    try:
+                        return bpy.ops.shapemove.build_from_motion(filepath=str(path), rig_name=paths.slug(item.name, 24))
+                    except RuntimeError as exc:  # its ERROR report
+                        raise ShapeMoveError(str(exc).replace("Error: ", "").strip()) from None
+            _retarget_job(context, str(path), active_rig(context), paths.slug(item.name, 24))
+        except ShapeMoveError as exc:
+            self.report({"ERROR"}, str(exc))
+            return {"CANCELLED"}
+        self.report({"INFO"}, f"retargeting {path.name}...")
+        return {"FINISHED"}
+
+
+# -- train ---------------------------------------------------------------------------------------
+class SHAPEMOVE_OT_train(_JobOperator, bpy.types.Operator):
+    """Train a model part on a dataset folder (runs in the background; cancel keeps a checkpoint)"""
+
+    bl_idname = "shapemove.train"
+    bl_label = "Train"
+
+    resume: BoolProperty(name="Resume", default=False, description="Continue the last (cancelled) run")
+
+    @classmethod
+    def poll(cls, context):
+        return not job_submit.running("train")
+
+    def start(self, context):
+        s = context.scene.shapemove
+        data = bpy.path.abspath(s.train_data)
+        if not s.train_data or not os.path.isdir(data):
+            raise ShapeMoveError(f"dataset folder not found: {data or '(none given)'}")
+        model_dir = paths.models_dir(context) / paths.slug(s.train_model_name)
+        params = {"kind": s.train_kind, "data": data, "model_dir": str(model_dir), "steps": s.train_steps,
+                  "resume": self.resume, "device": setting("device", "cpu"), "config": s.train_config,
+                  "body": body_spec(context)}
+        scene_name = context.scene.name
+
+        def done(msg):
+            scene = bpy.data.scenes.get(scene_name)
+            r = msg["result"]
+            if scene is not None and r.get("published"):
+                scene.shapemove.train_result = r["model_dir"]
+
+        job_submit.submit_job("train", params, kind="train", label=f"train {s.train_kind}", on_result=done)
+        return f"training {s.train_kind} into {model_dir}"
+
+
+class SHAPEMOVE_OT_use_model(bpy.types.Operator):
+    """Use this model folder for generation and search"""
+
+    bl_idname = "shapemove.use_model"
+    bl_label = "Use as Active Model"
+
+    directory: StringProperty(name="Model folder", subtype="DIR_PATH", default="")
+
+    def execute(self, context):
+        folder = bpy.path.abspath(self.directory or context.scene.shapemove.train_result)
+        if not folder or not os.path.isfile(os.path.join(folder, "savae.pt")):
+            self.report({"ERROR"}, f"{folder or '(no folder)'} is not a model folder (no savae.pt)")
+            return {"CANCELLED"}
+        prefs = preferences(context)
+        if prefs is None:
+            self.report({"ERROR"}, "the ShapeMove preferences are not available (extension not enabled)")
+            return {"CANCELLED"}
+        prefs.active_model = folder
+        return {"FINISHED"}
+
+
+# -- export --------------------------------------------------------------------------------------
+class SHAPEMOVE_OT_export(bpy.types.Operator, ExportHelper):
+    """Export the active ShapeMove rig with its animation (FBX, glTF or BVH)"""
+
+    bl_idname = "shapemove.export"
+    bl_label = "Export Rig"
+
+    filename_ext = ".fbx"
+    filter_glob: StringProperty(default="*.fbx;*.glb;*.bvh", options={"HIDDEN"})
+    format: EnumProperty(name="Format", default="FBX",
+                         items=[("FBX", "FBX", ""), ("GLTF", "glTF (.glb)", ""), ("BVH", "BVH", "")])
+
+    @classmethod
+    def poll(cls, context):
+        return context.mode == "OBJECT" and active_rig(context) is not None
+
+    def check(self, context):
+        want = FORMATS[self.format]
+        stem, ext = os.path.splitext(self.filepath)
+        if ext.lower() != want:
+            self.filepath = (stem if ext.lower() in FORMATS.values() else self.filepath) + want
+            return True
+        return False
+
+    def invoke(self, context, event):
+        self.format = context.scene.shapemove.export_format
+        self.filename_ext = FORMATS[self.format]
+        return super().invoke(context, event)
+
+    def execute(self, context):
+        try:
+            path = export_rig(context, active_rig(context), self.filepath, self.format)
+        except ShapeMoveError as exc:
+            self.report({"ERROR"}, str(exc))
+            return {"CANCELLED"}
+        self.report({"INFO"}, f"wrote {path}")
+        return {"FINISHED"}
+
+
+# -- preferences ---------------------------------------------------------------------------------
+class SHAPEMOVE_OT_detect_python(bpy.types.Operator):
+    """Find a Python with PyTorch for the ShapeMove jobs"""
+
+    bl_idname = "shapemove.detect_python"
+    bl_label = "Detect Python"
+
+    def execute(self, context):
+        try:
+            found = paths.detect_python()
+        except ShapeMoveError as exc:
+            self.report({"ERROR"}, str(exc))
+            return {"CANCELLED"}
+        prefs = preferences(context)
+        if not found:
+            self.report({"INFO"}, "Blender's Python has PyTorch: jobs run inside Blender")
+        elif prefs is not None:
+            prefs.python_env = found
+            self.report({"INFO"}, f"using {found}")
+        return {"FINISHED"}
+
+
+classes = (SHAPEMOVE_OT_build_from_motion, SHAPEMOVE_OT_generate, SHAPEMOVE_OT_cancel_job,
+           SHAPEMOVE_OT_random_shape, SHAPEMOVE_OT_reset_shape, SHAPEMOVE_OT_shape_from_text, SHAPEMOVE_OT_measure,
+           SHAPEMOVE_OT_redecode, SHAPEMOVE_OT_retarget, SHAPEMOVE_OT_library_search, SHAPEMOVE_OT_library_import,
+           SHAPEMOVE_OT_train, SHAPEMOVE_OT_use_model, SHAPEMOVE_OT_export, SHAPEMOVE_OT_detect_python)

@@ -1,33 +1,133 @@
-"""Sidebar panels (View3D > Sidebar > ShapeMove)."""
+"""Sidebar panels (View3D > Sidebar > ShapeMove): Generate, Shape, Retarget, Library, Train, Export.
+
+Panels only draw; every change goes through an operator or a property (see operators.py,
+properties.py). A panel whose job runs shows its progress and a Cancel button instead of its start
+button.
+"""
 from __future__ import annotations
 
 import bpy
 
+from . import job_submit, semantic_shape
+from .redecode import HAS_TOKENS_KEY
 from .shape_sync import NUM_BETAS, rig_of
 
 
-class SHAPEMOVE_PT_main(bpy.types.Panel):
+def _job_fraction(kind: str):
+    """(fraction, status text) of the panel's running job, or None."""
+    from . import jobs
+
+    if not job_submit.running(kind):
+        return None
+    mgr = jobs.manager()
+    job = mgr.jobs.get(job_submit.RUNNING[kind])
+    return (job.fraction if job is not None else 0.0), mgr.status
+
+
+def draw_job(layout, kind: str, operator: str, text: str, icon: str = "PLAY", **props):
+    """The start button, or progress + Cancel while the panel's job runs."""
+    state = _job_fraction(kind)
+    if state is None:
+        op = layout.operator(operator, text=text, icon=icon)
+        for k, v in props.items():
+            setattr(op, k, v)
+        return
+    fraction, status = state
+    row = layout.row(align=True)
+    if hasattr(row, "progress"):  # Blender 4.0+
+        row.progress(factor=fraction, type="BAR", text=status or f"{100 * fraction:.0f}%")
+    else:
+        row.label(text=status or f"{100 * fraction:.0f}%")
+    row.operator("shapemove.cancel_job", text="", icon="CANCEL").kind = kind
+
+
+class _Panel:
+    bl_space_type = "VIEW_3D"
+    bl_region_type = "UI"
+    bl_category = "ShapeMove"
+
+
+class _SubPanel(_Panel):
+    bl_parent_id = "SHAPEMOVE_PT_main"
+
+
+class SHAPEMOVE_PT_main(_Panel, bpy.types.Panel):
     bl_label = "ShapeMove"
     bl_idname = "SHAPEMOVE_PT_main"
-    bl_space_type = "VIEW_3D"
-    bl_region_type = "UI"
-    bl_category = "ShapeMove"
 
     def draw(self, context):
-        self.layout.operator("shapemove.build_from_motion", icon="ARMATURE_DATA")
+        layout = self.layout
+        layout.operator("shapemove.build_from_motion", icon="ARMATURE_DATA")
+        wm = context.window_manager
+        status = getattr(wm, "shapemove_status", "")
+        if status:
+            row = layout.row(align=True)
+            row.label(text=status, icon="INFO")
+            if hasattr(bpy.types, "SHAPEMOVE_OT_cancel_jobs"):
+                row.operator("shapemove.cancel_jobs", text="", icon="CANCEL")
 
 
-class SHAPEMOVE_PT_shape(bpy.types.Panel):
+class SHAPEMOVE_PT_generate(_SubPanel, bpy.types.Panel):
+    bl_label = "Generate"
+    bl_idname = "SHAPEMOVE_PT_generate"
+
+    def draw(self, context):
+        s = context.scene.shapemove
+        col = self.layout.column()
+        col.prop(s, "prompt", text="")
+        col.prop(s, "shape_text")
+        row = col.row(align=True)
+        row.prop(s, "use_seconds", text="")
+        sub = row.row(align=True)
+        sub.enabled = s.use_seconds
+        sub.prop(s, "seconds")
+        row = col.row(align=True)
+        row.prop(s, "seed")
+        row.prop(s, "temperature")
+        draw_job(col, "generate", "shapemove.generate", "Generate")
+
+
+class SHAPEMOVE_PT_shape(_SubPanel, bpy.types.Panel):
     bl_label = "Shape"
     bl_idname = "SHAPEMOVE_PT_shape"
-    bl_space_type = "VIEW_3D"
-    bl_region_type = "UI"
-    bl_category = "ShapeMove"
-    bl_parent_id = "SHAPEMOVE_PT_main"
 
     @classmethod
     def poll(cls, context):
         return rig_of(context.active_object) is not None
+
+    def draw(self, context):
+        rig = rig_of(context.active_object)
+        s = context.scene.shapemove
+        layout = self.layout
+        if semantic_shape.semantic_body(rig) is not None:
+            col = layout.column(align=True)
+            for name in semantic_shape.PHENOTYPES:
+                col.prop(rig.shapemove, name, slider=True)
+        row = layout.row(align=True)
+        row.operator("shapemove.random_shape", text="Random", icon="MOD_NOISE")
+        row.operator("shapemove.reset_shape", text="Reset", icon="LOOP_BACK")
+        row.prop(s, "random_scale", text="")
+        col = layout.column(align=True)
+        col.prop(s, "shape_from_text", text="")
+        draw_job(col, "shape", "shapemove.shape_from_text", "Apply Shape from Text", icon="FONT_DATA")
+        if rig.get(HAS_TOKENS_KEY):
+            row = layout.row(align=True)
+            row.prop(s, "auto_redecode")
+            row.operator("shapemove.redecode", text="", icon="FILE_REFRESH")
+        box = layout.box()
+        m = rig.shapemove
+        if m.height_cm > 0:
+            grid = box.grid_flow(columns=2, align=True)
+            for prop in ("height_cm", "chest_cm", "waist_cm", "hip_cm"):
+                grid.label(text=f"{m.bl_rna.properties[prop].name}: {getattr(m, prop):.1f}")
+        draw_job(box, "measure", "shapemove.measure", "Measure", icon="DRIVER_DISTANCE")
+
+
+class SHAPEMOVE_PT_shape_betas(_Panel, bpy.types.Panel):
+    bl_label = "Betas"
+    bl_idname = "SHAPEMOVE_PT_shape_betas"
+    bl_parent_id = "SHAPEMOVE_PT_shape"
+    bl_options = {"DEFAULT_CLOSED"}
 
     def draw(self, context):
         rig = rig_of(context.active_object)
@@ -36,4 +136,95 @@ class SHAPEMOVE_PT_shape(bpy.types.Panel):
             col.prop(rig.shapemove, "betas", index=i, text=f"Beta {i}", slider=True)
 
 
-classes = (SHAPEMOVE_PT_main, SHAPEMOVE_PT_shape)
+class SHAPEMOVE_PT_retarget(_SubPanel, bpy.types.Panel):
+    bl_label = "Retarget"
+    bl_idname = "SHAPEMOVE_PT_retarget"
+    bl_options = {"DEFAULT_CLOSED"}
+
+    def draw(self, context):
+        s = context.scene.shapemove
+        col = self.layout.column()
+        col.row().prop(s, "retarget_source", expand=True)
+        if s.retarget_source == "FILE":
+            col.prop(s, "retarget_path", text="")
+        else:
+            obj = context.active_object
+            col.label(text=f"Source: {obj.name}" if obj is not None and obj.type == "ARMATURE" else
+                      "Make the source armature active", icon="ARMATURE_DATA")
+        col.prop(s, "retarget_target")
+        draw_job(col, "retarget", "shapemove.retarget", "Retarget", icon="CON_ARMATURE")
+
+
+class SHAPEMOVE_UL_library(bpy.types.UIList):
+    def draw_item(self, context, layout, data, item, icon, active_data, active_property, index=0, flt_flag=0):
+        row = layout.row(align=True)
+        row.label(text=item.caption or item.name, icon="ANIM")
+        row.label(text=f"{item.score:.2f}")
+
+
+class SHAPEMOVE_PT_library(_SubPanel, bpy.types.Panel):
+    bl_label = "Library"
+    bl_idname = "SHAPEMOVE_PT_library"
+    bl_options = {"DEFAULT_CLOSED"}
+
+    def draw(self, context):
+        s = context.scene.shapemove
+        col = self.layout.column()
+        col.prop(s, "library_folder", text="")
+        row = col.row(align=True)
+        row.prop(s, "library_query", text="", icon="VIEWZOOM")
+        row.prop(s, "library_top_k", text="")
+        draw_job(col, "search", "shapemove.library_search", "Search", icon="VIEWZOOM")
+        if len(s.library_results):
+            col.template_list("SHAPEMOVE_UL_library", "", s, "library_results", s, "library_index", rows=4)
+            col.operator("shapemove.library_import", icon="IMPORT").index = -1
+
+
+class SHAPEMOVE_PT_train(_SubPanel, bpy.types.Panel):
+    bl_label = "Train"
+    bl_idname = "SHAPEMOVE_PT_train"
+    bl_options = {"DEFAULT_CLOSED"}
+
+    def draw(self, context):
+        from .preferences import setting
+
+        s = context.scene.shapemove
+        col = self.layout.column()
+        col.prop(s, "train_data")
+        col.row().prop(s, "train_kind", expand=True)
+        col.prop(s, "train_model_name")
+        row = col.row(align=True)
+        row.prop(s, "train_steps")
+        row.prop(s, "train_config", text="")
+        if job_submit.running("train"):
+            draw_job(col, "train", "shapemove.train", "Start")
+        else:
+            row = col.row(align=True)
+            row.operator("shapemove.train", text="Start", icon="PLAY").resume = False
+            row.operator("shapemove.train", text="Resume", icon="FF").resume = True
+        if s.train_result:
+            box = col.box()
+            box.label(text=s.train_result, icon="CHECKMARK")
+            box.operator("shapemove.use_model", icon="MODIFIER").directory = s.train_result
+        col.label(text=f"Active model: {setting('active_model') or 'default'}")
+
+
+class SHAPEMOVE_PT_export(_SubPanel, bpy.types.Panel):
+    bl_label = "Export"
+    bl_idname = "SHAPEMOVE_PT_export"
+    bl_options = {"DEFAULT_CLOSED"}
+
+    @classmethod
+    def poll(cls, context):
+        return rig_of(context.active_object) is not None
+
+    def draw(self, context):
+        s = context.scene.shapemove
+        row = self.layout.row(align=True)
+        row.prop(s, "export_format", text="")
+        row.operator("shapemove.export", text="Export", icon="EXPORT").format = s.export_format
+
+
+classes = (SHAPEMOVE_PT_main, SHAPEMOVE_PT_generate, SHAPEMOVE_PT_shape, SHAPEMOVE_PT_shape_betas,
+           SHAPEMOVE_PT_retarget, SHAPEMOVE_UL_library, SHAPEMOVE_PT_library, SHAPEMOVE_PT_train,
+           SHAPEMOVE_PT_export)

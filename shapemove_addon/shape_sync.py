@@ -63,8 +63,8 @@ def on_betas_changed(obj, context=None) -> None:
     """Hook run whenever a rig's betas change: re-place the bones on the new rest joints.
 
     The armature's keyed local rotations are kept (rebased onto the new bone frames), so the same
-    motion now plays on the new body. Re-decoding the motion for the new body (the SA-VAE
-    retarget) plugs in here later."""
+    motion now plays on the new body at once; when the rig has motion tokens, a debounced job then
+    re-decodes the motion for the new body (``redecode.schedule``) and replaces the keys."""
     rig = rig_of(obj)
     if rig is None:
         return
@@ -77,6 +77,9 @@ def on_betas_changed(obj, context=None) -> None:
     place_bones(context, rig, rest_joints_for(jt, jd, betas), names, parents)
     rig["shapemove_betas"] = betas.tolist()
     context.scene.frame_set(context.scene.frame_current)  # re-evaluate the rebased action
+    from . import redecode
+
+    redecode.schedule(rig)
 
 
 def stale_rigs(scene) -> list:
@@ -128,3 +131,6 @@ def unregister():
     if bpy.app.timers.is_registered(_run_pending):
         bpy.app.timers.unregister(_run_pending)
     _pending.clear()
+    from . import redecode
+
+    redecode.unregister()

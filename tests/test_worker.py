@@ -140,6 +140,7 @@ def test_ping_round_trip(shared):
     assert res["pong"] is True and res["pid"] == shared.pid != os.getpid()
     assert res["protocol"] == P.PROTOCOL_VERSION
     assert {"body_info", "measure", "build_dataset", "train_vae"} <= set(res["ops"])
+    assert {"generate", "retarget", "search", "train"} <= set(res["ops"])  # the panel ops (jobs_shapemove)
     assert shared.alive() and not shared.pending
     assert time.monotonic() - t0 < 20
 
@@ -317,6 +318,8 @@ def test_python_without_requirements_says_what_is_missing():
         assert c.call("ping", timeout=30)["pong"]
         with pytest.raises(ShapeMoveError, match=f"needs the Python package 'numpy', which is not installed in {bare}"):
             c.call("body_info", timeout=30)
+        with pytest.raises(ShapeMoveError, match="unknown op 'generate'.*panel ops .* need the Python package"):
+            c.call("generate", {}, timeout=30)
     finally:
         c.stop()
 

@@ -1,11 +1,12 @@
 """Text-to-motion evaluation: generate one motion per clip of a split and score it beside the real clip.
 
     res = eval_generate("DATA", split="test", model_dir="weights/default")
-    res["generated"]["r_precision_top1"], res["real"]["r_precision_top1"]   # model vs ceiling
+    res["r_precision_top1"], res["ground_truth"]["r_precision_top1"]   # model vs the real-data ceiling
 
 For every clip the prompt is one of its captions (chosen with ``seed``) and its numeric shape text
 (line 1 of ``shape_texts/ID.txt``); the motion is as long as the real clip (capped at the T5's
-``max_codes``). Both columns hold the same keys (``KEYS``):
+``max_codes``). The result holds the ``KEYS`` of the generated motions and, under
+"ground_truth", the same keys for the real clips (as ``eval recon`` does):
 
 - r_precision_top1/top3, matching_score: TMA embeddings of the motion features (T,263) against
   the caption embeddings (groups of 32, ``retrieval.r_precision``);
@@ -95,8 +96,8 @@ def shape_errors(body, predicted: np.ndarray, true: np.ndarray) -> tuple[float, 
 
 def score(tma, texts: list[str], feats: list, reference=None, clips_physics: list[dict] = (),
           height_err: float = 0.0, waist_err: float = 0.0) -> tuple[dict, np.ndarray]:
-    """(the ``KEYS`` of one column, its motion embeddings). ``reference``: (N,E) real motion embeddings for FID (None: the
-    column's own embeddings, i.e. the real-data ceiling)."""
+    """(the ``KEYS`` of one column, its motion embeddings). ``reference``: (N,E) real motion
+    embeddings for FID (None: the column's own embeddings, i.e. the real-data ceiling)."""
     from .report import aggregate
     from .retrieval import fid, matching_score, r_precision
     from .tma_embed import embed_motions, embed_texts
@@ -118,8 +119,8 @@ def score(tma, texts: list[str], feats: list, reference=None, clips_physics: lis
 
 def eval_generate(data, split: str = "test", model_dir=None, tma=None, max_clips: int | None = None, seed: int = 0,
                   progress=None, generator=None) -> dict:
-    """Generate one motion per clip of ``split`` and score it; returns {"generated": {KEYS},
-    "real": {KEYS}} (see the module docstring). ``tma``: a path (tma.pt or its folder), a
+    """Generate one motion per clip of ``split`` and score it; returns {KEYS..., "ground_truth":
+    {KEYS}} (see the module docstring). ``tma``: a path (tma.pt or its folder), a
     ``load_tma`` tuple, or None for the model folder's ``tma/``. ``generator``: an already loaded
     ``Generator`` (then ``model_dir`` is ignored). progress(fraction, message) after each clip."""
     from ..generation.generate import Generator, Request
@@ -153,7 +154,7 @@ def eval_generate(data, split: str = "test", model_dir=None, tma=None, max_clips
     real, real_emb = score(tma, texts, [c["features"] for c in clips], None, real_phys)
     h, w = shape_errors(gen.body, np.stack([m.betas for m in motions]), np.stack([c["betas"] for c in clips]))
     generated, _ = score(tma, texts, [m.features for m in motions], real_emb, gen_phys, h, w)
-    return {"generated": generated, "real": real}
+    return {**generated, "ground_truth": real}
 
 
 LABELS = {
@@ -167,45 +168,57 @@ LABELS = {
 
 def format_results(res: dict, title: str = "Text-to-motion evaluation") -> str:
     """The generated and real columns as a plain-text table."""
-    g, r = res["generated"], res["real"]
+    g, r = res, res["ground_truth"]
     fmt = lambda v: "nan" if isinstance(v, float) and math.isnan(v) else f"{v:.3f}"  # noqa: E731
     rows = [(label, better, fmt(g[k]), fmt(r[k])) for k, (label, better) in LABELS.items()]
-    head = ("metric", "better", "generated", "real")
+    head = ("metric", "better", "generated", "ground truth")
     w = [max(len(row[i]) for row in rows + [head]) for i in range(4)]
     line = lambda row: "  ".join(c.ljust(w[i]) if i < 2 else c.rjust(w[i]) for i, c in enumerate(row))  # noqa: E731
     sep = "-" * len(line(head))
     return "\n".join([f"{title} ({g['clips']} clips)", sep, line(head), sep] + [line(row) for row in rows] + [sep])
 
 
-def from_cli(args) -> dict:
-    """`python -m shapemove eval generate`: args.data, args.split, args.model, args.tma,
-    args.max_clips, args.json (all but data optional); prints the table, writes the JSON."""
-    data = getattr(args, "data", None)
-    if data is None:
-        raise ShapeMoveError("eval generate needs --data DIR (a built dataset folder)")
-    bar = None
-    if not getattr(args, "quiet", False):
-        from tqdm import tqdm
+def add_arguments(p) -> None:
+    """Options of `python -m shapemove eval generate`."""
+    p.add_argument("--data", type=Path, required=True, help="dataset folder from `data build`")
+    p.add_argument("--split", default="test", choices=["train", "val", "test"])
+    p.add_argument("--json", type=Path, required=True, help="write the metrics here")
+    p.add_argument("--model", type=Path, default=None, help="model folder (default: the embedded default model)")
+    p.add_argument("--tma", type=Path, default=None, help="TMA for the retrieval metrics (default: the model's tma/)")
+    p.add_argument("--max-clips", type=int, default=None, help="evaluate a seeded random subset of N clips")
+    p.add_argument("--seed", type=int, default=0, help="caption choice, clip subset and sampling seed")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
 
-        bar = tqdm(total=1.0, desc="eval generate", bar_format="{desc}: {percentage:3.0f}% {postfix}")
+
+def write_json(path, res: dict) -> Path:
+    """``res`` as JSON, atomically; non-finite floats become null."""
+    clean = lambda v: ({k: clean(x) for k, x in v.items()} if isinstance(v, dict)  # noqa: E731
+                       else None if isinstance(v, float) and not math.isfinite(v) else v)
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(path.name + ".tmp")
+    tmp.write_text(json.dumps(clean(res), indent=2) + "\n")
+    os.replace(tmp, path)
+    return path
+
+
+def from_cli(args) -> int:
+    """`python -m shapemove eval generate` (see ``add_arguments``): prints the table, writes the JSON."""
+    from tqdm import tqdm
+
+    split = getattr(args, "split", None) or "test"
+    bar = tqdm(total=100, desc="eval generate", unit="%", disable=getattr(args, "quiet", False))
 
     def progress(frac, msg):
-        if bar is not None:
-            bar.n = frac
-            bar.set_postfix_str(msg)
+        bar.update(round(100 * frac) - bar.n)
+        bar.set_postfix_str(msg)
 
-    res = eval_generate(data, getattr(args, "split", None) or "test", getattr(args, "model", None),
-                        getattr(args, "tma", None), getattr(args, "max_clips", None), getattr(args, "seed", 0) or 0,
-                        progress=progress)
-    if bar is not None:
+    try:
+        res = eval_generate(args.data, split, getattr(args, "model", None), getattr(args, "tma", None),
+                            getattr(args, "max_clips", None), getattr(args, "seed", 0) or 0, progress=progress)
+    finally:
         bar.close()
-    print(format_results(res, f"Text-to-motion evaluation, {Path(data).name}/{getattr(args, 'split', None) or 'test'}"))
-    out = getattr(args, "json", None)
-    if out:
-        out = Path(out)
-        out.parent.mkdir(parents=True, exist_ok=True)
-        tmp = out.with_name(out.name + ".tmp")
-        tmp.write_text(json.dumps(res, indent=2))
-        os.replace(tmp, out)
-        print(f"wrote {out}")
-    return res
+    print(format_results(res, f"Text-to-motion evaluation, {split} split"))
+    if getattr(args, "json", None):
+        print(f"wrote {write_json(args.json, res)}")
+    return 0

@@ -72,10 +72,11 @@ def recon_clip(vae, body, norm_feats: np.ndarray, betas: np.ndarray, ik_refine_i
 
 
 def eval_recon(data, checkpoint, split: str = "test", body=None, max_clips: int | None = None, progress=None,
-               ik_refine_iters: int = 10) -> dict:
+               ik_refine_iters: int = 10, per_clip: list | None = None) -> dict:
     """Reconstruction metrics of the SA-VAE ``checkpoint`` (run folder or .pt) on the ``split``
     clips of the dataset folder ``data``, with the ground truth's beside (see the module doc).
-    progress(fraction, clip id) after each clip."""
+    progress(fraction, clip id) after each clip; ``per_clip``: a list to receive one dict per clip
+    ({"id", "frames", the KEYS, "ground_truth": {KEYS}})."""
     from ..body.kinematics import axis_angle_to_matrix
     from ..generation.retarget import load_vae
     from ..models.fsq import codebook_usage
@@ -103,6 +104,8 @@ def eval_recon(data, checkpoint, split: str = "test", body=None, max_clips: int 
         gt_rot = axis_angle_to_matrix(torch.as_tensor(_load(root, "poses", cid)[:n])).numpy()
         g = evaluate_motion(body, betas, gt_rot, _load(root, "transl", cid)[:n])
         g["mpjpe_mm"] = mpjpe_mm(gt_joints, gt_joints)
+        if per_clip is not None:
+            per_clip.append({"id": cid, "frames": n, **_pick(m), "ground_truth": _pick(g)})
         model_rows.append(m)
         gt_rows.append(g)
         all_indices.append(idx)

@@ -135,9 +135,9 @@ class ShapeMoveT5(nn.Module):
         if info.get("format") != FORMAT:
             raise ShapeMoveError(f"{directory}: unsupported model format {info.get('format')!r} (expected {FORMAT})")
         tok = load_tokenizer(directory)
-        lm = T5ForConditionalGeneration.from_pretrained(str(directory), local_files_only=True)
+        lm = T5ForConditionalGeneration.from_pretrained(str(directory), local_files_only=True, dtype=torch.float32)
         head = BetaHead(lm.config.d_model)
-        head.load_state_dict(load_file(str(directory / "beta_head.safetensors")))
+        head.load_state_dict({k: v.float() for k, v in load_file(str(directory / "beta_head.safetensors")).items()})
         model = cls(lm, head, MotionVocab(tok), info.get("beta_weight", 1.0))
         model.info = info
         return model.eval(), tok

@@ -77,8 +77,8 @@ def generate(params, progress, cancel) -> dict:
     "temperature", "top_k", "model" (folder, optional), "body", "out" (.npz)} -> the motion file
     written, its facts and the body's measurements (cm)."""
     from ..generation.generate import Request
-    from ..runner import JobCancelled
     from ..scene.motion_file import save_motion
+    from .runner import JobCancelled
 
     op = "generate"
     out = _out_path(params, op)
@@ -120,9 +120,13 @@ def redecode(params, progress, cancel) -> dict:
 
 
 def retarget(params, progress, cancel) -> dict:
-    """params {"source" (BVH / ASF+AMC / AMASS .npz), "body", "betas" (10, optional: else fitted to
-    the source skeleton), "out"} -> the motion on the body, written to ``out``."""
-    from ..generation.retarget import retarget as _retarget
+    """params {"source" (BVH / ASF+AMC / AMASS .npz), "body", "betas" (10, optional: else the
+    source subject's own shape, fitted to its bone lengths), "method" ("auto" | "savae" | "naive";
+    auto = through the SA-VAE when a model has one, else naive), "model", "out"} -> the motion on
+    the body, written to ``out``."""
+    from ..body.fit import bone_lengths, fit_betas_to_bone_lengths
+    from ..body.load import load_body_model
+    from ..generation.retarget import load_vae, naive_retarget, retarget as savae_retarget, source_joints
     from ..scene.motion_file import save_motion
 
     op = "retarget"
@@ -130,10 +134,30 @@ def retarget(params, progress, cancel) -> dict:
     source = Path(param(params, op, "source", str))
     if not source.is_file():
         raise ShapeMoveError(f"op 'retarget': source file not found: {source}")
+    method = param(params, op, "method", str, "auto")
+    if method not in ("auto", "savae", "naive"):
+        raise ShapeMoveError(f"op 'retarget': method must be auto, savae or naive, got {method!r}")
+    body = load_body_model(param(params, op, "body", str, None))
     progress(0.1, f"reading {source.name}")
-    motion = _retarget(source, body=param(params, op, "body", str, None), betas=_betas(params, op))
+    joints, _ = source_joints(source, body)
+    betas = _betas(params, op)
+    if betas is None:  # the subject's own proportions
+        betas = fit_betas_to_bone_lengths(body, np.median(bone_lengths(joints), axis=0)).betas
+    vae = None
+    if method != "naive":
+        try:
+            vae = load_vae(param(params, op, "model", str, None), body)
+        except ShapeMoveError:
+            if method == "savae":
+                raise
+    if cancel():
+        from .runner import JobCancelled
+
+        raise JobCancelled
+    progress(0.3, "retargeting" + (" through the SA-VAE" if vae is not None else " (naive: no SA-VAE model)"))
+    motion = savae_retarget(source, vae, body, betas) if vae is not None else naive_retarget(source, body, betas)
     save_motion(out, motion)
-    return _motion_facts(out, motion)
+    return {**_motion_facts(out, motion), "method": "savae" if vae is not None else "naive"}
 
 
 def search(params, progress, cancel) -> dict:
@@ -219,23 +243,18 @@ def train(params, progress, cancel) -> dict:
 
 
 def betas_from_text(params, progress, cancel) -> dict:
-    """params {"text": shape sentence ("a tall man, chest circumference of 104 cm"), "body"} ->
-    {"betas": 10 numbers, "measurements": wanted (cm), "achieved": measured on the result (cm)}."""
+    """params {"text": shape text ("a tall, heavy-set man", "standing 185 cm tall, with a waist
+    circumference of 90 cm"), "body"} -> {"betas": 10 numbers, "measurements": the targets (cm),
+    "achieved": measured on the result (cm)}."""
     from ..body.load import load_body_model
-    from ..body.shape_from_measurements import betas_for_measurements
-    from ..data.shape_text import parse_shape_sentence
+    from ..body.shape_from_measurements import betas_for_measurements, targets_from_shape_text
 
     op = "betas_from_text"
-    text = param(params, op, "text", str).strip()
-    if not text:
-        raise ShapeMoveError("op 'betas_from_text': the shape text is empty (e.g. 'a man with a height of 185 cm')")
-    wanted = parse_shape_sentence(text)
-    if not wanted:
-        raise ShapeMoveError(f"no measurements found in {text!r}: write e.g. 'a height of 180 cm, "
-                             "waist circumference of 85 cm'")
+    text = param(params, op, "text", str)
     body = load_body_model(param(params, op, "body", str, None))
-    betas = np.asarray(betas_for_measurements(body, wanted), dtype=np.float64).reshape(-1)
-    return {"betas": betas.tolist(), "measurements": wanted, "achieved": _measurements(body, betas.astype(np.float32))}
+    wanted = targets_from_shape_text(text, body)
+    betas = np.asarray(betas_for_measurements(body, wanted) if wanted else np.zeros(10), np.float32).reshape(-1)
+    return {"betas": betas.tolist(), "measurements": wanted, "achieved": _measurements(body, betas)}
 
 
 OPS = {"generate": generate, "redecode": redecode, "retarget": retarget, "search": search, "train": train,

@@ -4,7 +4,8 @@
 soon and return what you have). Bad params -> ShapeMoveError naming the op and the parameter.
 Heavy imports (torch, the models) happen inside each op, so the worker starts fast.
 To add an op: write ``def my_op(params, progress, cancel) -> dict`` next to the code it runs and add
-one line to ``JOBS`` below (or call ``register("name", func)`` before the worker serves).
+one line to ``JOBS`` below (or call ``register("name", func)`` before the worker serves). The
+panel ops of ``jobs_shapemove`` join through ``default_jobs()``, which the runners use.
 """
 from __future__ import annotations
 
@@ -169,6 +170,29 @@ JOBS: dict = {
     "train_vae": train_vae,
     "cli": cli,
 }
+
+
+_PANEL_OPS: list[str] = []  # "" once added, else why they could not be
+
+
+def default_jobs() -> dict:
+    """JOBS plus the ops behind the Blender panels (``jobs_shapemove``: generate, retarget, train,
+    search, ...), added on first use. In a Python that cannot import them: JOBS alone, and
+    ``panel_ops_problem()`` says why."""
+    if not _PANEL_OPS:
+        try:
+            from .jobs_shapemove import register as add_panel_ops
+
+            add_panel_ops(JOBS)
+            _PANEL_OPS.append("")
+        except ModuleNotFoundError as exc:
+            _PANEL_OPS.append(f"the panel ops (generate, train, ...) need the Python package {exc.name!r}, "
+                              f"which is not installed in {sys.executable}")
+    return JOBS
+
+
+def panel_ops_problem() -> str:
+    return _PANEL_OPS[0] if _PANEL_OPS else ""
 
 
 def register(name: str, func) -> None:

@@ -37,10 +37,10 @@ class _Job:
 
 class JobRunner:
     def __init__(self, emit, jobs: dict | None = None):
-        from .ops import JOBS
+        from .ops import default_jobs
 
         self.emit = emit
-        self.jobs = JOBS if jobs is None else jobs
+        self.jobs = default_jobs() if jobs is None else jobs
         self._queue: deque[_Job] = deque()
         self._current: _Job | None = None
         self._cv = threading.Condition()
@@ -69,8 +69,11 @@ class JobRunner:
             self.emit(P.result(req.id, {"shutdown": True}))
             return False
         elif req.op not in self.jobs:
+            from .ops import panel_ops_problem
+
+            note = f" ({panel_ops_problem()})" if panel_ops_problem() else ""
             self.emit(P.error(req.id, f"unknown op {req.op!r}; known ops: "
-                                      f"{', '.join(sorted([*P.CONTROL_OPS, *self.jobs]))}"))
+                                      f"{', '.join(sorted([*P.CONTROL_OPS, *self.jobs]))}{note}"))
         else:
             with self._cv:
                 if self._closing:

@@ -1,0 +1,61 @@
+"""`python -m shapemove retarget --motion IN (--betas b0,…,b9 | --shape-text TEXT) [--checkpoint RUN]
+--out OUT.npz [--naive]`: a captured motion (BVH, ASF/AMC, AMASS .npz) performed by another body.
+
+The body: explicit betas, or a shape text - a measured sentence ("A person standing 190 cm tall,
+with a waist circumference of 100 cm") or adjectives ("a tall, heavy-set man") - turned into
+betas by matching the body's measurements (``core/body/shape_from_measurements.py``).
+Default: through the SA-VAE (``core/generation/retarget.py``; the output keeps its motion tokens,
+so it can be re-decoded for other bodies); ``--naive`` copies the rotations instead.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+
+def add_arguments(p):
+    p.add_argument("--motion", type=Path, required=True, help="input motion: .bvh, .amc (with its .asf) or AMASS .npz")
+    p.add_argument("--betas", default=None, help="target body shape b0,…,b9 (missing values are 0)")
+    p.add_argument("--shape-text", default=None, help='target body as text, e.g. "A person standing 190 cm tall"')
+    p.add_argument("--checkpoint", type=Path, default=None,
+                   help="SA-VAE run folder or .pt (default: the embedded model's savae.pt)")
+    p.add_argument("--out", type=Path, required=True, help="output motion file (.npz)")
+    p.add_argument("--naive", action="store_true", help="copy the rotations instead of going through the SA-VAE")
+    p.add_argument("--body-model", default=None, help="openbody (default) or an SMPL-family file")
+
+
+def target_betas(body, betas_text: str | None, shape_text: str | None):
+    """Exactly one of --betas / --shape-text -> (10,) betas."""
+    from ..core.body.shape_from_measurements import betas_from_shape_text
+    from ..core.errors import ShapeMoveError
+    from ..core.generation.generate import parse_betas
+
+    if (betas_text is None) == (shape_text is None):
+        raise ShapeMoveError("give the target body with exactly one of --betas or --shape-text")
+    return parse_betas(betas_text) if betas_text is not None else betas_from_shape_text(body, shape_text)
+
+
+def run(args) -> int:
+    from ..core.body.load import load_body_model
+    from ..core.body.measure import measure
+    from ..core.errors import ShapeMoveError
+    from ..core.generation.retarget import load_vae, naive_retarget, retarget
+    from ..core.scene.motion_file import save_motion
+
+    if args.out.suffix.lower() != ".npz":
+        raise ShapeMoveError(f"--out must end in .npz, got {args.out}")
+    if not args.motion.is_file():
+        raise ShapeMoveError(f"motion file not found: {args.motion}")
+    body = load_body_model(args.body_model)
+    betas = target_betas(body, args.betas, args.shape_text)
+    if args.naive:
+        motion = naive_retarget(args.motion, body, betas)
+        how = "naive (rotations copied)"
+    else:
+        motion = retarget(args.motion, load_vae(args.checkpoint, body), body, betas)
+        how = f"SA-VAE, {len(motion.tokens)} tokens"
+    save_motion(args.out, motion)
+    m = measure(body, motion.betas)
+    print(f"wrote {args.out}: {motion.num_frames} frames ({motion.num_frames / motion.fps:.1f} s), {how}")
+    print("betas: " + ",".join(f"{v:.2f}" for v in motion.betas))
+    print("body: " + ", ".join(f"{k.replace('_cm', '')} {v:.0f} cm" for k, v in m.items()))
+    return 0
