@@ -129,6 +129,10 @@ class SHAPEMOVE_PT_shape_betas(_Panel, bpy.types.Panel):
     bl_parent_id = "SHAPEMOVE_PT_shape"
     bl_options = {"DEFAULT_CLOSED"}
 
+    @classmethod
+    def poll(cls, context):
+        return rig_of(context.active_object) is not None
+
     def draw(self, context):
         rig = rig_of(context.active_object)
         col = self.layout.column(align=True)

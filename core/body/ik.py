@@ -448,7 +448,8 @@ def solve_ik(joints, rest_joints, parents=PARENTS, refine_iters: int = 10, max_t
             with torch.no_grad():
                 before = torch.linalg.norm(_fk(rot, rest, parents, transl) - target, dim=-1).max()
             if before > 1e-5:
-                rot, transl = refine(rot, transl, target, rest, parents, iters=refine_iters)
+                with torch.enable_grad():  # callers may run under no_grad; the refinement needs gradients
+                    rot, transl = refine(rot, transl, target, rest, parents, iters=refine_iters)
         return _result(rot, transl, target, rest, parents)
 
 

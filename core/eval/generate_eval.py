@@ -111,8 +111,7 @@ def score(tma, texts: list[str], feats: list, reference=None, clips_physics: lis
         f = max(0.0, fid(m, m if reference is None else reference))
     phys = aggregate(list(clips_physics))
     out = {"r_precision_top1": r["top1"], "r_precision_top3": r["top3"], "matching_score": matching_score(t, m),
-           "fid": f,
-           **{k: float(phys[k]) for k in PHYSICS}, "height_err_cm": height_err, "waist_err_cm": waist_err,
+           "fid": f, **{k: float(phys[k]) for k in PHYSICS}, "height_err_cm": height_err, "waist_err_cm": waist_err,
            "clips": len(feats)}
     return out, m
 

@@ -35,7 +35,8 @@ def source_motion(data, clip):
     p = Path(data) / "new_joints" / f"{clip}.npy"
     if not p.is_file():
         raise ShapeMoveError(f"{data}: no clip {clip!r} (new_joints/{clip}.npy missing)")
-    return Motion22(joints=np.load(p).astype(np.float32), fps=20.0, source=str(clip), subject="", offsets=np.zeros((22, 3)))
+    joints = np.load(p).astype(np.float32)
+    return Motion22(joints=joints, fps=20.0, source=str(clip), subject="", offsets=np.zeros((22, 3)))
 
 
 def _score(body, motion, betas) -> dict:

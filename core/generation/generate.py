@@ -18,6 +18,7 @@ import torch
 
 from ..errors import ShapeMoveError
 from ..scene.motion_file import Motion
+from .decode import decode_tokens
 from .prompts import check_prompt
 
 FPS = 20
@@ -94,28 +95,7 @@ class Generator:
     # -- motion ------------------------------------------------------------------------------
     def decode_motion(self, codes: list[int], betas: np.ndarray, prompt: str | None = None) -> Motion:
         """Tokens + body shape -> Motion on the body model (SA-VAE decode, joints, IK)."""
-        from ..body.ik import solve_ik
-        from ..body.kinematics import matrix_to_axis_angle
-        from ..motion.features import joints_from_features
-
-        if not codes:
-            raise ShapeMoveError("no motion tokens to decode")
-        b = torch.as_tensor(np.asarray(betas, np.float32)).reshape(1, 10)
-        idx = torch.as_tensor(codes, dtype=torch.long)[None]
-        with torch.no_grad():
-            feats = self.vae.denormalize(self.vae.decode_long(self.vae.quantizer.indices_to_codes(idx), b))[0]
-            joints = joints_from_features(feats).numpy()
-        joints[..., 1] -= joints[:, [7, 8, 10, 11], 1].min()
-        with torch.no_grad():
-            rest = self.body.rest_joints(b)[0].numpy()
-        ik = solve_ik(joints, rest, refine_iters=self.ik_refine_iters)
-        rot = torch.as_tensor(np.asarray(ik.rotations, np.float32))
-        poses = matrix_to_axis_angle(rot).numpy().astype(np.float32)
-        m = Motion(joints=joints.astype(np.float32), betas=b[0].numpy(), poses=poses,
-                   transl=np.asarray(ik.transl, np.float32), fps=float(FPS), body_model=self.body.name,
-                   prompt=prompt, tokens=np.asarray(codes, np.int16), features=feats.numpy().astype(np.float32))
-        m.ik_error_cm = float(ik.mean_error_cm)
-        return m
+        return decode_tokens(codes, self.vae, self.body, betas, self.ik_refine_iters, prompt=prompt)
 
     def generate(self, prompt: str, shape_text: str | None = None, betas=None, seconds: float | None = None,
                  seed: int = 0, temperature: float = 1.0, top_k: int | None = 50) -> Motion:

@@ -25,6 +25,7 @@ import torch
 from ..errors import ShapeMoveError
 from ..io.mocap import Motion22
 from ..scene.motion_file import Motion, validate
+from .decode import check_betas, decode_tokens
 
 FPS = 20
 
@@ -66,24 +67,19 @@ def source_joints(motion, body=None) -> tuple[np.ndarray, str]:
             raise ShapeMoveError(f"motion file not found: {path}")
         motion = load_smpl22(path, fps=FPS, body_model=body)
     if not isinstance(motion, Motion22):
-        raise ShapeMoveError(f"retarget needs a motion file (.bvh, .amc, AMASS .npz) or a Motion22, got {type(motion).__name__}")
+        raise ShapeMoveError("retarget needs a motion file (.bvh, .amc, AMASS .npz) or a Motion22, "
+                             f"got {type(motion).__name__}")
     joints = np.asarray(motion.joints, dtype=np.float64)
     if joints.ndim != 3 or joints.shape[1:] != (22, 3):
         raise ShapeMoveError(f"{motion.source}: joints must be (T,22,3), got {joints.shape}")
     if abs(motion.fps - FPS) > 1e-6:
         joints = resample_positions(joints, motion.fps, FPS)
     if len(joints) < MIN_FRAMES:
-        raise ShapeMoveError(f"{motion.source}: too short to retarget ({len(joints)} frames at {FPS} fps, need {MIN_FRAMES})")
+        raise ShapeMoveError(f"{motion.source}: too short to retarget ({len(joints)} frames at {FPS} fps, "
+                             f"need {MIN_FRAMES})")
     if not np.isfinite(joints).all():
         raise ShapeMoveError(f"{motion.source}: non-finite joint positions")
     return joints.astype(np.float32), str(motion.source)
-
-
-def check_betas(betas) -> np.ndarray:
-    b = np.asarray(betas, dtype=np.float32).reshape(-1)
-    if b.shape != (10,) or not np.isfinite(b).all():
-        raise ShapeMoveError(f"betas must be 10 finite values, got shape {b.shape}")
-    return b
 
 
 def processor(body, ik_refine_iters: int = 10):
@@ -101,33 +97,6 @@ def encode_source(joints: np.ndarray, vae, body, ik_refine_iters: int = 10) -> l
     with torch.no_grad():
         _, indices = vae.encode(x)
     return [int(i) for i in indices[0]]
-
-
-def decode_tokens(codes: list[int], vae, body, betas, ik_refine_iters: int = 10, prompt: str | None = None) -> Motion:
-    """Tokens + betas (10,) -> Motion on ``body``, as ``Generator.decode_motion`` does it (SA-VAE
-    ``decode_long``, joints from the features, lowest foot on the floor, IK) without a T5.
-    (Not delegated: ``decode_motion`` runs the IK under ``no_grad``, where the IK's LBFGS
-    refinement cannot take gradients.)"""
-    from ..body.ik import solve_ik
-    from ..body.kinematics import matrix_to_axis_angle
-    from ..motion.features import joints_from_features
-
-    if not codes:
-        raise ShapeMoveError("no motion tokens to decode")
-    b = torch.as_tensor(check_betas(betas))[None]
-    with torch.no_grad():
-        idx = torch.as_tensor(codes, dtype=torch.long)[None]
-        feats = vae.denormalize(vae.decode_long(vae.quantizer.indices_to_codes(idx), b))[0]
-        joints = joints_from_features(feats.double()).float().numpy()
-        rest = body.rest_joints(b)[0].numpy()
-    joints[..., 1] -= joints[:, [7, 8, 10, 11], 1].min()
-    ik = solve_ik(joints, rest, refine_iters=ik_refine_iters)
-    poses = matrix_to_axis_angle(torch.as_tensor(ik.rotations)).numpy().astype(np.float32)
-    m = Motion(joints=joints, betas=b[0].numpy(), poses=poses, transl=np.asarray(ik.transl, np.float32),
-               fps=float(FPS), body_model=body.name, prompt=prompt, tokens=np.asarray(codes, np.int16),
-               features=feats.numpy().astype(np.float32))
-    m.ik_error_cm = float(ik.mean_error_cm)
-    return m
 
 
 def retarget(motion, vae, body, betas, ik_refine_iters: int = 10) -> Motion:

@@ -1,0 +1,240 @@
+"""SA-VAE evaluation (`eval recon`), retargeting (SA-VAE and naive, `retarget`), betas from
+measurements / shape texts, and the SA-VAE vs naive comparison. A tiny SA-VAE is trained on the
+`tiny_dataset` fixture (real clips, real builder) for a few steps."""
+import json
+
+import numpy as np
+import pytest
+import torch
+
+from shapemove.core.errors import ShapeMoveError
+
+RUN_CLIP = "dataset-1_run_happy_001"  # 93 frames; the tiny dataset also holds its augmented copy
+RECON_KEYS = {"mpjpe_mm", "bone_err_mm", "penetrate_cm", "float_cm", "skate_pct", "dyn_stable_pct",
+              "code_usage_pct", "clips"}
+
+
+@pytest.fixture(scope="module")
+def body():
+    from shapemove.core.body.load import load_body_model
+
+    return load_body_model(None)
+
+
+@pytest.fixture(scope="module")
+def vae_run(tiny_dataset, body, tmp_path_factory):
+    """A tiny SA-VAE trained for 20 steps on the tiny dataset (a few seconds)."""
+    from shapemove.core.models.savae import SAVAEConfig, TrainSettings
+    from shapemove.core.train.train_vae import train_vae
+
+    cfg = SAVAEConfig(width=16, depth=1, shape_hidden=16,
+                      train=TrainSettings(steps=20, batch_size=4, lr=1e-2, warmup_steps=2, log_every=10, val_every=20,
+                                          val_batches=1, ckpt_every=1000))
+    out = tmp_path_factory.mktemp("savae_run")
+    train_vae(tiny_dataset, out, cfg, body=body, device="cpu", verbose=False)
+    return out
+
+
+@pytest.fixture(scope="module")
+def vae(vae_run, body):
+    from shapemove.core.generation.retarget import load_vae
+
+    return load_vae(vae_run, body)
+
+
+@pytest.fixture(scope="module")
+def run_bvh(mocap_root):
+    return mocap_root / "bandai" / "dataset-1" / "data" / f"{RUN_CLIP}.bvh"
+
+
+def _height(body, betas) -> float:
+    from shapemove.core.body.measure import measure
+
+    return measure(body, betas)["height_cm"]
+
+
+# -- betas from measurements and shape texts ----------------------------------------------------------
+
+def test_betas_for_measurements(openbody):
+    from shapemove.core.body.measure import MEASUREMENTS, measure
+    from shapemove.core.body.shape_from_measurements import betas_for_measurements, fast_measure
+
+    b = np.random.default_rng(1).standard_normal((2, 10))
+    m = measure(openbody, b)
+    assert np.allclose(fast_measure(openbody, b, MEASUREMENTS), np.stack([m[k] for k in MEASUREMENTS], 1), atol=1e-3)
+    for h in (190.0, 155.0):
+        betas = betas_for_measurements(openbody, {"height_cm": h})
+        assert betas.shape == (10,) and abs(_height(openbody, betas) - h) < 1.0
+        assert np.linalg.norm(betas) < 3.0                   # the prior keeps the other directions small
+    betas = betas_for_measurements(openbody, {"height_cm": 180.0, "waist_cm": 100.0})
+    got = measure(openbody, betas)
+    assert abs(got["height_cm"] - 180) < 1.0 and abs(got["waist_cm"] - 100) < 1.0
+    with pytest.raises(ShapeMoveError, match="unknown measurement"):
+        betas_for_measurements(openbody, {"shoe_size": 44})
+    with pytest.raises(ShapeMoveError, match="plausible"):
+        betas_for_measurements(openbody, {"height_cm": 400})
+
+
+def test_targets_from_shape_text(openbody):
+    from shapemove.core.body.shape_from_measurements import betas_from_shape_text, targets_from_shape_text
+
+    t = targets_from_shape_text("A person standing 182 cm tall, with a chest circumference of 101 cm, "
+                                "a waist circumference of 90 cm, an arm length of 55 cm.")
+    assert t == {"height_cm": 182.0, "chest_cm": 101.0, "waist_cm": 90.0, "arm_length_cm": 55.0}
+    t = targets_from_shape_text("a tall, heavy-set man")          # band middles: 185 cm, waist/height 0.565
+    assert t["height_cm"] == 185.0 and t["waist_cm"] == pytest.approx(0.565 * 185)
+    assert targets_from_shape_text("A very short, slim woman") == {"height_cm": 150.0, "waist_cm": pytest.approx(61.5)}
+    assert targets_from_shape_text("an average-sized person") == {}
+    assert np.all(betas_from_shape_text(openbody, "an average-sized person") == 0)
+    for bad in ("a blue banana", "   "):
+        with pytest.raises(ShapeMoveError):
+            targets_from_shape_text(bad)
+
+
+# -- eval recon ---------------------------------------------------------------------------------------
+
+def test_eval_recon(tiny_dataset, vae_run, body):
+    from shapemove.core.eval.recon import eval_recon
+    from shapemove.core.train.motion_dataset import read_split
+
+    seen, rows = [], []
+    r = eval_recon(tiny_dataset, vae_run, split="test", body=body, progress=lambda f, cid: seen.append(f), per_clip=rows)
+    ids = read_split(tiny_dataset, "test")
+    assert set(r) == RECON_KEYS | {"ground_truth"} and set(r["ground_truth"]) == RECON_KEYS
+    assert all(np.isfinite(r[k]) for k in RECON_KEYS) and r["clips"] == len(ids) >= 1
+    gt = r["ground_truth"]
+    assert gt["mpjpe_mm"] == 0.0 and gt["code_usage_pct"] is None
+    assert gt["bone_err_mm"] < 0.1             # the dataset's motion is FK of the clip's own body
+    assert r["mpjpe_mm"] > 0 and 0 < r["code_usage_pct"] <= 100
+    assert seen[-1] == 1.0 and [row["id"] for row in rows] == ids
+    assert all(row["frames"] % 4 == 0 for row in rows)
+    n = np.array([row["frames"] for row in rows])           # pooled = frame-weighted mean of the clips
+    assert r["mpjpe_mm"] == pytest.approx((n * [row["mpjpe_mm"] for row in rows]).sum() / n.sum())
+
+
+def test_cli_eval_recon(tiny_dataset, vae_run, tmp_path, capsys):
+    from shapemove.cli import main
+    from shapemove.core.models.savae import SAVAEConfig
+    from shapemove.core.train.checkpoint import make_metadata, save_checkpoint
+
+    out = tmp_path / "recon.json"
+    assert main(["eval", "recon", "--data", str(tiny_dataset), "--checkpoint", str(vae_run / "savae.pt"),
+                 "--json", str(out), "--max-clips", "1", "--quiet"]) == 0
+    res = json.loads(out.read_text())
+    assert set(res) == RECON_KEYS | {"ground_truth"} and res["clips"] == 1 and res["ground_truth"]["mpjpe_mm"] == 0
+    text = capsys.readouterr().out
+    assert "ground truth" in text and "MPJPE" in text and not list(tmp_path.glob("*.tmp"))
+    # bad inputs: one-line errors, exit code 2
+    other = save_checkpoint(tmp_path / "tma.pt", {"model": {}},
+                            make_metadata("tma", SAVAEConfig().to_dict(), "openbody-v1", np.zeros(263), np.ones(263)))
+    for argv in (["--data", str(tiny_dataset), "--checkpoint", str(other)],
+                 ["--data", str(tmp_path / "nowhere"), "--checkpoint", str(vae_run)],
+                 ["--data", str(tiny_dataset), "--checkpoint", str(tmp_path)]):
+        assert main(["eval", "recon", *argv, "--json", str(out), "--quiet"]) == 2
+    assert "expected 'savae'" in capsys.readouterr().err
+
+
+# -- retargeting --------------------------------------------------------------------------------------
+
+def test_retarget_through_savae(run_bvh, tiny_dataset, vae, body):
+    from shapemove.core.body.shape_from_measurements import betas_from_shape_text
+    from shapemove.core.eval.bones import bone_lengths, target_bone_lengths
+    from shapemove.core.generation.retarget import decode_tokens, retarget
+    from shapemove.core.scene.motion_file import validate
+
+    tall_b = betas_from_shape_text(body, "A person standing 190 cm tall")
+    short_b = betas_from_shape_text(body, "A person standing 155 cm tall")
+    tall, short = retarget(run_bvh, vae, body, tall_b), retarget(run_bvh, vae, body, short_b)
+    total = []                                             # summed bone length of the posed body (m)
+    for m, b in ((tall, tall_b), (short, short_b)):
+        validate(m)
+        assert np.array_equal(m.betas, b) and m.num_frames == 4 * len(m.tokens) == 92  # 93 frames -> 92 rows
+        with torch.no_grad():                              # the body Blender poses: the target's bones
+            fk = body.forward(torch.as_tensor(b)[None], torch.as_tensor(m.poses), torch.as_tensor(m.transl)).joints
+        assert np.abs(bone_lengths(fk[:, :22]) - target_bone_lengths(body, torch.as_tensor(b)[None])).max() < 1e-4
+        assert np.abs(fk[:, :22].numpy() - m.joints).mean() < 0.05       # IK follows the decoded joints
+        total.append(bone_lengths(fk[:, :22]).sum(1).mean())
+    assert total[0] > total[1] + 0.3                                             # 190 cm vs 155 cm body
+    assert np.array_equal(tall.tokens, short.tokens)        # same motion tokens, decoded for two bodies
+    assert np.abs(tall.features - short.features).max() > 0  # the decoder saw the new betas
+    # the tokens are the builder's canonical features of that clip, encoded
+    x = np.load(tiny_dataset / "norm_joint_vecs" / f"{RUN_CLIP}.npy")[:92]
+    with torch.no_grad():
+        _, idx = vae.encode(vae.normalize(torch.as_tensor(x))[None])
+    assert np.array_equal(tall.tokens, idx[0].numpy())
+    again = decode_tokens([int(t) for t in tall.tokens], vae, body, tall_b)  # re-decodable from its tokens
+    assert np.allclose(again.features, tall.features, atol=1e-5)
+
+
+def test_naive_retarget_is_the_builders_augmentation(run_bvh, tiny_dataset, body):
+    from shapemove.core.eval.bones import bone_lengths, target_bone_lengths
+    from shapemove.core.generation.retarget import naive_retarget
+
+    betas = np.load(tiny_dataset / "betas" / f"{RUN_CLIP}_aug.npy")      # the builder's sampled body
+    m = naive_retarget(run_bvh, body, betas)
+    # rotations copied unchanged from the subject's IK; joints, transl = the builder's augmented copy
+    assert np.array_equal(m.poses, np.load(tiny_dataset / "poses" / f"{RUN_CLIP}.npy"))
+    assert np.allclose(m.joints, np.load(tiny_dataset / "new_joints" / f"{RUN_CLIP}_aug.npy"), atol=1e-6)
+    assert np.allclose(m.transl, np.load(tiny_dataset / "transl" / f"{RUN_CLIP}_aug.npy"), atol=1e-6)
+    # bones are exactly the new body's, the lowest foot joint is on the floor
+    err = np.abs(bone_lengths(m.joints) - target_bone_lengths(body, torch.as_tensor(betas)[None]))
+    assert err.max() < 1e-5 and m.joints[:, [7, 8, 10, 11], 1].min() == pytest.approx(0, abs=1e-6)
+    # root path scaled by the pelvis-height ratio of the new and the subject's body
+    sub = np.load(tiny_dataset / "new_joints" / f"{RUN_CLIP}.npy")
+    rest = lambda b: body.rest_joints(torch.as_tensor(b)[None])[0].numpy()  # noqa: E731
+    ph = lambda r: r[0, 1] - r[[7, 8, 10, 11], 1].min()  # noqa: E731
+    s = ph(rest(betas)) / ph(rest(np.load(tiny_dataset / "betas" / f"{RUN_CLIP}.npy")))
+    step = lambda j: j[:, 0, [0, 2]] - j[0, 0, [0, 2]]  # noqa: E731
+    assert np.allclose(step(m.joints), s * step(sub), atol=1e-4) and abs(s - 1) > 0.01
+
+
+def test_compare_retargeting(tiny_dataset, vae_run, body):
+    from shapemove.core.body.shape_from_measurements import betas_for_measurements
+    from shapemove.core.eval.retarget_compare import KEYS, compare_retargeting
+
+    targets = [betas_for_measurements(body, {"height_cm": h}) for h in (190.0, 155.0)]
+    r = compare_retargeting(tiny_dataset, vae_run, ["cmu_09_01"], targets, body=body)
+    assert set(r) == {"savae", "naive"}
+    for name in r:
+        assert set(r[name]) == set(KEYS) | {"clips", "bodies"} and r[name]["bodies"] == 2
+        assert all(np.isfinite(r[name][k]) for k in KEYS)
+    assert r["naive"]["bone_err_mm"] < 0.01 < r["savae"]["bone_err_mm"]
+    with pytest.raises(ShapeMoveError, match="no clip"):
+        compare_retargeting(tiny_dataset, vae_run, ["no_such_clip"], targets, body=body)
+
+
+def test_cli_retarget(run_bvh, vae_run, body, tmp_path, capsys):
+    from shapemove.cli import main
+    from shapemove.cli.retarget import run
+    from shapemove.core.models.savae import SAVAEConfig
+    from shapemove.core.scene.motion_file import load_motion
+    from shapemove.core.train.checkpoint import make_metadata, save_checkpoint
+
+    out = tmp_path / "tall.npz"
+    assert main(["retarget", "--motion", str(run_bvh), "--shape-text", "A person standing 190 cm tall",
+                 "--checkpoint", str(vae_run), "--out", str(out)]) == 0
+    m = load_motion(out)
+    assert m.tokens is not None and abs(_height(body, m.betas) - 190) < 1.0
+    assert main(["retarget", "--motion", str(run_bvh), "--betas", "1,0.5", "--naive", "--out", str(tmp_path / "n.npz")]) == 0
+    assert np.allclose(load_motion(tmp_path / "n.npz").betas[:3], [1, 0.5, 0])
+    capsys.readouterr()
+
+    def args(**kw):
+        import argparse
+
+        base = dict(motion=run_bvh, betas=None, shape_text=None, checkpoint=vae_run, out=tmp_path / "x.npz",
+                    naive=False, body_model=None)
+        return argparse.Namespace(**{**base, **kw})
+
+    other = save_checkpoint(tmp_path / "t5.pt", {"model": {}},    # a checkpoint of another kind
+                            make_metadata("t5", SAVAEConfig().to_dict(), body.name, np.zeros(263), np.ones(263)))
+    bad = [(dict(motion=tmp_path / "missing.bvh", betas="1"), "not found"),
+           (dict(betas="1", shape_text="A person standing 190 cm tall"), "exactly one"),
+           (dict(), "exactly one"),
+           (dict(shape_text="a purple teapot"), "cannot read a body shape"),
+           (dict(betas="1", out=tmp_path / "x.bvh"), r"\.npz"),
+           (dict(betas="1", checkpoint=tmp_path / "nothing"), "not found"),
+           (dict(betas="1", checkpoint=other), "expected 'savae'")]
+    for kw, message in bad:
+        with pytest.raises(ShapeMoveError, match=message):
+            run(args(**kw))
