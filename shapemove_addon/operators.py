@@ -276,7 +276,8 @@ class SHAPEMOVE_OT_redecode(_JobOperator, _RigOperator, bpy.types.Operator):
 
 # -- retarget ------------------------------------------------------------------------------------
 def _retarget_job(context, source: str, target_rig, name: str) -> None:
-    params = {"source": source, "body": rig_body_spec(target_rig), "out": str(paths.new_motion_path(name))}
+    params = {"source": source, "body": rig_body_spec(target_rig), "model": setting("active_model") or None,
+              "out": str(paths.new_motion_path(name))}
     if target_rig is not None:
         params["betas"] = shape_sync.current_betas(target_rig).tolist()
 
@@ -449,8 +450,9 @@ class SHAPEMOVE_OT_use_model(bpy.types.Operator):
 
     def execute(self, context):
         folder = bpy.path.abspath(self.directory or context.scene.shapemove.train_result)
-        if not folder or not os.path.isfile(os.path.join(folder, "savae.pt")):
-            self.report({"ERROR"}, f"{folder or '(no folder)'} is not a model folder (no savae.pt)")
+        parts = ("savae.pt", "t5", os.path.join("tma", "tma.pt"))
+        if not folder or not any(os.path.exists(os.path.join(folder, p)) for p in parts):
+            self.report({"ERROR"}, f"{folder or '(no folder)'} is not a model folder (no savae.pt, t5/ or tma/)")
             return {"CANCELLED"}
         prefs = preferences(context)
         if prefs is None:

@@ -104,6 +104,7 @@ def _answered(name, betas, msg) -> None:
     if name in _scheduled:
         return  # a newer change is waiting for its timer
     apply_motion(rig, load_motion(msg["result"]["path"]))
+    rig["shapemove_redecoded_file"] = msg["result"]["path"]
 
 
 def apply_motion(rig, motion) -> bpy.types.Action:

@@ -139,6 +139,7 @@ def retarget(params, progress, cancel) -> dict:
         raise ShapeMoveError(f"op 'retarget': method must be auto, savae or naive, got {method!r}")
     body = load_body_model(param(params, op, "body", str, None))
     progress(0.1, f"reading {source.name}")
+    source = _library_clip(source)
     joints, _ = source_joints(source, body)
     betas = _betas(params, op)
     if betas is None:  # the subject's own proportions
@@ -156,8 +157,38 @@ def retarget(params, progress, cancel) -> dict:
         raise JobCancelled
     progress(0.3, "retargeting" + (" through the SA-VAE" if vae is not None else " (naive: no SA-VAE model)"))
     motion = savae_retarget(source, vae, body, betas) if vae is not None else naive_retarget(source, body, betas)
+    motion.prompt = motion.prompt or (source.subject if not isinstance(source, Path) else source.stem)
     save_motion(out, motion)
     return {**_motion_facts(out, motion), "method": "savae" if vae is not None else "naive"}
+
+
+def _library_clip(path: Path):
+    """A search library's clip that is not a mocap file -> Motion22 (20 fps): a dataset's
+    ``new_joint_vecs/ID.npy`` (HumanML3D features) or a ``.npz`` with ``joints`` (T,22,3) or
+    ``features`` (T,263). Mocap files (.bvh, .amc, AMASS .npz) are returned unchanged."""
+    from ..io.mocap import Motion22
+    from ..motion.features import joints_from_features
+
+    joints = None
+    if path.suffix.lower() == ".npy":
+        try:
+            joints = joints_from_features(np.load(path, allow_pickle=False).astype(np.float32))
+        except (OSError, ValueError) as exc:
+            raise ShapeMoveError(f"{path}: not a HumanML3D feature file ({exc})") from None
+    elif path.suffix.lower() == ".npz":
+        try:
+            with np.load(path, allow_pickle=False) as z:
+                if "poses" not in z.files and "trans" not in z.files:  # not a motion/AMASS file
+                    if "joints" in z.files:
+                        joints = z["joints"].astype(np.float32)
+                    elif "features" in z.files:
+                        joints = joints_from_features(z["features"].astype(np.float32))
+        except (OSError, ValueError) as exc:
+            raise ShapeMoveError(f"{path}: unreadable ({exc})") from None
+    if joints is None:
+        return path
+    return Motion22(joints=np.asarray(joints, np.float64), fps=20.0, source=str(path), subject=path.stem,
+                    offsets=np.zeros((22, 3)))
 
 
 def search(params, progress, cancel) -> dict:

@@ -1,0 +1,100 @@
+"""The dataset builder on real clips: layout, shape-aware vs normalized motion, resumability,
+failure reporting."""
+import json
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+import torch
+
+from shapemove.core.body.fit import bone_lengths
+from shapemove.core.data.build import build_dataset
+from shapemove.core.motion.features import joints_from_features
+
+
+def _ids(root, split):
+    return (Path(root) / f"{split}.txt").read_text().split()
+
+
+def test_layout_and_contents(tiny_dataset, openbody):
+    root = Path(tiny_dataset)
+    metas = [json.loads(ln) for ln in (root / "meta.jsonl").read_text().splitlines()]
+    ids = [m["id"] for m in metas]
+    assert len(ids) >= 12 and sorted(ids) == sorted(_ids(root, "train") + _ids(root, "val") + _ids(root, "test"))
+    assert np.load(root / "Mean.npy").shape == (263,) and (np.load(root / "Std.npy") > 0).all()
+    for m in metas:
+        cid = m["id"]
+        j = np.load(root / "new_joints" / f"{cid}.npy")
+        f = np.load(root / "new_joint_vecs" / f"{cid}.npy")
+        nj = np.load(root / "norm_joints" / f"{cid}.npy")
+        assert j.shape == nj.shape and j.shape[1:] == (22, 3) and f.shape == (len(j) - 1, 263)
+        assert np.load(root / "poses" / f"{cid}.npy").shape == (len(j), 24, 3)
+        assert (root / "texts" / f"{cid}.txt").read_text().strip()
+        shape_lines = (root / "shape_texts" / f"{cid}.txt").read_text().splitlines()
+        assert shape_lines[0].startswith("A person standing") and shape_lines[1].startswith(("a ", "an "))
+        assert m["fps"] == 20 and m["frames"] == len(j) and m["licence"]
+        # feet on the floor: the lowest foot joint over the clip is at y = 0
+        assert j[:, [7, 8, 10, 11], 1].min() == pytest.approx(0.0, abs=1e-5)
+
+
+def test_shape_aware_bones_match_the_fitted_body_and_normalized_the_canonical(tiny_dataset, openbody):
+    root = Path(tiny_dataset)
+    canon = bone_lengths(openbody.rest_joints(None)[0].numpy()[:22])
+    for cid in _ids(root, "train")[:4]:
+        betas = np.load(root / "betas" / f"{cid}.npy")
+        own = bone_lengths(openbody.rest_joints(torch.as_tensor(betas)[None])[0].numpy()[:22])
+        shaped = bone_lengths(np.load(root / "new_joints" / f"{cid}.npy"))
+        normal = bone_lengths(np.load(root / "norm_joints" / f"{cid}.npy"))
+        np.testing.assert_allclose(shaped, np.broadcast_to(own, shaped.shape), atol=1e-4)
+        np.testing.assert_allclose(normal, np.broadcast_to(canon, normal.shape), atol=1e-4)
+        # same rotations: the 6D rotation block of both feature sets is identical
+        fs = np.load(root / "new_joint_vecs" / f"{cid}.npy")
+        fn = np.load(root / "norm_joint_vecs" / f"{cid}.npy")
+        np.testing.assert_allclose(fs[:, 67:193], fn[:, 67:193], atol=1e-5)
+        # features decode back to the stored joints (up to the canonical placement of frame 0)
+        rec = joints_from_features(fs)
+        np.testing.assert_allclose(bone_lengths(rec), shaped[1:], atol=1e-3)
+
+
+def test_augmented_copies_are_on_other_bodies(tiny_dataset):
+    root = Path(tiny_dataset)
+    metas = [json.loads(ln) for ln in (root / "meta.jsonl").read_text().splitlines()]
+    aug = [m for m in metas if "augmented_from" in m]
+    assert aug, "Bandai clips in the tiny set should get augmented copies"
+    for m in aug:
+        src = m["augmented_from"]
+        assert not np.allclose(np.load(root / "betas" / f"{m['id']}.npy"), np.load(root / "betas" / f"{src}.npy"))
+        assert m["split"] == next(x["split"] for x in metas if x["id"] == src)
+        # stride follows leg length: the root path scales with the pelvis height
+        a, b = np.load(root / "new_joints" / f"{m['id']}.npy"), np.load(root / "new_joints" / f"{src}.npy")
+        ratio = np.ptp(a[:, 0, [0, 2]], 0).max() / max(np.ptp(b[:, 0, [0, 2]], 0).max(), 1e-6)
+        height_ratio = a[:, 0, 1].mean() / b[:, 0, 1].mean()
+        assert ratio == pytest.approx(height_ratio, rel=0.15)
+
+
+def test_rerun_skips_finished_clips_and_reports_failures(mocap_root, tmp_path):
+    src = tmp_path / "src"
+    src.mkdir()
+    bvh = Path(mocap_root) / "bandai" / "dataset-2" / "data" / "dataset-2_walk_masculine_003.bvh"
+    shutil.copy(bvh, src / "walk.bvh")
+    (src / "walk.txt").write_text("a man walks forward.\n")
+    (src / "broken.bvh").write_text("HIERARCHY\nROOT Hips\n{\n  OFFSET 0 0\n")
+    out = tmp_path / "out"
+    first = build_dataset([src], out, verbose=False, ik_refine_iters=0)
+    assert first.built == 1 and len(first.failures) == 1
+    cid, why = first.failures[0]
+    assert cid == "broken" and len(why) > 10 and "Traceback" not in why
+    assert (out / "texts" / "walk.txt").read_text() == "a man walks forward.\n"
+    stamp = (out / "new_joints" / "walk.npy").stat().st_mtime_ns
+    again = build_dataset([src], out, verbose=False, ik_refine_iters=0)
+    assert again.built == 0 and again.skipped_done == 1
+    assert (out / "new_joints" / "walk.npy").stat().st_mtime_ns == stamp
+    assert "failed: 1" in (out / "build_report.txt").read_text()
+
+
+def test_no_clips_is_a_clear_error(tmp_path):
+    from shapemove.core.errors import ShapeMoveError
+
+    with pytest.raises(ShapeMoveError, match="no motion clips"):
+        build_dataset([tmp_path], tmp_path / "out", verbose=False)
