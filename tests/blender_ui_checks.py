@@ -35,8 +35,14 @@ RESULTS: dict = {"timings": {}}
 ADDON = "bl_ext.user_default.shapemove"
 
 
-def timed(name):
+MODELS = bool(CONFIG.get("model_dir"))  # the second run: jobs with trained (tiny) models
+
+
+def timed(name, models: bool = False):
+    """Run the section now (only in the run it belongs to) and record its time or its error."""
     def deco(fn):
+        if name != "install" and models != MODELS:
+            return fn
         t0 = time.perf_counter()
         try:
             fn()
@@ -446,6 +452,108 @@ def _dead_worker():
     res["height_unchanged"] = rig.shapemove.height_cm == h
     prefs.python_env = ""
     RESULTS["dead_worker"] = res
+
+
+# -- run 2: generate, re-decode, search, import, train with tiny trained models ----------------------
+def job_messages():
+    """Record the error messages of the jobs that end in an error (instead of popups)."""
+    errors: list = []
+    jobs = ext("shapemove_addon.jobs")
+    original = jobs.report_error
+    jobs.report_error = lambda text: errors.append(text)
+    return errors, lambda: setattr(jobs, "report_error", original)
+
+
+@timed("generate", models=True)
+def _generate():
+    jobs, client = ext("shapemove_addon.jobs"), ext("core.worker.client")
+    jobs.manager().set_runner(client.InProcessRunner())
+    prefs = bpy.context.preferences.addons[ADDON].preferences
+    prefs.active_model = CONFIG["model_dir"]
+    s = bpy.context.scene.shapemove
+    s.prompt, s.use_seconds, s.seconds, s.seed = "a person walks forward", True, 2.0, 1
+    errors, restore = job_messages()
+    before = set(bpy.data.objects)
+    r = bpy.ops.shapemove.generate()
+    finished = run_jobs()
+    restore()
+    new = [o for o in bpy.data.objects if o not in before]
+    rig = next((o for o in new if o.type == "ARMATURE"), None)
+    STATE["gen_rig"] = rig
+    RESULTS["generate"] = {"result": sorted(r), "finished": finished, "errors": errors,
+                           "new": sorted(o.type for o in new), "active_is_rig": bpy.context.active_object == rig,
+                           "has_tokens": bool(rig and rig.get("shapemove_has_tokens")),
+                           "frames": keyed_frames(rig) if rig else 0,
+                           "height_cm": rig.shapemove.height_cm if rig else 0.0,
+                           "data_dir": os.path.dirname(rig["shapemove_motion_file"]) if rig else ""}
+
+
+@timed("redecode", models=True)
+def _redecode():
+    rig = STATE["gen_rig"]
+    redecode = ext("shapemove_addon.redecode")
+    sync = ext("shapemove_addon.shape_sync")
+    bpy.context.view_layer.objects.active = rig
+    rig.shapemove.betas[1] = float(rig.shapemove.betas[1] + 1.5)  # the slider
+    pending = sorted(redecode.pending())
+    errors, restore = job_messages()
+    redecode._fire()  # what the debounce timer does
+    finished = run_jobs()
+    restore()
+    path = rig.get("shapemove_redecoded_file")
+    res = {"pending": pending, "finished": finished, "errors": errors, "file": path}
+    if path:
+        m = ext("core.scene.motion_file").load_motion(path)
+        body = ext("core.scene.bodies").load_body(m.body_model)
+        axes = ext("core.scene.axes")
+        names = list(ext("core.body.skeleton").JOINT_NAMES)[:22]
+        k = m.num_frames // 2
+        bpy.context.scene.frame_set(1 + k)
+        out = body.forward(torch.as_tensor(m.betas)[None], torch.as_tensor(m.poses[k:k + 1]),
+                           torch.as_tensor(m.transl[k:k + 1]))
+        res.update(fk_error_m=float(np.abs(posed_heads(rig, names) - axes.points_to_z_up(out.joints[0, :22].numpy())).max()),
+                   betas_match=bool(np.abs(m.betas - sync.current_betas(rig)).max() < 1e-4),
+                   tokens_match=bool(np.array_equal(m.tokens, ext("core.scene.motion_file").load_motion(
+                       rig["shapemove_motion_file"]).tokens)))
+    RESULTS["redecode"] = res
+
+
+@timed("library", models=True)
+def _library():
+    s = bpy.context.scene.shapemove
+    s.library_folder, s.library_query, s.library_top_k = CONFIG["dataset"], "a person walks", 3
+    errors, restore = job_messages()
+    r = bpy.ops.shapemove.library_search()
+    finished = run_jobs()
+    items = [(i.name, i.score, os.path.basename(i.path)) for i in s.library_results]
+    panel = draw_panels()["SHAPEMOVE_PT_library"]
+    before = set(bpy.data.objects)
+    r2 = bpy.ops.shapemove.library_import(index=0)
+    finished2 = run_jobs()
+    restore()
+    new = [o for o in bpy.data.objects if o not in before]
+    rig = next((o for o in new if o.type == "ARMATURE"), None)
+    RESULTS["library"] = {"search": sorted(r), "finished": finished, "items": items, "errors": errors,
+                          "list_rows": [d["rows"] for d in panel if d["kind"] == "list"],
+                          "import": sorted(r2), "import_finished": finished2, "new": sorted(o.type for o in new),
+                          "rig_frames": keyed_frames(rig) if rig else 0}
+
+
+@timed("train", models=True)
+def _train():
+    s = bpy.context.scene.shapemove
+    s.train_data, s.train_kind, s.train_steps, s.train_config, s.train_model_name = \
+        CONFIG["dataset"], "tma", 2, "tiny", "trained"
+    errors, restore = job_messages()
+    r = bpy.ops.shapemove.train(resume=False)
+    running = ext("shapemove_addon.job_submit").running("train")
+    finished = run_jobs(timeout=300)
+    restore()
+    r2 = report_error(lambda: bpy.ops.shapemove.use_model())
+    prefs = bpy.context.preferences.addons[ADDON].preferences
+    RESULTS["train"] = {"result": sorted(r), "running": running, "finished": finished, "errors": errors,
+                        "train_result": s.train_result, "use": r2, "active_model": prefs.active_model,
+                        "tma_file": os.path.isfile(os.path.join(s.train_result, "tma", "tma.pt")) if s.train_result else False}
 
 
 with open(CONFIG["results"], "w") as f:

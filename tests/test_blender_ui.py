@@ -8,12 +8,15 @@ from __future__ import annotations
 
 import importlib.util
 import json
+import os
 import subprocess
 import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
+
+from tiny_models import tiny_bundle  # noqa: F401  (session fixture)
 
 from shapemove.core.body.body_arrays import load_body_arrays, load_smpl_arrays
 from shapemove.core.errors import ShapeMoveError
@@ -149,6 +152,24 @@ def test_naive_retarget_op_writes_a_motion_for_the_given_body(mocap_root, tmp_pa
 
 
 # -- real Blender --------------------------------------------------------------------------------
+def _extension_zip(out: Path) -> str:
+    spec = importlib.util.spec_from_file_location("build_extension", ROOT / "tools" / "build_extension.py")
+    builder = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(builder)
+    return str(builder.build(out))
+
+
+def _run_checks(d: Path, config: dict) -> dict:
+    (d / "config.json").write_text(json.dumps(config))
+    proc = subprocess.run([sys.executable, str(ROOT / "tests" / "blender_ui_checks.py"), str(d / "config.json")],
+                          capture_output=True, text=True, timeout=600)
+    if proc.returncode != 0 or not (d / "results.json").exists():
+        pytest.fail(f"blender_ui_checks.py failed ({proc.returncode}):\n{proc.stderr[-4000:]}")
+    results = json.loads((d / "results.json").read_text())
+    print("blender ui timings (s):", {k: round(v, 2) for k, v in results["timings"].items()})
+    return results
+
+
 @pytest.fixture(scope="module")
 def ui(tmp_path_factory, openbody):
     pytest.importorskip("bpy", reason="needs the bpy module (pip install bpy==5.0.1)")
@@ -156,29 +177,36 @@ def ui(tmp_path_factory, openbody):
     from shapemove.core.body.shape_from_measurements import betas_from_shape_text
 
     d = tmp_path_factory.mktemp("blender_ui")
-    spec = importlib.util.spec_from_file_location("build_extension", ROOT / "tools" / "build_extension.py")
-    builder = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(builder)
     betas = np.random.default_rng(5).normal(0, 0.8, 10).astype(np.float32)
     save_motion(d / "motion.npz", _motion(openbody, betas, 1, tokens=np.arange(3)))
     save_motion(d / "motion2.npz", _motion(openbody, betas, 2))
     (d / "corrupt.npz").write_bytes(b"this is not a zip file")
     (d / "export").mkdir()
     (d / "home").mkdir()
-    config = dict(zip=str(builder.build(d / "dist")), motion=str(d / "motion.npz"), motion2=str(d / "motion2.npz"),
+    config = dict(zip=_extension_zip(d / "dist"), motion=str(d / "motion.npz"), motion2=str(d / "motion2.npz"),
                   missing_motion=str(d / "missing.npz"), corrupt_motion=str(d / "corrupt.npz"),
                   user_resources=str(d / "user"), home=str(d / "home"), export_dir=str(d / "export"),
                   results=str(d / "results.json"), shape_text=SHAPE_TEXT)
-    (d / "config.json").write_text(json.dumps(config))
-    proc = subprocess.run([sys.executable, str(ROOT / "tests" / "blender_ui_checks.py"), str(d / "config.json")],
-                          capture_output=True, text=True, timeout=600)
-    if proc.returncode != 0 or not (d / "results.json").exists():
-        pytest.fail(f"blender_ui_checks.py failed ({proc.returncode}):\n{proc.stderr[-4000:]}")
-    results = json.loads((d / "results.json").read_text())
+    results = _run_checks(d, config)
     results["_betas"] = betas
     results["_zero_measure"] = measure(openbody, np.zeros(10, np.float32))
     results["_text_betas"] = betas_from_shape_text(openbody, SHAPE_TEXT)
-    print("blender ui timings (s):", {k: round(v, 2) for k, v in results["timings"].items()})
+    return results
+
+
+@pytest.fixture(scope="module")
+def ui_models(tmp_path_factory, tiny_bundle):
+    """The jobs that need trained models, with the tiny models of the ``tiny_bundle`` fixture."""
+    pytest.importorskip("bpy", reason="needs the bpy module (pip install bpy==5.0.1)")
+    model_dir, dataset = tiny_bundle
+    d = tmp_path_factory.mktemp("blender_ui_models")
+    (d / "home").mkdir()
+    (d / "export").mkdir()
+    config = dict(zip=_extension_zip(d / "dist"), model_dir=str(model_dir), dataset=str(dataset),
+                  user_resources=str(d / "user"), home=str(d / "home"), export_dir=str(d / "export"),
+                  results=str(d / "results.json"))
+    results = _run_checks(d, config)
+    results["_user"] = str(d / "user")
     return results
 
 
@@ -299,3 +327,42 @@ def test_missing_or_dead_worker_is_an_error_and_changes_nothing(ui):
     assert r["submit"] == ["ok", ["FINISHED"]] and r["finished"]
     assert len(r["job_errors"]) == 1 and "worker process died" in r["job_errors"][0]
     assert r["counts_equal"] and r["height_unchanged"]
+
+
+# -- jobs with trained (tiny) models -----------------------------------------------------------------
+@pytest.mark.slow
+def test_generate_builds_a_rig_from_the_job(ui_models):
+    r = _section(ui_models, "generate")
+    assert r["result"] == ["FINISHED"] and r["finished"] and r["errors"] == []
+    assert r["new"] == ["ARMATURE", "MESH"] and r["active_is_rig"] and r["has_tokens"]
+    assert r["frames"] == 40  # 2 s at 20 fps
+    assert 120 < r["height_cm"] < 220  # the measurements came back with the motion
+    # written under the extension's user folder (bpy.utils.extension_path_user), not the package
+    assert r["data_dir"] == os.path.join(ui_models["_user"], "extensions", ".user", "user_default", "shapemove", "data")
+
+
+@pytest.mark.slow
+def test_shape_change_redecodes_the_motion(ui_models):
+    r = _section(ui_models, "redecode")
+    assert r["pending"] and r["finished"] and r["errors"] == [] and r["file"]
+    assert r["betas_match"] and r["tokens_match"]  # same tokens, decoded for the new body
+    assert r["fk_error_m"] < MM  # the rig plays the re-decoded motion
+
+
+@pytest.mark.slow
+def test_library_search_and_import(ui_models):
+    r = _section(ui_models, "library")
+    assert r["search"] == ["FINISHED"] and r["finished"] and r["errors"] == []
+    assert len(r["items"]) == 3 and r["list_rows"] == [3]
+    scores = [i[1] for i in r["items"]]
+    assert scores == sorted(scores, reverse=True) and all(-1 <= x <= 1 for x in scores)
+    assert r["import"] == ["FINISHED"] and r["import_finished"]
+    assert r["new"] == ["ARMATURE", "MESH"] and r["rig_frames"] > 10
+
+
+@pytest.mark.slow
+def test_train_job_publishes_a_selectable_model(ui_models):
+    r = _section(ui_models, "train")
+    assert r["result"] == ["FINISHED"] and r["running"] and r["finished"] and r["errors"] == []
+    assert r["train_result"].endswith("trained") and r["tma_file"]
+    assert r["use"] == ["ok", ["FINISHED"]] and r["active_model"] == r["train_result"]

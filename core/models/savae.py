@@ -186,6 +186,7 @@ class SAVAE(nn.Module):
         (default window/4), each with its own shape token, cross-faded over ``overlap`` codes, so
         every frame sits as close to a shape token as in training."""
         chunk = chunk or self.cfg.train.window // self.cfg.downsample
+        overlap = min(overlap, chunk // 2)  # short training windows give short chunks
         n, up = codes.shape[1], self.cfg.downsample
         if n <= chunk:
             return self.decode(codes, betas)

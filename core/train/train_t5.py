@@ -184,7 +184,7 @@ def _train(data, vae_path, out, c, base_model, resume, dist, progress, cancel, v
         step += 1
         bar.update(1)
         if step % c.log_every == 0 or step == c.steps:
-            m = distributed.mean_over_ranks({"loss": float(res["loss"]), "ce": float(res["ce"]), "l1": float(res["l1"])}, dist)
+            m = distributed.mean_over_ranks({"loss": float(res["loss"].detach()), "ce": float(res["ce"]), "l1": float(res["l1"])}, dist)
             metrics = {"step": step, "lr": scheduler.get_last_lr()[0], "train": m,
                        "sec_per_step": (time.time() - t0) / max(1, step - s0)}
             t0, s0 = time.time(), step
