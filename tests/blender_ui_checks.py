@@ -539,6 +539,30 @@ def _library():
                           "rig_frames": keyed_frames(rig) if rig else 0}
 
 
+@timed("retarget_action", models=True)
+def _retarget_action():
+    bpy.ops.import_anim.bvh(filepath=CONFIG["bvh"], update_scene_fps=False, update_scene_duration=False)
+    src = bpy.context.active_object
+    for o in bpy.context.view_layer.objects:
+        o.select_set(o == src)
+    s = bpy.context.scene.shapemove
+    s.retarget_source, s.retarget_target = "ACTION", STATE["gen_rig"]
+    errors, restore = job_messages()
+    before = set(bpy.data.objects)
+    r = bpy.ops.shapemove.retarget()
+    finished = run_jobs()
+    restore()
+    new = [o for o in bpy.data.objects if o not in before]
+    rig = next((o for o in new if o.type == "ARMATURE"), None)
+    sync = ext("shapemove_addon.shape_sync")
+    RESULTS["retarget_action"] = {
+        "source": src.name, "source_type": src.type, "result": sorted(r), "finished": finished, "errors": errors,
+        "new": sorted(o.type for o in new), "frames": keyed_frames(rig) if rig else 0,
+        "betas_error": float(np.abs(sync.current_betas(rig) - sync.current_betas(STATE["gen_rig"])).max()) if rig else None,
+        "bvh_written": sorted(f for f in os.listdir(os.path.dirname(STATE["gen_rig"]["shapemove_motion_file"]))
+                              if f.endswith(".bvh"))}
+
+
 @timed("train", models=True)
 def _train():
     s = bpy.context.scene.shapemove

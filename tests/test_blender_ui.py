@@ -195,14 +195,15 @@ def ui(tmp_path_factory, openbody):
 
 
 @pytest.fixture(scope="module")
-def ui_models(tmp_path_factory, tiny_bundle):
+def ui_models(tmp_path_factory, tiny_bundle, mocap_root):
     """The jobs that need trained models, with the tiny models of the ``tiny_bundle`` fixture."""
     pytest.importorskip("bpy", reason="needs the bpy module (pip install bpy==5.0.1)")
     model_dir, dataset = tiny_bundle
     d = tmp_path_factory.mktemp("blender_ui_models")
     (d / "home").mkdir()
     (d / "export").mkdir()
-    config = dict(zip=_extension_zip(d / "dist"), model_dir=str(model_dir), dataset=str(dataset),
+    bvh = next(Path(mocap_root).rglob("dataset-2_raise-up-both-hands_feminine_007.bvh"))
+    config = dict(zip=_extension_zip(d / "dist"), model_dir=str(model_dir), dataset=str(dataset), bvh=str(bvh),
                   user_resources=str(d / "user"), home=str(d / "home"), export_dir=str(d / "export"),
                   results=str(d / "results.json"))
     results = _run_checks(d, config)
@@ -220,6 +221,7 @@ PANELS = ["SHAPEMOVE_PT_export", "SHAPEMOVE_PT_generate", "SHAPEMOVE_PT_library"
           "SHAPEMOVE_PT_retarget", "SHAPEMOVE_PT_shape", "SHAPEMOVE_PT_shape_betas", "SHAPEMOVE_PT_train"]
 
 
+@pytest.mark.blender
 def test_panels_register_and_draw_in_the_factory_scene(ui):
     r = _section(ui, "install")
     assert r["result"] == ["FINISHED"] and r["enabled"] and r["panels"] == PANELS and not r["torch_imported"]
@@ -240,6 +242,7 @@ def test_panels_register_and_draw_in_the_factory_scene(ui):
     assert prefs == ["body_model", "python_env", "models_dir", "active_model", "device"]
 
 
+@pytest.mark.blender
 def test_rig_from_a_motion_file_without_torch(ui):
     r = _section(ui, "build")
     assert r["result"] == ["FINISHED"] and r["new_objects"] == 2
@@ -253,12 +256,14 @@ def test_rig_from_a_motion_file_without_torch(ui):
     assert export_ops == [{"kind": "operator", "op": "shapemove.export", "text": "Export", "props": {"format": "FBX"}}]
 
 
+@pytest.mark.blender
 def test_redecoded_motion_replaces_the_keys(ui):
     r = _section(ui, "apply_motion")
     assert r["fk_error_m"] < MM  # the rig now plays motion 2 exactly
     assert r["actions_after"] == r["actions_before"] and r["same_name"] and r["frames"] == FRAMES
 
 
+@pytest.mark.blender
 def test_semantic_height_slider_makes_the_skeleton_taller(ui):
     r = _section(ui, "semantic")
     assert r["slider_after"] == pytest.approx(r["slider_before"] + 0.1, abs=1e-6)
@@ -268,6 +273,7 @@ def test_semantic_height_slider_makes_the_skeleton_taller(ui):
     assert r["redecode_pending"] == ["Rig"] and r["redecode_timer"]  # the motion follows (debounced job)
 
 
+@pytest.mark.blender
 def test_random_and_reset(ui):
     r = _section(ui, "random_reset")
     assert r["random"] == r["reset"] == ["FINISHED"]
@@ -276,6 +282,7 @@ def test_random_and_reset(ui):
     assert r["betas_reset"] == [0.0] * 10 and r["rest_error_reset_m"] < 1e-5
 
 
+@pytest.mark.blender
 def test_exports_reimport_with_the_same_bones_and_frames(ui):
     r = _section(ui, "export")
     assert r["rig_bones"] == 24 and r["rig_frames"] == FRAMES
@@ -292,6 +299,7 @@ def test_exports_reimport_with_the_same_bones_and_frames(ui):
     assert r["operator"] == ["ok", ["FINISHED"]] and r["operator_file"]
 
 
+@pytest.mark.blender
 def test_bad_input_is_reported_and_changes_nothing(ui):
     r = _section(ui, "errors_reported")
     assert r["missing_file"][0] == "error" and "motion file not found" in r["missing_file"][1]
@@ -302,6 +310,7 @@ def test_bad_input_is_reported_and_changes_nothing(ui):
     assert r["counts_equal"]
 
 
+@pytest.mark.blender
 def test_measure_job_in_process_updates_the_rig(ui):
     r = _section(ui, "measure_job")
     assert r["result"] == ["FINISHED"] and r["running_after_submit"] and r["finished"]
@@ -314,6 +323,7 @@ def test_measure_job_in_process_updates_the_rig(ui):
                                     "props": {"kind": "measure"}} in r["panel_while_running"]
 
 
+@pytest.mark.blender
 def test_shape_from_text_job_sets_the_betas(ui):
     r = _section(ui, "shape_text_job")
     assert r["result"] == ["FINISHED"] and r["finished"]
@@ -321,6 +331,7 @@ def test_shape_from_text_job_sets_the_betas(ui):
     assert r["height_cm"] == pytest.approx(185.0, abs=1.0) and r["skeleton_after"] > r["skeleton_before"]
 
 
+@pytest.mark.blender
 def test_missing_or_dead_worker_is_an_error_and_changes_nothing(ui):
     r = _section(ui, "dead_worker")
     assert r["missing_python"][0] == "error" and "Python environment not found" in r["missing_python"][1]
@@ -330,6 +341,7 @@ def test_missing_or_dead_worker_is_an_error_and_changes_nothing(ui):
 
 
 # -- jobs with trained (tiny) models -----------------------------------------------------------------
+@pytest.mark.blender
 @pytest.mark.slow
 def test_generate_builds_a_rig_from_the_job(ui_models):
     r = _section(ui_models, "generate")
@@ -341,6 +353,7 @@ def test_generate_builds_a_rig_from_the_job(ui_models):
     assert r["data_dir"] == os.path.join(ui_models["_user"], "extensions", ".user", "user_default", "shapemove", "data")
 
 
+@pytest.mark.blender
 @pytest.mark.slow
 def test_shape_change_redecodes_the_motion(ui_models):
     r = _section(ui_models, "redecode")
@@ -349,6 +362,7 @@ def test_shape_change_redecodes_the_motion(ui_models):
     assert r["fk_error_m"] < MM  # the rig plays the re-decoded motion
 
 
+@pytest.mark.blender
 @pytest.mark.slow
 def test_library_search_and_import(ui_models):
     r = _section(ui_models, "library")
@@ -360,6 +374,17 @@ def test_library_search_and_import(ui_models):
     assert r["new"] == ["ARMATURE", "MESH"] and r["rig_frames"] > 10
 
 
+@pytest.mark.blender
+@pytest.mark.slow
+def test_retarget_the_active_armatures_action_onto_a_rig(ui_models):
+    r = _section(ui_models, "retarget_action")
+    assert r["source_type"] == "ARMATURE" and r["result"] == ["FINISHED"] and r["finished"] and r["errors"] == []
+    assert r["new"] == ["ARMATURE", "MESH"] and r["frames"] > 20
+    assert r["betas_error"] < 1e-5  # the target rig's body
+    assert len(r["bvh_written"]) == 1  # the action went to the worker as a BVH in the data folder
+
+
+@pytest.mark.blender
 @pytest.mark.slow
 def test_train_job_publishes_a_selectable_model(ui_models):
     r = _section(ui_models, "train")

@@ -98,3 +98,13 @@ def test_no_clips_is_a_clear_error(tmp_path):
 
     with pytest.raises(ShapeMoveError, match="no motion clips"):
         build_dataset([tmp_path], tmp_path / "out", verbose=False)
+
+
+def test_fitted_bodies_are_plausible_people(tiny_dataset):
+    """The betas fitted to real subjects stay in the shape space's range and measure like people."""
+    root = Path(tiny_dataset)
+    for ln in (root / "meta.jsonl").read_text().splitlines():
+        m = json.loads(ln)
+        betas = np.load(root / "betas" / f"{m['id']}.npy")
+        assert np.abs(betas).max() < 4, (m["id"], betas)
+        assert 145 < m["measure"]["height_cm"] < 200 and 55 < m["measure"]["waist_cm"] < 130, m
