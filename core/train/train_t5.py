@@ -27,6 +27,7 @@ from ..errors import ShapeMoveError
 from ..models.shapemove_t5 import ShapeMoveT5, T5Size, size_from_dict
 from ..models.tokenizer import add_motion_tokens, load_tokenizer, tokenizer_from_sentencepiece, train_sentencepiece
 from . import distributed
+from .run_log import record
 from .checkpoint import config_differences, save_checkpoint
 from .t5_dataset import T2MExamples, all_texts, collate, tokenize_clips
 from .train_vae import rng_state, set_rng_state
@@ -190,10 +191,7 @@ def _train(data, vae_path, out, c, base_model, resume, dist, progress, cancel, v
             t0, s0 = time.time(), step
             if dist.is_main:
                 bar.set_postfix(ce=f"{m['ce']:.3f}", l1=f"{m['l1']:.3f}")
-                with open(out / "log.jsonl", "a") as f:
-                    f.write(json.dumps(metrics) + "\n")
-                if progress:
-                    progress(step / c.steps, f"step {step}/{c.steps} ce {m['ce']:.3f}")
+                record(out, metrics, progress, step, c.steps, f"ce {m['ce']:.3f}")
         if step % c.ckpt_every == 0 and step < c.steps:
             save()
     bar.close()

@@ -31,6 +31,7 @@ from ..errors import ShapeMoveError
 from ..eval.tma_embed import KIND, eval_pairs, pad_batch, score_pairs
 from ..models.tma import TMA, TMAConfig
 from . import distributed
+from .run_log import record
 from .checkpoint import load_checkpoint, make_metadata, save_checkpoint, stats_hash
 from .motion_dataset import load_stats, read_split
 from .t5_dataset import read_lines
@@ -308,10 +309,7 @@ def _train(data, out, c, resume, body_name, dist, progress, cancel, verbose) -> 
             if dist.is_main:
                 bar.set_postfix(loss=f"{train_metrics['loss']:.3f}",
                                 **({"r1": f"{metrics['val']['r_precision_top1']:.3f}"} if "val" in metrics else {}))
-                with open(out / "log.jsonl", "a") as f:
-                    f.write(json.dumps(metrics) + "\n")
-                if progress is not None:
-                    progress(step / c.steps, f"step {step}/{c.steps} loss {train_metrics['loss']:.3f}")
+                record(out, metrics, progress, step, c.steps, f"loss {train_metrics['loss']:.3f}")
         if step % c.ckpt_every == 0 and step < c.steps:
             save()
             distributed.barrier(dist)

@@ -28,6 +28,7 @@ from ..errors import ShapeMoveError
 from ..models.savae import SAVAE, SAVAEConfig, TrainSettings
 from ..models.vae_losses import bone_lengths, vae_losses
 from . import distributed
+from .run_log import record
 from .checkpoint import load_checkpoint, make_metadata, save_checkpoint, stats_hash
 from .motion_dataset import BatchStream, MotionClips
 
@@ -209,10 +210,7 @@ def _train(data, out, cfg, t, resume, body, dist, progress, cancel, verbose) -> 
             if dist.is_main:
                 bar.set_postfix(loss=f"{train_metrics['total']:.4f}",
                                 **({"val": f"{metrics['val']['total']:.4f}"} if "val" in metrics else {}))
-                with open(out / "log.jsonl", "a") as f:
-                    f.write(json.dumps(metrics) + "\n")
-                if progress is not None:
-                    progress(step / t.steps, f"step {step}/{t.steps} loss {train_metrics['total']:.4f}")
+                record(out, metrics, progress, step, t.steps, f"loss {train_metrics['total']:.4f}")
         if step % t.ckpt_every == 0 and step < t.steps:
             save()
             distributed.barrier(dist)
