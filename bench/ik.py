@@ -4,6 +4,12 @@ LBFGS optimisation from identity rotations (100 iterations), on the same frames.
 Targets: real clips (Bandai, HDM05, CMU through ``core.io.mocap.load_smpl22``, 20 fps) retargeted
 onto the body model fitted to each clip's bone lengths; without the archives, FK of random
 plausible poses on the body. Times are the best of a few repeats (the machine is shared).
+
+Then, per archive (5 clips each), the joint error of the real pipeline (rig map -> betas -> IK on
+OpenBody) for each rig-map layout and body fit: the legacy SMPL spine fractions with the
+exact-skeleton bone-length fit (the baseline), OpenBody's layout (``core.io.rig_map``), and the
+plausible-body fit ``fit_betas_to_motion`` (largest |beta| printed: the exact-skeleton fit reaches
+its cm by betas of +-20..60, i.e. deformed bodies).
 """
 from __future__ import annotations
 
@@ -57,6 +63,68 @@ def _real_clips(n: int, max_frames: int):
         out.append((f"{folder}/{paths[0].name}", m.joints[:max_frames]))
         if len(out) == n:
             break
+    return out
+
+
+ARCHIVE_CLIPS = {  # archive -> globs (the first match of each), 5 clips per archive
+    "bandai": ["dataset-1/data/dataset-1_walk-back_active_001.bvh", "dataset-1/data/dataset-1_dash_active_001.bvh",
+               "dataset-1/data/dataset-1_bow_active_001.bvh", "dataset-2/data/*_raise-up-both-hands_*.bvh",
+               "dataset-1/data/dataset-1_kick_*.bvh"],
+    "hdm05": ["mm/HDM_mm_grabHighR_*.amc", "bk/*jogLeftCircle*.amc", "dg/*hopBoth*.amc", "bd/*kickLFront*.amc",
+              "mm/*squat*.amc"],
+    "cmu": ["bvh/02/*.bvh", "bvh/07/*.bvh", "bvh/13/*.bvh", "bvh/09/*.bvh", "asfamc/03/03_01.amc"],
+}
+
+
+def _archive_table(body, quick: bool) -> dict:
+    """Mean joint error (cm) per archive and (layout, fit); per joint for the baseline and the best."""
+    from ..core.body.fit import bone_lengths, fit_betas_to_bone_lengths, fit_betas_to_motion
+    from ..core.body.skeleton import JOINT_NAMES
+    from ..core.io.archive import mocap_root
+    from ..core.io.mocap import load_mocap
+    from ..core.io.resample import resample_positions
+    from ..core.io.rig_map import DEFAULT_LAYOUT, OPENBODY_LAYOUT, SMPL_LAYOUT, detect_rig, mapping_matrix
+
+    layouts = {"smpl": SMPL_LAYOUT, "default": DEFAULT_LAYOUT, "openbody": OPENBODY_LAYOUT}
+    fits = {"lengths": lambda j: fit_betas_to_bone_lengths(body, np.median(bone_lengths(j), 0)),
+            "motion": lambda j: fit_betas_to_motion(body, j)}
+    root, frames, out = mocap_root(), 60 if quick else 200, {}
+    for archive, patterns in ARCHIVE_CLIPS.items():
+        err, per, beta = {}, {}, {}
+        for pattern in patterns[:1 if quick else None]:
+            paths = sorted((root / archive).glob(pattern))
+            if not paths:
+                continue
+            mocap = load_mocap(paths[0])
+            rig = detect_rig(mocap.names)
+            for lname, layout in layouts.items():
+                W = mapping_matrix(rig, mocap.names, mocap.positions, layout)
+                joints = resample_positions(np.matmul(W, mocap.positions), mocap.fps, 20.0)[:frames]
+                for fname, fit_fn in fits.items():
+                    fit = fit_fn(joints)
+                    rest = body.rest_joints(torch.tensor(fit.betas)[None])[0].double().numpy()
+                    res = solve_ik(joints, rest)
+                    err.setdefault((lname, fname), []).append(res.mean_error_cm)
+                    per.setdefault((lname, fname), []).append(res.per_joint_error_cm())
+                    beta[(lname, fname)] = max(beta.get((lname, fname), 0.0), float(np.abs(fit.betas).max()))
+        if not err:
+            continue
+        n = len(err[("smpl", "lengths")])
+        print(f"  {archive} ({n} clips, <= {frames} frames): mean joint error cm (max |beta|)")
+        for (lname, fname), e in err.items():
+            print(f"    layout {lname:8s} fit {fname:7s}: {np.mean(e):5.2f} cm  ({beta[(lname, fname)]:.1f})")
+        for key in (("smpl", "lengths"), ("openbody", "motion")):
+            pj = np.mean(per[key], 0)
+            print(f"    per joint, {key[0]} + {key[1]}: " + ", ".join(f"{JOINT_NAMES[j]} {pj[j]:.1f}" for j in range(22)))
+        before, after = np.mean(err[("smpl", "lengths")]), np.mean(err[("openbody", "motion")])
+        print(f"    -> {before:.2f} cm (legacy layout, exact-skeleton fit) vs {after:.2f} cm (OpenBody layout, "
+              f"plausible fit): ratio {before / after:.2f}")
+        out[f"ik_{archive}_legacy_err_cm"] = float(before)
+        out[f"ik_{archive}_err_cm"] = float(after)
+        out[f"ik_{archive}_default_layout_err_cm"] = float(np.mean(err[("default", "motion")]))
+        out[f"ik_{archive}_openbody_lengths_fit_err_cm"] = float(np.mean(err[("openbody", "lengths")]))
+        out[f"ik_{archive}_max_abs_beta"] = beta[("openbody", "motion")]
+        out[f"ik_{archive}_legacy_max_abs_beta"] = beta[("smpl", "lengths")]
     return out
 
 
@@ -157,7 +225,12 @@ def run(quick: bool = False) -> dict:
           f"max_turn 89: {loose.err_cm:.3f}) vs baseline {base.err_cm:.3f} cm; bone-direction turn p99 "
           f"{ours.turn_p99:.1f} deg vs baseline {base.turn_p99:.1f} deg")
     print(f"  reachable targets (body fits): solve_ik {ours_fit.err_cm:.4f} cm vs baseline {base_fit.err_cm:.4f} cm")
-    return {"ik_speedup": speedup, "ik_err_cm": ours.err_cm, "ik_baseline_err_cm": base.err_cm,
+    try:
+        archives = _archive_table(body, quick)
+    except Exception as exc:  # archives absent
+        print(f"  per-archive table skipped ({exc})")
+        archives = {}
+    return {**archives, "ik_speedup": speedup, "ik_err_cm": ours.err_cm, "ik_baseline_err_cm": base.err_cm,
             "ik_analytic_err_cm": analytic.err_cm, "ik_analytic_speedup": base.time / analytic.time,
             "ik_max_turn_89_err_cm": loose.err_cm, "ik_bone_turn_p99_deg": ours.turn_p99,
             "ik_baseline_bone_turn_p99_deg": base.turn_p99, "ik_reachable_err_cm": ours_fit.err_cm,

@@ -6,8 +6,8 @@ import pytest
 import torch
 from synthetic_smpl import write_model
 
-from shapemove.core.body.fit import (_bone_basis, body_bone_lengths, bone_lengths,
-                                     fit_betas_to_bone_lengths, fit_betas_to_skeleton)
+from shapemove.core.body.fit import (MOTION_REG, SUBTREE_WEIGHTS, _bone_basis, body_bone_lengths, bone_lengths,
+                                     fit_betas_to_bone_lengths, fit_betas_to_motion, fit_betas_to_skeleton)
 from shapemove.core.body.kinematics import axis_angle_to_matrix, forward_kinematics
 from shapemove.core.body.skeleton import BODY_BONES
 from shapemove.core.body.smpl_family import SMPLFamilyBody
@@ -125,3 +125,48 @@ def test_openbody_recovery(request):
         seen = vt[s > 1e-2]
         assert len(seen) >= 1
         np.testing.assert_allclose(seen @ fit.betas, seen @ betas, atol=0.1)
+
+
+def test_subtree_weights_hand_derived():
+    """Each bone weighs the joints it carries: pelvis->spine1 13 (spine1..wrists), pelvis->left_hip
+    4 (hip, knee, ankle, foot), spine3->left_collar 4 (collar, shoulder, elbow, wrist), feet 1."""
+    n = SUBTREE_WEIGHTS / SUBTREE_WEIGHTS[9]  # bone 9 = left_ankle -> left_foot
+    np.testing.assert_allclose(n[[0, 2, 5, 8, 11, 12, 14, 19]], [4, 13, 12, 11, 2, 4, 1, 1], atol=1e-9)
+    np.testing.assert_allclose(SUBTREE_WEIGHTS.mean(), 1.0)
+
+
+def _motion(body, betas, frames=30, seed=0):
+    rng = np.random.default_rng(seed)
+    rest = body.rest_joints(torch.as_tensor(betas, dtype=torch.float32)[None])[0].double()
+    aa = torch.tensor(rng.normal(0, 0.3, (frames, 24, 3)))
+    pos, _ = forward_kinematics(axis_angle_to_matrix(aa), rest.expand(frames, -1, -1), body.parents)
+    return pos[:, :22].numpy() + rng.normal(0, 1, 3)
+
+
+def test_motion_fit_recovers_the_body(openbody):
+    """A motion of OpenBody itself: bone lengths back within 5 mm (the prior's pull), size beta
+    within 0.1."""
+    rng = np.random.default_rng(3)
+    for seed in range(2):
+        betas = rng.uniform(-1, 1, 10)
+        fit = fit_betas_to_motion(openbody, _motion(openbody, betas, seed=seed))
+        assert np.abs(fit.fitted_lengths - body_bone_lengths(openbody, betas)).max() < 5e-3
+        assert abs(fit.betas[0] - betas[0]) < 0.1
+
+
+def test_motion_fit_keeps_betas_plausible(openbody):
+    """A torso 20 % shorter than any OpenBody: the exact-skeleton fit buys ~1 mm per bone with
+    betas of ~8 (a deformed body); the motion fit stays within the N(0,1) prior."""
+    lengths = body_bone_lengths(openbody)
+    lengths[[2, 5, 8, 11]] *= 0.8  # pelvis->spine1, spine1->spine2, spine2->spine3, spine3->neck
+    loose = fit_betas_to_bone_lengths(openbody, lengths)
+    fit = fit_betas_to_bone_lengths(openbody, lengths, SUBTREE_WEIGHTS, MOTION_REG)
+    assert np.abs(loose.betas).max() > 5 and np.abs(fit.betas).max() < 2
+    assert fit.residual < 0.015
+
+
+def test_motion_fit_bad_input(openbody):
+    with pytest.raises(ShapeMoveError, match=r"\(T,22,3\)"):
+        fit_betas_to_motion(openbody, np.zeros((22, 3)))
+    with pytest.raises(ShapeMoveError, match="no finite frame"):
+        fit_betas_to_motion(openbody, np.full((4, 22, 3), np.nan))

@@ -263,3 +263,42 @@ def test_baseline_is_less_accurate_on_reachable_targets(rest):
     ours = solve_ik(joints, rest)
     assert base.rotations.shape == (40, 24, 3, 3)
     assert ours.mean_error_cm < 0.01 < base.mean_error_cm
+
+
+# (archive path, limits in cm with OPENBODY_LAYOUT / DEFAULT_LAYOUT + plausible body fit), measured
+# 3.30/3.48, 2.06/2.27, 2.03/2.22, 1.49/1.60 cm; the legacy SMPL_LAYOUT gives 4.12, 3.23, 3.32, 2.75 cm
+ARCHIVE_CLIPS = [
+    ("bandai/dataset-1/data/dataset-1_walk-back_active_001.bvh", 3.6, 3.8),
+    ("hdm05/bd/HDM_bd_kickLFront1Reps_001_120.amc", 2.4, 2.6),
+    ("cmu/bvh/02/02_01.bvh", 2.3, 2.5),
+    ("cmu/asfamc/03/03_01.amc", 1.8, 1.9),
+]
+
+
+@pytest.mark.parametrize("clip,limit,limit_default", ARCHIVE_CLIPS,
+                         ids=[c.split("/")[0] + "-" + c.split("/")[-1] for c, _, _ in ARCHIVE_CLIPS])
+def test_real_clip_mapped_in_openbody_layout(mocap_root, openbody, clip, limit, limit_default):
+    """The dataset path on each archive: rig mapping in OpenBody's layout, betas fitted to the
+    clip within the N(0,1) prior (fit_betas_to_motion), IK. The legacy SMPL-fraction layout
+    costs >= 0.5 cm more with the same kind of fit."""
+    from shapemove.core.body.fit import fit_betas_to_motion
+    from shapemove.core.io.mocap import load_mocap
+    from shapemove.core.io.resample import resample_positions
+    from shapemove.core.io.rig_map import DEFAULT_LAYOUT, OPENBODY_LAYOUT, SMPL_LAYOUT, detect_rig, mapping_matrix
+
+    path = mocap_root / clip
+    if not path.is_file():
+        pytest.fail(f"clip missing from the archive: {path}")
+    mocap = load_mocap(path)
+    err = {}
+    for name, layout in (("openbody", OPENBODY_LAYOUT), ("default", DEFAULT_LAYOUT), ("smpl", SMPL_LAYOUT)):
+        W = mapping_matrix(detect_rig(mocap.names), mocap.names, mocap.positions, layout)
+        joints = resample_positions(np.matmul(W, mocap.positions), mocap.fps, 20.0)[:80]
+        fit = fit_betas_to_motion(openbody, joints)
+        assert np.abs(fit.betas).max() < 3.0  # a plausible body
+        rest = openbody.rest_joints(torch.tensor(fit.betas)[None])[0].double().numpy()
+        res = solve_ik(joints, rest)
+        _report(res, f"{clip} {name} layout, |betas|max {np.abs(fit.betas).max():.2f}")
+        err[name] = res.mean_error_cm
+    assert err["openbody"] < limit and err["default"] < limit_default
+    assert err["openbody"] < err["default"] < err["smpl"] - 0.5

@@ -1,11 +1,12 @@
-"""Rig mapping to the 22 SMPL body joints: direct joints, spine-chain interpolation, left/right,
-namespaces, unknown rigs."""
+"""Rig mapping to the 22 SMPL body joints: direct joints, spine-chain interpolation and hip width
+in the body's layout (OpenBody's by default), left/right, namespaces, unknown rigs."""
 import numpy as np
 import pytest
 
-from mocap_synth import SMPL_REST, mixamo_skeleton
+from mocap_synth import MIXAMO, SMPL_REST, mixamo_skeleton
 from shapemove.core.errors import ShapeMoveError
-from shapemove.core.io.rig_map import SPINE_FRACTIONS, detect_rig, map_positions, normalize
+from shapemove.core.io.rig_map import (DEFAULT_LAYOUT, OPENBODY_LAYOUT, SMPL_LAYOUT, SPINE_FRACTIONS, BodyLayout, body_layout,
+                                       detect_rig, map_positions, normalize)
 
 
 def _chain_point(points, frac):
@@ -19,19 +20,61 @@ def _chain_point(points, frac):
 
 def test_mixamo_direct_and_chain_joints():
     names, parents, rest = mixamo_skeleton()
-    j22, rig = map_positions(names, rest[None])
-    assert rig.name == "mixamo"
+    plain, _ = map_positions(names, rest[None])  # DEFAULT_LAYOUT: OpenBody's spine, the rig's hips
+    j22, rig = map_positions(names, rest[None], layout=OPENBODY_LAYOUT)
+    assert rig.name == "mixamo" and DEFAULT_LAYOUT.spine == OPENBODY_LAYOUT.spine
+    np.testing.assert_allclose(plain[0, [1, 2]], SMPL_REST[[1, 2]], atol=1e-12)
+    np.testing.assert_allclose(np.delete(plain[0], [1, 2], 0), np.delete(j22[0], [1, 2], 0), atol=1e-12)
     j22 = j22[0]
     # every limb joint, the neck and the head come straight from the source
-    for i in [1, 2, 4, 5, 7, 8, 10, 11, 12, 13, 14, 15, 16, 17, 18, 19, 20, 21]:
+    for i in [4, 5, 7, 8, 10, 11, 12, 13, 14, 15, 16, 17, 18, 19, 20, 21]:
         np.testing.assert_allclose(j22[i], SMPL_REST[i], atol=1e-12)
     # pelvis/spine1/2/3 lie on the mid-hips -> Hips -> Spine -> Spine1 -> Spine2 -> Neck polyline
-    chain = np.stack([(SMPL_REST[1] + SMPL_REST[2]) / 2, SMPL_REST[0], SMPL_REST[3], SMPL_REST[6],
-                      SMPL_REST[9], SMPL_REST[12]])
+    mid = (SMPL_REST[1] + SMPL_REST[2]) / 2
+    chain = np.stack([mid, SMPL_REST[0], SMPL_REST[3], SMPL_REST[6], SMPL_REST[9], SMPL_REST[12]])
     for name, idx in (("pelvis", 0), ("spine1", 3), ("spine2", 6), ("spine3", 9)):
         np.testing.assert_allclose(j22[idx], _chain_point(chain, SPINE_FRACTIONS[name]), atol=1e-12)
-    # the pelvis sits between and above the hips, like SMPL's (~9 cm)
-    assert abs(j22[0, 0]) < 1e-9 and 0.05 < j22[0, 1] - SMPL_REST[1, 1] < 0.13
+    # OpenBody's pelvis sits ~2 cm above the mid-hips point; its hips are spread about that point
+    # to 0.138 x leg length each side (SMPL_REST: leg 0.815 m, hips 0.07 m out -> 0.1125 m)
+    assert abs(j22[0, 0]) < 1e-9 and 0.01 < j22[0, 1] - mid[1] < 0.03
+    leg = np.linalg.norm(SMPL_REST[4] - SMPL_REST[1]) + np.linalg.norm(SMPL_REST[7] - SMPL_REST[4])
+    for side, sign in ((1, 1), (2, -1)):
+        np.testing.assert_allclose(j22[side], mid + sign * np.array([OPENBODY_LAYOUT.hip_width * leg, 0, 0]),
+                                   atol=1e-12)
+
+
+def test_legacy_smpl_layout():
+    """SMPL_LAYOUT: the rig's own hip joints, the pelvis ~9 cm above them (neutral SMPL)."""
+    names, parents, rest = mixamo_skeleton()
+    j22, _ = map_positions(names, rest[None], layout=SMPL_LAYOUT)
+    np.testing.assert_allclose(j22[0, [1, 2]], SMPL_REST[[1, 2]], atol=1e-12)
+    assert abs(j22[0, 0, 0]) < 1e-9 and 0.05 < j22[0, 0, 1] - SMPL_REST[1, 1] < 0.13
+
+
+def test_openbody_layout_matches_the_asset(openbody):
+    """The constants are OpenBody's own rest joints, and mapping a rig that stands on OpenBody's
+    joints gives OpenBody's pelvis, spine and hips back."""
+    rest = openbody.rest_joints()[0].double().numpy()
+    measured = body_layout(rest)
+    np.testing.assert_allclose(OPENBODY_LAYOUT.spine, measured.spine, atol=1e-3)
+    assert abs(OPENBODY_LAYOUT.hip_width - measured.hip_width) < 1e-3
+    names, _, _ = mixamo_skeleton()
+    src = np.stack([rest[MIXAMO[n.split(":")[-1]]] for n in names])
+    j22, _ = map_positions(names, src[None], layout=measured)
+    np.testing.assert_allclose(j22[0], rest[:22], atol=1e-9)
+    # the rounded constants: within a millimetre
+    j22, _ = map_positions(names, src[None], layout=OPENBODY_LAYOUT)
+    np.testing.assert_allclose(j22[0], rest[:22], atol=1e-3)
+
+
+def test_hip_width_scales_with_the_leg_not_the_unit():
+    names, parents, rest = mixamo_skeleton()
+    a, _ = map_positions(names, rest[None], layout=OPENBODY_LAYOUT)
+    b, _ = map_positions(names, 100 * rest[None], layout=OPENBODY_LAYOUT)  # centimetres: the same skeleton
+    np.testing.assert_allclose(100 * a, b, atol=1e-9)
+    wide = BodyLayout(spine=OPENBODY_LAYOUT.spine, hip_width=0.2)
+    c, _ = map_positions(names, rest[None], layout=wide)
+    assert np.linalg.norm(c[0, 1] - c[0, 2]) > np.linalg.norm(a[0, 1] - a[0, 2]) + 0.09
 
 
 def test_mapping_is_linear_per_frame():

@@ -11,6 +11,14 @@ with Levenberg-Marquardt (Gauss-Newton with damping) in float64, started from ze
 positions are given, from the ridge solution on root-relative joints; the better end wins.
 ``reg`` (m^2 per unit beta^2) = 1e-6 is the MAP weight for ~1 mm bone-length noise under the
 N(0,1) beta prior: directions the bone lengths can't see (girth) stay near 0.
+
+That suits a skeleton OF the body. A mocap clip (``fit_betas_to_motion``) is another skeleton:
+rig conventions and proportions the 10 betas cannot express leave cm of bone-length error
+(OpenBody's first beta carries 98 % of the shape variance, mostly overall size; the other nine
+move a joint < 1 cm per unit), and chasing them with reg 1e-6 drives betas to +-20..60 (chest
+girths of 3 m). So a clip is fitted with ``MOTION_REG`` (~1.4 cm bone noise) and each bone weighted
+by the number of joints it carries (``SUBTREE_WEIGHTS``: a torso bone moves 11-13 joints, a
+foot one), which is what the joint error of the retargeted motion counts.
 """
 from __future__ import annotations
 
@@ -24,6 +32,19 @@ from .skeleton import BODY_BONES, JOINT_INDEX, JOINT_NAMES, NUM_BODY_JOINTS
 
 NUM_BONES = len(BODY_BONES)  # 21
 DEFAULT_REG = 1e-6
+MOTION_REG = 2e-4  # (1.4 cm)^2: betas of real clips stay within the N(0,1) prior (|beta_i| <~ 3)
+
+
+def _subtree_weights() -> np.ndarray:
+    """(21,) joints of the 22-joint body at or below each bone's child, normalised to mean 1."""
+    n = np.ones(NUM_BODY_JOINTS)
+    for j in range(NUM_BODY_JOINTS - 1, 0, -1):
+        n[BODY_BONES[j - 1][0]] += n[j]
+    w = n[1:]
+    return w / w.mean()
+
+
+SUBTREE_WEIGHTS = _subtree_weights()
 
 
 @dataclass
@@ -150,6 +171,21 @@ def fit_betas_to_bone_lengths(body: BodyModel, lengths, weights=None, reg: float
                                                          for s in (init if isinstance(init, list) else [init])]
     best = min((_levenberg_marquardt(a, B, target, w, reg, s) for s in starts), key=lambda bc: bc[1])
     return _result(body, best[0], target, w)
+
+
+def fit_betas_to_motion(body: BodyModel, joints, weights=None, reg: float = MOTION_REG) -> BetaFit:
+    """Betas of a body that carries a mocap clip: joints (T,22,3) (or (T,24,3)) metres in SMPL order,
+    e.g. ``Motion22.joints``. Fits the median bone lengths over the frames with ``SUBTREE_WEIGHTS``
+    (or ``weights`` (21,)) and the ``MOTION_REG`` prior, so the betas stay a plausible body.
+    """
+    x = np.asarray(joints, dtype=np.float64)
+    if x.ndim != 3 or x.shape[0] < 1 or x.shape[1] not in (NUM_BODY_JOINTS, 24) or x.shape[2] != 3:
+        raise ShapeMoveError(f"motion joints must be (T,22,3) or (T,24,3) in SMPL joint order, got shape {x.shape}")
+    ok = np.all(np.isfinite(x[:, :NUM_BODY_JOINTS]), axis=(1, 2))
+    if not ok.any():
+        raise ShapeMoveError("motion joints contain no finite frame")
+    lengths = np.median(bone_lengths(x[ok, :NUM_BODY_JOINTS]), axis=0)
+    return fit_betas_to_bone_lengths(body, lengths, SUBTREE_WEIGHTS if weights is None else weights, reg)
 
 
 def fit_betas_to_positions(body: BodyModel, joints, weights=None, reg: float = DEFAULT_REG) -> np.ndarray:

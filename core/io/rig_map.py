@@ -3,13 +3,21 @@
 Every SMPL joint is a fixed linear combination of source joint positions, so a whole clip maps
 with one matrix product: ``smpl22 = W @ source`` with W (22, J). A rule is one of
 
-- ``"Name"``: the source joint itself (hips, knees, ankles, shoulders, elbows, wrists, head);
+- ``"Name"``: the source joint itself (knees, ankles, shoulders, elbows, wrists, neck, head);
 - ``("lerp", "A", "B", t)``: (1-t)*A + t*B (CMU clavicles start on the mid-line: the SMPL collar
   sits ~45% of the way to the shoulder);
-- ``("chain", f)``: the point at fraction f of the arc length of the rig's spine chain, which runs
-  from the midpoint of the two hip joints to the neck. SMPL's pelvis, spine1, spine2 and spine3
-  sit at 0.15, 0.34, 0.56 and 0.64 of that arc (neutral SMPL rest pose), so every rig gets
-  SMPL-like spine proportions whatever its own spine joints are.
+- ``("chain", k)``: spine joint k (pelvis, spine1, spine2, spine3) at the body's fraction of the
+  arc length of the rig's spine chain, which runs from the midpoint of the two hip joints up the
+  rig's spine joints to the neck.
+
+The joints a rig has no counterpart for are placed with the BODY's layout (``BodyLayout``), so the
+mapped skeleton has the proportions of the body the motion is retargeted onto (OpenBody,
+``OPENBODY_LAYOUT``, measured on its mean rest joints by ``body_layout``): pelvis, spine1, spine2
+and spine3 at the body's fractions of the mid-hips -> neck arc (``DEFAULT_LAYOUT``), and
+optionally the hip joints spread sideways about the mid-hips point to the body's hip width for the
+clip's leg length (mocap rigs put the hip joints 6-11 cm from the mid-line, OpenBody 11 cm at 81 cm
+of leg). With the full OpenBody layout a body whose bone lengths fit the clip reproduces it to
+~0.6 cm; with the legacy SMPL fractions (``SMPL_LAYOUT``) the spine alone cost 2-4 cm.
 
 Left means the subject's left (SMPL/HumanML3D: left hip at +X when the body faces +Z).
 Source names are compared case-insensitively after dropping a namespace (``mixamorig:Hips``).
@@ -26,8 +34,41 @@ from ..errors import ShapeMoveError
 
 SMPL22 = JOINT_NAMES[:NUM_BODY_JOINTS]
 
-# fractions of the mid-hips -> neck arc (neutral SMPL: hips 0.09 below the pelvis, neck 0.51 above)
-SPINE_FRACTIONS = {"pelvis": 0.15, "spine1": 0.34, "spine2": 0.56, "spine3": 0.64}
+SPINE_JOINTS = ("pelvis", "spine1", "spine2", "spine3")
+
+
+@dataclass(frozen=True)
+class BodyLayout:
+    """Where a body model keeps the joints mocap rigs lack. ``spine``: fractions of the mid-hips
+    -> pelvis -> spine1 -> spine2 -> spine3 -> neck arc for the four SPINE_JOINTS; ``hip_width``:
+    half the distance between the hip joints divided by the leg length (hip -> knee -> ankle),
+    or None to keep the rig's own hip joints."""
+
+    spine: tuple
+    hip_width: float | None = None
+
+
+# OpenBody's mean rest joints (assets/openbody.npz; tests check these against ``body_layout``)
+OPENBODY_LAYOUT = BodyLayout(spine=(0.032, 0.300, 0.445, 0.669), hip_width=0.138)
+# what ``mapping_matrix`` / ``mocap.load_smpl22`` use: OpenBody's spine, the rig's own hip joints
+# (so the mapped thigh stays the source's thigh bone; pass OPENBODY_LAYOUT for the hip width too)
+DEFAULT_LAYOUT = BodyLayout(spine=OPENBODY_LAYOUT.spine, hip_width=None)
+# the approximate neutral-SMPL fractions used before (hips 0.09 below the pelvis, neck 0.51 above)
+SMPL_LAYOUT = BodyLayout(spine=(0.15, 0.34, 0.56, 0.64), hip_width=None)
+SPINE_FRACTIONS = dict(zip(SPINE_JOINTS, OPENBODY_LAYOUT.spine))
+
+
+def body_layout(rest_joints) -> BodyLayout:
+    """The BodyLayout of a body's rest joints (22 or 24, 3) in SMPL order, metres."""
+    j = np.asarray(rest_joints, dtype=np.float64).reshape(-1, 3)
+    if j.shape[0] < NUM_BODY_JOINTS or not np.all(np.isfinite(j)):
+        raise ShapeMoveError(f"rest joints must be (22,3) or (24,3) finite values, got {np.shape(rest_joints)}")
+    pts = np.stack([(j[1] + j[2]) / 2, j[0], j[3], j[6], j[9], j[12]])
+    cum = np.cumsum(np.linalg.norm(np.diff(pts, axis=0), axis=-1))
+    leg = (np.linalg.norm(j[4] - j[1]) + np.linalg.norm(j[7] - j[4]) + np.linalg.norm(j[5] - j[2])
+           + np.linalg.norm(j[8] - j[5])) / 2
+    return BodyLayout(spine=tuple(float(c) for c in cum[:4] / cum[-1]),
+                      hip_width=float(np.linalg.norm(j[1] - j[2]) / 2 / leg))
 
 
 def _limbs(hip, knee, ankle, foot, collar, shoulder, elbow, wrist):
@@ -65,8 +106,8 @@ def _rig(name, chain, neck, head, limbs, optional=()):
     rules = dict(limbs)
     rules["neck"] = neck
     rules["head"] = head
-    for joint, frac in SPINE_FRACTIONS.items():
-        rules[joint] = ("chain", frac)
+    for k, joint in enumerate(SPINE_JOINTS):
+        rules[joint] = ("chain", k)  # index into BodyLayout.spine
     return Rig(name, rules, tuple(chain) + (neck,), neck, head, tuple(optional))
 
 
@@ -151,11 +192,11 @@ def detect_rig(names) -> Rig:
         f"{', ...' if len(names) > 12 else ''})")
 
 
-def mapping_matrix(rig: Rig, names, positions: np.ndarray) -> np.ndarray:
+def mapping_matrix(rig: Rig, names, positions: np.ndarray, layout: BodyLayout = DEFAULT_LAYOUT) -> np.ndarray:
     """W (22, J) such that ``W @ positions[t]`` is the SMPL22 skeleton at frame t.
 
-    ``positions`` (T,J,3) fixes the spine-chain segment lengths (median over frames, so it works
-    whatever the rig's rest pose is)."""
+    ``positions`` (T,J,3) fixes the spine-chain segment lengths and the leg length (medians over
+    frames, so it works whatever the rig's rest pose is); ``layout``: the target body's layout."""
     index = {normalize(n): i for i, n in enumerate(names)}
     J = len(names)
 
@@ -171,33 +212,43 @@ def mapping_matrix(rig: Rig, names, positions: np.ndarray) -> np.ndarray:
             return (1 - rule[3]) * onehot(rule[1]) + rule[3] * onehot(rule[2])
         raise AssertionError(rule)
 
-    points = []
-    if rig.chain:
-        points.append(0.5 * (rule_weights(rig.rules["left_hip"]) + rule_weights(rig.rules["right_hip"])))
-        points += [onehot(n) for n in rig.chain if normalize(n) in index]
-        pts = np.stack(points)                                          # (K,J)
-        chain_pos = np.matmul(pts, positions)  # (T,K,3)
-        seg = np.median(np.linalg.norm(np.diff(chain_pos, axis=1), axis=-1), axis=0)  # (K-1,)
-        cum = np.concatenate([[0.0], np.cumsum(seg)])
-        total = cum[-1]
-
     W = np.zeros((len(SMPL22), J))
     for i, joint in enumerate(SMPL22):
         rule = rig.rules[joint]
+        if not (isinstance(rule, tuple) and rule[0] == "chain"):
+            W[i] = rule_weights(rule)
+    if not rig.chain:
+        return W
+
+    def median_length(w):  # median over frames of |w @ positions|
+        return float(np.median(np.linalg.norm(np.matmul(w, positions), axis=-1)))
+
+    mid = 0.5 * (W[1] + W[2])
+    pts = np.stack([mid] + [onehot(n) for n in rig.chain if normalize(n) in index])  # (K,J)
+    seg = np.array([median_length(b - a) for a, b in zip(pts[:-1], pts[1:])])       # (K-1,)
+    cum = np.concatenate([[0.0], np.cumsum(seg)])
+    if not cum[-1] > 0:
+        raise ShapeMoveError(f"degenerate skeleton: the spine chain of the {rig.name} rig has zero length")
+    for i, joint in enumerate(SMPL22):
+        rule = rig.rules[joint]
         if isinstance(rule, tuple) and rule[0] == "chain":
-            if not total > 0:
-                raise ShapeMoveError(f"degenerate skeleton: the spine chain of the {rig.name} rig has zero length")
-            s = rule[1] * total
+            s = layout.spine[rule[1]] * cum[-1]
             k = int(np.clip(np.searchsorted(cum, s, side="right") - 1, 0, len(seg) - 1))
             t = 0.0 if seg[k] <= 0 else (s - cum[k]) / seg[k]
             W[i] = (1 - t) * pts[k] + t * pts[k + 1]
-        else:
-            W[i] = rule_weights(rule)
+    if layout.hip_width is not None:
+        # spread (or narrow) the hip joints about the mid-hips point to the body's hip width
+        leg = sum(median_length(W[c] - W[p]) for p, c in ((1, 4), (4, 7), (2, 5), (5, 8))) / 2
+        half = median_length(W[1] - W[2]) / 2
+        if half > 1e-3 * leg:
+            scale = float(np.clip(layout.hip_width * leg / half, 0.5, 2.5))
+            W[1], W[2] = mid + scale * (W[1] - mid), mid + scale * (W[2] - mid)
     return W
 
 
-def map_positions(names, positions: np.ndarray, rig: Rig | None = None) -> tuple[np.ndarray, Rig]:
+def map_positions(names, positions: np.ndarray, rig: Rig | None = None,
+                  layout: BodyLayout = DEFAULT_LAYOUT) -> tuple[np.ndarray, Rig]:
     """(T,J,3) source positions -> ((T,22,3) SMPL22 positions, rig used)."""
     rig = rig or detect_rig(names)
-    W = mapping_matrix(rig, names, positions)
+    W = mapping_matrix(rig, names, positions, layout)
     return np.matmul(W, positions), rig
