@@ -62,6 +62,8 @@ def test_augmented_copies_are_on_other_bodies(tiny_dataset):
     metas = [json.loads(ln) for ln in (root / "meta.jsonl").read_text().splitlines()]
     aug = [m for m in metas if "augmented_from" in m]
     assert aug, "Bandai clips in the tiny set should get augmented copies"
+    bodies = {np.load(root / "betas" / f"{m['id']}.npy").tobytes() for m in aug}
+    assert len(bodies) == len(aug), "every augmented copy gets its own body"
     for m in aug:
         src = m["augmented_from"]
         assert not np.allclose(np.load(root / "betas" / f"{m['id']}.npy"), np.load(root / "betas" / f"{src}.npy"))

@@ -81,7 +81,15 @@ def hull_perimeter(points: np.ndarray) -> float:
 def girth(vertices, faces, y: float, inside_points) -> float:
     """Convex-hull perimeter (metres) of the section pieces at Y=y that enclose one of the
     (x, z) inside_points; 0 when none does."""
-    pieces = [s for s in cross_section(vertices, faces, y) if any(contains(s, p) for p in inside_points)]
+    section = cross_section(vertices, faces, y)
+    pieces = [s for s in section if any(contains(s, p) for p in inside_points)]
+    if not pieces and section:
+        # a thin body can have its spine joint just outside the skin: take the piece closest to it
+        # (within 10 cm), never an arm
+        p0 = np.asarray(inside_points[0], np.float64)
+        dist = [np.linalg.norm(np.asarray(s).reshape(-1, 2) - p0, axis=1).min() for s in section]
+        if min(dist) < 0.10:
+            pieces = [section[int(np.argmin(dist))]]
     if not pieces:
         return 0.0
     return hull_perimeter(np.concatenate(pieces).reshape(-1, 2))

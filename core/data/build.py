@@ -170,7 +170,9 @@ def _write_clip(out: Path, cid: str, arrays: dict, clip: ClipSource, split: str,
 
 
 def _augment_betas(cid: str) -> np.ndarray:
-    seed = int.from_bytes(cid.encode()[-8:].rjust(8, b"\0"), "little") % (2**32)
+    import hashlib
+
+    seed = int(hashlib.sha1(cid.encode()).hexdigest()[:8], 16)  # the whole id: every clip its own body
     rng = np.random.default_rng(seed)
     return np.clip(rng.standard_normal(10), -AUGMENT_BETA_CLIP, AUGMENT_BETA_CLIP).astype(np.float32)
 
