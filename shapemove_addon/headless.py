@@ -82,6 +82,8 @@ def render_video(blend: Path, mp4: Path) -> Path:
     bpy.ops.wm.open_mainfile(filepath=str(Path(blend).resolve()))
     scene = bpy.context.scene
     r = scene.render
+    if hasattr(r.image_settings, "media_type"):  # Blender 5.0+: FFMPEG is a video media type
+        r.image_settings.media_type = "VIDEO"
     r.image_settings.file_format = "FFMPEG"
     r.ffmpeg.format = "MPEG4"
     r.ffmpeg.codec = "H264"

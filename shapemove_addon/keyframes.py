@@ -3,7 +3,8 @@
 Keys are written per F-Curve with ``keyframe_points.add(n)`` + ``foreach_set("co", ...)``, which
 is tens of times faster than one ``keyframe_insert`` per bone and frame. Blender 4.4 introduced
 slotted actions (F-Curves live in a channelbag of a layer/strip for an action slot) and 5.0 removed
-the legacy ``Action.fcurves``; both layouts are handled here.
+the legacy ``Action.fcurves``; both layouts are handled here (checked against bpy 4.2, 4.3, 4.4,
+4.5 and 5.0 with ``tools/check_blender_versions.sh``).
 """
 from __future__ import annotations
 
@@ -32,7 +33,16 @@ def _fcurve_factory(action, obj):
             channelbag = strip.channelbag(slot, ensure=True)
         else:
             channelbag = action_ensure_channelbag_for_slot(action, slot)
-        return lambda path, index, group: channelbag.fcurves.new(path, index=index, group_name=group)
+        groups = {}
+
+        def new(path, index, group):
+            # ChannelbagFCurves.new takes group_name only from 5.0: group the curve ourselves
+            fc = channelbag.fcurves.new(path, index=index)
+            if group not in groups:
+                groups[group] = channelbag.groups.get(group) or channelbag.groups.new(group)
+            fc.group = groups[group]
+            return fc
+        return new
     anim.action = action  # Blender 4.2 / 4.3: legacy flat list
     return lambda path, index, group: action.fcurves.new(path, index=index, action_group=group)
 

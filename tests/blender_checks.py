@@ -72,6 +72,14 @@ def _install():
                           "torch_imported": "torch" in sys.modules}  # registering must not need torch
 
 
+@timed("user_dir")
+def _user_dir():
+    # the installed extension keeps its files under bpy.utils.extension_path_user (4.2+)
+    path = str(ext("shapemove_addon.paths").user_dir())
+    RESULTS["user_dir"] = {"path": path, "expected": bpy.utils.extension_path_user(ADDON),
+                           "in_user_resources": path.startswith(CONFIG["user_resources"] + os.sep)}
+
+
 import torch  # noqa: E402  (after the install check above)
 
 
@@ -113,6 +121,10 @@ def check_rig(label, motion_path, lbs=True):
     res["fcurves"] = len(fcurves)
     res["keys_per_fcurve"] = sorted({len(fc.keyframe_points) for fc in fcurves})
     res["keyed_frames"] = sorted({int(round(k.co[0])) for fc in fcurves for k in fc.keyframe_points})
+    # every curve sits in the group of its bone (the Dope Sheet / Graph Editor channel list)
+    res["misgrouped_fcurves"] = [f"{fc.data_path}[{fc.array_index}]" for fc in fcurves
+                                 if fc.group is None or fc.data_path.split('"')[1] != fc.group.name]
+    res["blender_version"] = list(bpy.app.version)
 
     # FK: evaluated bone heads == the motion's joints (Z-up)
     joints_z = axes.points_to_z_up(motion.joints)
@@ -266,6 +278,18 @@ if CONFIG.get("cli_blend"):
 
         res["png_std"] = float(np.asarray(Image.open(png).convert("RGB"), dtype=np.float64).std() / 255)
         RESULTS["cli"] = res
+
+
+if CONFIG.get("cli_blend"):
+    @timed("video")
+    def _video():
+        # render_video on the saved scene; the MP4 read back as a movie clip has every frame
+        headless = ext("shapemove_addon.headless")
+        mp4 = os.path.join(CONFIG["render_dir"], "cli.mp4")
+        headless.render_video(CONFIG["cli_blend"], mp4)
+        clip = bpy.data.movieclips.load(mp4)
+        RESULTS["video"] = {"frames": clip.frame_duration, "size": list(clip.size),
+                            "no_tmp": not any(".tmp" in f for f in os.listdir(CONFIG["render_dir"]))}
 
 
 with open(CONFIG["results"], "w") as f:

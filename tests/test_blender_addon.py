@@ -1,6 +1,6 @@
 """The extension inside real Blender (bpy module): install the zip, build rigs with the operator,
 check the scene, the forward kinematics, the skinning, shape changes, failure clean-up, a
-headless Workbench render and the `blend` command.
+headless Workbench render, the `blend` command and the MP4 of a saved scene.
 
 All Blender work happens in one subprocess (tests/blender_checks.py): BLENDER_USER_RESOURCES has
 to point at a temporary folder before bpy is imported. Its measurements are asserted here.
@@ -76,6 +76,12 @@ def test_extension_installs_and_registers(blender):
     assert r == {"result": ["FINISHED"], "enabled": True, "operator": True, "panel": True, "torch_imported": False}
 
 
+def test_user_folder_is_the_extensions_user_path(blender):
+    r = _section(blender, "user_dir")
+    assert r["path"] == r["expected"] and r["in_user_resources"] and Path(r["path"]).is_dir()
+    assert "extensions" in Path(r["path"]).parts and Path(r["path"]).name == "shapemove"
+
+
 def test_operator_builds_mesh_shape_keys_armature_and_modifier(blender):
     r = _section(blender, "capsule")
     assert r["result"] == ["FINISHED"]
@@ -98,6 +104,7 @@ def test_action_keys_every_frame_and_sets_the_scene_timing(blender):
     assert r["frame_range"] == [1, FRAMES] and r["fps"] == r["motion_fps"] == 20
     assert r["fcurves"] == 24 * 4 + 3  # a quaternion per bone + the root location
     assert r["keys_per_fcurve"] == [FRAMES] and r["keyed_frames"] == list(range(1, FRAMES + 1))
+    assert r["misgrouped_fcurves"] == []  # grouped per bone on every Blender (4.4 has no group_name=)
 
 
 def test_evaluated_bones_and_mesh_follow_the_motion(blender):
@@ -152,3 +159,8 @@ def test_blend_command_saves_and_renders(blender):
     assert r["exit"] == 0 and r["png"] and r["blend"] and r["png_std"] > 0.05
     assert r["objects"] == ["ARMATURE", "CAMERA", "MESH", "MESH"] and r["camera"] and r["action"]
     assert r["frame_range"] == [1, FRAMES]
+
+
+def test_render_video_writes_every_frame(blender):
+    r = _section(blender, "video")  # the MP4, read back by Blender's movie clip loader
+    assert r["frames"] == FRAMES and r["size"] == [64, 48] and r["no_tmp"]
