@@ -7,6 +7,7 @@ calls ``emit(message_dict)`` (from any thread) with protocol responses.
 """
 from __future__ import annotations
 
+import atexit
 import math
 import os
 import sys
@@ -47,6 +48,8 @@ class JobRunner:
         self._closing = False
         self._thread = threading.Thread(target=self._loop, name="shapemove-job", daemon=True)
         self._thread.start()
+        # bpy 4.2-4.5 crash or hang at interpreter exit while a thread still runs: stop it first
+        atexit.register(self.close, 1.0)
 
     # -- requests -----------------------------------------------------------------------------
     @property
