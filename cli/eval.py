@@ -47,7 +47,7 @@ def add_recon(sub):
     p.add_argument("--split", default="test", choices=["train", "val", "test"])
     p.add_argument("--checkpoint", type=Path, required=True, help="SA-VAE run folder or .pt file")
     p.add_argument("--json", type=Path, required=True, help="write the metrics here")
-    p.add_argument("--max-clips", type=int, default=None, help="evaluate only the first N clips")
+    p.add_argument("--max-clips", type=int, default=None, help="evaluate a seeded random subset of N clips")
     p.add_argument("--body-model", default=None, help="openbody (default) or an SMPL-family file")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(_run=run_recon)

@@ -90,7 +90,9 @@ def eval_recon(data, checkpoint, split: str = "test", body=None, max_clips: int 
         raise ShapeMoveError(f"split must be train, val or test, got {split!r}")
     body = _body(body)
     vae = load_vae(checkpoint, body)
-    ids = read_split(root, split)[:max_clips] if max_clips else read_split(root, split)
+    ids = read_split(root, split)
+    if max_clips and len(ids) > max_clips:  # a seeded random subset: the split is sorted by source
+        ids = [ids[i] for i in np.sort(np.random.default_rng(0).choice(len(ids), max_clips, replace=False))]
     if not ids:
         raise ShapeMoveError(f"{root}: the {split} split has no clips ({split}.txt missing or empty)")
     model_rows, gt_rows, all_indices = [], [], []
