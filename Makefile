@@ -41,7 +41,7 @@ train-default: setup
 	$(PY) -m shapemove train tma --data $(BUILT) --config configs/default_tma.json --out $(RUNS)/tma --resume
 	$(PY) -m shapemove train t5 --data $(BUILT) --config configs/default_t5.json --vae $(RUNS)/vae/savae.pt \
 		--out $(RUNS)/t5 --resume $(if $(BASE_T5),--base-model $(BASE_T5),)
-	$(PY) tools/export_default.py --vae $(RUNS)/vae --t5 $(RUNS)/t5 --tma $(RUNS)/tma --out weights/default
+	$(PY) tools/export_default.py --vae $(RUNS)/vae --t5 $(RUNS)/t5 --tma $(RUNS)/tma --out weights/default --card configs/model_card.json
 
 eval: setup
 	$(PY) -m shapemove eval recon --data $(BUILT) --split test --checkpoint weights/default/savae.pt --json out/eval_recon.json

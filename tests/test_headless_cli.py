@@ -1,0 +1,70 @@
+"""The headless commands end to end with tiny trained models: `demo` and `render` write a .blend,
+a preview strip and the motion; a bad prompt in a batch is reported and skipped."""
+import json
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from tiny_models import tiny_bundle  # noqa: F401  (session fixture)
+
+pytestmark = [pytest.mark.slow, pytest.mark.blender]
+
+
+def _run(args, cwd):
+    env = dict(os.environ, OMP_NUM_THREADS="1")
+    return subprocess.run([sys.executable, "-m", "shapemove", *args], cwd=cwd, env=env, capture_output=True,
+                          text=True, timeout=600)
+
+
+def _png_size(path):
+    with open(path, "rb") as f:
+        head = f.read(24)
+    assert head[:8] == b"\x89PNG\r\n\x1a\n"
+    return int.from_bytes(head[16:20], "big"), int.from_bytes(head[20:24], "big")
+
+
+def test_demo_writes_blend_preview_and_motion(tiny_bundle, tmp_path):
+    model, _ = tiny_bundle
+    r = _run(["demo", "--model", str(model), "--out", str(tmp_path / "demo"), "--seconds", "2", "--frames", "3"],
+             tmp_path)
+    assert r.returncode == 0, r.stderr[-2000:]
+    out = tmp_path / "demo"
+    assert (out / "shapemove.blend").stat().st_size > 100_000
+    w, h = _png_size(out / "preview.png")
+    assert (w, h) == (3 * 320, 320)  # a strip of three 320x320 frames
+    with np.load(out / "motion.npz") as z:
+        assert z["poses"].shape == (40, 24, 3) and z["betas"].shape == (10,)
+    for word in ("prompt:", "body:", "height", "scene:", "preview:"):
+        assert word in r.stdout
+    assert not list(out.glob("*.tmp*"))
+
+
+def test_render_batch_skips_a_bad_prompt(tiny_bundle, tmp_path):
+    model, _ = tiny_bundle
+    prompts = tmp_path / "prompts.jsonl"
+    prompts.write_text("\n".join(json.dumps(p) for p in [
+        {"prompt": "a person walks forward", "seconds": 2},
+        {"prompt": "12345 !!"},
+        {"prompt": "someone waves with the left hand", "shape_text": "a short, slim woman", "seconds": 2.4},
+    ]) + "\n")
+    r = _run(["render", "--prompts", str(prompts), "--out", str(tmp_path / "r"), "--model", str(model),
+              "--frames", "2", "--resolution", "96", "96"], tmp_path)
+    assert r.returncode == 0, r.stderr[-2000:]
+    assert "rendered 2 of 3 prompts" in r.stdout
+    assert "no words" in r.stdout + r.stderr
+    blends = sorted((tmp_path / "r").glob("*.blend"))
+    assert [b.name[:3] for b in blends] == ["000", "002"]
+    for b in blends:
+        assert _png_size(b.with_suffix(".png")) == (2 * 96, 96)
+    with np.load(blends[1].with_suffix(".npz")) as z:
+        assert z["poses"].shape[0] == 48  # 2.4 s at 20 fps
+
+
+def test_render_rejects_a_bad_prompts_file(tmp_path):
+    bad = tmp_path / "p.jsonl"
+    bad.write_text('{"prompt": "a person walks"}\nnot json\n')
+    r = _run(["render", "--prompts", str(bad), "--out", str(tmp_path / "r")], tmp_path)
+    assert r.returncode == 2 and "p.jsonl:2: not valid JSON" in r.stderr
