@@ -10,7 +10,7 @@ import torch
 from shapemove.core.errors import ShapeMoveError
 
 RUN_CLIP = "dataset-1_run_happy_001"  # 93 frames; the tiny dataset also holds its augmented copy
-RECON_KEYS = {"mpjpe_mm", "bone_err_mm", "penetrate_cm", "float_cm", "skate_pct", "dyn_stable_pct",
+RECON_KEYS = {"mpjpe_mm", "mpjpe_local_mm", "bone_err_mm", "penetrate_cm", "float_cm", "skate_pct", "dyn_stable_pct",
               "code_usage_pct", "clips"}
 
 
