@@ -9,6 +9,9 @@ def add_arguments(p):
     p.add_argument("--prompt", required=True, help='motion text, e.g. "a person jogs forward and waves"')
     p.add_argument("--shape-text", default=None, help='body text, e.g. "a tall, heavy-set man" or a measured sentence')
     p.add_argument("--betas", default=None, help="explicit body shape b0,…,b9 (overrides the predicted one)")
+    p.add_argument("--shape-from", choices=["auto", "head"], default="auto",
+                   help="auto: a shape text with measurements or size words is fitted on the mesh, other text goes "
+                        "through the T5's [BETA] head; head: always the [BETA] head")
     p.add_argument("--seconds", type=float, default=None, help="motion length (default: the model decides, <= 10 s)")
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--temperature", type=float, default=1.0, help="sampling temperature; 0 = greedy")
@@ -28,10 +31,13 @@ def run(args) -> int:
         raise ShapeMoveError(f"--out must end in .npz, got {args.out}")
     betas = parse_betas(args.betas) if args.betas else None
     gen = Generator(args.model, body=args.body_model)
-    motion = gen.generate(args.prompt, args.shape_text, betas, args.seconds, args.seed, args.temperature, args.top_k)
+    from ..core.generation.generate import Request
+
+    motion = gen.generate_batch([Request(args.prompt, args.shape_text, betas, args.seconds, args.seed, args.temperature,
+                                         args.top_k, args.shape_from)])[0]
     save_motion(args.out, motion)
     m = measure(gen.body, motion.betas)
     print(f"wrote {args.out}: {motion.num_frames} frames ({motion.num_frames / motion.fps:.1f} s), "
           f"{len(motion.tokens)} tokens, IK error {motion.ik_error_cm:.2f} cm")
-    print("body: " + ", ".join(f"{k.replace('_cm', '')} {v:.0f} cm" for k, v in m.items()))
+    print(f"body ({getattr(motion, 'shape_source', '[BETA] head')}): " + ", ".join(f"{k.replace('_cm', '')} {v:.0f} cm" for k, v in m.items()))
     return 0

@@ -154,3 +154,21 @@ def test_eval_generate_command(tiny_bundle, tmp_path, capsys):
     res = json.loads(out.read_text())
     assert set(res) - {"ground_truth"} == set(res["ground_truth"]) == set(KEYS) and res["clips"] == 2
     assert "Text-to-motion evaluation" in capsys.readouterr().out
+
+
+def test_body_shape_from_stated_measurements_or_the_beta_head(generator):
+    from shapemove.core.body.measure import measure
+    from shapemove.core.generation.generate import Request
+
+    tall = generator.generate_batch([Request("a person walks", "A person standing 190 cm tall", seconds=1.2)])[0]
+    assert tall.shape_source == "measurements"
+    assert measure(generator.body, tall.betas)["height_cm"] == pytest.approx(190, abs=1.5)
+    short = generator.generate_batch([Request("a person walks", "a short, slim woman", seconds=1.2)])[0]
+    assert measure(generator.body, short.betas)["height_cm"] < measure(generator.body, tall.betas)["height_cm"] - 20
+    head = generator.generate_batch([Request("a person walks", "A person standing 190 cm tall", seconds=1.2,
+                                             shape_from="head")])[0]
+    assert head.shape_source == "[BETA] head"
+    free = generator.generate_batch([Request("a person walks", "an athletic dancer", seconds=1.2)])[0]
+    assert free.shape_source == "[BETA] head"  # free text the measurement fit cannot read
+    given = generator.generate_batch([Request("a person walks", "tall", betas=np.full(10, 0.5), seconds=1.2)])[0]
+    assert given.shape_source == "given" and np.allclose(given.betas, 0.5)

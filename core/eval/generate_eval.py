@@ -141,7 +141,8 @@ def eval_generate(data, split: str = "test", model_dir=None, tma=None, max_clips
     motions = []
     for i, c in enumerate(clips):
         seconds = float(np.clip(len(c["features"]) / FPS, max(0.4, down / FPS), max_s))
-        req = Request(c["caption"], c["shape_text"], seconds=seconds, seed=seed + i)
+        # the model's own reading of the shape text ([BETA] head), not the measurement fit
+        req = Request(c["caption"], c["shape_text"], seconds=seconds, seed=seed + i, shape_from="head")
         motions.append(gen.generate_batch([req])[0])
         step(i, f"generated {c['id']}")
     gen_phys, real_phys = [], []

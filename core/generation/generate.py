@@ -33,6 +33,7 @@ class Request:
     seed: int = 0
     temperature: float = 1.0
     top_k: int | None = 50
+    shape_from: str = "auto"  # "auto": measurements stated in the shape text win; "head": the [BETA] head only
 
 
 def parse_betas(text: str) -> np.ndarray:
@@ -112,11 +113,30 @@ class Generator:
             if cancel is not None and cancel():
                 break
             codes, pred = self.tokens_for([r])
-            betas = np.asarray(r.betas, np.float32) if r.betas is not None else pred[0].numpy()
-            out.append(self.decode_motion(codes[0], betas, prompt=r.prompt))
+            betas, source = self.body_shape(r, pred[0].numpy())
+            motion = self.decode_motion(codes[0], betas, prompt=r.prompt)
+            motion.shape_source = source
+            out.append(motion)
             if progress is not None:
                 progress((i + 1) / len(reqs), r.prompt)
         return out
+
+    def body_shape(self, r: Request, predicted: np.ndarray) -> tuple[np.ndarray, str]:
+        """The betas for a request and where they came from: explicit betas; else, when the shape
+        text states measurements or size words ("190 cm tall", "tall, heavy-set"), a body fitted to
+        those numbers on the mesh (exact where the text is explicit); else the T5's [BETA] head."""
+        from ..body.shape_from_measurements import betas_for_measurements, targets_from_shape_text
+
+        if r.betas is not None:
+            return np.asarray(r.betas, np.float32), "given"
+        if r.shape_text and r.shape_from == "auto":
+            try:
+                targets = targets_from_shape_text(r.shape_text, self.body)
+            except ShapeMoveError:  # free text the fit does not read: the model's reading of it
+                targets = {}
+            if targets:
+                return np.asarray(betas_for_measurements(self.body, targets), np.float32), "measurements"
+        return np.asarray(predicted, np.float32), "[BETA] head"
 
     def redecode(self, motion: Motion, betas) -> Motion:
         """The same tokens on another body: feet stay planted and bones keep the new lengths."""
