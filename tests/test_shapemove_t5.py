@@ -100,3 +100,25 @@ def test_bad_prompts_give_clear_errors(bad, match):
 
 def test_good_prompt_is_tidied():
     assert check_prompt("  a person\n walks   forward ") == "a person walks forward"
+
+
+def test_build_on_a_local_pretrained_t5_folder(tok, tmp_path):
+    """A user's pretrained T5 on disk (here a small one saved with plain transformers): its weights
+    are kept, the embeddings grow for the motion tokens, nothing is fetched."""
+    from transformers import T5Config, T5ForConditionalGeneration
+
+    base_tok = tokenizer_from_sentencepiece(train_sentencepiece(TEXTS, tmp_path / "sp", vocab_size=150))
+    n_text = base_tok.convert_tokens_to_ids("[MID_0]")  # the plain vocabulary before our tokens
+    cfg = T5Config(vocab_size=n_text, d_model=32, d_ff=64, num_layers=1, num_decoder_layers=1, num_heads=2, d_kv=16,
+                   decoder_start_token_id=0)
+    torch.manual_seed(3)
+    plain = T5ForConditionalGeneration(cfg)
+    plain.save_pretrained(str(tmp_path / "base"))
+    m = ShapeMoveT5.build(base_tok, base_model=tmp_path / "base")
+    assert m.lm.get_input_embeddings().weight.shape[0] == len(base_tok) == n_text + 1003
+    torch.testing.assert_close(m.lm.get_input_embeddings().weight[:n_text], plain.get_input_embeddings().weight)
+    enc = base_tok(["a person walks forward."], return_tensors="pt")
+    out = m(enc.input_ids, enc.attention_mask, torch.tensor([m.vocab.target_ids([5, 6])]), torch.zeros(1, 10))
+    assert torch.isfinite(out["loss"])
+    with pytest.raises(ShapeMoveError, match="not a pretrained T5"):
+        ShapeMoveT5.build(base_tok, base_model=tmp_path)
