@@ -81,6 +81,11 @@ class BodyModel(torch.nn.Module):
         return self.joint_template + torch.einsum("jcb,nb->njc", self.joint_shapedirs, b)
 
     # -- pose ----------------------------------------------------------------------------------
+    def pose_offsets(self, rotmats: torch.Tensor) -> torch.Tensor | None:
+        """(B,V,3) pose-dependent vertex offsets added before skinning (none for a plain LBS model;
+        the SMPL family's pose correctives)."""
+        return None
+
     def forward(self, betas=None, rotations=None, transl=None) -> BodyOutput:
         """betas (B,10); rotations (B,24,3) axis-angle or (B,24,3,3) local; transl (B,3)."""
         if rotations is None:
@@ -93,6 +98,9 @@ class BodyModel(torch.nn.Module):
         if b.shape[0] == 1 and B > 1:
             b = b.expand(B, -1)
         verts = self.rest_vertices(b)
+        offsets = self.pose_offsets(rotmats)
+        if offsets is not None:
+            verts = verts + offsets
         joints_rest = self.rest_joints(b)
         posed_joints, world = forward_kinematics(rotmats, joints_rest, self.parents)
         verts = linear_blend_skinning(verts, self.skin_weights_t, skinning_transforms(world, joints_rest))

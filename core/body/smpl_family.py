@@ -36,8 +36,7 @@ import numpy as np
 import torch
 
 from ..errors import ShapeMoveError
-from .kinematics import as_rotation_matrices, forward_kinematics, linear_blend_skinning, skinning_transforms
-from .model import BodyModel, BodyOutput
+from .model import BodyModel
 from .skeleton import NUM_BODY_JOINTS, NUM_JOINTS, PARENTS
 
 REQUIRED_KEYS = ("v_template", "shapedirs", "J_regressor", "weights", "kintree_table", "f")
@@ -255,23 +254,11 @@ class SMPLFamilyBody(BodyModel):
         family = FAMILY_BY_JOINTS.get(np.asarray(arrays["J_regressor"]).shape[0], "smpl")
         return cls(arrays, model_name(path, family, arrays.get("gender")), pose_correctives, where=str(path))
 
-    def forward(self, betas=None, rotations=None, transl=None) -> BodyOutput:
-        """As ``BodyModel.forward`` plus the pose-corrective offsets (smplx's ``lbs``)."""
-        if self.posedirs is None or rotations is None:
-            return super().forward(betas, rotations, transl)
-        rotmats = as_rotation_matrices(torch.as_tensor(rotations, dtype=torch.float32))
+    def pose_offsets(self, rotmats: torch.Tensor) -> torch.Tensor | None:
+        """The pose-corrective offsets (smplx's ``lbs``): posedirs . (R - I) of the body joints."""
+        if self.posedirs is None:
+            return None
         B = rotmats.shape[0]
-        b = self._betas(betas, B)
-        if b.shape[0] == 1 and B > 1:
-            b = b.expand(B, -1)
-        joints_rest = self.rest_joints(b)
         eye = torch.eye(3, dtype=rotmats.dtype, device=rotmats.device)
         feature = (rotmats[:, 1: 1 + self.posed_joints] - eye).reshape(B, -1)
-        verts = self.rest_vertices(b) + (feature @ self.posedirs).reshape(B, -1, 3)
-        posed_joints, world = forward_kinematics(rotmats, joints_rest, self.parents)
-        verts = linear_blend_skinning(verts, self.skin_weights_t, skinning_transforms(world, joints_rest))
-        if transl is not None:
-            t = torch.as_tensor(transl, dtype=torch.float32).reshape(-1, 1, 3)
-            verts = verts + t
-            posed_joints = posed_joints + t
-        return BodyOutput(vertices=verts, joints=posed_joints)
+        return (feature @ self.posedirs).reshape(B, -1, 3)
