@@ -97,17 +97,7 @@ def add_generate(sub):
         return
     p = sub.add_parser("generate", help="text-to-motion metrics (generated motions beside the real clips)",
                        description="text-to-motion metrics (generated motions beside the real clips)")
-    if hasattr(mod, "add_arguments"):
-        mod.add_arguments(p)
-    else:  # the arguments ``generate_eval.from_cli`` reads
-        p.add_argument("--data", type=Path, required=True, help="dataset folder from `data build`")
-        p.add_argument("--split", default="test", choices=["train", "val", "test"])
-        p.add_argument("--model", type=Path, default=None, help="model folder (default: the embedded default model)")
-        p.add_argument("--tma", type=Path, default=None, help="tma.pt or its folder (default: MODEL/tma)")
-        p.add_argument("--json", type=Path, default=None, help="write the metrics here")
-        p.add_argument("--max-clips", type=int, default=None, help="evaluate only N clips")
-        p.add_argument("--seed", type=int, default=0, help="caption choice and sampling seed")
-        p.add_argument("--quiet", action="store_true", help="no progress bar")
+    mod.add_arguments(p)
     p.set_defaults(_run=lambda args: _exit_code(mod.from_cli(args)))
 
 
