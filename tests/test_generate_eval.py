@@ -103,8 +103,11 @@ def test_eval_generate_on_the_test_split(tiny_bundle, generator):
     # height/waist errors are those of the generated bodies (same seeds -> same betas)
     from shapemove.core.body.measure import measure
 
+    from shapemove.core.generation.generate import Request
+
     clips = load_clips(data, "test")
-    pred = [generator.generate(c["caption"], c["shape_text"], seconds=len(c["features"]) / 20, seed=i).betas
+    pred = [generator.generate_batch([Request(c["caption"], c["shape_text"], seconds=len(c["features"]) / 20, seed=i,
+                                              shape_from="head")])[0].betas
             for i, c in enumerate(clips)]
     mp, mt = measure(generator.body, np.stack(pred)), measure(generator.body, np.stack([c["betas"] for c in clips]))
     assert gen["height_err_cm"] == pytest.approx(np.abs(mp["height_cm"] - mt["height_cm"]).mean(), rel=1e-5)
