@@ -43,9 +43,13 @@ train-default: setup
 		--out $(RUNS)/t5 --resume $(if $(BASE_T5),--base-model $(BASE_T5),)
 	$(PY) tools/export_default.py --vae $(RUNS)/vae --t5 $(RUNS)/t5 --tma $(RUNS)/tma --out weights/default --card configs/model_card.json
 
+# Evaluation tables of the README (needs $(BUILT) from train-default); the 1-step SA-VAE is the untrained baseline.
 eval: setup
-	$(PY) -m shapemove eval recon --data $(BUILT) --split test --checkpoint weights/default/savae.pt --json out/eval_recon.json
-	$(PY) -m shapemove eval generate --data $(BUILT) --split test --model weights/default --json out/eval_generate.json
+	$(PY) -m shapemove train vae --data $(BUILT) --config configs/default_vae.json --steps 1 --out runs/untrained --quiet
+	$(PY) -m shapemove eval recon --data $(BUILT) --split test --checkpoint weights/default/savae.pt --max-clips 40 --json out/eval_recon.json
+	$(PY) -m shapemove eval recon --data $(BUILT) --split test --checkpoint runs/untrained/savae.pt --max-clips 40 --json out/eval_recon_untrained.json
+	$(PY) -m shapemove eval generate --data $(BUILT) --split test --model weights/default --max-clips 60 --json out/eval_generate.json
+	$(PY) tools/eval_report.py
 
 extension: setup
 	$(PY) tools/build_extension.py --out dist

@@ -1,6 +1,7 @@
 """The ShapeMove T5: tokenizer with motion tokens, [BETA] head, constrained decoding, save/load."""
 from pathlib import Path
 
+import numpy as np
 import pytest
 import torch
 
@@ -122,3 +123,39 @@ def test_build_on_a_local_pretrained_t5_folder(tok, tmp_path):
     assert torch.isfinite(out["loss"])
     with pytest.raises(ShapeMoveError, match="not a pretrained T5"):
         ShapeMoveT5.build(base_tok, base_model=tmp_path)
+
+
+def test_text_to_motion_and_motion_to_text_examples_from_real_clips(tiny_dataset):
+    """The T5 training examples: the paper's prompt format with [BETA] targets and betas, and with
+    m2t_share the reverse task (motion tokens in, caption out); both batch and give a finite loss."""
+    import random
+
+    from shapemove.core.models.savae import SAVAE, SAVAEConfig
+    from shapemove.core.models.tokenizer import MotionVocab
+    from shapemove.core.train.motion_dataset import load_stats, read_split
+    from shapemove.core.train.t5_dataset import T2MExamples, all_texts, collate, tokenize_clips
+
+    torch.manual_seed(0)
+    vae = SAVAE(SAVAEConfig(width=16, depth=1, shape_hidden=16), *load_stats(tiny_dataset))
+    ids = read_split(tiny_dataset, "train")
+    tokens = tokenize_clips(vae, tiny_dataset, ids)
+    n = np.load(tiny_dataset / "norm_joint_vecs" / f"{ids[0]}.npy").shape[0]
+    assert len(tokens[ids[0]]) == n // 4 and tokens[ids[0]].max() < 1000
+    import tempfile
+
+    with tempfile.TemporaryDirectory() as d:
+        tok = tokenizer_from_sentencepiece(train_sentencepiece(all_texts(tiny_dataset, ids), Path(d) / "sp", 300))
+    vocab = MotionVocab(tok)
+    rng = random.Random(0)
+    t2m = [T2MExamples(tiny_dataset, "train", tokens, max_codes=8).sample(rng) for _ in range(6)]
+    assert all("The person demonstrates a motion like:" in e["input"] and 1 <= len(e["codes"]) <= 8 for e in t2m)
+    m2t = [T2MExamples(tiny_dataset, "train", tokens, max_codes=8, m2t_share=1.0).sample(rng) for _ in range(6)]
+    assert all(e["input"].startswith("Describe the motion: [SOM]") and e["codes"] is None and e["text"] for e in m2t)
+    model = ShapeMoveT5.build(tok, T5Size.tiny())
+    for batch in (t2m, m2t, t2m[:3] + m2t[:3]):
+        ids_, attn, labels, betas = collate(batch, tok, vocab)
+        out = model(ids_, attn, labels, betas)
+        assert torch.isfinite(out["loss"])
+    # motion-to-text rows have no [BETA]: only the text-to-motion rows feed the betas loss
+    ids_, attn, labels, betas = collate(m2t, tok, vocab)
+    assert not (labels == vocab.beta_id).any() and model(ids_, attn, labels, betas)["l1"] == 0
