@@ -42,7 +42,7 @@ def build_tiny_dataset(mocap_root: Path, out: Path) -> Path:
             joints = proc.load(clips[cid])
             todo = [(cid, None)] + ([(cid + "_aug", AUG_BETAS)] if cid == CLIPS["train"][0] else [])
             for name, betas in todo:
-                arrays = proc.process(clips[cid], joints, betas)
+                arrays = proc.process(joints, betas)
                 for key in ("norm_joint_vecs", "new_joint_vecs", "betas"):
                     np.save(out / key / f"{name}.npy", np.asarray(arrays[key], np.float32))
                 splits[split].append(name)

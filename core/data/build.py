@@ -122,8 +122,8 @@ class ClipProcessor:
         joints[..., 1] -= joints[:, [7, 8, 10, 11], 1].min()
         return joints.astype(np.float32)
 
-    def process(self, clip: ClipSource, joints: np.ndarray, betas: np.ndarray | None = None):
-        """Returns dict of arrays/texts for a clip on body ``betas`` (fitted when None)."""
+    def process(self, joints: np.ndarray, betas: np.ndarray | None = None):
+        """Arrays of one clip (its 22 joints at 20 fps) on the body ``betas`` (the fitted body when None)."""
         import torch
 
         from ..body.ik import solve_ik
@@ -223,7 +223,7 @@ def build_dataset(sources: list[Path], out: Path, body=None, augment_share: floa
         try:
             joints = proc.load(clip)
             for cid, b in todo:
-                arrays = proc.process(clip, joints, b)
+                arrays = proc.process(joints, b)
                 extra = {"augmented_from": clip.id} if b is not None else {}
                 _write_clip(out, cid, arrays, clip, split, extra)
                 if b is None:

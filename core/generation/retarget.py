@@ -91,7 +91,7 @@ def processor(body, ik_refine_iters: int = 10):
 def encode_source(joints: np.ndarray, vae, body, ik_refine_iters: int = 10) -> list[int]:
     """(T,22,3) source joints -> motion tokens: the builder's canonical features, SA-VAE encoded.
     T-1 feature rows are cut to a multiple of the VAE's downsampling (4): (T-1)//4 tokens."""
-    feats = processor(body, ik_refine_iters).process(None, joints)["norm_joint_vecs"]
+    feats = processor(body, ik_refine_iters).process(joints)["norm_joint_vecs"]
     n = len(feats) // vae.cfg.downsample * vae.cfg.downsample
     x = vae.normalize(torch.as_tensor(feats[:n], dtype=torch.float32))[None]
     with torch.no_grad():
@@ -116,7 +116,7 @@ def naive_retarget(motion, body, betas, ik_refine_iters: int = 10) -> Motion:
     scaled by the pelvis-height (leg length) ratio; lowest foot joint on the floor. T frames."""
     betas = check_betas(betas)
     joints, _ = source_joints(motion, body)
-    a = processor(body, ik_refine_iters).process(None, joints, betas)
+    a = processor(body, ik_refine_iters).process(joints, betas)
     out = Motion(joints=a["new_joints"], betas=betas, poses=a["poses"], transl=np.asarray(a["transl"], np.float32),
                  fps=float(FPS), body_model=body.name)
     validate(out)
