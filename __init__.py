@@ -5,7 +5,18 @@ top of the Python package ``shapemove`` used from the command line (``python -m 
 Nothing here imports bpy at import time, so the command line works without Blender.
 """
 
-__version__ = "0.1.0"
+
+def _manifest_version() -> str:
+    """The version, written once: in blender_manifest.toml (Blender reads it there; pyproject.toml
+    takes it from here)."""
+    import os
+    import tomllib
+
+    with open(os.path.join(os.path.dirname(os.path.abspath(__file__)), "blender_manifest.toml"), "rb") as f:
+        return str(tomllib.load(f)["version"])
+
+
+__version__ = _manifest_version()
 
 
 def register():

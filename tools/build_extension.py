@@ -18,7 +18,8 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 # build/run outputs that must never be shipped even if the manifest forgets them
-ALWAYS_EXCLUDE = ["/dist/", ".pytest_cache/", "/out/", "/runs/", "*.pyc", "*.tmp"]
+ALWAYS_EXCLUDE = ["/dist/", "/data/", "/.cache/", "/.venv/", "/.git/", ".pytest_cache/", "/out/", "/runs/",
+                  "__pycache__/", "*.pyc", "*.tmp"]
 
 
 def _matches(rel: str, is_dir: bool, pattern: str) -> bool:

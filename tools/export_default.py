@@ -60,9 +60,13 @@ def main() -> int:
                   metadata={"format": "pt"})
     if args.tma is not None:
         export_checkpoint(args.tma / "tma.pt", tmp / "tma" / "tma.pt")
-        shutil.copytree(args.tma / "tokenizer", tmp / "tma" / "tokenizer")
+        if (args.tma / "tokenizer").is_dir():  # sentencepiece TMAs only; MiniLM TMAs have none
+            shutil.copytree(args.tma / "tokenizer", tmp / "tma" / "tokenizer")
     card = json.loads(args.card.read_text()) if args.card else {}
     (tmp / "MODEL_CARD.json").write_text(json.dumps(card, indent=2))
+    licence = ROOT / "weights" / "default" / "LICENSE.txt"  # the weights' CC BY-NC licence + attributions
+    if licence.is_file():
+        shutil.copy2(licence, tmp / "LICENSE.txt")
     old = args.out.with_name(args.out.name + ".old")
     shutil.rmtree(old, ignore_errors=True)
     if args.out.exists():
