@@ -116,16 +116,17 @@ def test_smplx_file_matches_smplx_lbs(tmp_path):
     np.testing.assert_allclose(body.skin_weights[:, 15], arrays["weights"][:, [15, 22, 23, 24]].sum(1), atol=1e-6)
 
 
-def test_npz_with_sparse_regressor_object(tmp_path):
-    """A hand-converted npz may hold J_regressor as a pickled scipy.sparse object."""
+def test_npz_with_sparse_regressor_object_is_refused(tmp_path):
+    """A hand-converted npz holding J_regressor as a pickled scipy.sparse object is refused with a
+    sentence (pickles inside an .npz are never loaded: see tests/test_hostile_body_files.py)."""
     import scipy.sparse
 
     ok = write_model(tmp_path / "SMPL_MALE.npz")
     (tmp_path / "sparse").mkdir()
     write_model(tmp_path / "sparse" / "SMPL_MALE.npz",
                 J_regressor=np.array(scipy.sparse.csr_matrix(ok["J_regressor"]), dtype=object))
-    a, b = SMPLFamilyBody.load(tmp_path / "SMPL_MALE.npz"), SMPLFamilyBody.load(tmp_path / "sparse" / "SMPL_MALE.npz")
-    assert torch.equal(a.j_regressor, b.j_regressor)
+    with pytest.raises(ShapeMoveError, match="J_regressor is a pickled Python object.*dense"):
+        SMPLFamilyBody.load(tmp_path / "sparse" / "SMPL_MALE.npz")
 
 
 def test_factory_caches_and_resolves(smpl_files, tmp_path):

@@ -50,6 +50,14 @@ HOW_TO = ("download the model yourself (SMPL: smpl.is.tue.mpg.de, SMPL-H: mano.i
 
 
 # -- reading the files ---------------------------------------------------------------------------
+# Model files are untrusted: the .pkl is read by an unpickler that resolves only the names below
+# (never builtins, never a callable that could run code, write files or allocate without bound),
+# and an .npz is read member by member with allow_pickle=False after checking each array header.
+MAX_PICKLE_BYTES = 400 * 2**20  # official SMPL/SMPL-H/SMPL-X .pkl files are 40..250 MB
+MAX_ARRAY_BYTES = 512 * 2**20  # all arrays we read, as float64; SMPL-X 2020 (400 betas) needs ~250 MB
+_SPARSE_NAMES = ("csc_matrix", "csr_matrix", "coo_matrix", "csc_array", "csr_array", "coo_array")
+
+
 class _ChumpyArray:
     """Stand-in for a pickled ``chumpy.Ch``: keeps its state; a plain Ch holds its value in ``x``."""
 
@@ -60,35 +68,141 @@ class _ChumpyArray:
         self.state = state
 
     def value(self):
-        x = self.state.get("x") if isinstance(self.state, dict) else None
-        if x is None:
-            raise ValueError("a chumpy expression (not a plain array) cannot be read without chumpy")
-        return x.value() if isinstance(x, _ChumpyArray) else np.asarray(x)
+        x, depth = self, 0
+        while isinstance(x, _ChumpyArray):  # iterative: a self-referencing pickle cannot recurse
+            state = getattr(x, "state", None)
+            x = state.get("x") if isinstance(state, dict) else None
+            depth += 1
+            if x is None or depth > 8:
+                raise ValueError("a chumpy expression (not a plain array) cannot be read without chumpy")
+        return np.asarray(x) if isinstance(x, np.ndarray) else _not_array(x)
+
+
+def _not_array(x):
+    raise ValueError(f"a chumpy value holds a {type(x).__name__}, not an array")
+
+
+class _NdarrayClass:
+    """What the pickle gets for ``numpy.ndarray``: only usable as the first argument of
+    ``_reconstruct`` (calling it, which would allocate any size, fails)."""
+
+
+_NDARRAY = _NdarrayClass()
+_RECONSTRUCT = np.ndarray((0,)).__reduce__()[0]  # numpy.core.multiarray._reconstruct
+_SCALAR = np.float64(0).__reduce__()[0]  # numpy.core.multiarray.scalar
+
+
+def _reconstruct(cls, shape, dtype):
+    """numpy's pickled-array constructor, for an empty ndarray only (its data comes with BUILD)."""
+    if cls is not _NDARRAY or tuple(shape) != (0,):
+        raise pickle.UnpicklingError("unexpected array constructor in a body-model file")
+    return _RECONSTRUCT(np.ndarray, (0,), dtype)
+
+
+def _scalar(dtype, data=None):
+    if not isinstance(dtype, np.dtype) or dtype.hasobject or not isinstance(data, bytes) or len(data) > 64:
+        raise pickle.UnpicklingError("unexpected numpy scalar in a body-model file")
+    return _SCALAR(dtype, data)
+
+
+def _make_set(items=()):
+    return set(items)
+
+
+def _copyreg_reconstructor(cls, base, state):
+    """Python 2 pickles create new-style objects this way; allow only the chumpy stand-in."""
+    if cls is not _ChumpyArray:
+        raise pickle.UnpicklingError("unexpected object constructor in a body-model file")
+    return object.__new__(_ChumpyArray)
+
+
+def _encode(text, encoding="latin1"):
+    if not isinstance(text, str) or encoding not in ("latin1", "latin-1", "utf-8", "utf8"):
+        raise pickle.UnpicklingError("unexpected text encoding in a body-model file")
+    return text.encode(encoding)
+
+
+_ALLOWED = {
+    ("numpy", "dtype"): np.dtype, ("numpy", "ndarray"): _NDARRAY,
+    ("numpy.core.multiarray", "_reconstruct"): _reconstruct, ("numpy._core.multiarray", "_reconstruct"): _reconstruct,
+    ("numpy.core.multiarray", "scalar"): _scalar, ("numpy._core.multiarray", "scalar"): _scalar,
+    ("copy_reg", "_reconstructor"): _copyreg_reconstructor, ("copyreg", "_reconstructor"): _copyreg_reconstructor,
+    ("__builtin__", "set"): _make_set, ("builtins", "set"): _make_set,
+    ("__builtin__", "object"): None, ("builtins", "object"): None,  # only as copy_reg's base argument
+    ("_codecs", "encode"): _encode,
+}
 
 
 class _ModelUnpickler(pickle.Unpickler):
-    """Only numpy / scipy.sparse / builtins classes; chumpy classes become ``_ChumpyArray``."""
+    """Resolves only what an SMPL-family pickle holds: numpy arrays / dtypes, scipy.sparse
+    matrices, chumpy arrays (as ``_ChumpyArray``). Anything else is refused."""
 
     def find_class(self, module, name):
-        top = module.split(".")[0]
-        if top == "chumpy":
+        if module.split(".")[0] == "chumpy" and name == "Ch":
             return _ChumpyArray
-        if module.startswith("scipy.sparse"):
+        if module.startswith("scipy.sparse") and name in _SPARSE_NAMES:
             import scipy.sparse
 
             return getattr(scipy.sparse, name)
-        if top in ("numpy", "copy_reg", "copyreg", "__builtin__", "builtins", "_codecs", "collections"):
-            return super().find_class(module, name)
-        raise pickle.UnpicklingError(f"unexpected class {module}.{name} in a body-model file")
+        if (module, name) in _ALLOWED:
+            return _ALLOWED[(module, name)]
+        raise pickle.UnpicklingError(f"refused to load {module}.{name} from a body-model file (only numpy arrays, "
+                                     "scipy.sparse matrices and chumpy arrays are allowed)")
 
 
-def _plain(value):
-    """chumpy / scipy.sparse / ndarray -> ndarray (or the value unchanged if it is none of those)."""
+def _plain(value, key: str):
+    """chumpy / scipy.sparse / ndarray -> a numeric ndarray, size-checked before any allocation."""
     if isinstance(value, _ChumpyArray):
-        return value.value()
-    if hasattr(value, "toarray") and "scipy.sparse" in type(value).__module__:
+        value = value.value()
+    module = type(value).__module__ or ""
+    if module.startswith("scipy.sparse") and hasattr(value, "toarray"):
+        shape = tuple(int(n) for n in value.shape)
+        if len(shape) != 2 or shape[0] * shape[1] * 8 > MAX_ARRAY_BYTES:
+            raise ValueError(f"{key} is a sparse matrix of shape {shape}, too large for a body model")
+        value.check_format(full_check=True)  # indices inside the shape, before any C code uses them
         return value.toarray()
+    if not isinstance(value, np.ndarray):
+        if key == "gender" and isinstance(value, (str, bytes)):
+            return np.asarray(value)
+        raise ValueError(f"{key} holds a {type(value).__name__}, not an array")
+    if key != "gender" and value.dtype.kind not in "biuf":
+        raise ValueError(f"{key} holds {value.dtype} values, not numbers")
     return value
+
+
+def _check_sizes(arrays: dict) -> None:
+    total = sum(int(np.prod(a.shape, dtype=np.float64)) * 8 for a in arrays.values())
+    if total > MAX_ARRAY_BYTES:
+        raise ValueError(f"its arrays would take {total / 2**20:.0f} MB, more than any SMPL-family model "
+                         f"({MAX_ARRAY_BYTES // 2**20} MB)")
+
+
+def _read_npz(path: Path, wanted) -> dict:
+    """The wanted arrays of an .npz: each header checked first; pickled (object) arrays refused."""
+    out, declared = {}, {}
+    with zipfile.ZipFile(path) as zf:
+        names = set(zf.namelist())
+        for k in wanted:
+            member = f"{k}.npy"
+            if member not in names:
+                continue
+            with zf.open(member) as fh:
+                version = np.lib.format.read_magic(fh)
+                shape, _, dtype = np.lib.format._read_array_header(fh, version, max_header_size=10000)
+            if dtype.hasobject and k == "gender":
+                continue  # optional: a pickled gender is skipped, never unpickled
+            if dtype.hasobject:
+                raise ValueError(f"{k} is a pickled Python object; pickles inside .npz files are never loaded - "
+                                 f"save {k} as a plain (dense) array, e.g. np.savez(..., {k}=matrix.toarray())")
+            declared[k] = shape
+        total = sum(int(np.prod(s, dtype=np.float64)) * 8 for s in declared.values())
+        if total > MAX_ARRAY_BYTES:
+            raise ValueError(f"its arrays would take {total / 2**20:.0f} MB, more than any SMPL-family model "
+                             f"({MAX_ARRAY_BYTES // 2**20} MB)")
+        for k in declared:
+            with zf.open(f"{k}.npy") as fh:
+                out[k] = np.lib.format.read_array(fh, allow_pickle=False, max_header_size=10000)
+    return out
 
 
 def read_model_file(path: str | Path) -> dict:
@@ -101,22 +215,25 @@ def read_model_file(path: str | Path) -> dict:
     wanted = REQUIRED_KEYS + ("posedirs", "gender")
     try:
         if path.suffix.lower() == ".npz":
-            with np.load(path, allow_pickle=True) as data:
-                raw = {k: data[k] for k in wanted if k in data.files}
+            raw = _read_npz(path, wanted)
         else:
+            size = path.stat().st_size
+            if size > MAX_PICKLE_BYTES:
+                raise ValueError(f"the file is {size / 2**20:.0f} MB, larger than any SMPL-family .pkl "
+                                 f"({MAX_PICKLE_BYTES // 2**20} MB)")
             with open(path, "rb") as fh:
                 raw = _ModelUnpickler(fh, encoding="latin1").load()
             if not isinstance(raw, dict):
                 raise ValueError(f"the pickle holds a {type(raw).__name__}, not a dict of arrays")
             raw = {k: raw[k] for k in wanted if k in raw}
-        out = {k: _plain(v) for k, v in raw.items()}
-        for k, v in out.items():  # npz may store a sparse regressor as a pickled object array
-            if isinstance(v, np.ndarray) and v.dtype == object and v.shape == ():
-                out[k] = _plain(v.item())
+        out = {k: _plain(v, k) for k, v in raw.items()}
+        _check_sizes({k: v for k, v in out.items() if k != "gender"})
     except ShapeMoveError:
         raise
-    except (OSError, ValueError, TypeError, EOFError, KeyError, AttributeError, ImportError, pickle.UnpicklingError,
-            zipfile.BadZipFile) as exc:
+    except MemoryError:
+        raise ShapeMoveError(f"could not read body model file {path}: it does not fit in memory. {HOW_TO}") from None
+    except (OSError, ValueError, TypeError, EOFError, KeyError, AttributeError, IndexError, ImportError,
+            RecursionError, pickle.UnpicklingError, zipfile.BadZipFile, zipfile.LargeZipFile) as exc:
         raise ShapeMoveError(f"could not read body model file {path}: {exc}. {HOW_TO}") from None
     missing = [k for k in REQUIRED_KEYS if k not in out]
     if missing:
@@ -131,6 +248,9 @@ def _check_shapes(a: dict, where: str) -> tuple[int, int]:
     def bad(msg):
         return ShapeMoveError(f"body model {where}: {msg}. {HOW_TO}")
 
+    for k in REQUIRED_KEYS + ("posedirs",):
+        if k in a and (np.asarray(a[k]).dtype.kind not in "biuf" or not np.all(np.isfinite(a[k]))):
+            raise bad(f"{k} holds NaN, infinite or non-numeric values")
     v = np.asarray(a["v_template"])
     if v.ndim != 2 or v.shape[1] != 3:
         raise bad(f"v_template should be (V,3), got {v.shape}")
@@ -154,6 +274,8 @@ def _check_shapes(a: dict, where: str) -> tuple[int, int]:
     if "posedirs" in a and np.asarray(a["posedirs"]).shape != (V, 3, 9 * (J - 1)):
         raise bad(f"posedirs should be ({V},3,{9 * (J - 1)}), got {np.asarray(a['posedirs']).shape}")
     parents = _parents(a)
+    if np.any(parents[1:] < 0) or np.any(parents[1:] >= np.arange(1, J)):
+        raise bad("kintree_table is not a joint tree (every parent must come before its child)")
     n = NUM_JOINTS if J == NUM_JOINTS else NUM_BODY_JOINTS
     if not np.array_equal(parents[:n], PARENTS[:n]):
         raise bad("kintree_table is not the SMPL joint tree")
