@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 import torch
 
-from shapemove.core.body.kinematics import axis_angle_to_matrix
+from shapemove.core.geometry.torch_ops import axis_angle_to_matrix
 from shapemove.core.body.model import BodyModel
 from shapemove.core.body.skeleton import BODY_BONES
 from shapemove.core.errors import ShapeMoveError

@@ -11,7 +11,7 @@ from shapemove.core.errors import ShapeMoveError
 from shapemove.core.motion import (canonicalize, feature_slices, features_from_joints,
                                    joints_from_features, local_rotations_from_joints, mean_std)
 from shapemove.core.motion.features import T2M_RAW_OFFSETS, _CHILD, _PARENTS
-from shapemove.core.motion.rotations import (matrix_to_rot6d, rot6d_to_matrix, rotation_between,
+from shapemove.core.geometry.rotations import (matrix_to_rot6d, rot6d_to_matrix, rotation_between,
                                              yaw_matrix)
 from shapemove.core.motion.skeleton_ops import gaussian_smooth
 

@@ -8,7 +8,7 @@ from synthetic_smpl import write_model
 
 from shapemove.core.body.fit import (MOTION_REG, SUBTREE_WEIGHTS, _bone_basis, body_bone_lengths, bone_lengths,
                                      fit_betas_to_bone_lengths, fit_betas_to_motion, fit_betas_to_skeleton)
-from shapemove.core.body.kinematics import axis_angle_to_matrix, forward_kinematics
+from shapemove.core.geometry.torch_ops import axis_angle_to_matrix, forward_kinematics
 from shapemove.core.body.skeleton import BODY_BONES
 from shapemove.core.body.smpl_family import SMPLFamilyBody
 from shapemove.core.errors import ShapeMoveError

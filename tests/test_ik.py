@@ -8,7 +8,7 @@ import torch
 
 from shapemove.core.body.ik import (_kabsch, bone_turn_deg, hinge_axes, ik_lbfgs_baseline, rest_with_bone_lengths,
                                     solve_ik)
-from shapemove.core.body.kinematics import axis_angle_to_matrix, forward_kinematics
+from shapemove.core.geometry.torch_ops import axis_angle_to_matrix, forward_kinematics
 from shapemove.core.body.skeleton import JOINT_INDEX as J
 from shapemove.core.body.skeleton import JOINT_NAMES, PARENTS
 from shapemove.core.errors import ShapeMoveError

@@ -44,10 +44,11 @@ def test_amass_z_up_to_y_up(tmp_path):
     expect = rest32[4] + np.array([shin[0], -shin[2], shin[1]])
     np.testing.assert_allclose(m.positions[2, 7], expect, atol=1e-6)
     # the stored rest offsets and local rotations reproduce the positions
-    from shapemove.core.io.fk import forward_kinematics
+    from shapemove.core.geometry.fk import forward_kinematics, joints_from_offsets
     trans_local = np.broadcast_to(m.offsets, (3, 24, 3)).copy()
     trans_local[:, 0] = m.positions[:, 0]
-    np.testing.assert_allclose(forward_kinematics(m.parents, trans_local, m.rotations), m.positions, atol=1e-6)
+    posed, _ = forward_kinematics(m.rotations, joints_from_offsets(trans_local, m.parents), m.parents)
+    np.testing.assert_allclose(posed, m.positions, atol=1e-6)
 
 
 def test_amass_betas_only_for_smpl_family(tmp_path):

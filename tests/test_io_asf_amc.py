@@ -141,10 +141,9 @@ def test_cmu_asf_units_and_bones(mocap_root):
 
 
 def _rest(m):
-    from shapemove.core.io.fk import forward_kinematics
+    from shapemove.core.geometry.fk import joints_from_offsets
 
-    eye = np.broadcast_to(np.eye(3), (1, m.num_joints, 3, 3))
-    return forward_kinematics(m.parents, m.offsets[None], eye)[0]
+    return joints_from_offsets(m.offsets, m.parents)
 
 
 def test_cmu_asf_agrees_with_cmu_bvh(mocap_root):

@@ -6,7 +6,7 @@ import pytest
 from mocap_synth import bvh_text, mixamo_skeleton, still_motion
 from shapemove.core.errors import ShapeMoveError
 from shapemove.core.io.bvh import load_bvh
-from shapemove.core.io.fk import forward_kinematics
+from shapemove.core.geometry.fk import forward_kinematics, joints_from_offsets
 from shapemove.core.io.mocap import load_mocap, load_smpl22
 from shapemove.core.io.rig_map import map_positions
 from shapemove.core.io.tpose import is_tpose
@@ -94,7 +94,8 @@ def test_unit_and_up_axis_detected(tmp_path, unit, scale, up):
     # offsets and local rotations were converted consistently with the positions
     local = np.broadcast_to(m.offsets, m.positions.shape).copy()
     local[:, 0] = m.positions[:, 0]
-    np.testing.assert_allclose(forward_kinematics(m.parents, local, m.rotations), m.positions, atol=1e-9)
+    posed, _ = forward_kinematics(m.rotations, joints_from_offsets(local, m.parents), m.parents)
+    np.testing.assert_allclose(posed, m.positions, atol=1e-9)
 
 
 def test_rejects_missing_motion(tmp_path):

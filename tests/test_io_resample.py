@@ -4,7 +4,7 @@ import pytest
 
 from mocap_synth import SMPL_REST
 from shapemove.core.errors import ShapeMoveError
-from shapemove.core.io.fk import axis_rotation
+from shapemove.core.geometry.rotations import axis_rotation
 from shapemove.core.io.resample import resample_positions, resample_rotations, sample_times
 from shapemove.core.io.tpose import is_tpose, tpose_lead_in
 

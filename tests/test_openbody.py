@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 import torch
 
-from shapemove.core.body.kinematics import axis_angle_to_matrix
+from shapemove.core.geometry.torch_ops import axis_angle_to_matrix
 from shapemove.core.body.measure import measure
 from shapemove.core.body.openbody import OpenBody
 from shapemove.core.body.skeleton import JOINT_INDEX as JI

@@ -11,7 +11,8 @@ from dataclasses import dataclass
 import numpy as np
 import torch
 
-from .kinematics import as_rotation_matrices, forward_kinematics, linear_blend_skinning, skinning_transforms
+from ..geometry.torch_ops import forward_kinematics
+from .kinematics import as_rotation_matrices, linear_blend_skinning, skinning_transforms
 from .skeleton import JOINT_NAMES, PARENTS
 
 NUM_BETAS = 10
@@ -103,7 +104,7 @@ class BodyModel(torch.nn.Module):
             verts = verts + offsets
         joints_rest = self.rest_joints(b)
         posed_joints, world = forward_kinematics(rotmats, joints_rest, self.parents)
-        verts = linear_blend_skinning(verts, self.skin_weights_t, skinning_transforms(world, joints_rest))
+        verts = linear_blend_skinning(verts, self.skin_weights_t, skinning_transforms(world, posed_joints, joints_rest))
         if transl is not None:
             t = torch.as_tensor(transl, dtype=torch.float32).reshape(-1, 1, 3)
             verts = verts + t

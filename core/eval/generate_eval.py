@@ -76,12 +76,10 @@ def load_clips(data, split: str = "test", max_clips: int | None = None, seed: in
 
 def physics(body, betas, poses, transl) -> dict:
     """``evaluate_motion`` of one clip: betas (10,), poses (T,24,3) axis-angle, transl (T,3)."""
-    import torch
-
-    from ..body.kinematics import axis_angle_to_matrix
+    from ..geometry.rotations import axis_angle_to_matrix
     from .evaluate import evaluate_motion
 
-    rot = axis_angle_to_matrix(torch.as_tensor(np.asarray(poses, np.float32))).numpy()
+    rot = axis_angle_to_matrix(poses)
     return evaluate_motion(body, betas, rot, transl)
 
 

@@ -78,7 +78,7 @@ def eval_recon(data, checkpoint, split: str = "test", body=None, max_clips: int 
     clips of the dataset folder ``data``, with the ground truth's beside (see the module doc).
     progress(fraction, clip id) after each clip; ``per_clip``: a list to receive one dict per clip
     ({"id", "frames", the KEYS, "ground_truth": {KEYS}})."""
-    from ..body.kinematics import axis_angle_to_matrix
+    from ..geometry.rotations import axis_angle_to_matrix
     from ..generation.retarget import load_vae
     from ..models.fsq import codebook_usage
     from ..motion.features import joints_from_features
@@ -105,7 +105,7 @@ def eval_recon(data, checkpoint, split: str = "test", body=None, max_clips: int 
         m = evaluate_motion(body, betas, rot, transl, joints=joints)
         m["mpjpe_mm"] = mpjpe_mm(joints, gt_joints)
         m["mpjpe_local_mm"] = mpjpe_mm(joints, gt_joints, root_aligned=True)  # pose only, no trajectory drift
-        gt_rot = axis_angle_to_matrix(torch.as_tensor(_load(root, "poses", cid)[:n])).numpy()
+        gt_rot = axis_angle_to_matrix(_load(root, "poses", cid)[:n])
         g = evaluate_motion(body, betas, gt_rot, _load(root, "transl", cid)[:n])
         g["mpjpe_mm"] = g["mpjpe_local_mm"] = mpjpe_mm(gt_joints, gt_joints)
         if per_clip is not None:

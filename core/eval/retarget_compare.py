@@ -14,7 +14,6 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-import torch
 
 from ..errors import ShapeMoveError
 from .evaluate import evaluate_motion
@@ -40,9 +39,9 @@ def source_motion(data, clip):
 
 
 def _score(body, motion, betas) -> dict:
-    from ..body.kinematics import axis_angle_to_matrix
+    from ..geometry.rotations import axis_angle_to_matrix
 
-    rot = axis_angle_to_matrix(torch.as_tensor(motion.poses)).numpy()
+    rot = axis_angle_to_matrix(motion.poses)
     return evaluate_motion(body, betas, rot, motion.transl, joints=motion.joints, target_betas=betas)
 
 

@@ -22,7 +22,7 @@ def decode_tokens(codes: list[int], vae, body, betas, ik_refine_iters: int = 10,
     """Motion tokens + betas (10,) -> Motion on ``body``: SA-VAE ``decode_long`` with the body's
     shape, joints from the features, lowest foot on the floor, IK onto the body."""
     from ..body.ik import solve_ik
-    from ..body.kinematics import matrix_to_axis_angle
+    from ..geometry.rotations import matrix_to_axis_angle
     from ..motion.features import joints_from_features
 
     if not codes:
@@ -35,7 +35,7 @@ def decode_tokens(codes: list[int], vae, body, betas, ik_refine_iters: int = 10,
         rest = body.rest_joints(b)[0].numpy()
     joints[..., 1] -= joints[:, [7, 8, 10, 11], 1].min()
     ik = solve_ik(joints, rest, refine_iters=ik_refine_iters)
-    poses = matrix_to_axis_angle(torch.as_tensor(ik.rotations)).numpy().astype(np.float32)
+    poses = matrix_to_axis_angle(ik.rotations).astype(np.float32)
     m = Motion(joints=joints, betas=b[0].numpy(), poses=poses, transl=np.asarray(ik.transl, np.float32),
                fps=float(FPS), body_model=body.name, prompt=prompt, tokens=np.asarray(codes, np.int16),
                features=feats.numpy().astype(np.float32))

@@ -17,7 +17,8 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from ..body.kinematics import axis_angle_to_matrix, forward_kinematics
+from ..geometry.fk import bone_offsets, forward_kinematics
+from ..geometry.rotations import axis_angle_to_matrix
 from ..body.skeleton import JOINT_NAMES, NUM_BODY_JOINTS, PARENTS
 from ..errors import ShapeMoveError
 from .mocap import Mocap, finish_mocap
@@ -76,16 +77,14 @@ def load_amass(path, body_model=None, betas="auto") -> Mocap:
     aa = np.zeros((T, 24, 3))
     aa[:, :NUM_BODY_JOINTS] = d["poses"].reshape(T, NUM_BODY_JOINTS, 3)
     with torch.no_grad():
-        rest = model.rest_joints(torch.as_tensor(shape, dtype=torch.float32)[None])[0].double()  # (24,3)
-        rot = axis_angle_to_matrix(torch.as_tensor(aa))                                         # (T,24,3,3)
-        posed, _ = forward_kinematics(rot, rest.expand(T, 24, 3), PARENTS)
-    positions = posed.numpy() + d["trans"][:, None]        # AMASS world, Z up
+        rest = model.rest_joints(torch.as_tensor(shape, dtype=torch.float32)[None])[0].double().numpy()  # (24,3)
+    rot = axis_angle_to_matrix(aa)                                                              # (T,24,3,3)
+    posed, _ = forward_kinematics(rot, rest, PARENTS)
+    positions = posed + d["trans"][:, None]                # AMASS world, Z up
     R = to_y_up("Z")
-    rotations = rot.numpy().copy()
+    rotations = rot.copy()
     rotations[:, 0] = R @ rotations[:, 0]                  # the model's rest frame is already Y up
-    rest = rest.numpy()
-    offsets = rest.copy()
-    offsets[1:] = rest[1:] - rest[PARENTS[1:]]
+    offsets = bone_offsets(rest, PARENTS)
     mocap = finish_mocap(JOINT_NAMES, PARENTS, offsets, positions @ R.T, d["fps"], str(path),
                          rotations=rotations, unit="m", scale=1.0, up_axis="Y", subject=Path(path).parent.name,
                          meta={"gender": d["gender"], "betas": d["betas"], "betas_used": bool(use)})

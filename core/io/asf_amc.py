@@ -20,7 +20,8 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ShapeMoveError
-from .fk import axis_rotation, forward_kinematics
+from ..geometry.fk import forward_kinematics, joints_from_offsets
+from ..geometry.rotations import axis_rotation
 from .mocap import Mocap, finish_mocap
 
 INCH = 0.0254
@@ -284,7 +285,7 @@ def amc_to_positions(skel: Skeleton, root: np.ndarray, values: dict, angle: floa
             C = fixed_axes_matrix(b.axis_order, b.axis * skel.angle_scale)
             M = fixed_axes_matrix(order, ang)
             rots[:, j] = C @ M @ C.T
-    positions = forward_kinematics(parents, trans, rots)
+    positions = forward_kinematics(rots, joints_from_offsets(trans, parents), parents)[0]
     return names, parents, offsets, positions, rots
 
 

@@ -12,7 +12,8 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ShapeMoveError
-from .fk import axis_rotation, forward_kinematics
+from ..geometry.fk import forward_kinematics, joints_from_offsets
+from ..geometry.rotations import axis_rotation
 from .mocap import Mocap, finish_mocap
 
 CHANNELS = {"xposition": ("p", 0), "yposition": ("p", 1), "zposition": ("p", 2),
@@ -220,7 +221,7 @@ def load_bvh(path, unit: str | None = None, up_axis: str | None = None) -> Mocap
     text = raw.decode("utf-8", errors="replace")
     names, parents, offsets, channels, data, dt = parse_bvh(text, path)
     trans, rots = bvh_local_transforms(offsets, channels, data)
-    positions = forward_kinematics(parents, trans, rots)
+    positions = forward_kinematics(rots, joints_from_offsets(trans, parents), parents)[0]
     scale = None
     if unit is not None:
         if unit not in UNITS:

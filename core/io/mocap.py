@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ShapeMoveError
-from .fk import forward_kinematics
+from ..geometry.fk import joints_from_offsets
 from .units_axes import detect_unit, detect_up_axis, smpl22_or_none, to_y_up
 
 
@@ -76,8 +76,7 @@ def finish_mocap(names, parents, offsets, positions, fps, source, *, rotations=N
     if scale is None:
         unit, scale = detect_unit(names, positions, smpl22=j22)
     if up_axis is None:
-        eye = np.broadcast_to(np.eye(3), (1, len(names), 3, 3))
-        rest = forward_kinematics(parents, offsets[None], eye)[0]
+        rest = joints_from_offsets(offsets, parents)
         up_axis = detect_up_axis(names, positions, rest=rest, smpl22=j22)
     R = to_y_up(up_axis)
     A = R * float(scale)
@@ -158,8 +157,7 @@ def mocap_to_smpl22(mocap: Mocap, fps: float = 20.0, drop_tpose: bool = True) ->
         raise ShapeMoveError(f"{mocap.source}: the clip holds nothing but a T-pose")
     joints = resample_positions(joints[cut:], mocap.fps, fps)
     # rest skeleton: FK of the offsets with identity rotations, mapped like the motion
-    eye = np.broadcast_to(np.eye(3), (1, mocap.num_joints, 3, 3))
-    rest = forward_kinematics(mocap.parents, mocap.offsets[None], eye)[0]
+    rest = joints_from_offsets(mocap.offsets, mocap.parents)
     rest22 = W @ rest
     par = PARENTS[:22]
     offsets = np.zeros((22, 3))

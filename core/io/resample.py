@@ -4,6 +4,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import ShapeMoveError
+from ..geometry.rotations import matrix_to_quaternion, quaternion_to_matrix, slerp
 
 
 def sample_times(num_frames: int, src_fps: float, dst_fps: float) -> np.ndarray:
@@ -30,36 +31,6 @@ def resample_positions(x: np.ndarray, src_fps: float, dst_fps: float = 20.0) -> 
     return (1 - w) * x[i0] + w * x[i1]
 
 
-def _matrix_to_quat(R: np.ndarray) -> np.ndarray:
-    """(...,3,3) rotation matrices -> (...,4) unit quaternions (w,x,y,z)."""
-    from scipy.spatial.transform import Rotation
-
-    q = Rotation.from_matrix(R.reshape(-1, 3, 3)).as_quat()  # x,y,z,w
-    return np.concatenate([q[:, 3:], q[:, :3]], -1).reshape(*R.shape[:-2], 4)
-
-
-def _quat_to_matrix(q: np.ndarray) -> np.ndarray:
-    from scipy.spatial.transform import Rotation
-
-    flat = q.reshape(-1, 4)
-    return Rotation.from_quat(np.concatenate([flat[:, 1:], flat[:, :1]], -1)).as_matrix().reshape(*q.shape[:-1], 3, 3)
-
-
-def slerp(q0: np.ndarray, q1: np.ndarray, w: np.ndarray) -> np.ndarray:
-    """Spherical interpolation of unit quaternions (...,4) with weights w (...) in [0,1]
-    (shortest arc)."""
-    dot = np.sum(q0 * q1, -1)
-    q1 = np.where(dot[..., None] < 0, -q1, q1)
-    dot = np.clip(np.abs(dot), -1.0, 1.0)
-    theta = np.arccos(dot)
-    s = np.sin(theta)
-    small = s < 1e-6
-    a = np.where(small, 1 - w, np.sin((1 - w) * theta) / np.where(small, 1, s))
-    b = np.where(small, w, np.sin(w * theta) / np.where(small, 1, s))
-    q = a[..., None] * q0 + b[..., None] * q1
-    return q / np.linalg.norm(q, axis=-1, keepdims=True)
-
-
 def resample_rotations(R: np.ndarray, src_fps: float, dst_fps: float = 20.0) -> np.ndarray:
     """(T,J,3,3) local rotations -> (T',J,3,3) at dst_fps by slerp between neighbouring frames."""
     if abs(src_fps - dst_fps) < 1e-9:
@@ -67,6 +38,6 @@ def resample_rotations(R: np.ndarray, src_fps: float, dst_fps: float = 20.0) -> 
     t = sample_times(len(R), src_fps, dst_fps)
     i0 = np.minimum(np.floor(t).astype(np.int64), len(R) - 1)
     i1 = np.minimum(i0 + 1, len(R) - 1)
-    q = _matrix_to_quat(np.asarray(R, dtype=np.float64))
+    q = matrix_to_quaternion(R)
     w = np.broadcast_to((t - i0)[:, None], (len(t), R.shape[1]))
-    return _quat_to_matrix(slerp(q[i0], q[i1], w))
+    return quaternion_to_matrix(slerp(q[i0], q[i1], w))

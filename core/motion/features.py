@@ -33,7 +33,7 @@ import torch
 
 from ..body.skeleton import FOOT_LEFT, FOOT_RIGHT, PARENTS
 from ..errors import ShapeMoveError
-from .rotations import matrix_to_rot6d, rotation_between, yaw_matrix
+from ..geometry.rotations import matrix_to_rot6d, rotation_between, yaw_matrix
 from .skeleton_ops import canonicalize, facing_directions, heading_angles, smooth_directions
 
 NUM_JOINTS = 22

@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 from ..body.skeleton import FACE_JOINTS
 from ..errors import ShapeMoveError
-from .rotations import yaw_matrix
+from ..geometry.rotations import yaw_matrix
 
 
 def check_joints(joints) -> np.ndarray:

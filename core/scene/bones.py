@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..body.skeleton import PARENTS
+from ..geometry.rotations import axis_angle_to_matrix
 
 # In Blender axes (after ``axes.points_to_z_up``) the body faces -Y with +Z up.
 FORWARD_Z_UP = (0.0, -1.0, 0.0)
@@ -45,15 +46,6 @@ def main_children(rest_joints, parents=PARENTS) -> list[int | None]:
     return out
 
 
-def _rodrigues(axis: np.ndarray, angle: np.ndarray) -> np.ndarray:
-    """(N,3) unit axes, (N,) angles -> (N,3,3)."""
-    x, y, z = axis[:, 0], axis[:, 1], axis[:, 2]
-    zero = np.zeros_like(x)
-    k = np.stack([zero, -z, y, z, zero, -x, -y, x, zero], -1).reshape(-1, 3, 3)
-    s, c = np.sin(angle)[:, None, None], np.cos(angle)[:, None, None]
-    return np.eye(3) + s * k + (1 - c) * (k @ k)
-
-
 def bone_matrix(vectors, rolls) -> np.ndarray:
     """Blender's vec_roll_to_mat3: (N,3) head->tail vectors and (N,) rolls -> (N,3,3) rest
     orientations (column 1 = the unit bone direction)."""
@@ -77,7 +69,7 @@ def bone_matrix(vectors, rolls) -> np.ndarray:
     m[:, 2, 1] = z
     m[:, 2, 2] = 1 - z * z / theta
     m[~regular] = np.diag([-1.0, -1.0, 1.0])
-    return _rodrigues(nor, rolls) @ m
+    return axis_angle_to_matrix(nor * rolls[:, None]) @ m
 
 
 def roll_for_z_axis(vectors, z_targets) -> np.ndarray:
