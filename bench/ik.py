@@ -129,7 +129,7 @@ def _archive_table(body, quick: bool) -> dict:
 
 
 def _synthetic_clip(rest, frames: int, seed: int = 0):
-    from ..core.body.kinematics import axis_angle_to_matrix, forward_kinematics
+    from ..core.geometry.torch_ops import axis_angle_to_matrix, forward_kinematics
     from ..core.body.skeleton import PARENTS
 
     g = torch.Generator().manual_seed(seed)
@@ -153,7 +153,7 @@ def _best_time(fn, repeats: int):
 
 def _reachable(res, rest):
     """FK of an IK result: targets the body reaches exactly (a real motion on a body that fits)."""
-    from ..core.body.kinematics import forward_kinematics
+    from ..core.geometry.torch_ops import forward_kinematics
     from ..core.body.skeleton import PARENTS
 
     rot = torch.tensor(res.rotations, dtype=torch.float64)

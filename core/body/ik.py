@@ -31,7 +31,7 @@ import numpy as np
 import torch
 
 from ..errors import ShapeMoveError
-from .kinematics import axis_angle_to_matrix, forward_kinematics
+from ..geometry.torch_ops import axis_angle_to_matrix, forward_kinematics
 from .skeleton import NUM_BODY_JOINTS, NUM_JOINTS, PARENTS
 
 # (limb root, hinge joint, end joint, hinge axis in the rest pose; positive angle = flexion)

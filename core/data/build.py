@@ -113,7 +113,7 @@ class ClipProcessor:
         ``scale`` (stride follows leg length); then the lowest foot joint is put on the floor."""
         import torch
 
-        from ..body.kinematics import forward_kinematics
+        from ..geometry.torch_ops import forward_kinematics
 
         rest = self.body.rest_joints(torch.as_tensor(betas)[None])  # (1,24,3)
         R = torch.as_tensor(rotations, dtype=torch.float32)
@@ -142,14 +142,14 @@ class ClipProcessor:
         shaped = self.pose_on(rot, root, target, s_target if betas is not None else 1.0)
         normal = self.pose_on(rot, root, np.zeros(10, np.float32), s_norm)
         local22 = rot[:, :22]
-        from ..body.kinematics import matrix_to_axis_angle
+        from ..geometry.rotations import matrix_to_axis_angle
 
         m = self.measure(target)
         return {
             "new_joints": shaped, "new_joint_vecs": features_from_joints(shaped, local22),
             "norm_joints": normal, "norm_joint_vecs": features_from_joints(normal, local22),
             "betas": target,
-            "poses": matrix_to_axis_angle(torch.as_tensor(rot)).numpy().astype(np.float32),
+            "poses": matrix_to_axis_angle(rot).astype(np.float32),
             "transl": shaped[:, 0] - rest_t[0],  # BodyModel.forward(target, poses, transl) -> shaped
             "ik_error_cm": float(ik.mean_error_cm),
             "measure": m,
