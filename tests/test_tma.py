@@ -8,7 +8,7 @@ import pytest
 import torch
 
 from shapemove.core.errors import ShapeMoveError
-from shapemove.core.eval.tma_embed import embed_motions, load_tma, real_motion_scores
+from shapemove.core.eval.tma_embed import embed_motions, load_tma, real_motion_scores, text_inputs
 from shapemove.core.models.tma import TMA
 from shapemove.core.search.motion_search import INDEX_NAME, index_library, search
 from shapemove.core.train.checkpoint import make_metadata, save_checkpoint
@@ -39,7 +39,7 @@ def trained(tiny_dataset, tmp_path_factory):
 
 def test_loss_falls_and_training_pairs_are_retrieved(tiny_dataset, trained):
     out, metrics = trained
-    assert metrics["step"] == STEPS and (out / "tma.pt").is_file() and (out / "tokenizer" / "tokenizer.json").is_file()
+    assert metrics["step"] == STEPS and (out / "tma.pt").is_file()
     model, tok, mean, std = load_tma(out / "tma.pt")
     m_ref, s_ref = load_stats(tiny_dataset)
     np.testing.assert_array_equal(mean, m_ref)
@@ -48,13 +48,13 @@ def test_loss_falls_and_training_pairs_are_retrieved(tiny_dataset, trained):
     c = TMATrainConfig.tiny()
     clips = TMAClips(tiny_dataset, "train", mean, std)
     texts, feats, lengths = clips.batch(c, 0)
-    enc = tok(texts, return_tensors="pt", padding=True)
+    text = text_inputs(model, tok, texts)  # MiniLM token states + mask
     keys = [caption_key(t) for t in texts]
     torch.manual_seed(c.seed)
     fresh = TMA(model.cfg).eval()
     with torch.no_grad():
-        before = float(fresh.loss(fresh.text(enc.input_ids, enc.attention_mask), fresh.motion(feats, lengths), keys))
-        after = float(model.loss(model.text(enc.input_ids, enc.attention_mask), model.motion(feats, lengths), keys))
+        before = float(fresh.loss(fresh.text(*text), fresh.motion(feats, lengths), keys))
+        after = float(model.loss(model.text(*text), model.motion(feats, lengths), keys))
     assert before > 1.5  # ~ log(batch): chance
     assert after < 0.5 * before, (before, after)
     # the trained model retrieves its own training pairs far above chance (1 / number of clips)
@@ -104,7 +104,6 @@ def test_resume_equals_uninterrupted(tiny_dataset, tmp_path):
 
 
 def test_checkpoint_of_another_kind_is_refused(trained, tmp_path):
-    shutil.copytree(trained[0] / "tokenizer", tmp_path / "tokenizer")
     meta = make_metadata("savae", {"x": 1}, "openbody", np.zeros(263), np.ones(263))
     save_checkpoint(tmp_path / "tma.pt", {"model": {}}, meta)
     with pytest.raises(ShapeMoveError, match="'savae' checkpoint, expected 'tma'"):
@@ -209,3 +208,29 @@ def test_cli_search_and_train_resume(tiny_dataset, trained, tmp_path, capsys):
     a = torch.load(trained[0] / "tma.pt", weights_only=True)["model"]
     b = torch.load(run / "tma.pt", weights_only=True)["model"]
     assert all(torch.equal(a[k], b[k]) for k in a)
+
+
+def test_tma_records_its_text_encoder_and_refuses_another(trained, tmp_path):
+    from shapemove.core.models.text_encoder import fingerprint
+
+    ckpt = torch.load(trained[0] / "tma.pt", weights_only=True)
+    assert ckpt["metadata"]["text_encoder"] == fingerprint()
+    assert ckpt["metadata"]["config"]["model"]["text_encoder"] == "minilm"
+    ckpt["metadata"]["text_encoder"] = {**fingerprint(), "sha256": "f" * 64}
+    torch.save(ckpt, tmp_path / "tma.pt")
+    with pytest.raises(ShapeMoveError, match="trained with text encoder"):
+        load_tma(tmp_path / "tma.pt")
+
+
+def test_sentencepiece_tma_of_the_old_default_still_loads():
+    from shapemove.core.generation.model_bundle import DEFAULT_MODEL_DIR
+
+    folder = DEFAULT_MODEL_DIR / "tma"
+    if not (folder / "tokenizer").is_dir():
+        pytest.skip("the default model's TMA is a MiniLM one now")
+    model, tok, mean, std = load_tma(folder)
+    assert model.cfg.text_encoder == "sentencepiece"
+    from shapemove.core.eval.tma_embed import embed_texts
+
+    v = embed_texts(model, tok, ["a person walks forward", "a person kicks"])
+    np.testing.assert_allclose(np.linalg.norm(v, axis=1), 1.0, atol=1e-5)

@@ -54,7 +54,8 @@ def build_tiny_bundle(data, out, body=None) -> Path:
         shutil.copytree(runs / "t5" / "t5", model / "t5")
         (model / "tma").mkdir()
         shutil.copy2(runs / "tma" / "tma.pt", model / "tma" / "tma.pt")
-        shutil.copytree(runs / "tma" / "tokenizer", model / "tma" / "tokenizer")
+        if (runs / "tma" / "tokenizer").is_dir():  # TMAs on sentencepiece; MiniLM ones need none
+            shutil.copytree(runs / "tma" / "tokenizer", model / "tma" / "tokenizer")
     finally:
         torch.set_num_threads(threads)
     _BUILT[key] = model

@@ -1,8 +1,11 @@
 """Using a trained TMA: load it, embed texts and motions, and score the real data (the ceiling
 that generated motions are compared against).
 
-A TMA run folder holds ``tma.pt`` (weights + metadata with the data's Mean/Std) and
-``tokenizer/`` beside it. Motions are raw (T,263) HumanML3D features; they are normalized with the
+A TMA run folder holds ``tma.pt`` (weights + metadata with the data's Mean/Std and the sha256 of
+the pretrained text encoder it reads: ``core/models/text_encoder.py``). TMAs trained before the
+pretrained encoder keep a sentencepiece ``tokenizer/`` beside ``tma.pt`` and still load. What
+``load_tma`` returns as the "tokenizer" is whatever turns texts into the text side's inputs: the
+frozen MiniLM, or that sentencepiece tokenizer (``text_inputs``). Motions are raw (T,263) HumanML3D features; they are normalized with the
 TMA's own Mean/Std. A motion longer than the model's ``max_frames`` is embedded as the mean of
 evenly spaced ``max_frames`` windows (re-normalized), the same crops the model was trained on.
 """
@@ -32,30 +35,52 @@ def tma_path(path) -> Path:
 
 
 def load_tma(path):
-    """(model in eval mode, tokenizer, mean (263,), std (263,)) from ``tma.pt`` (or its folder).
-    A checkpoint of another kind, or one without its ``tokenizer/`` folder, is a ShapeMoveError."""
-    from ..models.tokenizer import load_tokenizer
+    """(model in eval mode, text reader, mean (263,), std (263,)) from ``tma.pt`` (or its folder).
+    A checkpoint of another kind, one trained on another text encoder, or an old one without its
+    ``tokenizer/`` folder, is a ShapeMoveError."""
     from ..train.checkpoint import load_checkpoint
 
     path = tma_path(path)
     ckpt = load_checkpoint(path, kind=KIND)
     meta = ckpt["metadata"]
     try:
-        cfg = TMAConfig(**meta["config"]["model"])
+        model_cfg = dict(meta["config"]["model"])
+        model_cfg.setdefault("text_encoder", "sentencepiece")  # checkpoints from before the pretrained encoder
+        cfg = TMAConfig(**model_cfg)
     except (KeyError, TypeError) as exc:
         raise ShapeMoveError(f"{path}: TMA checkpoint without a valid model config ({exc})") from exc
-    tok_dir = path.parent / "tokenizer"
-    if not tok_dir.is_dir():
-        raise ShapeMoveError(f"{path}: its tokenizer folder is missing ({tok_dir}); keep tokenizer/ beside tma.pt")
-    tok = load_tokenizer(tok_dir)
-    if len(tok) != cfg.vocab_size:
-        raise ShapeMoveError(f"{path}: tokenizer in {tok_dir} has {len(tok)} tokens, the model expects {cfg.vocab_size}")
+    if cfg.text_encoder == "minilm":
+        from ..models.text_encoder import check_fingerprint, load_text_encoder
+
+        check_fingerprint(meta.get("text_encoder"), str(path))
+        tok = load_text_encoder()
+    elif cfg.text_encoder == "sentencepiece":
+        from ..models.tokenizer import load_tokenizer
+
+        tok_dir = path.parent / "tokenizer"
+        if not (tok_dir / "tokenizer.json").is_file():
+            raise ShapeMoveError(f"{path}: its tokenizer is missing ({tok_dir}/tokenizer.json); keep tokenizer/ beside tma.pt")
+        tok = load_tokenizer(tok_dir)
+        if len(tok) != cfg.vocab_size:
+            raise ShapeMoveError(f"{path}: tokenizer in {tok_dir} has {len(tok)} tokens, the model expects {cfg.vocab_size}")
+    else:
+        raise ShapeMoveError(f"{path}: unknown TMA text encoder {cfg.text_encoder!r}")
     model = TMA(cfg)
     model.load_state_dict(ckpt["model"])
     model.eval()
     mean = np.asarray(meta["mean"], np.float32)
     std = np.asarray(meta["std"], np.float32)
     return model, tok, mean, std
+
+
+def text_inputs(model: TMA, tok, texts: list[str]) -> tuple[torch.Tensor, torch.Tensor]:
+    """What ``model.text`` reads for ``texts``: MiniLM token states + mask (``tok`` a TextEncoder or
+    StateCache), or sentencepiece ids + mask (old models)."""
+    if model.cfg.text_encoder == "minilm":
+        x, m = tok.states(texts)
+        return x[:, : model.cfg.max_text], m[:, : model.cfg.max_text]
+    enc = tok(texts, return_tensors="pt", padding=True, truncation=True, max_length=model.cfg.max_text)
+    return enc.input_ids, enc.attention_mask
 
 
 def _device(model) -> torch.device:
@@ -72,8 +97,8 @@ def embed_texts(model: TMA, tok, texts: list[str], batch: int = 128) -> np.ndarr
     model.eval()
     out = []
     for s in range(0, len(texts), batch):
-        enc = tok(texts[s:s + batch], return_tensors="pt", padding=True, truncation=True, max_length=model.cfg.max_text)
-        out.append(model.text(enc.input_ids.to(_device(model)), enc.attention_mask.to(_device(model))).cpu())
+        a, b = text_inputs(model, tok, texts[s:s + batch])
+        out.append(model.text(a.to(_device(model)), b.to(_device(model))).cpu())
     model.train(was_training)
     return torch.cat(out).numpy().astype(np.float32)
 

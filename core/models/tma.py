@@ -1,7 +1,10 @@
 """TMA: a contrastive text-motion alignment model (Human TOMATO's evaluator), used for
 R-precision / matching score / FID and to search a motion library by text.
 
-Text: the ShapeMove sentencepiece tokens -> small Transformer encoder -> mean pool -> unit vector.
+Text (``text_encoder="minilm"``, the default): the frozen pretrained MiniLM's token states (as TMR
+reads a frozen language model) -> linear to ``dim`` -> small trained Transformer -> mean pool ->
+unit vector. ``"sentencepiece"`` (models trained before MiniLM): the ShapeMove sentencepiece tokens
+-> embedding -> small Transformer -> mean pool -> unit vector.
 Motion: normalised 263-dim features -> 1D conv stem (4x down) -> Transformer -> mean pool -> unit
 vector. Trained with a symmetric InfoNCE loss where captions that are identical are not treated
 as negatives of each other (the same sentence often describes several clips).
@@ -27,6 +30,7 @@ class TMAConfig:
     max_text: int = 64
     max_frames: int = 200
     temperature: float = 0.07
+    text_encoder: str = "minilm"  # or "sentencepiece" (old checkpoints; vocab_size then counts its pieces)
 
     @classmethod
     def tiny(cls, vocab_size: int) -> "TMAConfig":
@@ -61,6 +65,23 @@ class TextEncoder(nn.Module):
         ids, mask = ids[:, : self.max_text], mask[:, : self.max_text].bool()
         x = self.embed(ids) + self.pos[: ids.shape[1]]
         x = self.encoder(x, src_key_padding_mask=~mask)
+        return F.normalize(self.out(_pool(x, mask)), dim=-1)
+
+
+class StateTextEncoder(nn.Module):
+    """Trained layers on top of a frozen pretrained encoder's token states (B, L, in_dim)."""
+
+    def __init__(self, cfg: TMAConfig, in_dim: int = 384):
+        super().__init__()
+        self.proj = nn.Sequential(nn.Linear(in_dim, cfg.dim), nn.LayerNorm(cfg.dim))
+        layer = nn.TransformerEncoderLayer(cfg.dim, cfg.heads, cfg.dim * 2, dropout=0.1, batch_first=True)
+        self.encoder = nn.TransformerEncoder(layer, cfg.layers, enable_nested_tensor=False)
+        self.out = nn.Linear(cfg.dim, cfg.embed)
+        self.max_text = cfg.max_text
+
+    def forward(self, states: torch.Tensor, mask: torch.Tensor) -> torch.Tensor:
+        states, mask = states[:, : self.max_text], mask[:, : self.max_text].bool()
+        x = self.encoder(self.proj(states), src_key_padding_mask=~mask)
         return F.normalize(self.out(_pool(x, mask)), dim=-1)
 
 
@@ -101,7 +122,9 @@ class TMA(nn.Module):
     def __init__(self, cfg: TMAConfig):
         super().__init__()
         self.cfg = cfg
-        self.text = TextEncoder(cfg)
+        if cfg.text_encoder not in ("minilm", "sentencepiece"):
+            raise ValueError(f"unknown TMA text encoder {cfg.text_encoder!r}")
+        self.text = StateTextEncoder(cfg) if cfg.text_encoder == "minilm" else TextEncoder(cfg)
         self.motion = MotionEncoder(cfg)
 
     def loss(self, t: torch.Tensor, m: torch.Tensor, text_keys: list[str] | None = None) -> torch.Tensor:

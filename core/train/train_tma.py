@@ -3,7 +3,10 @@
     train_tma(data="DATA", out="runs/tma", config="small")                          # one process
     torchrun --nproc_per_node 2 -m shapemove train tma --data DATA --out RUN        # DDP
 
-1. a sentencepiece tokenizer is trained on the train split's captions (``out/tokenizer/``);
+1. the captions of the train and val splits are read by the frozen pretrained MiniLM once (their
+   token states are cached in memory); the TMA's own text layers are trained on top of them.
+   (``model.text_encoder="sentencepiece"``: a sentencepiece tokenizer trained on the captions,
+   ``out/tokenizer/``, the TMA of models from before the pretrained encoder);
 2. each step draws ``batch_size`` distinct training clips; each gives one of its captions and a
    random crop (up to ``max_frames``) of either its normalized-body or its shape-aware features
    (``shape_aware_share``), so the model aligns text with motion whatever the body;
@@ -28,7 +31,7 @@ from torch import nn
 from torch.nn.parallel import DistributedDataParallel as DDP
 
 from ..errors import ShapeMoveError
-from ..eval.tma_embed import KIND, eval_pairs, pad_batch, score_pairs
+from ..eval.tma_embed import KIND, eval_pairs, pad_batch, score_pairs, text_inputs
 from ..models.tma import TMA, TMAConfig
 from . import distributed
 from .run_log import record
@@ -43,14 +46,14 @@ FEATURE_KINDS = ("norm_joint_vecs", "new_joint_vecs")
 
 @dataclass
 class TMATrainConfig:
-    model: dict = field(default_factory=lambda: asdict(TMAConfig()))  # vocab_size is set from the tokenizer
+    model: dict = field(default_factory=lambda: asdict(TMAConfig()))  # sentencepiece: vocab_size set from it
     steps: int = 6000
     batch_size: int = 64
     lr: float = 2e-4
     warmup_steps: int = 200
     weight_decay: float = 0.01
     grad_clip: float = 1.0
-    vocab_size: int = 2000          # sentencepiece upper bound (a small corpus gets fewer pieces)
+    vocab_size: int = 2000          # sentencepiece only: upper bound (a small corpus gets fewer pieces)
     shape_aware_share: float = 0.5  # share of crops from new_joint_vecs (else norm_joint_vecs)
     seed: int = 0
     log_every: int = 50
@@ -198,7 +201,14 @@ def train_tma(data, out, config=None, steps: int | None = None, batch_size: int 
         distributed.cleanup()
 
 
-def _tokenizer(data: Path, out: Path, c: TMATrainConfig, dist):
+def _text_reader(data: Path, out: Path, c: TMATrainConfig, dist, texts: list[str], verbose: bool):
+    """MiniLM with every caption's token states cached, or (old TMAs) the sentencepiece tokenizer."""
+    if c.model.get("text_encoder", "minilm") == "minilm":
+        from ..models.text_encoder import StateCache, load_text_encoder
+
+        cache = StateCache(load_text_encoder())
+        cache.add(texts, progress=dist.is_main and verbose)
+        return cache
     from ..models.tokenizer import load_tokenizer, tokenizer_from_sentencepiece, train_sentencepiece
 
     tok_dir = out / "tokenizer"
@@ -216,7 +226,9 @@ def _tokenizer(data: Path, out: Path, c: TMATrainConfig, dist):
                 shutil.rmtree(tok_dir)
             os.replace(tmp, tok_dir)
     distributed.barrier(dist)
-    return load_tokenizer(tok_dir)
+    tok = load_tokenizer(tok_dir)
+    c.model["vocab_size"] = len(tok)
+    return tok
 
 
 def _train(data, out, c, resume, body_name, dist, progress, cancel, verbose) -> dict:
@@ -233,8 +245,7 @@ def _train(data, out, c, resume, body_name, dist, progress, cancel, verbose) -> 
     if min(c.batch_size, len(train_set)) < 2 * dist.world_size:
         raise ShapeMoveError(f"batch of {min(c.batch_size, len(train_set))} clips is too small for {dist.world_size} processes")
     val_feats, val_texts = eval_pairs(data, read_split(data, "val"))
-    tok = _tokenizer(data, out, c, dist)
-    c.model["vocab_size"] = len(tok)
+    tok = _text_reader(data, out, c, dist, [t for caps in train_set.captions for t in caps] + val_texts, verbose)
     cfg = TMAConfig(**c.model)
     # -- model, optimizer, resume ------------------------------------------------------------
     torch.manual_seed(c.seed)  # same initial weights on every rank
@@ -260,7 +271,12 @@ def _train(data, out, c, resume, body_name, dist, progress, cancel, verbose) -> 
     def save(final: bool = False) -> None:
         if not dist.is_main:
             return
-        meta = make_metadata(KIND, asdict(c), body_name, mean, std, step, data=str(data))
+        extra = {}
+        if cfg.text_encoder == "minilm":
+            from ..models.text_encoder import fingerprint
+
+            extra["text_encoder"] = fingerprint()
+        meta = make_metadata(KIND, asdict(c), body_name, mean, std, step, data=str(data), **extra)
         save_checkpoint(last, {"model": model.state_dict(), "optimizer": optimizer.state_dict(),
                                "scheduler": scheduler.state_dict(), "step": step, "rng": rng_state()}, meta)
         if final:
@@ -284,8 +300,8 @@ def _train(data, out, c, resume, body_name, dist, progress, cancel, verbose) -> 
         if distributed.broadcast_flag(bool(cancel and dist.is_main and cancel()), dist):
             break
         texts, feats, lengths = train_set.batch(c, step, dist.rank, dist.world_size)
-        enc = tok(texts, return_tensors="pt", padding=True, truncation=True, max_length=cfg.max_text)
-        loss = pairs(enc.input_ids.to(dist.device), enc.attention_mask.to(dist.device), feats.to(dist.device),
+        text_a, text_b = text_inputs(model, tok, texts)
+        loss = pairs(text_a.to(dist.device), text_b.to(dist.device), feats.to(dist.device),
                      lengths.to(dist.device), [caption_key(t) for t in texts])
         optimizer.zero_grad(set_to_none=True)
         loss.backward()
