@@ -22,10 +22,12 @@ import numpy as np
 from ..errors import ShapeMoveError
 from ..geometry.fk import forward_kinematics, joints_from_offsets
 from ..geometry.rotations import axis_rotation
+from .limits import MAX_HIERARCHY_BYTES, MAX_JOINT_FRAMES, check_joint_frames, parse_floats, read_text
 from .mocap import Mocap, finish_mocap
 
 INCH = 0.0254
 MAX_VALUE = 1e7
+MAX_BONES = 1000
 
 
 @dataclass
@@ -85,7 +87,7 @@ def _order(s: str, source) -> str:
 
 
 def parse_asf(text: str, source="ASF") -> Skeleton:
-    bones, children = {}, {}
+    bones, children, listed = {}, {}, set()
     root_order, root_axis = ["TX", "TY", "TZ", "RX", "RY", "RZ"], "XYZ"
     root_pos, root_ori = np.zeros(3), np.zeros(3)
     length_unit, angle_deg = 1.0, True
@@ -128,6 +130,8 @@ def parse_asf(text: str, source="ASF") -> Skeleton:
                     raise ShapeMoveError(f"{source}: ASF bone block without a name")
                 if bone.name in bones or bone.name == "root":
                     raise ShapeMoveError(f"{source}: ASF bone {bone.name!r} defined twice")
+                if len(bones) >= MAX_BONES:
+                    raise ShapeMoveError(f"{source}: ASF has more than {MAX_BONES} bones")
                 bones[bone.name] = bone
                 bone = None
             elif bone is not None:
@@ -150,8 +154,9 @@ def parse_asf(text: str, source="ASF") -> Skeleton:
                 continue
             parent = parts[0]
             for child in parts[1:]:
-                if child in children.get(parent, []) or any(child in c for c in children.values()):
+                if child in listed:  # a set: checking every list would be quadratic in bones
                     raise ShapeMoveError(f"{source}: ASF hierarchy lists {child!r} twice")
+                listed.add(child)
                 children.setdefault(parent, []).append(child)
     if not bones:
         raise ShapeMoveError(f"{source}: ASF has no bones (not an ASF skeleton file?)")
@@ -204,6 +209,7 @@ def parse_amc(text: str, skel: Skeleton, source="AMC"):
     dofs["root"] = len(skel.root_order)
     chunks = {name: [] for name in dofs}
     frames = 0
+    joints = 2 * len(skel.bones) + 1  # upper bound of bones + End Sites
     for raw in text.splitlines():
         line = raw.strip()
         if not line or line[0] == "#":
@@ -218,6 +224,8 @@ def parse_amc(text: str, skel: Skeleton, source="AMC"):
         name, rest = (line.split(None, 1) + [""])[:2]
         if name.isdigit():
             frames += 1
+            if frames * joints > MAX_JOINT_FRAMES:  # stop before storing more lines than could ever be used
+                check_joint_frames(frames, joints, source, "AMC")
             continue
         if frames == 0:
             raise ShapeMoveError(f"{source}: AMC data before the first frame number: {line[:40]!r}")
@@ -235,10 +243,7 @@ def parse_amc(text: str, skel: Skeleton, source="AMC"):
         if len(lines) != frames:
             raise ShapeMoveError(f"{source}: AMC has {len(lines)} lines for {name!r} in {frames} frames "
                                  "(truncated file or wrong skeleton)")
-        try:
-            arr = np.array(" ".join(lines).split(), dtype=np.float64)
-        except ValueError:
-            raise ShapeMoveError(f"{source}: AMC values for {name!r} contain something that is not a number") from None
+        arr = parse_floats(" ".join(lines), frames * dofs[name] + 1, source, f"AMC values for {name!r}")
         if arr.size != frames * dofs[name]:
             raise ShapeMoveError(f"{source}: AMC has {arr.size} values for {name!r}, expected {dofs[name]} per frame")
         if not np.all(np.isfinite(arr)) or (arr.size and np.abs(arr).max() > MAX_VALUE):
@@ -290,13 +295,7 @@ def amc_to_positions(skel: Skeleton, root: np.ndarray, values: dict, angle: floa
 
 
 def _read_text(path: Path, what: str) -> str:
-    try:
-        raw = path.read_bytes()
-    except OSError as exc:
-        raise ShapeMoveError(f"cannot read {what} {path}: {exc.strerror}") from None
-    if b"\0" in raw[:4096]:
-        raise ShapeMoveError(f"{path}: binary data, not an {what} text file")
-    return raw.decode("utf-8", errors="replace")
+    return read_text(path, what, MAX_HIERARCHY_BYTES if what == "ASF" else None)
 
 
 def load_asf(path) -> Skeleton:

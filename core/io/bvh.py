@@ -14,6 +14,7 @@ import numpy as np
 from ..errors import ShapeMoveError
 from ..geometry.fk import forward_kinematics, joints_from_offsets
 from ..geometry.rotations import axis_rotation
+from .limits import MAX_HIERARCHY_BYTES, check_joint_frames, parse_floats, read_text
 from .mocap import Mocap, finish_mocap
 
 CHANNELS = {"xposition": ("p", 0), "yposition": ("p", 1), "zposition": ("p", 2),
@@ -160,26 +161,32 @@ def parse_bvh(text: str, source="BVH"):
     head, sep, motion = text.partition("MOTION")
     if not sep:
         raise ShapeMoveError(f"{source}: not a BVH file (no MOTION section)")
+    if len(head) > MAX_HIERARCHY_BYTES:
+        raise ShapeMoveError(f"{source}: BVH hierarchy is {len(head) / 2**20:.0f} MB, larger than any skeleton "
+                             f"({MAX_HIERARCHY_BYTES // 2**20} MB)")
     names, parents, offsets, channels = parse_hierarchy(head, source)
+    del head
     frames, dt, body = _motion_header(motion, source)
+    del motion
     C = sum(len(c) for c in channels)
     if not (np.isfinite(frames) and frames == int(frames) and frames >= 1):
         raise ShapeMoveError(f"{source}: BVH says {frames} frames")
     if not (np.isfinite(dt) and dt > 0):
         raise ShapeMoveError(f"{source}: BVH frame time {dt} is not positive")
-    try:
-        data = np.array(body.split(), dtype=np.float64)
-    except ValueError:
-        raise ShapeMoveError(f"{source}: BVH motion data contains something that is not a number") from None
     frames = int(frames)
     if C == 0:
         raise ShapeMoveError(f"{source}: BVH has no channels")
-    if data.size % C:
-        raise ShapeMoveError(f"{source}: BVH motion data has {data.size} values, not a whole number of "
-                             f"frames of {C} channels (truncated file or wrong channel count)")
-    if data.size // C < frames:
+    check_joint_frames(frames, len(names), source, "BVH")  # before allocating anything per frame
+    if frames * C > len(body) // 2 + 1:  # each value needs at least a digit and a separator
+        raise ShapeMoveError(f"{source}: BVH is truncated: header says {frames} frames of {C} channels, "
+                             f"the file holds at most {(len(body) // 2 + 1) // C}")
+    data = parse_floats(body, frames * C, source, "BVH motion data")
+    if data.size < frames * C:
+        if data.size % C:
+            raise ShapeMoveError(f"{source}: BVH motion data has {data.size} values, not a whole number of "
+                                 f"frames of {C} channels (truncated file or wrong channel count)")
         raise ShapeMoveError(f"{source}: BVH is truncated: header says {frames} frames, data holds {data.size // C}")
-    data = data.reshape(-1, C)[:frames]
+    data = data.reshape(frames, C)
     if not np.all(np.isfinite(data)) or np.abs(data).max() > MAX_VALUE:
         raise ShapeMoveError(f"{source}: BVH motion data holds NaN, inf or absurdly large values")
     return names, parents, offsets, channels, data, float(dt)
@@ -212,13 +219,7 @@ def load_bvh(path, unit: str | None = None, up_axis: str | None = None) -> Mocap
     from .units_axes import UNITS
 
     path = Path(path)
-    try:
-        raw = path.read_bytes()
-    except OSError as exc:
-        raise ShapeMoveError(f"cannot read {path}: {exc.strerror}") from None
-    if b"\0" in raw[:4096]:
-        raise ShapeMoveError(f"{path}: binary data, not a BVH text file")
-    text = raw.decode("utf-8", errors="replace")
+    text = read_text(path, "BVH")
     names, parents, offsets, channels, data, dt = parse_bvh(text, path)
     trans, rots = bvh_local_transforms(offsets, channels, data)
     positions = forward_kinematics(rots, joints_from_offsets(trans, parents), parents)[0]

@@ -28,7 +28,7 @@ from ..models.shapemove_t5 import ShapeMoveT5, T5Size, size_from_dict
 from ..models.tokenizer import add_motion_tokens, load_tokenizer, tokenizer_from_sentencepiece, train_sentencepiece
 from . import distributed
 from .run_log import record
-from .checkpoint import config_differences, save_checkpoint
+from .checkpoint import config_differences, load_checkpoint, save_checkpoint
 from .t5_dataset import T2MExamples, all_texts, collate, tokenize_clips
 from .train_vae import rng_state, set_rng_state
 
@@ -140,7 +140,7 @@ def _train(data, vae_path, out, c, base_model, resume, dist, progress, cancel, v
     step, rng = 0, random.Random(c.seed + 1000 * dist.rank)
     last = out / "last.pt"
     if resume and last.is_file():
-        ckpt = torch.load(last, map_location=dist.device, weights_only=False)
+        ckpt = load_checkpoint(last, map_location=dist.device, kind=KIND)  # weights_only=True: never unpickles code
         diff = config_differences(ckpt["config"], asdict(c), ignore=("steps",))
         if ckpt.get("kind") != KIND or diff:
             raise ShapeMoveError(f"{last}: cannot resume, the configuration differs ({', '.join(diff) or 'kind'})")

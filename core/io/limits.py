@@ -1,0 +1,82 @@
+"""Bounds for reading untrusted motion files (BVH, ASF/AMC, DeepMimic, resampling), checked BEFORE
+anything is allocated, so a small hostile file cannot ask for gigabytes or hours.
+
+The limits sit far above any real capture: the longest clip of CMU/HDM05/Bandai is ~36,000 frames
+(5 min at 120 fps) on ~40 joints (1.4 M joint-frames); a limit of 2 M joint-frames keeps every
+reader's peak memory well under 1 GB (the readers hold ~6 float64 (T,J,3,3) arrays at most).
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import ShapeMoveError
+
+MAX_TEXT_BYTES = 64 * 2**20  # a motion text file larger than this is refused (largest real: ~10 MB)
+MAX_JOINT_FRAMES = 2_000_000  # frames x joints of one clip, before and after resampling
+MAX_SECONDS = 3600.0  # one hour of motion
+MAX_HIERARCHY_BYTES = 4 * 2**20  # a skeleton description (BVH HIERARCHY, ASF) larger than this is refused
+_CHUNK = 1 << 20
+
+
+def read_text(path, what: str, max_bytes: int | None = None) -> str:
+    """The text of a motion file: size checked before reading, binary files refused."""
+    path = Path(path)
+    max_bytes = max_bytes or MAX_TEXT_BYTES
+    try:
+        size = path.stat().st_size
+        if size > max_bytes:
+            raise ShapeMoveError(f"{path}: the {what} file is {size / 2**20:.0f} MB; motion files larger than "
+                                 f"{max_bytes // 2**20} MB are refused (split the clip)")
+        with open(path, "rb") as fh:
+            raw = fh.read(max_bytes + 1)
+    except OSError as exc:
+        raise ShapeMoveError(f"cannot read {what} {path}: {exc.strerror or exc}") from None
+    if len(raw) > max_bytes:
+        raise ShapeMoveError(f"{path}: the {what} file is larger than {max_bytes // 2**20} MB")
+    if b"\0" in raw[:4096]:
+        raise ShapeMoveError(f"{path}: binary data, not an {what} text file")
+    return raw.decode("utf-8", errors="replace")
+
+
+def check_joint_frames(frames, joints, source, what: str = "clip") -> None:
+    """Refuse a clip whose frames x joints would not fit the bounds above."""
+    if frames * joints > MAX_JOINT_FRAMES:
+        raise ShapeMoveError(f"{source}: the {what} has {int(frames):,} frames x {int(joints):,} joints, more than "
+                             f"{MAX_JOINT_FRAMES:,} joint-frames (about {MAX_SECONDS / 60:.0f} min of a full body); "
+                             "split it into shorter clips")
+
+
+def parse_floats(text: str, count: int, source, what: str) -> np.ndarray:
+    """The first ``count`` whitespace-separated numbers of ``text`` (fewer if the text ends first),
+    parsed chunk by chunk so memory stays ~8 bytes per number (``str.split`` of the whole text
+    would need ~60). Raises ShapeMoveError naming ``what`` on a token that is not a number."""
+    out = np.empty(count, dtype=np.float64)
+    n, pos, size = 0, 0, len(text)
+    while n < count and pos < size:
+        end = min(size, pos + _CHUNK)
+        if end < size:  # cut at whitespace so no number is split
+            cut = max(text.rfind(" ", pos, end), text.rfind("\n", pos, end), text.rfind("\t", pos, end))
+            end = cut + 1 if cut > pos else end
+        toks = text[pos:end].split()
+        pos = end
+        if not toks:
+            continue
+        toks = toks[: count - n]
+        try:
+            vals = np.array(toks, dtype=np.float64)
+        except ValueError:
+            bad = next(t for t in toks if not _is_float(t))
+            raise ShapeMoveError(f"{source}: {what} contains something that is not a number: {bad[:40]!r}") from None
+        out[n: n + len(vals)] = vals
+        n += len(vals)
+    return out[:n]
+
+
+def _is_float(t: str) -> bool:
+    try:
+        float(t)
+        return True
+    except ValueError:
+        return False

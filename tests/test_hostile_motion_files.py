@@ -1,0 +1,121 @@
+"""Memory and time bombs in motion files (issue 11): each hostile file is built on the spot and
+loaded in a child process limited to 1 GB more address space and 30 s; it must end in a
+ShapeMoveError sentence, well inside both limits."""
+import numpy as np
+import pytest
+
+from limited_run import run_limited
+from mocap_synth import MIXAMO, MIXAMO_PARENT, SMPL_REST, bvh_text
+
+GB = 1 << 30
+
+
+def _mixamo_bvh(frames: int, frame_time: float) -> str:
+    names = list(MIXAMO)
+    parents = [-1] + [names.index(MIXAMO_PARENT[n]) for n in names[1:]]
+    rest = SMPL_REST[[MIXAMO[n] for n in names]]
+    t = np.arange(frames)[:, None]
+    motion = 20 * np.sin(0.05 * t + np.arange(6 + 3 * (len(names) - 1)))  # swinging joints, not a T-pose
+    motion[:, :3] = rest[0] * 100 + np.array([0.0, 0.0, 1.0]) * t
+    for arm, sign in (("LeftArm", -1), ("RightArm", 1)):  # arms down: no T-pose lead-in to cut
+        motion[:, 6 + 3 * (names.index(arm) - 1)] += sign * 70
+    return bvh_text(names, parents, rest * 100, motion, frame_time=frame_time)
+
+
+def _chain_bvh(joints: int, frames: int, data_frames: int) -> str:
+    """``joints`` nested joints with no channels under a root with one: tiny file, huge (T,J)."""
+    head = ["HIERARCHY", "ROOT r", "{", "OFFSET 0 0 0", "CHANNELS 1 Xposition"]
+    head += [f"JOINT j{i}\n{{\nOFFSET 0 1 0" for i in range(joints - 1)] + ["}"] * joints
+    return "\n".join(head + ["MOTION", f"Frames: {frames}", "Frame Time: 0.01"] + ["0"] * data_frames) + "\n"
+
+
+def _asf(bones: int, dof: bool = True) -> str:
+    out = [":version 1.10", ":name x", ":units", "  mass 1.0", "  length 0.45", "  angle deg", ":root",
+           "  order TX TY TZ RX RY RZ", "  axis XYZ", "  position 0 0 0", "  orientation 0 0 0", ":bonedata"]
+    for i in range(bones):
+        out += ["begin", f"  id {i + 1}", f"  name b{i}", "  direction 0 1 0", "  length 1", "  axis 0 0 0 XYZ"]
+        out += ["  dof rx"] if dof else []
+        out += ["end"]
+    out += [":hierarchy", "begin", "  root b0"] + [f"  b{i} b{i + 1}" for i in range(bones - 1)] + ["end"]
+    return "\n".join(out) + "\n"
+
+
+def _check(results, match):
+    for r in results:
+        assert r["outcome"] == "ShapeMoveError", r
+        assert any(m in r["message"] for m in match), r
+        assert r["max_rss"] < GB, r
+        assert r["seconds"] < 30, r
+
+
+def test_bvh_and_amc_bombs(tmp_path):
+    cases, match = [], []
+
+    def add(name, text, asf=None, expect=""):
+        p = tmp_path / name
+        p.write_text(text)
+        cases.append({"path": str(p), "asf": asf})
+        match.append(expect)
+
+    # 1. ~300 KB: 1,999 joints x 20,000 frames declared (was > 4 GB)
+    add("joints.bvh", _chain_bvh(1999, 20000, 20000), expect="joint-frames")
+    # 2. 'Frame Time: 2.0' on 9,000 frames: 5 h of motion upsampled 40x to 20 fps (was 2.9 GB, > 300 s)
+    add("slow.bvh", _mixamo_bvh(9000, 2.0), expect="longer than 3600 s")
+    # 3. header claims far more frames than the data holds (nothing allocated for them)
+    add("claims.bvh", _chain_bvh(3, 10**9, 5), expect="joint-frames")
+    add("claims2.bvh", _chain_bvh(3, 600000, 5), expect="truncated")
+    # 4. AMC: 2.5 M frame numbers on a 100-bone skeleton without values (frames x joints bomb)
+    asf = tmp_path / "s.asf"
+    asf.write_text(_asf(100, dof=False))
+    add("frames.amc", "\n".join(str(i) for i in range(1, 2_500_000)) + "\n", asf=str(asf), expect="joint-frames")
+    # 5. ASF with 5,000 bones (hierarchy check was quadratic) and one over the bone limit
+    big = tmp_path / "big.asf"
+    big.write_text(_asf(5000))
+    add("big.amc", "1\nroot 0 0 0 0 0 0\n", asf=str(big), expect="more than 1000 bones")
+    # 6. a 100 MB (sparse) BVH is refused before it is read
+    huge = tmp_path / "huge.bvh"
+    with open(huge, "wb") as fh:
+        fh.truncate(100 * 2**20)
+    cases.append({"path": str(huge), "asf": None})
+    match.append("larger than 64 MB")
+    # 7. a 50 MB hierarchy of junk tokens
+    add("junk.bvh", "HIERARCHY\nROOT a\n{\n" + "x " * 5_000_000 + "\nMOTION\n", expect="BVH hierarchy is")
+    results = run_limited(cases, timeout_s=30, mem_bytes=GB)
+    assert len(results) == len(cases)
+    for r, m in zip(results, match):
+        _check([r], [m])
+
+
+def test_asf_with_many_bones_is_fast(tmp_path):
+    """999 chained bones (under the limit) parse in well under a second: no quadratic step."""
+    import time
+
+    from shapemove.core.io.asf_amc import parse_asf
+
+    t0 = time.perf_counter()
+    skel = parse_asf(_asf(999))
+    assert len(skel.bones) == 999
+    assert time.perf_counter() - t0 < 1.0
+
+
+def test_resampling_is_capped():
+    from shapemove.core.errors import ShapeMoveError
+    from shapemove.core.io.resample import resample_positions, sample_times
+
+    x = np.zeros((1000, 22, 3))
+    assert resample_positions(x, 120.0).shape == (167, 22, 3)
+    with pytest.raises(ShapeMoveError, match="longer than 3600 s"):
+        resample_positions(x, 0.25)  # 4,000 s
+    with pytest.raises(ShapeMoveError, match="joint-frames"):
+        sample_times(3000, 1.0, 1000.0, joints=22)  # 3 M output frames
+    with pytest.raises(ShapeMoveError, match="positive"):
+        sample_times(10, float("nan"), 20.0)
+
+
+def test_real_sized_clip_still_loads(tmp_path):
+    """A 2-minute 120 fps clip (14,400 frames, 22 joints) loads inside the limits."""
+    p = tmp_path / "long.bvh"
+    p.write_text(_mixamo_bvh(14400, 1 / 120))
+    (r,) = run_limited([{"path": str(p), "asf": None}], timeout_s=30, mem_bytes=GB)
+    assert r["outcome"] == "ok", r
+    assert r["max_rss"] < GB
