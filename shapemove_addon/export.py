@@ -1,8 +1,18 @@
 """Export a ShapeMove rig (armature + body, with its animation) as FBX, glTF (.glb) or BVH.
 
-The exporters bundled with Blender do the work; they see only the rig (selection overridden) and
-write to a temporary name first, renamed when complete (atomic). Selection, the active object and
-the mode are restored afterwards.
+Each file reads back through Blender's own importer with its default settings at the same bone and
+mesh positions (tests/test_blender_export.py):
+- glTF: Blender's exporter with every skin influence (not only the 4 largest) and the rig's
+  action sampled per frame, at Blender's glTF times (frame f at f / fps, which its importer reads
+  back at frame f).
+- FBX: Blender's exporter, Y up, "FBX_SCALE_ALL" (1 unit = 1 m in the file's UnitScaleFactor,
+  objects at scale 1, no 100x root nodes), so game engines import it at the right size; the
+  action is written from time 0 (Blender's FBX exporter writes absolute frame times, and its
+  importer adds one frame, so the keys are moved to frame 0 for the export and back afterwards).
+- BVH: ``bvh_writer`` (Y up, centimetres, world-aligned rest frames), not Blender's exporter,
+  which writes Z-up armature axes.
+The exporters see only the rig (selection overridden) and write to a temporary name first,
+renamed when complete (atomic). Selection, the active object and the mode are restored afterwards.
 """
 from __future__ import annotations
 
@@ -11,9 +21,12 @@ import os
 from pathlib import Path
 
 import bpy
+import numpy as np
 
 from ..core.errors import ShapeMoveError
-from .shape_sync import body_of, rig_of
+from .bvh_writer import write_bvh
+from .keyframes import action_fcurves
+from .rig_state import body_of, rig_of
 
 FORMATS = {"FBX": ".fbx", "GLTF": ".glb", "BVH": ".bvh"}
 
@@ -36,6 +49,32 @@ def _only_selected(context, objects, active):
         for o in view_layer.objects:
             o.select_set(o in before)
         view_layer.objects.active = prev_active
+
+
+@contextlib.contextmanager
+def _action_from_frame_zero(rig, scene, start: int, end: int):
+    """Move the rig's keys by -start and the scene range to [0, end - start] while exporting."""
+    anim = rig.animation_data
+    curves = action_fcurves(anim.action, rig) if anim is not None and anim.action is not None else []
+    saved = (scene.frame_start, scene.frame_end, scene.frame_current)
+
+    def shift(delta):
+        for fc in curves:
+            points = fc.keyframe_points
+            for attr in ("co", "handle_left", "handle_right"):
+                co = np.empty(2 * len(points), dtype=np.float32)
+                points.foreach_get(attr, co)
+                co[0::2] += delta
+                points.foreach_set(attr, co)
+            fc.update()
+    shift(-start)
+    try:
+        scene.frame_start, scene.frame_end = 0, end - start
+        yield
+    finally:
+        shift(start)
+        scene.frame_start, scene.frame_end = saved[0], saved[1]
+        scene.frame_set(saved[2])
 
 
 def _frame_range(rig, scene) -> tuple[int, int]:
@@ -67,21 +106,28 @@ def export_rig(context, rig, filepath, fmt: str = "FBX") -> Path:
     try:
         with _only_selected(context, objects, rig):
             if fmt == "FBX":
-                result = bpy.ops.export_scene.fbx(
-                    filepath=str(tmp), use_selection=True, object_types={"ARMATURE", "MESH"}, add_leaf_bones=False,
-                    bake_anim=True, bake_anim_use_all_actions=False, bake_anim_use_nla_strips=False,
-                    bake_anim_force_startend_keying=True, bake_anim_simplify_factor=0.0, use_armature_deform_only=True)
+                with _action_from_frame_zero(rig, context.scene, start, end):
+                    result = bpy.ops.export_scene.fbx(
+                        filepath=str(tmp), use_selection=True, object_types={"ARMATURE", "MESH"},
+                        add_leaf_bones=False, apply_unit_scale=True, apply_scale_options="FBX_SCALE_ALL",
+                        axis_forward="-Z", axis_up="Y", bake_space_transform=False,
+                        bake_anim=True, bake_anim_use_all_actions=False, bake_anim_use_nla_strips=False,
+                        bake_anim_force_startend_keying=True, bake_anim_simplify_factor=0.0,
+                        use_armature_deform_only=True)
             elif fmt == "GLTF":
                 result = bpy.ops.export_scene.gltf(
                     filepath=str(tmp), export_format="GLB", use_selection=True, export_animations=True,
-                    export_skins=True, export_morph=True, export_animation_mode="ACTIVE_ACTIONS",
-                    export_force_sampling=True, export_frame_range=False)
+                    export_skins=True, export_all_influences=True, export_morph=True,
+                    export_animation_mode="ACTIVE_ACTIONS", export_force_sampling=True, export_frame_range=False)
             else:
-                result = bpy.ops.export_anim.bvh(filepath=str(tmp), frame_start=start, frame_end=end,
-                                                 rotate_mode="NATIVE", root_transform_only=True)
-    except RuntimeError as exc:
+                write_bvh(context.scene, rig, tmp, start, end)
+                result = {"FINISHED"}
+    except (RuntimeError, OSError) as exc:
         tmp.unlink(missing_ok=True)
         raise ShapeMoveError(f"{fmt} export of {rig.name!r} failed: {str(exc).strip()}") from None
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise
     if "FINISHED" not in result or not tmp.is_file():
         tmp.unlink(missing_ok=True)
         raise ShapeMoveError(f"{fmt} export of {rig.name!r} wrote nothing")
