@@ -149,7 +149,7 @@ def mocap_to_smpl22(mocap: Mocap, fps: float = 20.0, drop_tpose: bool = True) ->
     from .rig_map import detect_rig, mapping_matrix
     from .tpose import tpose_lead_in
 
-    rig = detect_rig(mocap.names)
+    rig = detect_rig(mocap.names, mocap.parents, joints_from_offsets(mocap.offsets, mocap.parents))
     W = mapping_matrix(rig, mocap.names, mocap.positions)
     joints = np.matmul(W, mocap.positions)
     cut = tpose_lead_in(joints, mocap.fps) if drop_tpose else 0

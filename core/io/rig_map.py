@@ -133,6 +133,10 @@ RIGS = [
          _limbs("{S}UpLeg", "{S}Leg", "{S}Foot", "{S}ToeBase",
                 "{S}Shoulder", "{S}Arm", "{S}ForeArm", "{S}Hand"),
          optional=("Hips", "Spine", "Spine1", "Spine2")),
+    # DeepMimic humanoid3d (io/deepmimic: root between the hips; head and toes are its virtual points)
+    _rig("deepmimic", ("root", "chest"), "neck", "head",
+         _limbs("{S}_hip", "{S}_knee", "{S}_ankle", "{S}_toe",
+                ("lerp", "neck", "{S}_shoulder", 0.45), "{S}_shoulder", "{S}_elbow", "{S}_wrist")),
 ]
 
 
@@ -159,9 +163,22 @@ def _required(rig: Rig) -> dict:
             for j, r in rig.rules.items()}
 
 
-def find_rig(names) -> Rig | None:
-    """The first rig whose every rule resolves against ``names``, else None."""
-    return _find_rig(tuple(names))
+def find_rig(names, parents=None, rest=None) -> Rig | None:
+    """The first rig whose every rule resolves against ``names``, else None. With ``parents``
+    (J,) and ``rest`` (J,3) rest positions, a skeleton absent from the tables is matched by its
+    shape (``skeleton_match.match_humanoid``); None when that fails too."""
+    rig = _find_rig(tuple(names))
+    if rig is None and parents is not None and rest is not None:
+        try:
+            rig = _match(names, parents, rest)
+        except ShapeMoveError:
+            return None
+    return rig
+
+
+def _match(names, parents, rest) -> Rig:
+    from .skeleton_match import match_humanoid
+    return match_humanoid(names, parents, rest)
 
 
 @lru_cache(maxsize=256)
@@ -173,12 +190,18 @@ def _find_rig(names: tuple) -> Rig | None:
     return None
 
 
-def detect_rig(names) -> Rig:
-    """Like ``find_rig`` but raises ShapeMoveError listing the SMPL joints that could not be mapped
-    (for the rig that came closest)."""
-    rig = find_rig(names)
+def detect_rig(names, parents=None, rest=None) -> Rig:
+    """Like ``find_rig`` but raises ShapeMoveError: for a skeleton given by names only, listing the
+    SMPL joints that could not be mapped (for the rig that came closest); with ``parents`` and
+    ``rest``, saying which body part the shape match could not find."""
+    rig = _find_rig(tuple(names))
     if rig is not None:
         return rig
+    if parents is not None and rest is not None:
+        try:
+            return _match(names, parents, rest)
+        except ShapeMoveError as exc:
+            raise ShapeMoveError(f"unknown skeleton ({len(names)} joints, not a rig in the tables): {exc}") from None
     have = {normalize(n) for n in names}
     best, best_missing = None, None
     for cand in RIGS:

@@ -27,9 +27,10 @@ _TO_Y_UP = {
 }
 
 
-def smpl22_or_none(names, positions):
-    """SMPL22 positions (T,22,3) of a sample of frames, or None for a rig we cannot map."""
-    rig = find_rig(names)
+def smpl22_or_none(names, positions, parents=None, rest=None):
+    """SMPL22 positions (T,22,3) of a sample of frames, or None for a rig we cannot map (with
+    ``parents`` and ``rest`` positions, a rig absent from the tables is matched by its shape)."""
+    rig = find_rig(names, parents, rest)
     if rig is None:
         return None
     pos = _sample(positions)
@@ -72,13 +73,14 @@ def _upright(j: np.ndarray) -> np.ndarray:
     return ok
 
 
-def detect_up_axis(names, positions: np.ndarray, rest: np.ndarray | None = None, smpl22=None) -> str:
+def detect_up_axis(names, positions: np.ndarray, rest: np.ndarray | None = None, smpl22=None, parents=None) -> str:
     """'Y', 'Z', '-Y', '-Z', 'X' or '-X': the world axis pointing up in positions (T,J,3).
 
     The rest skeleton ``rest`` (J,3) decides when it stands upright (ASF and most BVH rigs); else
     the frames where the subject stands upright vote (a clip that lies on the floor still has some);
-    else the median ankles->head direction."""
-    rig = find_rig(names)
+    else the median ankles->head direction. ``parents`` lets a rig absent from the tables be
+    matched by its shape."""
+    rig = find_rig(names, parents, rest)
     if rig is None:
         ext = np.median(np.ptp(_sample(positions), axis=1), axis=0)
         return "XYZ"[int(np.argmax(ext))] if np.all(np.isfinite(ext)) else "Y"
@@ -87,7 +89,7 @@ def detect_up_axis(names, positions: np.ndarray, rest: np.ndarray | None = None,
         jr = np.matmul(mapping_matrix(rig, names, r), r)
         if _upright(jr)[0]:
             return _axis_of(jr[0, 15] - 0.5 * (jr[0, 7] + jr[0, 8]))
-    j = smpl22 if smpl22 is not None else smpl22_or_none(names, positions)
+    j = smpl22 if smpl22 is not None else smpl22_or_none(names, positions, parents, rest)
     up = j[:, 15] - 0.5 * (j[:, 7] + j[:, 8])
     ok = _upright(j)
     if ok.any():
