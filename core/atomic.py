@@ -23,7 +23,7 @@ _REASONS = {errno.ENOSPC: "the disk is full", errno.EDQUOT: "the disk quota is e
             errno.EROFS: "the file system is read-only", errno.EACCES: "permission denied",
             errno.EPERM: "permission denied", errno.ENOTDIR: "a parent of it is a file, not a folder",
             errno.EISDIR: "it is a folder", errno.ENAMETOOLONG: "the name is too long",
-            errno.EEXIST: "a file is in the way"}
+            errno.EEXIST: "a file is in the way", errno.EFBIG: "the file grew past the allowed size (disk full or a file-size limit)"}
 
 
 def os_error_sentence(exc: OSError, path, verb: str = "write") -> str:
