@@ -10,18 +10,37 @@ from shapemove.core.data.splits import split_of
 
 
 def test_bandai_captions_use_content_and_style():
-    caps = cap.bandai_captions("wave-left-hand", "elderly", "dataset-2_wave-left-hand_elderly_001")
-    assert len(caps) == 3 and len(set(caps)) == 3
-    assert all("waves with the left hand" in c for c in caps)
-    assert any("elderly" in c for c in caps)
+    cid = "dataset-2_wave-left-hand_elderly_001"
+    caps = cap.bandai_captions("wave-left-hand", "elderly", cid)
+    assert len(caps) == cap.N_CAPTIONS == 6 and len(set(caps)) == 6
+    assert caps[0] == "A person waves with the left hand slowly, like an elderly person."  # plainest first
+    assert all("wav" in c and "left" in c for c in caps)
+    assert all("elderly" in c for c in caps)              # the style in every sentence (adverb or subject)
+    assert any(" is waving" in c for c in caps)           # progressive sentence shape
     assert all(c[0].isupper() and c.endswith(".") for c in caps)
-    # deterministic per clip
-    assert caps == cap.bandai_captions("wave-left-hand", "elderly", "dataset-2_wave-left-hand_elderly_001")
+    assert caps == cap.bandai_captions("wave-left-hand", "elderly", cid)  # deterministic per clip
+    assert caps[1:] != cap.bandai_captions("wave-left-hand", "elderly", "dataset-2_wave-left-hand_elderly_002")[1:]
 
 
 def test_normal_style_adds_no_manner():
     caps = cap.bandai_captions("run", "normal", "x")
     assert all("normal" not in c for c in caps)
+    assert caps[0] == "A person runs forward."
+
+
+def test_styles_as_adverbs():
+    caps = cap.bandai_captions("walk", "happy", "dataset-1_walk_happy_003", n=20)
+    assert any(c.startswith(("Happily, ", "Cheerfully, ")) for c in caps)      # adverb first
+    assert any(c.endswith(("happily.", "cheerfully.")) for c in caps)          # adverb last
+    assert any(c.startswith("A happy person ") for c in caps)                 # style as the subject
+
+
+def test_gerunds():
+    pairs = {"walks": "walking", "runs": "running", "lies": "lying", "dances": "dancing", "hops": "hopping",
+             "punches": "punching", "does": "doing", "squats": "squatting", "waves": "waving", "ties": "tying"}
+    assert {v: cap.gerund(v) for v in pairs} == pairs
+    assert cap.progressive("jumps and turns in the air") == "jumping and turning in the air"
+    assert cap.progressive("crawls on hands and knees") == "crawling on hands and knees"
 
 
 def test_hdm05_class_phrases():
@@ -33,10 +52,28 @@ def test_hdm05_class_phrases():
 
 def test_cmu_captions_prefer_kit_sentences():
     kit = {"02_01": [{"text": "a person walks forward slowly.", "start": 0, "end": 3}]}
-    assert cap.cmu_captions("02_01", kit, "walk") == ["A person walks forward slowly."]
+    caps = cap.cmu_captions("02_01", kit, "walk")
+    assert caps[0] == "A person walks forward slowly." and len(caps) >= 3
+    assert all("walk" in c for c in caps)
     fallback = cap.cmu_captions("01_02", kit, "playground - climb")
     assert fallback and all("climb" in c for c in fallback)
     assert cap.cmu_captions("99_99", kit, None) == []
+
+
+def test_cmu_multi_action_trials_say_what_they_hold():
+    caps = cap.cmu_captions("13_30", None, "jumping jacks, side twists, squats, jog")
+    assert caps[0] == "A person does jumping jacks, does side twists, does a squat, then jogs."
+    assert any("jumping jacks, side twists, squats, jog" in c for c in caps)
+    # alternatives ("run/jog") are one action, not a sequence; styles become adverbs
+    assert cap.cmu_captions("02_03", None, "run/jog")[0] == "A person runs."
+    assert cap.cmu_captions("105_13", None, "SadWalk")[0] == "A person walks sadly."
+    assert cap.cmu_captions("105_01", None, "WalkDigital8")[0] == "A person walks in a figure eight."
+
+
+def test_deepmimic_captions_from_motion_names():
+    assert cap.deepmimic_captions("cartwheel", "deepmimic_cartwheel")[0] == "A person does a cartwheel."
+    assert cap.deepmimic_captions("long_walk2_mirror", "x")[0] == "A person walks around."
+    assert cap.deepmimic_captions("stealthy_walk0", "x")[0] == "A person sneaks forward."
 
 
 MEAS = {"height_cm": 182.4, "chest_cm": 101.2, "waist_cm": 99.6, "hip_cm": 104.0,
@@ -83,6 +120,20 @@ def test_discover_shared_layout(mocap_root):
     hd = next(c for c in by["hdm05"] if c.id == "HDM_bd_kickLFront1Reps_001_120")
     assert hd.skeleton_path.name == "HDM_bd.asf" and hd.skeleton_path.is_file()
     assert "CC BY-NC" in by["bandai"][0].licence
+    # cmu_extra.tar.xz adds 107 CMU trials (no id clashes with cmu.tar.xz), deepmimic.tar.xz 29 clips
+    assert len(by["cmu"]) == 185 and "cmu_105_16" in trials and "cmu_13_30" in trials
+    assert len(by["deepmimic"]) == 29
+    dm = {c.id: c for c in by["deepmimic"]}
+    assert dm["deepmimic_cartwheel"].labels["actions"] == ["cartwheel"]
+    assert dm["deepmimic_long_walk1_mirror"].labels == {"motion": "long_walk1_mirror", "mirrored": True,
+                                                       "actions": ["walk"]}
+    assert dm["deepmimic_walk"].licence.startswith("MIT")
+    # every clip has actions from the vocabulary except two CMU trials whose description names none
+    cmu = {c.id: c for c in by["cmu"]}
+    assert cmu["cmu_13_30"].labels["actions"][:4] == ["jumping jacks", "side twist", "squat", "jog"]
+    assert cmu["cmu_105_16"].labels["actions"] == ["limp", "walk"]  # main action first
+    assert by["bandai"][0].labels["actions"] and hd.labels["actions"] == ["kick"]
+    assert sorted(c.id for c in clips if not c.labels["actions"]) == ["cmu_105_37", "cmu_105_38"]
 
 
 def test_discover_generic_folder_with_captions(tmp_path):

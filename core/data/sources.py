@@ -1,8 +1,10 @@
 """Find the clips in a source folder or archive, with their subject, licence and captions.
 
-Understands the layout of ``../shared/data`` (``bandai/``, ``hdm05/``, ``cmu/``) and any other
-folder of BVH / ASF+AMC / AMASS ``.npz`` files, where a same-name ``.txt`` beside a file holds its
-captions (one per line).
+Understands the layout of ``../shared/data`` (``bandai/``, ``hdm05/``, ``cmu/`` -- also the
+``cmu/`` inside ``cmu_extra.tar.xz`` --, ``deepmimic/``) and any other folder of BVH / ASF+AMC /
+AMASS ``.npz`` files, where a same-name ``.txt`` beside a file holds its captions (one per line).
+Every clip's ``labels["actions"]`` lists its canonical actions (``actions.clip_actions``, main one
+first); the builder writes the labels into the clip's meta.
 """
 from __future__ import annotations
 
@@ -15,11 +17,13 @@ from pathlib import Path
 from ..errors import ShapeMoveError
 from ..io.archive import default_cache_dir, unpack
 from . import captions as cap
+from .actions import clip_actions
 
 LICENCES = {
     "bandai": "CC BY-NC 4.0 (Bandai Namco Research Inc.)",
     "hdm05": "CC BY-SA 3.0 (HDM05, Mueller et al. 2007)",
     "cmu": "CMU Graphics Lab Motion Capture Database (free for research and commercial use, not for resale)",
+    "deepmimic": "MIT (DeepMimic reference motions, Copyright (c) 2018 Xue Bin Peng)",
     "user": "user-supplied (licence as stated by its owner)",
 }
 
@@ -28,7 +32,7 @@ LICENCES = {
 class ClipSource:
     id: str
     path: Path
-    dataset: str            # bandai | hdm05 | cmu | user
+    dataset: str            # bandai | hdm05 | cmu | deepmimic | user
     subject: str
     captions: list[str]
     labels: dict = field(default_factory=dict)
@@ -71,6 +75,8 @@ def discover(folder: Path) -> list[ClipSource]:
             clips = _hdm05(root)
         elif root.name == "cmu" or (root / "cmu_index.csv").is_file():
             clips = _cmu(root)
+        elif root.name == "deepmimic" or any(root.glob("humanoid3d_*.txt")):
+            clips = _deepmimic(root)
         else:
             continue
         found += clips
@@ -80,6 +86,8 @@ def discover(folder: Path) -> list[ClipSource]:
     ids = [c.id for c in found]
     if len(ids) != len(set(ids)):
         raise ShapeMoveError(f"{folder}: two clips map to the same id")
+    for c in found:
+        c.labels.setdefault("actions", clip_actions(c.dataset, c.labels, c.captions))
     return sorted(found, key=lambda c: c.id)
 
 
@@ -137,6 +145,17 @@ def _cmu(root: Path) -> list[ClipSource]:
         caps = cap.cmu_captions(trial, kit, index.get(trial))
         out.append(ClipSource(f"cmu_{trial}", f, "cmu", f"cmu-{subject}", caps,
                               {"description": index.get(trial, ""), "kit": trial in kit}, skeleton_path=asf))
+    return out
+
+
+def _deepmimic(root: Path) -> list[ClipSource]:
+    """DeepMimic's ``humanoid3d_<motion>.txt`` (and ``long/``): one retargeted character, MIT licence."""
+    out = []
+    for f in sorted(root.glob("humanoid3d_*.txt")) + sorted(root.glob("long/humanoid3d_*.txt")):
+        motion = f.stem[len("humanoid3d_"):]
+        cid = f"deepmimic_{motion}"
+        out.append(ClipSource(cid, f, "deepmimic", "deepmimic", cap.deepmimic_captions(motion, cid),
+                              {"motion": motion, "mirrored": motion.endswith("_mirror")}))
     return out
 
 

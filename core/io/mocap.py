@@ -2,7 +2,7 @@
 one call the dataset builder and the IK benchmark use: ``load_smpl22(path) -> Motion22``.
 
 ``load_mocap`` dispatches on the extension: ``.bvh``, ``.amc`` (its ``.asf`` is found beside it),
-``.npz`` (AMASS, needs a body model).
+``.npz`` (AMASS, needs a body model), ``.txt``/``.json`` (DeepMimic JSON motions).
 """
 from __future__ import annotations
 
@@ -93,7 +93,7 @@ def finish_mocap(names, parents, offsets, positions, fps, source, *, rotations=N
 
 
 def load_mocap(path, body_model=None, **kwargs) -> Mocap:
-    """Read a ``.bvh``, ``.amc`` (with the ``.asf`` beside it) or AMASS ``.npz`` file."""
+    """Read a ``.bvh``, ``.amc`` (with the ``.asf`` beside it), AMASS ``.npz`` or DeepMimic ``.txt``/``.json`` file."""
     path = Path(path)
     if not path.is_file():
         raise ShapeMoveError(f"motion file not found: {path}")
@@ -107,7 +107,10 @@ def load_mocap(path, body_model=None, **kwargs) -> Mocap:
     if ext == ".npz":
         from .amass import load_amass
         return load_amass(path, body_model=body_model, **kwargs)
-    raise ShapeMoveError(f"{path}: unsupported motion file type {ext!r} (use .bvh, .amc or AMASS .npz)")
+    if ext in (".txt", ".json"):
+        from .deepmimic import load_deepmimic
+        return load_deepmimic(path, **kwargs)
+    raise ShapeMoveError(f"{path}: unsupported motion file type {ext!r} (use .bvh, .amc, AMASS .npz or DeepMimic .txt)")
 
 
 @dataclass

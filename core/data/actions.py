@@ -1,0 +1,246 @@
+"""The canonical action vocabulary: what the motion data holds, under one name per action.
+
+``ACTIONS`` maps each canonical name ("walk", "jumping jacks", "spin kick", ...) to an ``Action``:
+``phrases`` are the verb phrases the caption generator writes for it (third person, present:
+"walks forward"), ``patterns`` the regular expressions (lower-case text) that recognise it in a
+source's labels or sentences (CMU index descriptions, KIT-ML sentences). The dataset builder stores
+a clip's actions in its meta (``labels["actions"]``, the main action first); ``known_actions``
+counts them over a built dataset, so a model can tell users what it knows.
+
+``find_actions(text)`` returns the actions a text names, in the order they appear; where two
+patterns overlap, the longer match wins ("jumping jacks" over "jump", "spin kick" over "kick").
+"""
+from __future__ import annotations
+
+import json
+import re
+from collections import Counter
+from dataclasses import dataclass
+from pathlib import Path
+
+from ..errors import ShapeMoveError
+
+
+@dataclass(frozen=True)
+class Action:
+    name: str
+    phrases: tuple      # verb phrases the captions use, third person present ("walks forward")
+    patterns: tuple     # regexes (lower-case text) that recognise the action
+    group: str          # locomotion | acrobatics | floor | exercise | gesture | combat | sport | dance
+
+
+def _a(name, group, phrases, patterns):
+    return Action(name, tuple(phrases), tuple(patterns), group)
+
+
+_LIST = [
+    # locomotion
+    _a("walk", "locomotion", ["walks", "walks forward", "takes a walk"],
+       [r"\bwalk(s|ing|ed)?\b", r"\bstroll", r"\bstrid(e|es|ing)\b"]),
+    _a("walk backward", "locomotion", ["walks backward", "walks backwards"],
+       [r"\bwalk\w*\s+backwards?\b", r"\bbackwards? walk"]),
+    _a("sidestep", "locomotion", ["walks sideways", "sidesteps", "steps to the side"],
+       [r"\bside ?steps?\b", r"\bwalk\w*\s+(to the )?sideways\b", r"\bsideways steps?\b", r"\bwalk\w* sideways"]),
+    _a("turn", "locomotion", ["turns around", "walks and turns"],
+       [r"\bturn(s|ing|ed)?\b(?! step)"]),
+    _a("walk in a circle", "locomotion", ["walks in a circle", "goes around in a circle"],
+       [r"\bin (a )?circles?\b", r"\bleft circle\b", r"\bcircle walk"]),
+    _a("walk in a figure eight", "locomotion", ["walks in a figure eight", "walks a figure-eight path"],
+       [r"figure[- ]?(8|eight)", r"\bdigital ?8\b", r"\bwalk ?8\b", r"\bmummy ?8\b"]),
+    _a("run", "locomotion", ["runs", "runs forward"], [r"\brun(s|ning)?\b", r"\bran\b"]),
+    _a("jog", "locomotion", ["jogs", "jogs forward", "goes for a jog"], [r"\bjog(s|ging|ged)?\b"]),
+    _a("sprint", "locomotion", ["sprints", "dashes forward at full speed"], [r"\bsprint", r"\bdash(es|ing)?\b"]),
+    _a("march", "locomotion", ["marches", "marches forward"], [r"\bmarch(es|ing)?\b"]),
+    _a("limp", "locomotion", ["limps", "walks with a limp"], [r"\blimp", r"\bhurt ?leg", r"\bbad ?leg"]),
+    _a("sneak", "locomotion", ["sneaks forward", "walks stealthily", "creeps forward"],
+       [r"\bsneak", r"\bstealth", r"\bcreep"]),
+    _a("zombie walk", "locomotion", ["walks like a zombie", "shuffles along like a zombie"],
+       [r"\bzombie", r"\bmumm(y|ies)\b"]),
+    _a("crawl", "floor", ["crawls on hands and knees", "crawls forward"], [r"\bcrawl"]),
+    # jumps and acrobatics
+    _a("jump", "acrobatics", ["jumps", "jumps up"], [r"\bjump(s|ing|ed)?\b", r"\bleap(s|ing|t)?\b"]),
+    _a("jump forward", "acrobatics", ["jumps forward", "does a long jump"],
+       [r"\b(forward|far|long) jumps?\b", r"\bjump\w*\s+(\w+ )?forward", r"\bjump\w* far\b", r"\bmakes a far jump"]),
+    _a("spin jump", "acrobatics", ["jumps and turns in the air", "does a spinning jump"],
+       [r"\bjump ?turn", r"\bjump\w* (up )?(and|while) (turn|spin)", r"^(90|180|270|360)\b(?![- ]?degree)",
+        r"\b(90|180|270|360)[- ]?(degrees? )?(\w+ ){0,3}jump"]),
+    _a("hop", "acrobatics", ["hops", "hops on both feet"], [r"\bhop(s|ping|ped)?\b"]),
+    _a("jumping jacks", "exercise", ["does jumping jacks"], [r"\bjumping[- ]jacks?\b"]),
+    _a("backflip", "acrobatics", ["does a backflip", "flips backward"], [r"\bback ?flip", r"\bflip\w* backwards?"]),
+    _a("sideflip", "acrobatics", ["does a side flip", "flips sideways"], [r"\bside ?flip"]),
+    _a("cartwheel", "acrobatics", ["does a cartwheel", "turns a cartwheel"], [r"\bcartwheel"]),
+    _a("roll", "floor", ["rolls on the ground", "does a forward roll"], [r"\broll(s|ing|ed)?\b(?! de)"]),
+    _a("get up", "floor", ["gets up from the ground", "stands up from the floor"],
+       [r"\bget(s|ting)? up\b", r"\bstand(s|ing)? up\b", r"\bgetup\b"]),
+    _a("lie down", "floor", ["lies down on the floor", "lies down"],
+       [r"\blie(s)? down", r"\blying down", r"\blays? down"]),
+    _a("sit", "floor", ["sits down", "sits"], [r"\bsit(s|ting)?\b", r"\bsat\b"]),
+    _a("climb", "sport", ["climbs", "climbs up"], [r"\bclimb"]),
+    _a("hang", "sport", ["hangs from a bar"], [r"\bhang(s|ing)?\b"]),
+    _a("swing", "sport", ["swings from a bar"], [r"\bswing(s|ing)?\b(?! (\w+ )?arms?)"]),
+    # exercise
+    _a("squat", "exercise", ["does a squat", "squats down"], [r"\bsquat"]),
+    _a("bend over", "exercise", ["bends over", "bends down"], [r"\bbend(s|ing)? (over|down)\b", r"\bbent over\b"]),
+    _a("pick up", "exercise", ["picks something up from the floor"],
+       [r"\bpick\w* (\w+ )?up\b", r"\bscoop"]),
+    _a("put down", "exercise", ["puts something down on the floor"],
+       [r"\bput\w* (\w+ )?down\b", r"\bdeposit"]),
+    _a("reach up", "exercise", ["reaches up high", "reaches up and grabs something"],
+       [r"\breach(es|ing)? (up|for|high)", r"\bgrab"]),
+    _a("stretch", "exercise", ["stretches", "does stretches"], [r"\bstretch(es|ing)?\b"]),
+    _a("side twist", "exercise", ["does side twists", "twists the upper body from side to side"],
+       [r"\bside twists?\b", r"\btwist"]),
+    _a("elbow to knee", "exercise", ["touches each elbow to the opposite knee"],
+       [r"\belbow\w* to (the )?(opposite )?knees?"]),
+    _a("arm circles", "exercise", ["rotates both arms", "makes circles with the arms"],
+       [r"\brotat\w* (both )?arms", r"\barm circles"]),
+    _a("balance", "exercise", ["balances on one leg"], [r"\bbalanc"]),
+    # gestures
+    _a("wave", "gesture", ["waves", "waves a hand"], [r"\bwav(e|es|ing)\b"]),
+    _a("wave goodbye", "gesture", ["waves goodbye"], [r"\bwav\w* (good)?-?bye", r"\bbye ?bye\b", r"\bbye\b"]),
+    _a("raise hand", "gesture", ["raises a hand", "raises a hand up"],
+       [r"\brais\w* (\w+ ){0,2}(hand|hands|arm|arms)\b", r"\blift\w* (\w+ )?arms?\b", r"\bhands? (up|in the air)",
+        r"\braise-up"]),
+    _a("bow", "gesture", ["bows", "takes a bow"], [r"\bbow(s|ing|ed)?\b"]),
+    _a("beckon", "gesture", ["beckons someone to come over", "calls someone over with a hand"],
+       [r"\bbeckon", r"\bcall\w* (someone|somebody)"]),
+    _a("guide", "gesture", ["guides someone with an open hand", "shows the way with a hand"],
+       [r"\bguid(e|es|ing)\b"]),
+    # combat
+    _a("punch", "combat", ["throws punches", "punches"], [r"\bpunch", r"\bstrike\b", r"\bbox(es|ing)\b", r"\bjab"]),
+    _a("kick", "combat", ["kicks", "kicks with one leg"], [r"\bkick(s|ing|ed)?\b"]),
+    _a("spin kick", "combat", ["does a spinning kick", "does a spin kick"],
+       [r"\bspin ?kick", r"\bspinning kick", r"\broundhouse"]),
+    _a("slash", "combat", ["slashes with a sword", "swings a sword"], [r"\bslash", r"\bsword"]),
+    # sport
+    _a("kick ball", "sport", ["kicks a ball"], [r"\bkick\w* (a |the )?(soccer )?ball", r"\bsoccer"]),
+    _a("throw", "sport", ["throws a ball"], [r"\bthrow\w* (a |the )?(\w+ )?ball", r"\bthrowbasketball"]),
+    _a("dribble", "sport", ["dribbles a basketball"], [r"\bdribbl"]),
+    _a("shoot", "sport", ["shoots a basketball"], [r"\bshoot(s|ing)?\b"]),
+    # dance
+    _a("dance", "dance", ["dances", "does a dance"],
+       [r"\bdanc(e|es|ing|er)\b", r"\bsalsa", r"\blambada", r"\blindy ?hop"]),
+    _a("ballet", "dance", ["does ballet moves", "dances ballet"],
+       [r"\bballet", r"\barabesque", r"\bjetes?\b", r"\bglissade", r"\bplie\b", r"\bpirouettes?\b"]),
+    _a("spin", "dance", ["spins around", "turns on the spot"], [r"\bspin(s|ning)?\b", r"\bwhirl", r"\bpirouettes?\b"]),
+    _a("pose", "dance", ["holds a pose", "strikes a pose"], [r"\bposes?\b", r"\byoga"]),
+    _a("wash", "gesture", ["washes", "takes a shower"], [r"\bwash", r"\bshower"]),
+]
+
+ACTIONS: dict[str, Action] = {a.name: a for a in _LIST}
+_COMPILED = [(a.name, re.compile(p)) for a in _LIST for p in a.patterns]
+
+
+def action(name: str) -> Action:
+    try:
+        return ACTIONS[name]
+    except KeyError:
+        raise ShapeMoveError(f"unknown action {name!r}; known: {', '.join(ACTIONS)}") from None
+
+
+def find_actions(text: str) -> list[str]:
+    """The canonical actions a text names, in order of appearance (longer overlapping match wins)."""
+    text = split_words(text)
+    hits = []  # (start, -length, name, end)
+    for name, rx in _COMPILED:
+        for m in rx.finditer(text):
+            hits.append((m.start(), -(m.end() - m.start()), name, m.end()))
+    hits.sort()
+    taken: list[tuple[int, int]] = []
+    found: list[tuple[int, str]] = []
+    for start, neg, name, end in sorted(hits, key=lambda h: (h[1], h[0])):  # longest first
+        if any(start < e and end > s for s, e in taken):
+            continue
+        taken.append((start, end))
+        found.append((start, name))
+    out: list[str] = []
+    for _, name in sorted(found):
+        if name not in out:
+            out.append(name)
+    return out
+
+
+def split_words(text: str) -> str:
+    """Lower-case text with camelCase and digits split off ('WalkDigital8' -> 'walk digital 8')."""
+    text = re.sub(r"(?<=[a-z])(?=[A-Z])", " ", str(text))
+    text = re.sub(r"(?<=[A-Za-z])(?=8\b)", " ", text)
+    return re.sub(r"[_]+", " ", text).lower()
+
+
+# Source labels with a known meaning (the first action is the clip's main one)
+BANDAI_ACTIONS = {
+    "walk": ["walk"], "run": ["run"], "dash": ["sprint"], "walk-back": ["walk backward"],
+    "walk-left": ["sidestep"], "walk-right": ["sidestep"], "walk-turn-left": ["walk", "turn"],
+    "walk-turn-right": ["walk", "turn"], "bow": ["bow"], "bye": ["wave goodbye"], "byebye": ["wave goodbye"],
+    "guide": ["guide"], "respond": ["raise hand"], "call": ["beckon"], "punch": ["punch"], "kick": ["kick"],
+    "slash": ["slash"], "dance-long": ["dance"], "dance-short": ["dance"], "wave-both-hands": ["wave"],
+    "wave-left-hand": ["wave"], "wave-right-hand": ["wave"], "raise-up-both-hands": ["raise hand"],
+    "raise-up-left-hand": ["raise hand"], "raise-up-right-hand": ["raise hand"],
+}
+HDM05_ACTIONS = {
+    "squat": ["squat"], "hopBothLegs": ["hop"], "depositFloorR": ["put down", "bend over"], "kickLFront": ["kick"],
+    "grabHighR": ["reach up"], "elbowToKnee": ["elbow to knee"], "lieDownFloor": ["lie down"],
+    "rotateArmsBothBackward": ["arm circles"], "jogLeftCircle": ["jog", "walk in a circle"], "sneak": ["sneak"],
+    "throwBasketball": ["throw"],
+}
+DEEPMIMIC_ACTIONS = {
+    "backflip": ["backflip"], "sideflip": ["sideflip"], "cartwheel": ["cartwheel"], "crawl": ["crawl"],
+    "getup_faceup": ["get up"], "getup_facedown": ["get up"], "roll": ["roll"], "spinkick": ["spin kick"],
+    "dance_a": ["dance"], "dance_b": ["dance"], "dance_spin": ["dance", "spin"], "zombie_walk": ["zombie walk"],
+    "long_zombie": ["zombie walk"], "stealthy_walk": ["sneak"], "jog": ["jog"], "run": ["run"], "walk": ["walk"],
+    "long_walk": ["walk"], "jump": ["jump forward", "jump"], "kick": ["kick"], "punch": ["punch"], "spin": ["spin"],
+}
+
+
+def _prefix_lookup(table: dict, key: str) -> list[str]:
+    for k in sorted(table, key=len, reverse=True):
+        if key.startswith(k):
+            return list(table[k])
+    return []
+
+
+def clip_actions(dataset: str, labels: dict, captions: list[str]) -> list[str]:
+    """A clip's actions, main one first: from its source label where the label is known, else
+    (CMU, user folders) from its description and captions."""
+    if dataset == "bandai":
+        return list(BANDAI_ACTIONS.get(labels.get("content", ""), [])) or _from_text(labels, captions)
+    if dataset == "hdm05":
+        return _prefix_lookup(HDM05_ACTIONS, labels.get("class", "")) or _from_text(labels, captions)
+    if dataset == "deepmimic":
+        return _prefix_lookup(DEEPMIMIC_ACTIONS, labels.get("motion", "")) or _from_text(labels, captions)
+    return _from_text(labels, captions)
+
+
+def _from_text(labels: dict, captions: list[str]) -> list[str]:
+    desc = labels.get("description", "")
+    if " - " in desc:  # "dance - pirouette": the scene names an action too
+        scene, rest = desc.split(" - ", 1)
+        out = find_actions(scene)
+        out += [a for a in find_actions(rest) if a not in out]
+    else:
+        out = find_actions(desc)
+    for c in captions:
+        out += [a for a in find_actions(c) if a not in out]
+    return out
+
+
+def known_actions(data_dir, split: str | None = None) -> list[tuple[str, int]]:
+    """(action, number of clips) over a built dataset's ``meta.jsonl`` (or ``meta/*.json``), most
+    frequent first; ``split`` restricts to one split. Composed and augmented clips count too."""
+    data_dir = Path(data_dir)
+    metas = []
+    if (data_dir / "meta.jsonl").is_file():
+        for line in (data_dir / "meta.jsonl").read_text(encoding="utf-8").splitlines():
+            if line.strip():
+                metas.append(json.loads(line))
+    elif (data_dir / "meta").is_dir():
+        metas = [json.loads(p.read_text(encoding="utf-8")) for p in sorted((data_dir / "meta").glob("*.json"))]
+    else:
+        raise ShapeMoveError(f"{data_dir}: not a built dataset (no meta.jsonl or meta/ folder)")
+    counts: Counter = Counter()
+    for m in metas:
+        if split is not None and m.get("split") != split:
+            continue
+        for a in set((m.get("labels") or {}).get("actions", [])):
+            counts[a] += 1
+    return sorted(counts.items(), key=lambda kv: (-kv[1], kv[0]))
