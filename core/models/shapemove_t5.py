@@ -16,9 +16,11 @@ import torch
 from torch import nn
 
 from ..errors import ShapeMoveError
+from ..model_files import damaged_model_errors, verify_manifest, write_manifest
 from .beta_head import BetaHead
 
 FORMAT = "shapemove-t5/1"
+T5_FILES = ("shapemove.json", "config.json", "model.safetensors", "beta_head.safetensors", "tokenizer.json")
 
 
 @dataclass
@@ -113,6 +115,7 @@ class ShapeMoveT5(nn.Module):
         save_file({k: v.contiguous() for k, v in self.beta_head.state_dict().items()}, str(tmp / "beta_head.safetensors"))
         info = {"format": FORMAT, "beta_weight": self.beta_weight, "d_model": self.lm.config.d_model, **(meta or {})}
         (tmp / "shapemove.json").write_text(json.dumps(info, indent=2, default=str))
+        write_manifest(tmp)  # sha256 of every file: loading refuses a damaged or swapped file
         old = directory.with_name(directory.name + ".old")
         shutil.rmtree(old, ignore_errors=True)
         if directory.exists():
@@ -131,14 +134,17 @@ class ShapeMoveT5(nn.Module):
         info_file = directory / "shapemove.json"
         if not info_file.is_file():
             raise ShapeMoveError(f"{directory} is not a ShapeMove T5 model (no shapemove.json)")
-        info = json.loads(info_file.read_text())
-        if info.get("format") != FORMAT:
-            raise ShapeMoveError(f"{directory}: unsupported model format {info.get('format')!r} (expected {FORMAT})")
-        tok = load_tokenizer(directory)
-        lm = T5ForConditionalGeneration.from_pretrained(str(directory), local_files_only=True, dtype=torch.float32)
-        head = BetaHead(lm.config.d_model)
-        head.load_state_dict({k: v.float() for k, v in load_file(str(directory / "beta_head.safetensors")).items()})
-        model = cls(lm, head, MotionVocab(tok), info.get("beta_weight", 1.0))
+        verify_manifest(directory, required=T5_FILES)
+        with damaged_model_errors(directory):
+            info = json.loads(info_file.read_text())
+            if not isinstance(info, dict) or info.get("format") != FORMAT:
+                raise ShapeMoveError(f"{directory}: unsupported model format "
+                                     f"{info.get('format') if isinstance(info, dict) else info!r} (expected {FORMAT})")
+            tok = load_tokenizer(directory)
+            lm = T5ForConditionalGeneration.from_pretrained(str(directory), local_files_only=True, dtype=torch.float32)
+            head = BetaHead(lm.config.d_model)
+            head.load_state_dict({k: v.float() for k, v in load_file(str(directory / "beta_head.safetensors")).items()})
+            model = cls(lm, head, MotionVocab(tok), info.get("beta_weight", 1.0))
         model.info = info
         return model.eval(), tok
 

@@ -1,9 +1,14 @@
 """The ShapeMove tokenizer: a sentencepiece model trained on the captions and shape texts,
 wrapped as a ``transformers`` T5 tokenizer, plus the motion vocabulary.
 
-Added tokens (one id each, never split): ``[MID_0]`` … ``[MID_999]`` (the SA-VAE's FSQ codes),
-``[SOM]``/``[EOM]`` (start/end of motion) and ``[BETA]`` (its decoder state is projected to betas).
-A user-supplied pretrained T5 directory brings its own tokenizer; the same tokens are added to it.
+Added tokens (one id each, never split): ``[MID_0]`` … ``[MID_{N-1}]`` (the SA-VAE's FSQ codes,
+N = the FSQ's codebook size, 1000 for levels [8,5,5,5]), ``[SOM]``/``[EOM]`` (start/end of motion)
+and ``[BETA]`` (its decoder state is projected to betas). A user-supplied pretrained T5 directory
+brings its own tokenizer; the same tokens are added to it.
+
+The default model reads prompts with the pretrained MiniLM (``text_encoder.py``) and its decoder
+writes only motion: ``MotionVocab.motion_only(N)`` is that decoder's own small vocabulary
+(pad, </s>, [BETA], [SOM], [EOM], N codes).
 """
 from __future__ import annotations
 
@@ -11,9 +16,14 @@ from pathlib import Path
 
 from ..errors import ShapeMoveError
 
-NUM_CODES = 1000
+NUM_CODES = 1000  # FSQ levels [8,5,5,5]; models record their own count
 SOM, EOM, BETA = "[SOM]", "[EOM]", "[BETA]"
 MOTION_TOKENS = [f"[MID_{i}]" for i in range(NUM_CODES)]
+MAX_CODES_LIMIT = 1 << 16
+
+
+def motion_tokens(num_codes: int = NUM_CODES) -> list[str]:
+    return [f"[MID_{i}]" for i in range(int(num_codes))]
 
 
 def train_sentencepiece(texts: list[str], out_prefix: Path, vocab_size: int = 2000, seed: int = 0) -> Path:
@@ -37,7 +47,7 @@ def train_sentencepiece(texts: list[str], out_prefix: Path, vocab_size: int = 20
     return out_prefix.with_suffix(".model")
 
 
-def tokenizer_from_sentencepiece(model_file: Path):
+def tokenizer_from_sentencepiece(model_file: Path, num_codes: int = NUM_CODES):
     """A T5 tokenizer whose vocabulary is the sentencepiece model's, plus the motion tokens."""
     import sentencepiece as spm
     from tokenizers import normalizers
@@ -49,42 +59,68 @@ def tokenizer_from_sentencepiece(model_file: Path):
     tok = T5Tokenizer(vocab=vocab, extra_ids=0)
     # the pieces were learnt on NFKC + case-folded text: normalise the same way at run time
     tok.backend_tokenizer.normalizer = normalizers.Sequence([normalizers.NFKC(), normalizers.Lowercase()])
-    return add_motion_tokens(tok)
+    return add_motion_tokens(tok, num_codes)
 
 
-def add_motion_tokens(tok):
+def add_motion_tokens(tok, num_codes: int = NUM_CODES):
     """Add the motion/shape tokens as special tokens (idempotent); returns the tokenizer."""
-    missing = [t for t in MOTION_TOKENS + [SOM, EOM, BETA] if tok.convert_tokens_to_ids(t) in (None, tok.unk_token_id)]
+    missing = [t for t in motion_tokens(num_codes) + [SOM, EOM, BETA]
+               if tok.convert_tokens_to_ids(t) in (None, tok.unk_token_id)]
     if missing:
         tok.add_tokens(missing, special_tokens=True)
     return tok
 
 
-def load_tokenizer(directory: Path):
+def load_tokenizer(directory: Path, require_json: bool = True, num_codes: int | None = None):
+    """The tokenizer saved in ``directory`` with the motion tokens. ``require_json``: a ShapeMove
+    model folder must hold its ``tokenizer.json`` (a pretrained T5 folder may bring only
+    ``spiece.model``); without it transformers would quietly build a different tokenizer."""
     from transformers import AutoTokenizer
 
     directory = Path(directory)
     if not directory.is_dir():
         raise ShapeMoveError(f"tokenizer folder not found: {directory}")
-    tok = AutoTokenizer.from_pretrained(str(directory), local_files_only=True)
+    if require_json and not (directory / "tokenizer.json").is_file():
+        raise ShapeMoveError(f"{directory}: the model's tokenizer (tokenizer.json) is missing; the folder is "
+                             "incomplete: copy the whole model folder again or retrain")
+    from ..model_files import damaged_model_errors, verify_manifest
+
+    verify_manifest(directory)  # sha256 of the files when a manifest lists them
+    with damaged_model_errors(directory):
+        tok = AutoTokenizer.from_pretrained(str(directory), local_files_only=True)
     saved = directory / "tokenizer.json"
     if saved.is_file() and getattr(tok, "backend_tokenizer", None) is not None:
         # some tokenizer classes rebuild their pipeline on load and drop the saved normalizer
         from tokenizers import Tokenizer
 
-        normalizer = Tokenizer.from_file(str(saved)).normalizer
+        with damaged_model_errors(directory):
+            normalizer = Tokenizer.from_file(str(saved)).normalizer
         if normalizer is not None and tok.backend_tokenizer.normalizer is None:
             tok.backend_tokenizer.normalizer = normalizer
-    return add_motion_tokens(tok)
+    if num_codes is None:
+        num_codes = count_motion_tokens(tok) or NUM_CODES
+    return add_motion_tokens(tok, num_codes)
+
+
+def count_motion_tokens(tok) -> int:
+    """How many [MID_i] tokens the tokenizer already has (0 for a fresh one)."""
+    vocab = tok.get_vocab()
+    n = 0
+    while n < MAX_CODES_LIMIT and f"[MID_{n}]" in vocab:
+        n += 1
+    return n
 
 
 class MotionVocab:
     """Ids of the added tokens in a given tokenizer, and code <-> token-id conversion."""
 
-    def __init__(self, tok):
-        self.first_code_id = tok.convert_tokens_to_ids(MOTION_TOKENS[0])
-        ids = tok.convert_tokens_to_ids(MOTION_TOKENS)
-        if ids != list(range(self.first_code_id, self.first_code_id + NUM_CODES)):
+    def __init__(self, tok=None, num_codes: int | None = None):
+        if tok is None:  # filled in by motion_only()
+            return
+        self.num_codes = int(num_codes) if num_codes is not None else (count_motion_tokens(tok) or NUM_CODES)
+        self.first_code_id = tok.convert_tokens_to_ids("[MID_0]")
+        ids = tok.convert_tokens_to_ids(motion_tokens(self.num_codes))
+        if ids != list(range(self.first_code_id, self.first_code_id + self.num_codes)):
             raise ShapeMoveError("motion tokens are not contiguous in this tokenizer")
         self.som_id = tok.convert_tokens_to_ids(SOM)
         self.eom_id = tok.convert_tokens_to_ids(EOM)
@@ -93,6 +129,18 @@ class MotionVocab:
         self.eos_id = tok.eos_token_id
         self.vocab_size = len(tok)
 
+    @classmethod
+    def motion_only(cls, num_codes: int) -> "MotionVocab":
+        """The vocabulary of a decoder that only writes motion: pad 0, </s> 1, [BETA] 2, [SOM] 3,
+        [EOM] 4, then the codes."""
+        if not 2 <= int(num_codes) <= MAX_CODES_LIMIT:
+            raise ShapeMoveError(f"motion vocabulary of {num_codes} codes: expected 2..{MAX_CODES_LIMIT}")
+        v = cls()
+        v.pad_id, v.eos_id, v.beta_id, v.som_id, v.eom_id = 0, 1, 2, 3, 4
+        v.first_code_id, v.num_codes = 5, int(num_codes)
+        v.vocab_size = 5 + v.num_codes
+        return v
+
     def codes_to_ids(self, codes):
         return [self.first_code_id + int(c) for c in codes]
 
@@ -100,7 +148,7 @@ class MotionVocab:
         return [int(i) - self.first_code_id for i in ids if self.is_code(i)]
 
     def is_code(self, i) -> bool:
-        return self.first_code_id <= int(i) < self.first_code_id + NUM_CODES
+        return self.first_code_id <= int(i) < self.first_code_id + self.num_codes
 
     def target_ids(self, codes) -> list[int]:
         """Decoder target of the text-to-motion task: [BETA] [SOM] codes… [EOM] </s>."""

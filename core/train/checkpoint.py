@@ -9,13 +9,14 @@ Everything is plain Python/tensors, so files load with ``torch.load(weights_only
 from __future__ import annotations
 
 import hashlib
-import os
 from pathlib import Path
 
 import numpy as np
 import torch
 
+from ..atomic import atomic_path
 from ..errors import ShapeMoveError
+from ..model_files import add_to_manifest, verify_file
 
 FORMAT = 1
 
@@ -44,10 +45,9 @@ def make_metadata(kind: str, config: dict, body: str, mean, std, step: int = 0, 
 def save_checkpoint(path, payload: dict, metadata: dict) -> Path:
     """Write ``{**payload, "metadata": metadata}`` to ``path`` atomically."""
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(path.name + ".tmp")
-    torch.save({**payload, "metadata": metadata}, tmp)
-    os.replace(tmp, path)
+    with atomic_path(path) as tmp:  # no half-written file or *.tmp left behind (disk full, read-only, ...)
+        torch.save({**payload, "metadata": metadata}, tmp)
+    add_to_manifest(path.parent, [path])  # loading checks its sha256
     return path
 
 
@@ -94,6 +94,7 @@ def load_checkpoint(path, map_location="cpu", **expect) -> dict:
     path = Path(path)
     if not path.is_file():
         raise ShapeMoveError(f"checkpoint not found: {path}")
+    verify_file(path)  # sha256 against the manifest beside it: a flipped byte is refused, not used
     try:
         ckpt = torch.load(path, map_location=map_location, weights_only=True)
     except Exception as exc:  # truncated/corrupt/unrelated file
