@@ -52,7 +52,7 @@ train-default: setup
 
 # Evaluation tables of the README (needs $(BUILT) from train-default); the 1-step SA-VAE is the untrained baseline.
 eval: setup
-	$(PY) -m shapemove train vae --data $(BUILT) --config configs/default_vae.json --steps 1 --out runs/untrained --quiet
+	$(PY) -m shapemove train vae --data $(BUILT) --config configs/default_vae.json --steps 1 --out runs/untrained --quiet --force
 	$(PY) -m shapemove eval recon --data $(BUILT) --split test --checkpoint weights/default/savae.pt --max-clips 40 --json out/eval_recon.json
 	$(PY) -m shapemove eval recon --data $(BUILT) --split test --checkpoint runs/untrained/savae.pt --max-clips 40 --json out/eval_recon_untrained.json
 	$(PY) -m shapemove eval generate --data $(BUILT) --split test --model weights/default --max-clips 60 --json out/eval_generate.json

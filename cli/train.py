@@ -1,4 +1,4 @@
-"""`python -m shapemove train KIND --data DIR --config small|paper|PATH.json --out RUN [--steps N] [--resume]`.
+"""`python -m shapemove train KIND --data DIR --config small|paper|PATH.json --out RUN [--steps N] [--resume|--force]`.
 
 KIND is vae (SA-VAE), t5 or tma. Each kind lives in ``core/train/train_KIND.py`` and defines
 ``from_cli(args) -> dict`` (the final metrics) reading the common arguments below (add a kind to
@@ -36,6 +36,8 @@ def add_arguments(p):
         s.add_argument("--out", type=Path, required=True, help="run folder (checkpoints, log.jsonl)")
         s.add_argument("--steps", type=int, help="override the config's number of steps")
         s.add_argument("--resume", action="store_true", help="continue from RUN/last.pt if it exists")
+        s.add_argument("--force", action="store_true",
+                       help="train a new model even if RUN already holds one (it is replaced at the end)")
         s.add_argument("--device", choices=["cpu", "cuda"], help="default: cuda when available")
         s.add_argument("--body", help="body model: openbody (default) or an SMPL-family file")
         s.add_argument("--quiet", action="store_true", help="no progress bar")
@@ -46,6 +48,9 @@ def add_arguments(p):
 
 
 def run(args) -> int:
+    from ..core.train.run_guard import check_run_folder
+
+    check_run_folder(args.out, args.kind, resume=args.resume, force=args.force)
     metrics = _module(args.kind).from_cli(args)
     if int(os.environ.get("RANK", 0)) == 0 and metrics:
         print(json.dumps(metrics, indent=1))
