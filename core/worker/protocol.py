@@ -21,7 +21,11 @@ from ..errors import ShapeMoveError
 PROTOCOL_VERSION = 1
 CONTROL_OPS = ("ping", "cancel", "shutdown")
 RESPONSE_TYPES = ("progress", "result", "error", "log")
-MAX_LINE = 16 * 1024 * 1024  # a request line longer than this is refused
+MAX_LINE = 16 * 1024 * 1024  # a request line longer than this is refused (the server never reads it whole)
+MAX_DEPTH = 32  # nesting of objects/arrays in a message
+MAX_ID_CHARS = 200
+MAX_INT_ID = 2**53  # ids must survive a round trip through any JSON reader
+MAX_SHUTDOWN_WAIT = 600.0
 
 
 class ProtocolError(ShapeMoveError):
@@ -69,19 +73,72 @@ def _loads(line, what: str) -> dict:
     line = line.strip()
     if not line:
         raise ProtocolError(f"empty {what}")
+    if _bracket_depth(line) > MAX_DEPTH:
+        raise ProtocolError(f"{what} is nested more than {MAX_DEPTH} levels deep")
     try:
         obj = json.loads(line)
     except json.JSONDecodeError as exc:
         raise ProtocolError(f"{what} is not valid JSON ({exc.msg} at column {exc.colno}): {line[:80]!r}") from None
+    except (ValueError, RecursionError) as exc:  # e.g. an integer of thousands of digits
+        raise ProtocolError(f"{what} cannot be read: {str(exc)[:120]}") from None
     if not isinstance(obj, dict):
         raise ProtocolError(f"{what} must be a JSON object, got {type(obj).__name__}")
     return obj
 
 
+def _bracket_depth(text: str) -> int:
+    """Deepest [ / { nesting outside strings, found without recursion (json.loads would recurse)."""
+    if text.count("[") + text.count("{") <= MAX_DEPTH:
+        return 0
+    depth = deepest = 0
+    in_str = escaped = False
+    for ch in text:
+        if in_str:
+            if escaped:
+                escaped = False
+            elif ch == "\\":
+                escaped = True
+            elif ch == '"':
+                in_str = False
+        elif ch == '"':
+            in_str = True
+        elif ch in "[{":
+            depth += 1
+            if depth > deepest:
+                deepest = depth
+                if deepest > MAX_DEPTH:
+                    return deepest
+        elif ch in "]}":
+            depth -= 1
+    return deepest
+
+
 def _check_id(value, what: str):
     if value is None or isinstance(value, bool) or not isinstance(value, (str, int)):
-        raise ProtocolError(f"{what} needs an \"id\" (string or integer), got {value!r}")
+        raise ProtocolError(f"{what} needs an \"id\" (string or integer), got {_short(value)}")
+    if isinstance(value, str) and len(value) > MAX_ID_CHARS:
+        raise ProtocolError(f"{what} id is {len(value)} characters long (limit {MAX_ID_CHARS})")
+    if isinstance(value, int) and abs(value) > MAX_INT_ID:
+        raise ProtocolError(f"{what} id {_short(value)} is too large (limit 2**53)")
     return value
+
+
+def _short(value) -> str:
+    if isinstance(value, int) and not isinstance(value, bool) and abs(value) > 10**30:
+        return "(a very large integer)"
+    text = repr(value)
+    return text if len(text) <= 80 else text[:77] + "..."
+
+
+def _check_control(rid, op: str, params: dict) -> None:
+    """Parameters of the control ops, checked before the runner uses them."""
+    if op == "shutdown" and "timeout" in params:
+        t = params["timeout"]
+        if isinstance(t, bool) or not isinstance(t, (int, float)) or not math.isfinite(t) or not 0 <= t <= MAX_SHUTDOWN_WAIT:
+            raise ProtocolError(f"request {rid!r}: shutdown \"timeout\" must be a number of seconds from 0 to "
+                                f"{MAX_SHUTDOWN_WAIT:g}, got {_short(t)}", rid)
+    if op == "cancel":
+        _check_id(params.get("job"), f"request {rid!r}: cancel")
 
 
 # -- requests ----------------------------------------------------------------------------------
@@ -101,8 +158,8 @@ def decode_request(line) -> Request:
     rid = obj.get("id")
     _check_id(rid, "request")
     op = obj.get("op")
-    if not isinstance(op, str) or not op:
-        raise ProtocolError(f"request {rid!r} needs an \"op\" (non-empty string), got {op!r}", rid)
+    if not isinstance(op, str) or not op or len(op) > MAX_ID_CHARS:
+        raise ProtocolError(f"request {rid!r} needs an \"op\" (non-empty string), got {_short(op)}", rid)
     params = obj.get("params", {})
     if params is None:
         params = {}
@@ -110,7 +167,8 @@ def decode_request(line) -> Request:
         raise ProtocolError(f"request {rid!r}: \"params\" must be an object, got {type(params).__name__}", rid)
     extra = set(obj) - {"id", "op", "params"}
     if extra:
-        raise ProtocolError(f"request {rid!r} has unknown keys: {', '.join(sorted(extra))}", rid)
+        raise ProtocolError(f"request {rid!r} has unknown keys: {', '.join(sorted(extra))[:200]}", rid)
+    _check_control(rid, op, params)
     return Request(rid, op, params)
 
 

@@ -62,6 +62,21 @@ class _PrintsToLog(io.TextIOBase):
         self.stderr.flush()
 
 
+def _bounded_lines(stream, limit: int):
+    """Lines of ``stream``, reading at most ``limit`` + 1 characters at a time: a longer line is
+    read through in chunks and yielded as None, so a 300 MB line never sits in memory."""
+    while True:
+        line = stream.readline(limit + 1)
+        if not line:
+            return
+        if len(line) <= limit or line.endswith("\n"):
+            yield line
+            continue
+        while line and not line.endswith("\n"):  # discard the rest of the line
+            line = stream.readline(1 << 20)
+        yield None
+
+
 def serve(stdin, stdout, jobs: dict | None = None, capture_prints: bool = False) -> int:
     """Read requests from ``stdin`` (text lines) and write responses to ``stdout`` until "shutdown"
     or end of input. ``capture_prints``: sys.stdout becomes stderr + log messages meanwhile."""
@@ -71,7 +86,11 @@ def serve(stdin, stdout, jobs: dict | None = None, capture_prints: bool = False)
     if capture_prints:
         sys.stdout = _PrintsToLog(emit, lambda: runner.current_id, sys.stderr)
     try:
-        for line in stdin:
+        for line in _bounded_lines(stdin, P.MAX_LINE):
+            if line is None:  # longer than MAX_LINE: skipped without being held in memory
+                emit(P.error(None, f"request line is too long (more than {P.MAX_LINE} characters); it was skipped",
+                             "ProtocolError"))
+                continue
             if not line.strip():
                 continue
             try:
