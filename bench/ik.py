@@ -8,8 +8,9 @@ plausible poses on the body. Times are the best of a few repeats (the machine is
 Then, per archive (5 clips each), the joint error of the real pipeline (rig map -> betas -> IK on
 OpenBody) for each rig-map layout and body fit: the legacy SMPL spine fractions with the
 exact-skeleton bone-length fit (the baseline), OpenBody's layout (``core.io.rig_map``), and the
-plausible-body fit ``fit_betas_to_motion`` (largest |beta| printed: the exact-skeleton fit reaches
-its cm by betas of +-20..60, i.e. deformed bodies).
+plausible-body fits ``fit_betas_to_motion`` and ``fit_betas_to_clip`` (the data builder's; also
+with its 10 IK steps) (largest |beta| printed: the exact-skeleton fit reaches its cm by betas of
++-20..60, i.e. deformed bodies).
 """
 from __future__ import annotations
 
@@ -78,7 +79,7 @@ ARCHIVE_CLIPS = {  # archive -> globs (the first match of each), 5 clips per arc
 
 def _archive_table(body, quick: bool) -> dict:
     """Mean joint error (cm) per archive and (layout, fit); per joint for the baseline and the best."""
-    from ..core.body.fit import bone_lengths, fit_betas_to_bone_lengths, fit_betas_to_motion
+    from ..core.body.fit import bone_lengths, fit_betas_to_bone_lengths, fit_betas_to_clip, fit_betas_to_motion
     from ..core.body.skeleton import JOINT_NAMES
     from ..core.io.archive import mocap_root
     from ..core.io.mocap import load_mocap
@@ -87,7 +88,8 @@ def _archive_table(body, quick: bool) -> dict:
 
     layouts = {"smpl": SMPL_LAYOUT, "default": DEFAULT_LAYOUT, "openbody": OPENBODY_LAYOUT}
     fits = {"lengths": lambda j: fit_betas_to_bone_lengths(body, np.median(bone_lengths(j), 0)),
-            "motion": lambda j: fit_betas_to_motion(body, j)}
+            "motion": lambda j: fit_betas_to_motion(body, j),
+            "clip": lambda j: fit_betas_to_clip(body, j)}
     root, frames, out = mocap_root(), 60 if quick else 200, {}
     for archive, patterns in ARCHIVE_CLIPS.items():
         err, per, beta = {}, {}, {}
@@ -105,6 +107,9 @@ def _archive_table(body, quick: bool) -> dict:
                     rest = body.rest_joints(torch.tensor(fit.betas)[None])[0].double().numpy()
                     res = solve_ik(joints, rest)
                     err.setdefault((lname, fname), []).append(res.mean_error_cm)
+                    if lname == "openbody" and fname == "clip":  # the data builder's settings
+                        err.setdefault(("openbody", "clip+10"), []).append(
+                            solve_ik(joints, rest, refine_iters=10).mean_error_cm)
                     per.setdefault((lname, fname), []).append(res.per_joint_error_cm())
                     beta[(lname, fname)] = max(beta.get((lname, fname), 0.0), float(np.abs(fit.betas).max()))
         if not err:
@@ -112,18 +117,22 @@ def _archive_table(body, quick: bool) -> dict:
         n = len(err[("smpl", "lengths")])
         print(f"  {archive} ({n} clips, <= {frames} frames): mean joint error cm (max |beta|)")
         for (lname, fname), e in err.items():
-            print(f"    layout {lname:8s} fit {fname:7s}: {np.mean(e):5.2f} cm  ({beta[(lname, fname)]:.1f})")
-        for key in (("smpl", "lengths"), ("openbody", "motion")):
+            b = beta[(lname, fname.split("+")[0])]
+            note = " (10 IK steps: the data builder's)" if fname == "clip+10" else ""
+            print(f"    layout {lname:8s} fit {fname:7s}: {np.mean(e):5.2f} cm  ({b:.1f}){note}")
+        for key in (("smpl", "lengths"), ("openbody", "clip")):
             pj = np.mean(per[key], 0)
             print(f"    per joint, {key[0]} + {key[1]}: " + ", ".join(f"{JOINT_NAMES[j]} {pj[j]:.1f}" for j in range(22)))
-        before, after = np.mean(err[("smpl", "lengths")]), np.mean(err[("openbody", "motion")])
+        before, after = np.mean(err[("smpl", "lengths")]), np.mean(err[("openbody", "clip")])
         print(f"    -> {before:.2f} cm (legacy layout, exact-skeleton fit) vs {after:.2f} cm (OpenBody layout, "
               f"plausible fit): ratio {before / after:.2f}")
         out[f"ik_{archive}_legacy_err_cm"] = float(before)
         out[f"ik_{archive}_err_cm"] = float(after)
+        out[f"ik_{archive}_motion_fit_err_cm"] = float(np.mean(err[("openbody", "motion")]))
+        out[f"ik_{archive}_builder_err_cm"] = float(np.mean(err[("openbody", "clip+10")]))
         out[f"ik_{archive}_default_layout_err_cm"] = float(np.mean(err[("default", "motion")]))
         out[f"ik_{archive}_openbody_lengths_fit_err_cm"] = float(np.mean(err[("openbody", "lengths")]))
-        out[f"ik_{archive}_max_abs_beta"] = beta[("openbody", "motion")]
+        out[f"ik_{archive}_max_abs_beta"] = beta[("openbody", "clip")]
         out[f"ik_{archive}_legacy_max_abs_beta"] = beta[("smpl", "lengths")]
     return out
 
@@ -199,10 +208,11 @@ def run(quick: bool = False) -> dict:
     solve_ik(clips[0][1][:8], rest)  # warm-up
     ik_lbfgs_baseline(clips[0][1][:8], rest, iters=2)
 
-    ours, analytic, loose, base, ours_fit, base_fit = (_Tally() for _ in range(6))
+    ours, analytic, loose, base, ours_fit, base_fit, ours10 = (_Tally() for _ in range(7))
     for name, joints in clips:
         fitted, fit_rms = _fit_rest(body, joints)
         r = ours.add(*_best_time(lambda: solve_ik(joints, fitted), 3), fitted, joints)
+        ours10.add(*_best_time(lambda: solve_ik(joints, fitted, refine_iters=10), 3), fitted, joints)
         a = analytic.add(*_best_time(lambda: solve_ik(joints, fitted, refine_iters=0), 3), fitted, joints)
         lo = loose.add(*_best_time(lambda: solve_ik(joints, fitted, max_turn_deg=89), 1), fitted, joints)
         b = base.add(*_best_time(lambda: ik_lbfgs_baseline(joints, fitted, iters=100), 1), fitted, joints)
@@ -220,7 +230,8 @@ def run(quick: bool = False) -> dict:
     speedup = base.time / ours.time
     print(f"  total {ours.frames} frames: solve_ik {ours.time:.3f} s ({ours.frames / ours.time:.0f} frames/s; "
           f"analytic only {analytic.time:.3f} s), LBFGS-100 baseline {base.time:.3f} s -> speedup x{speedup:.1f} "
-          f"(analytic only x{base.time / analytic.time:.0f})")
+          f"(analytic only x{base.time / analytic.time:.0f}; 10 refinement steps x{base.time / ours10.time:.1f}, "
+          f"err {ours10.err_cm:.3f} cm)")
     print(f"  joint error on the fitted body: solve_ik {ours.err_cm:.3f} cm (analytic {analytic.err_cm:.3f}, "
           f"max_turn 89: {loose.err_cm:.3f}) vs baseline {base.err_cm:.3f} cm; bone-direction turn p99 "
           f"{ours.turn_p99:.1f} deg vs baseline {base.turn_p99:.1f} deg")
@@ -230,7 +241,8 @@ def run(quick: bool = False) -> dict:
     except Exception as exc:  # archives absent
         print(f"  per-archive table skipped ({exc})")
         archives = {}
-    return {**archives, "ik_speedup": speedup, "ik_err_cm": ours.err_cm, "ik_baseline_err_cm": base.err_cm,
+    return {**archives, "ik_speedup": speedup, "ik_speedup_10_steps": base.time / ours10.time,
+            "ik_err_cm_10_steps": ours10.err_cm, "ik_err_cm": ours.err_cm, "ik_baseline_err_cm": base.err_cm,
             "ik_analytic_err_cm": analytic.err_cm, "ik_analytic_speedup": base.time / analytic.time,
             "ik_max_turn_89_err_cm": loose.err_cm, "ik_bone_turn_p99_deg": ours.turn_p99,
             "ik_baseline_bone_turn_p99_deg": base.turn_p99, "ik_reachable_err_cm": ours_fit.err_cm,

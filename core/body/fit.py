@@ -19,6 +19,10 @@ move a joint < 1 cm per unit), and chasing them with reg 1e-6 drives betas to +-
 girths of 3 m). So a clip is fitted with ``MOTION_REG`` (~1.4 cm bone noise) and each bone weighted
 by the number of joints it carries (``SUBTREE_WEIGHTS``: a torso bone moves 11-13 joints, a
 foot one), which is what the joint error of the retargeted motion counts.
+
+``fit_betas_to_clip`` (the data builder's fit) goes one step further: starting from that fit it
+alternates IK and a linear least-squares step on the betas with the IK poses held fixed, so it
+also sees where the hips, neck and collars sit (layout, not bone lengths).
 """
 from __future__ import annotations
 
@@ -235,3 +239,86 @@ def fit_betas_to_skeleton(body: BodyModel, skeleton, weights=None, reg: float = 
         raise ShapeMoveError(f"match must be 'lengths' or 'positions', got {match!r}")
     ridge = fit_betas_to_positions(body, x, None, reg)
     return fit_betas_to_bone_lengths(body, bone_lengths(x), weights, reg, init=[np.zeros(NUM_BETAS), ridge])
+
+
+CLIP_REG = 1e-4       # the bone-length start (``fit_betas_to_motion``): real clips keep |beta| <~ 2.5
+CLIP_POSE_REG = 1e-5  # per frame and joint, m^2 per unit beta^2, in the pose-aware rounds
+CLIP_FRAMES = 48     # frames (evenly spread) the clip fit looks at
+CLIP_ROUNDS = 3      # IK <-> betas alternations
+
+
+def _world_rotations(rot: np.ndarray) -> np.ndarray:
+    """(F,24,3,3) local rotations -> (F,22,3,3) world rotations of the body joints."""
+    from .skeleton import PARENTS
+
+    G = np.empty((rot.shape[0], NUM_BODY_JOINTS, 3, 3))
+    G[:, 0] = rot[:, 0]
+    for j in range(1, NUM_BODY_JOINTS):
+        G[:, j] = G[:, PARENTS[j]] @ rot[:, j]
+    return G
+
+
+def fit_betas_to_clip(body: BodyModel, joints, reg: float = CLIP_REG, pose_reg: float = CLIP_POSE_REG,
+                      frames: int = CLIP_FRAMES, rounds: int = CLIP_ROUNDS, refine_iters: int = 3) -> BetaFit:
+    """Betas for retargeting a mocap clip onto ``body`` by IK with the least joint error: the data
+    builder's fit. joints (T,22,3) (or (T,24,3)) metres in SMPL order, e.g. ``Motion22.joints``.
+
+    Starts from ``fit_betas_to_motion`` (bone lengths), then alternates ``rounds`` times, on
+    ``frames`` evenly spread frames: IK (``ik.solve_ik``) with the current betas, then the betas
+    (and per-frame translations) that minimise the squared joint error of THOSE poses - with the
+    rotations fixed, forward kinematics is linear in the rest joints, so in the betas - plus
+    ``reg`` x frames x 22 x |betas|^2 (a N(0,1) prior at ~1.4 cm joint noise). Unlike bone lengths
+    this sees the layout of the pelvis and chest (where hips, neck and collars sit), which is
+    what the joint error counts. The IK poses change with the betas, hence the rounds; the
+    result with the lowest IK error (bone-length fit included) wins.
+    """
+    from .ik import solve_ik
+    from .skeleton import PARENTS
+
+    x = np.asarray(joints, dtype=np.float64)
+    if pose_reg < 0 or frames < 1 or rounds < 0:
+        raise ShapeMoveError("pose_reg must be >= 0, frames >= 1 and rounds >= 0")
+    start = fit_betas_to_motion(body, joints, reg=reg)
+    ok = np.flatnonzero(np.all(np.isfinite(x[:, :NUM_BODY_JOINTS]), axis=(1, 2)))
+    tgt = x[ok[np.unique(np.linspace(0, len(ok) - 1, min(frames, len(ok))).round().astype(int))], :NUM_BODY_JOINTS]
+    F = len(tgt)
+    j0 = body.joint_template.detach().cpu().double().numpy()[:NUM_BODY_JOINTS]
+    jd = body.joint_shapedirs.detach().cpu().double().numpy()[:NUM_BODY_JOINTS]
+    par = PARENTS[:NUM_BODY_JOINTS]
+    # bone offsets a_k + B_k b (pelvis: its rest position)
+    a = j0.copy()
+    a[1:] -= j0[par[1:]]
+    B = jd.copy()
+    B[1:] -= jd[par[1:]]
+    # chain[k, i] = 1 when bone i lies on the path from the pelvis to joint k (itself included)
+    chain = np.zeros((NUM_BODY_JOINTS, NUM_BODY_JOINTS))
+    for k in range(NUM_BODY_JOINTS):
+        i = k
+        while i >= 0:
+            chain[k, i] = 1.0
+            i = par[i]
+
+    def ik_error(b):
+        rest = body.rest_joints(np.asarray(b, np.float32)[None])[0].double().numpy()
+        res = solve_ik(tgt, rest, refine_iters=refine_iters)
+        return res, float(res.joint_error.mean())
+
+    best_b = start.betas.astype(np.float64)
+    res, best_err = ik_error(best_b)
+    b = best_b
+    for _ in range(rounds):
+        G = _world_rotations(res.rotations.astype(np.float64))
+        # the world rotation that carries bone i: its parent's (the pelvis offset is not rotated)
+        R = np.concatenate([np.broadcast_to(np.eye(3), (F, 1, 3, 3)), G[:, par[1:]]], 1)   # (F,22,3,3)
+        Ra, RB = np.einsum("fiab,ib->fia", R, a), np.einsum("fiab,ibc->fiac", R, B)
+        pa = np.einsum("ki,fia->fka", chain, Ra)           # (F,22,3)  FK at betas 0, no translation
+        pB = np.einsum("ki,fiac->fkac", chain, RB)         # (F,22,3,10)
+        # the per-frame translation is free: centre both sides over the joints
+        r = (tgt - pa) - (tgt - pa).mean(1, keepdims=True)
+        M = pB - pB.mean(1, keepdims=True)
+        M = M.reshape(-1, NUM_BETAS)
+        b = np.linalg.solve(M.T @ M + pose_reg * F * NUM_BODY_JOINTS * np.eye(NUM_BETAS), M.T @ r.reshape(-1))
+        res, err = ik_error(b)
+        if err < best_err:
+            best_b, best_err = b, err
+    return _result(body, best_b, start.target_lengths, np.where(np.isfinite(start.target_lengths), 1.0, 0.0))
