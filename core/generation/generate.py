@@ -103,11 +103,12 @@ class Generator:
         return self.generate_batch([Request(prompt, shape_text, betas, seconds, seed, temperature, top_k)])[0]
 
     def generate_batch(self, reqs: list[Request], progress=None, cancel=None) -> list[Motion]:
+        from .sampling_params import check_sampling
+
         for r in reqs:
             r.prompt = check_prompt(r.prompt)
             r.shape_text = check_prompt(r.shape_text, "shape text", allow_empty=True) or None
-            if r.temperature < 0:
-                raise ShapeMoveError("temperature must be >= 0 (0 = greedy)")
+            r.seed, r.temperature, r.top_k = check_sampling(r.seed, r.temperature, r.top_k)
         out = []
         for i, r in enumerate(reqs):
             if cancel is not None and cancel():

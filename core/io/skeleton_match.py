@@ -37,6 +37,8 @@ ARM_WORDS = ("arm", "hand", "shoulder", "clav", "elbow", "wrist", "humerus", "ra
 END_WORDS = ("end", "top", "nub", "site", "tip")
 THIGH_OVER_SHIN = 1.0     # hip->knee / knee->ankle of adults (0.9-1.1)
 UPPER_OVER_FOREARM = 1.05  # shoulder->elbow / elbow->wrist
+UPPER_ARM_OVER_LEG = 0.34  # shoulder->elbow / (hip->knee->ankle) of adults
+FOREARM_OVER_LEG = 0.33    # elbow->wrist / (hip->knee->ankle)
 COLLAR_OUT = 0.45          # SMPL's collar joint: this fraction of the way from the mid-line to the shoulder
 
 
@@ -216,6 +218,7 @@ def _leg(tree, hub, leaf, up, scale):
                              "joint or foot end to place the SMPL foot (ball of the foot) on; add a toe bone or an "
                              "End Site to the foot")
     best = None
+    span = tree.dist(hub, ankle)
     for hi, ki in itertools.combinations(range(ankle_i), 2):
         hip, knee = chain[hi], chain[ki]
         a, b = P[knee] - P[hip], P[ankle] - P[knee]
@@ -223,6 +226,7 @@ def _leg(tree, hub, leaf, up, scale):
         if la < 0.05 * scale or lb < 0.05 * scale:
             continue
         cost = abs(np.log(la / lb / THIGH_OVER_SHIN)) + (1 - np.dot(a, b) / (la * lb))
+        cost += 2.0 * (1 - (la + lb) / span)  # thigh + shin make most of the leg (not two halves of a shin)
         cost += 1.0 if np.linalg.norm(P[hip] - P[hub]) < 0.03 * scale else 0.0
         if best is None or cost < best[0]:
             best = (cost, hip, knee)
@@ -232,11 +236,12 @@ def _leg(tree, hub, leaf, up, scale):
     return dict(hip=best[1], knee=best[2], ankle=ankle, foot=foot)
 
 
-def _arm(tree, hub, leaf, up, scale):
+def _arm(tree, hub, leaf, up, scale, leg3):
     chain = tree.down_path(hub, leaf)
     P = tree.rest
     names = tree.names
     best = None
+    span = tree.dist(hub, leaf)
     for si, ei, wi in itertools.combinations(range(len(chain)), 3):
         s, e, w = chain[si], chain[ei], chain[wi]
         a, b = P[e] - P[s], P[w] - P[e]
@@ -245,6 +250,8 @@ def _arm(tree, hub, leaf, up, scale):
             continue
         hand = max(np.linalg.norm(P[c] - P[w]) for c in chain[wi:])
         cost = abs(np.log(la / lb / UPPER_OVER_FOREARM)) + (1 - np.dot(a, b) / (la * lb))
+        cost += 1.0 - (la + lb) / span  # upper arm + forearm make most of the arm (not two halves of one)
+        cost += abs(np.log(la / leg3 / UPPER_ARM_OVER_LEG)) + abs(np.log(lb / leg3 / FOREARM_OVER_LEG))
         cost += 0.5 * max(0.0, hand / lb - 1.0)  # a hand longer than the forearm: wrist too early
         cost += 1.0 if np.linalg.norm(_lateral(P[s] - P[hub], up)) < 0.03 * scale else 0.0
         if best is None or cost < best[0]:
@@ -347,7 +354,7 @@ def match_humanoid(names, parents, rest, rig_name: str = "auto"):
                 f"cannot find a humanoid: the longest limb ends are {', '.join(tree.names[j] for j in leaves)}, "
                 f"and {tree.names[short[0]]!r} is far too short for an {label}; a humanoid needs five ends, "
                 "two feet, two hands and a head (a whole-body skeleton, or a bone-mapping preset)")
-    if tree.lca(hub_l, hub_a) != hub_l or any(tree.lca(hub_a, x) != hub_a for x in (*arms, head_leaf)) \
+    if any(tree.lca(hub_a, x) != hub_a for x in (*arms, head_leaf)) \
             or any(tree.lca(hub_l, x) != hub_l for x in legs):
         raise ShapeMoveError(f"cannot find a humanoid: the arms ({tree.names[arms[0]]}, {tree.names[arms[1]]}) do "
                              f"not hang from a spine above the legs ({tree.names[legs[0]]}, {tree.names[legs[1]]})")
@@ -356,7 +363,9 @@ def match_humanoid(names, parents, rest, rig_name: str = "auto"):
         up = tree.rest[head_leaf] - tree.rest[hub_l]
     up = up / max(np.linalg.norm(up), 1e-12)
     leg_parts = [_leg(tree, hub_l, x, up, leg_len) for x in legs]
-    arm_parts = [_arm(tree, hub_a, x, up, leg_len) for x in arms]
+    leg3 = np.mean([np.linalg.norm(tree.rest[p["knee"]] - tree.rest[p["hip"]])
+                    + np.linalg.norm(tree.rest[p["ankle"]] - tree.rest[p["knee"]]) for p in leg_parts])
+    arm_parts = [_arm(tree, hub_a, x, up, leg_len, leg3) for x in arms]
 
     # left/right: names first, then geometry (left = up x forward, forward from the feet)
     def name_vote(pa, pb, ja, jb):
@@ -380,7 +389,8 @@ def match_humanoid(names, parents, rest, rig_name: str = "auto"):
 
     leg_l, leg_r = order(leg_parts, legs, hub_l, "hip")
     arm_l, arm_r = order(arm_parts, arms, hub_a, "shoulder")
-    spine_path = [hub_l] + tree.down_path(hub_l, hub_a) if hub_a != hub_l else [hub_l]
+    base = tree.lca(hub_l, hub_a)  # where the legs' branch meets the spine (the legs' hub, or above it)
+    spine_path = [base] + tree.down_path(base, hub_a) if hub_a != base else [base]
     head, neck, spine = _head_neck(tree, spine_path, tree.down_path(hub_a, head_leaf), leg_len)
 
     if len(set(norm)) != len(norm):
