@@ -17,6 +17,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "train": ("train", "train a model: `train vae|t5|tma`"),
     "eval": ("eval", "evaluate: `eval recon|generate`"),
     "retarget": ("retarget", "move a motion onto another body through the SA-VAE"),
+    "retarget-rig": ("retarget_rig", "bake a motion onto your own armature in a .blend (Rigify, Mixamo, CC, ...)"),
     "generate": ("generate", "text prompt -> body shape and motion (.npz)"),
     "search": ("search", "rank a folder of motions by a text query (TMA)"),
     "blend": ("blend", "build a .blend scene from a motion (.npz), optionally render a frame"),
@@ -61,6 +62,15 @@ def main(argv: list[str] | None = None) -> int:
         return int(module.run(args) or 0)
     except UserError as exc:
         print(f"error: {exc}", file=sys.stderr)
+        return 2
+    except OSError as exc:  # read-only folder, a parent that is a file, disk full, ...: a sentence
+        from ..core.atomic import os_error_sentence
+
+        where = exc.filename if exc.filename is not None else "a file"
+        print(f"error: {os_error_sentence(exc, where, 'use')}", file=sys.stderr)
+        return 2
+    except MemoryError:
+        print("error: out of memory (the input is too large for this machine)", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         print("interrupted", file=sys.stderr)

@@ -6,8 +6,6 @@ baseline (measured in the same run) and the ratio. ``all`` runs them in order an
 from __future__ import annotations
 
 import importlib
-import json
-import os
 from pathlib import Path
 
 BENCHES = ["ik", "keys", "generate", "train"]
@@ -33,9 +31,8 @@ def run(args) -> int:
         print(f"== bench {name}")
         results.update(mod.run(quick=args.quick))
     if args.json:
-        args.json.parent.mkdir(parents=True, exist_ok=True)
-        tmp = args.json.with_suffix(args.json.suffix + ".tmp")
-        tmp.write_text(json.dumps(results, indent=2))
-        os.replace(tmp, args.json)
+        from ..core.atomic import atomic_write_json
+
+        atomic_write_json(args.json, results)
         print(f"wrote {args.json}")
     return 0

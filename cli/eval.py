@@ -18,7 +18,6 @@ from __future__ import annotations
 import importlib
 import json
 import math
-import os
 from pathlib import Path
 
 
@@ -31,12 +30,9 @@ def write_json(path: Path, result: dict) -> Path:
             return [clean(x) for x in v]
         return None if isinstance(v, float) and not math.isfinite(v) else v
 
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text(json.dumps(clean(result), indent=2) + "\n")
-    os.replace(tmp, path)
-    return path
+    from ..core.atomic import atomic_write_json
+
+    return atomic_write_json(path, clean(result))
 
 
 # -- eval recon ------------------------------------------------------------------------------------

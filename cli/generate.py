@@ -29,6 +29,11 @@ def run(args) -> int:
 
     if args.out.suffix.lower() != ".npz":
         raise ShapeMoveError(f"--out must end in .npz, got {args.out}")
+    from ..core.atomic import ensure_parent
+    from ..core.generation.sampling_params import check_sampling
+
+    check_sampling(args.seed, args.temperature, args.top_k)  # before loading any model
+    ensure_parent(args.out)  # a parent that is a file, or no permission: said now, not after generating
     betas = parse_betas(args.betas) if args.betas else None
     gen = Generator(args.model, body=args.body_model)
     from ..core.generation.generate import Request

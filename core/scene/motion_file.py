@@ -7,7 +7,6 @@ rotations (SMPL convention, relative to the body's rest pose), ``transl`` (T,3) 
 """
 from __future__ import annotations
 
-import os
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -73,7 +72,6 @@ def save_motion(path, m: Motion) -> Path:
     """Write ``m`` atomically to ``path`` (.npz)."""
     validate(m)
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
     arrays = dict(joints=m.joints, betas=m.betas, poses=m.poses, transl=m.transl,
                   fps=np.float32(m.fps), body_model=np.str_(m.body_model))
     if m.prompt is not None:
@@ -81,10 +79,11 @@ def save_motion(path, m: Motion) -> Path:
     for name in ("tokens", "features"):
         if getattr(m, name) is not None:
             arrays[name] = np.asarray(getattr(m, name))
-    tmp = path.with_name(path.name + ".tmp")
-    with open(tmp, "wb") as f:
-        np.savez(f, **arrays)
-    os.replace(tmp, path)
+    from ..atomic import atomic_path
+
+    with atomic_path(path) as tmp:  # read-only folder, a parent that is a file, disk full: a sentence, no *.tmp
+        with open(tmp, "wb") as f:
+            np.savez(f, **arrays)
     return path
 
 

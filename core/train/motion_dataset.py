@@ -23,10 +23,13 @@ def load_stats(root) -> tuple[np.ndarray, np.ndarray]:
     """Mean/Std (263,) float32 of a dataset folder."""
     root = Path(root)
     try:
-        mean = np.load(root / "Mean.npy").astype(np.float32)
-        std = np.load(root / "Std.npy").astype(np.float32)
+        mean = np.load(root / "Mean.npy", allow_pickle=False).astype(np.float32)
+        std = np.load(root / "Std.npy", allow_pickle=False).astype(np.float32)
     except FileNotFoundError as exc:
         raise ShapeMoveError(f"{root}: Mean.npy/Std.npy missing; is this a built dataset folder? (`data build`)") from exc
+    except (OSError, ValueError, EOFError, TypeError) as exc:  # pickled, truncated or not an .npy: never unpickled
+        raise ShapeMoveError(f"{root}: Mean.npy/Std.npy cannot be read as plain number arrays ({str(exc)[:120]}); "
+                             "rebuild the dataset with `data build`") from None
     if mean.shape != std.shape or mean.ndim != 1 or not (np.isfinite(mean).all() and np.isfinite(std).all()):
         raise ShapeMoveError(f"{root}: Mean.npy/Std.npy must be finite vectors of equal length")
     if (std <= 0).any():

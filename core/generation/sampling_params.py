@@ -1,0 +1,47 @@
+"""Check a generation request's sampling numbers (from the command line, the worker or the UI)
+before any model runs: NaN/inf temperatures, negative top-k or out-of-range seeds are a sentence,
+not a traceback from deep inside torch."""
+from __future__ import annotations
+
+import math
+
+from ..errors import ShapeMoveError
+
+MAX_TEMPERATURE = 100.0
+MAX_SEED = 2**63 - 1
+
+
+def _integer(value, name: str) -> int:
+    if isinstance(value, bool):
+        raise ShapeMoveError(f"{name} must be a whole number, got {value!r}")
+    if isinstance(value, float) and math.isfinite(value) and value == int(value):
+        value = int(value)
+    if not isinstance(value, int):
+        try:
+            import numpy as np
+
+            if isinstance(value, np.integer):
+                return int(value)
+        except ImportError:  # pragma: no cover
+            pass
+        raise ShapeMoveError(f"{name} must be a whole number, got {str(value)[:40]!r}")
+    return value
+
+
+def check_sampling(seed, temperature, top_k) -> tuple[int, float, int | None]:
+    """(seed, temperature, top_k) validated: seed 0..2**63-1, temperature finite in [0, 100]
+    (0 = greedy), top_k None/0 (no limit) or a positive whole number."""
+    seed = _integer(seed, "seed")
+    if not 0 <= seed <= MAX_SEED:
+        raise ShapeMoveError(f"seed must be between 0 and 2**63-1, got {seed if abs(seed) < 10**30 else 'a huge number'}")
+    if isinstance(temperature, bool) or not isinstance(temperature, (int, float)):
+        raise ShapeMoveError(f"temperature must be a number, got {str(temperature)[:40]!r}")
+    temperature = float(temperature)
+    if not math.isfinite(temperature) or not 0 <= temperature <= MAX_TEMPERATURE:
+        raise ShapeMoveError(f"temperature must be a finite number from 0 (greedy) to {MAX_TEMPERATURE:g}, "
+                             f"got {temperature}")
+    if top_k is not None:
+        top_k = _integer(top_k, "top-k")
+        if top_k < 0:
+            raise ShapeMoveError(f"top-k must be 0 (no limit) or a positive whole number, got {top_k}")
+    return seed, temperature, top_k
