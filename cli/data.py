@@ -1,4 +1,5 @@
-"""`python -m shapemove data build --source PATH [PATH ...] --out DIR`."""
+"""`python -m shapemove data build --source PATH [PATH ...] --out DIR` and
+`python -m shapemove data compose --data DIR --count N --seed 0`."""
 from __future__ import annotations
 
 from pathlib import Path
@@ -19,9 +20,21 @@ def add_arguments(p):
                    help="LBFGS refinement steps after the analytic IK (0 = analytic only, faster)")
     b.add_argument("--shard", default="0/1", help="i/n: build every n-th clip starting at i (run n processes on one --out)")
     b.add_argument("--only", nargs="*", default=None, help="only clips whose id starts with one of these")
+    c = sub.add_parser("compose", help="add 'A, then B' clips joined with a blended transition to a built dataset")
+    c.add_argument("--data", type=Path, required=True, help="a dataset folder made by `data build`")
+    c.add_argument("--count", type=int, default=1000, help="number of composed clips to add")
+    c.add_argument("--seed", type=int, default=0)
+    c.add_argument("--body-model", default=None, help="openbody (default) or a path to SMPL model files")
 
 
 def run(args) -> int:
+    if args.action == "compose":
+        from ..core.body.load import load_body_model
+        from ..core.data.compose import compose_dataset
+
+        ids = compose_dataset(args.data, args.count, seed=args.seed, body=load_body_model(args.body_model))
+        print(f"composed clips written: {len(ids)} (training split); {args.data}/meta.jsonl, split lists and Mean/Std refreshed")
+        return 0
     from ..core.body.load import load_body_model
     from ..core.data.build import AUGMENT_SHARE, build_dataset
 

@@ -24,7 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ShapeMoveError
-from .shape_text import shape_adjectives, shape_sentence
+from .shape_text import shape_texts
 from .sources import ClipSource, discover, open_source
 from .splits import split_of
 
@@ -161,7 +161,7 @@ def _write_clip(out: Path, cid: str, arrays: dict, clip: ClipSource, split: str,
         _save_npy(out / key / f"{cid}.npy", np.asarray(arrays[key], dtype=np.float32))
     _save_text(out / "texts" / f"{cid}.txt", "\n".join(clip.captions) + "\n")
     m = arrays["measure"]
-    _save_text(out / "shape_texts" / f"{cid}.txt", shape_sentence(m) + "\n" + shape_adjectives(m) + "\n")
+    _save_text(out / "shape_texts" / f"{cid}.txt", "\n".join(shape_texts(m, cid)) + "\n")
     meta = {"id": cid, "source": str(clip.path), "dataset": clip.dataset, "subject": clip.subject,
             "licence": clip.licence, "fps": FPS, "frames": int(arrays["new_joints"].shape[0]),
             "labels": clip.labels, "split": split, "ik_error_cm": round(arrays["ik_error_cm"], 3),
