@@ -237,7 +237,9 @@ def test_real_clip_on_openbody_fitted_to_bone_lengths(mocap_root, openbody):
     turn_base = bone_turn_deg(base.rotations, base.transl, rest, joints)
     print(f"bone turn p99: solve_ik {np.percentile(turn, 99):.1f} deg, baseline {np.percentile(turn_base, 99):.1f} deg")
     assert res.mean_error_cm < 6.0
-    assert np.percentile(turn, 99) < 32 < np.percentile(turn_base, 99)
+    # the refinement lets a bone turn up to free_turn_deg=30 from the target's at no cost, a bit
+    # more against a penalty
+    assert np.percentile(turn, 99) < 35 < np.percentile(turn_base, 99)
     assert loose.mean_error_cm < res.mean_error_cm
 
 

@@ -259,7 +259,7 @@ def _world_rotations(rot: np.ndarray) -> np.ndarray:
 
 
 def fit_betas_to_clip(body: BodyModel, joints, reg: float = CLIP_REG, pose_reg: float = CLIP_POSE_REG,
-                      frames: int = CLIP_FRAMES, rounds: int = CLIP_ROUNDS, refine_iters: int = 3) -> BetaFit:
+                      frames: int = CLIP_FRAMES, rounds: int = CLIP_ROUNDS, refine_iters: int = 2) -> BetaFit:
     """Betas for retargeting a mocap clip onto ``body`` by IK with the least joint error: the data
     builder's fit. joints (T,22,3) (or (T,24,3)) metres in SMPL order, e.g. ``Motion22.joints``.
 

@@ -392,7 +392,7 @@ def _fk_world(rot: torch.Tensor, offs: torch.Tensor, parents, transl: torch.Tens
     return torch.stack(P, 1), torch.stack(G, 1)
 
 
-def refine(rot0, transl0, target, rest, parents, iters: int = 3, end_weight: float = 3.0,
+def refine(rot0, transl0, target, rest, parents, iters: int = 2, end_weight: float = 3.0,
            bone_weight: float = 1.0, free_turn_deg: float = 30.0, huber: float = 5e-3, damping: float = 1e-3, tol: float = 1e-3):
     """Up to ``iters`` damped Gauss-Newton steps per frame, batched over frames, on
 
@@ -441,7 +441,9 @@ def refine(rot0, transl0, target, rest, parents, iters: int = 3, end_weight: flo
     res, bres, dist, loss = terms(pos)
     lam = torch.full((T,), damping, dtype=torch.float32)  # per frame: up when a step fails
     for _ in range(iters):
-        w = torch.cat([weight / dist.clamp_min(huber), (100.0 * bw ** 2).expand(T, n)], 1).float()  # (T,44)
+        # (T,44) joint IRLS weights; bone weights where the bone is past its free turn (the
+        # hinge has no curvature inside the free cone)
+        w = torch.cat([weight / dist.clamp_min(huber), 100.0 * bw ** 2 * (bres != 0).any(-1)], 1).float()
         # blocks: d (w x (p_k - p_j)) / dw = skew(p_j - p_k) for an ancestor j of joint k; the bone
         # (p, k) turns by skew(p_p - p_k); the translation moves joints by I (float32 is plenty
         # for a step: the loss and the pose stay float64)
@@ -449,12 +451,16 @@ def refine(rot0, transl0, target, rest, parents, iters: int = 3, end_weight: flo
         zero = torch.zeros_like(x)
         A = torch.stack([zero, -z, y, z, zero, -x, -y, x, zero], -1).reshape(T, -1, 3, 3)
         A = torch.where((kinds == 2)[:, None, None], eye3, A)
-        J = torch.zeros(T, 2 * n, nb, 3, 3, dtype=torch.float32)
-        J[:, rows, cols] = A
-        J = J.transpose(2, 3).reshape(T, 2 * n * 3, nb * 3)
-        wJ = w.repeat_interleave(3, dim=1)[..., None] * J
+        # bone rows only for the bones past their free turn in some frame (usually a few)
+        keep = torch.cat([torch.ones(n, dtype=torch.bool), (bres != 0).any(-1).any(0)])
+        slot = torch.cumsum(keep, 0) - 1
+        blk = keep[rows]
+        J = torch.zeros(T, int(keep.sum()), nb, 3, 3, dtype=torch.float32)
+        J[:, slot[rows[blk]], cols[blk]] = A[:, blk]
+        J = J.transpose(2, 3).reshape(T, -1, nb * 3)
+        wJ = w[:, keep].repeat_interleave(3, dim=1)[..., None] * J
         H = J.transpose(1, 2) @ wJ
-        g = wJ.transpose(1, 2) @ torch.cat([res, bres], 1).float().reshape(T, -1, 1)
+        g = wJ.transpose(1, 2) @ torch.cat([res, bres], 1)[:, keep].float().reshape(T, -1, 1)
         diag = torch.diagonal(H, dim1=1, dim2=2)
         # relative damping + a floor for directions the joints don't see (a straight limb's twist)
         H = H + torch.diag_embed(lam[:, None] * diag + 1e-3 * diag.mean(-1, keepdim=True))
@@ -485,11 +491,11 @@ def refine(rot0, transl0, target, rest, parents, iters: int = 3, end_weight: flo
     return rot, tr
 
 
-def solve_ik(joints, rest_joints, parents=PARENTS, refine_iters: int = 3, max_turn_deg: float = 30.0) -> IKResult:
+def solve_ik(joints, rest_joints, parents=PARENTS, refine_iters: int = 2, max_turn_deg: float = 30.0) -> IKResult:
     """joints (T,22,3) metres Y-up; rest_joints (24,3) of the target body (e.g.
     ``BodyModel.rest_joints(betas)[0]``). Analytic IK then up to ``refine_iters`` Gauss-Newton
     steps (``refine``; 0 = analytic only; skipped when the analytic error is already below 0.01 mm).
-    Each step costs about a third of the analytic solve: 3 keeps ``bench ik``'s >= 30x over the
+    Each step costs about half the analytic solve: 2 keep ``bench ik``'s >= 30x over the
     100-iteration L-BFGS baseline; 10 (what the data builder passes) lowers the error further.
     ``max_turn_deg``: when the body's proportions differ from the targets', how far (degrees) a
     bone may turn away from the target bone's direction to reach a target joint; larger trades
