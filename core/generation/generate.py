@@ -77,7 +77,6 @@ class Generator:
     @torch.no_grad()
     def tokens_for(self, reqs: list[Request]) -> tuple[list[list[int]], torch.Tensor]:
         from ..models.constrained_decoding import decode
-        from ..models.shapemove_t5 import shapemove_prompt
 
         if self.t5 is None:
             raise ShapeMoveError(f"{self.model_dir} has no t5/ model: text-to-motion needs one (train t5)")
@@ -85,10 +84,8 @@ class Generator:
         for r in reqs:  # one at a time: each has its own seed, length and temperature
             g = torch.Generator().manual_seed(int(r.seed))
             lo, hi = self._length(r.seconds)
-            enc = self.tok([shapemove_prompt(r.prompt, r.shape_text)], return_tensors="pt", truncation=True,
-                           max_length=256)
-            out = decode(self.t5, enc.input_ids, enc.attention_mask, lo, hi, temperature=r.temperature,
-                         top_k=r.top_k, generator=g)
+            inputs = self.t5.inputs_for(self.tok, [r.prompt], [r.shape_text])
+            out = decode(self.t5, inputs, lo, hi, temperature=r.temperature, top_k=r.top_k, generator=g)
             codes.append(out.codes[0])
             betas.append(out.betas[0])
         return codes, torch.stack(betas)

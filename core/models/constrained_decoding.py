@@ -3,7 +3,8 @@
 Logits are masked so that nothing but motion tokens (and `[EOM]` once the minimum length is
 reached) can appear in the motion span; `[EOM]` is forced at the maximum length. The betas come
 from the decoder state whose input is `[BETA]`. Batched; sampling with temperature/top-k, or
-greedy at temperature 0.
+greedy at temperature 0. The decoder keeps its key/value cache between steps (one new token per
+step), for either encoder (``ShapeMoveT5.encode``/``step``).
 """
 from __future__ import annotations
 
@@ -22,29 +23,31 @@ class Decoded:
 def motion_mask(vocab, vocab_size: int, allow_end: bool) -> torch.Tensor:
     """Additive logit mask: 0 for motion codes (and [EOM] when allowed), -inf elsewhere."""
     mask = torch.full((vocab_size,), float("-inf"))
-    mask[vocab.first_code_id: vocab.first_code_id + 1000] = 0.0
+    mask[vocab.first_code_id: vocab.first_code_id + vocab.num_codes] = 0.0
     if allow_end:
         mask[vocab.eom_id] = 0.0
     return mask
 
 
 @torch.no_grad()
-def decode(model, input_ids, attention_mask, min_codes: int, max_codes: int, temperature: float = 1.0,
+def decode(model, inputs: tuple, min_codes: int, max_codes: int, temperature: float = 1.0,
            top_k: int | None = None, generator: torch.Generator | None = None) -> Decoded:
-    lm, vocab = model.lm, model.vocab
-    B = input_ids.shape[0]
-    enc = lm.get_encoder()(input_ids=input_ids, attention_mask=attention_mask)
-    start = lm.config.decoder_start_token_id
+    """``inputs``: ``model.inputs_for(...)`` (token ids + mask for a T5, states + mask + segments
+    for MiniLM)."""
+    vocab = model.vocab
+    enc, enc_mask = model.encode(*inputs)
+    B = enc.shape[0]
+    start = vocab.pad_id  # decoder_start_token_id of every ShapeMove decoder
     seq = torch.tensor([[start, vocab.beta_id, vocab.som_id]] * B, dtype=torch.long)
     # the state whose input is [BETA] (position 1) gives the betas
-    out = lm(encoder_outputs=enc, attention_mask=attention_mask, decoder_input_ids=seq, output_hidden_states=True)
-    betas = model.beta_head(out.decoder_hidden_states[-1][:, 1])
-    V = out.logits.shape[-1]
+    logits, hidden, past = model.step(enc, enc_mask, seq, use_cache=True)
+    betas = model.beta_head(hidden[:, 1])
+    V = logits.shape[-1]
     mask_open, mask_closed = motion_mask(vocab, V, True), motion_mask(vocab, V, False)
     done = torch.zeros(B, dtype=torch.bool)
     codes: list[list[int]] = [[] for _ in range(B)]
     for step in range(max_codes + 1):
-        logits = out.logits[:, -1].float()
+        logits = logits[:, -1].float()
         if step >= max_codes:  # forced end
             nxt = torch.full((B,), vocab.eom_id, dtype=torch.long)
         else:
@@ -54,7 +57,7 @@ def decode(model, input_ids, attention_mask, min_codes: int, max_codes: int, tem
             else:
                 logits = logits / temperature
                 if top_k:
-                    kth = logits.topk(top_k, dim=-1).values[:, -1:]
+                    kth = logits.topk(min(int(top_k), V), dim=-1).values[:, -1:]
                     logits = logits.masked_fill(logits < kth, float("-inf"))
                 nxt = torch.multinomial(torch.softmax(logits, -1), 1, generator=generator).squeeze(1)
         nxt = torch.where(done, torch.full_like(nxt, vocab.pad_id), nxt)
@@ -65,5 +68,5 @@ def decode(model, input_ids, attention_mask, min_codes: int, max_codes: int, tem
         seq = torch.cat([seq, nxt[:, None]], 1)
         if done.all():
             break
-        out = lm(encoder_outputs=enc, attention_mask=attention_mask, decoder_input_ids=seq)
+        logits, _, past = model.step(enc, enc_mask, nxt[:, None], past=past, use_cache=True)
     return Decoded(codes=codes, betas=betas, token_ids=seq[:, 1:].tolist())

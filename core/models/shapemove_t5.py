@@ -1,26 +1,43 @@
-"""ShapeMove's language model: a T5 that reads shape + motion text and writes `[BETA]` followed by
-motion tokens; the decoder state at `[BETA]` is projected to betas (``BetaHead``).
+"""ShapeMove's language model: reads shape + motion text, writes `[BETA]` followed by motion
+tokens; the decoder state at `[BETA]` is projected to betas (``BetaHead``).
 
-Loss = token cross-entropy + ``beta_weight`` * L1(betas). Saved with ``save_pretrained``
-(safetensors) so plain ``transformers`` loads the language model; the beta head and ShapeMove's
-metadata sit beside it in the same folder.
+Two encoders (``encoder`` in the folder's ``shapemove.json``):
+- ``"minilm"`` (default): the prompt is read by the frozen pretrained all-MiniLM-L6-v2
+  (``text_encoder.py``). Shape text and motion text are encoded separately (segments 0 and 1),
+  their token states projected 384 -> d_model and concatenated; a T5 *decoder* stack
+  cross-attends to them and writes from its own motion-only vocabulary (pad, </s>, [BETA],
+  [SOM], [EOM], the N FSQ codes). Saved as ``model.safetensors`` + ``config.json`` (the
+  decoder's T5Config) + the encoder's fingerprint, which loading checks.
+- ``"t5"``: a whole T5 encoder-decoder on a sentencepiece tokenizer trained on the captions (from
+  scratch), or a local pretrained T5 folder (``--base-model``) with its own tokenizer; saved with
+  ``save_pretrained`` + ``tokenizer.json`` (its sha256 recorded and checked on load).
+Format ``shapemove-t5/1`` folders (T5 + tokenizer, before the pretrained encoder) still load.
+
+Loss = token cross-entropy + ``beta_weight`` * L1(betas). The beta head and ShapeMove's metadata
+sit beside the weights in the same folder.
 """
 from __future__ import annotations
 
+import hashlib
 import json
 import os
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
 import torch
+import torch.nn.functional as F
 from torch import nn
 
 from ..errors import ShapeMoveError
 from ..model_files import damaged_model_errors, verify_manifest, write_manifest
 from .beta_head import BetaHead
 
-FORMAT = "shapemove-t5/1"
+FORMAT_V1 = "shapemove-t5/1"  # T5 + sentencepiece tokenizer (the default model until it is retrained)
+FORMAT = "shapemove-t5/2"
+ENCODERS = ("minilm", "t5")
 T5_FILES = ("shapemove.json", "config.json", "model.safetensors", "beta_head.safetensors", "tokenizer.json")
+MINILM_FILES = ("shapemove.json", "config.json", "model.safetensors", "beta_head.safetensors")
+KNOWN_JSON, KNOWN_VECTORS = "known_texts.json", "known_texts.safetensors"
 
 
 @dataclass
@@ -46,17 +63,72 @@ def shapemove_prompt(motion_text: str, shape_text: str | None = None) -> str:
     return f"{head}The person demonstrates a motion like: {motion_text}."
 
 
-class ShapeMoveT5(nn.Module):
-    def __init__(self, lm, beta_head: BetaHead, vocab, beta_weight: float = 1.0):
+def _sha256(path: Path) -> str:
+    h = hashlib.sha256()
+    with open(path, "rb") as f:
+        while block := f.read(1 << 20):
+            h.update(block)
+    return h.hexdigest()
+
+
+class MiniLMDecoder(nn.Module):
+    """MiniLM token states -> (projection + segment embedding) -> T5 decoder stack -> motion logits."""
+
+    def __init__(self, config, text_dim: int = 384):
         super().__init__()
+        from transformers.models.t5.modeling_t5 import T5Stack
+
+        self.config = config
+        d = config.d_model
+        self.proj = nn.Sequential(nn.Linear(text_dim, d), nn.LayerNorm(d))
+        self.segment = nn.Embedding(2, d)  # 0 shape text, 1 motion text
+        self.decoder = T5Stack(config)
+        self.lm_head = nn.Linear(d, config.vocab_size, bias=False)
+
+    @staticmethod
+    def make_config(size: "T5Size", vocab_size: int):
+        from transformers import T5Config
+
+        return T5Config(vocab_size=vocab_size, d_model=size.d_model, d_ff=size.d_ff, d_kv=size.d_kv,
+                        num_layers=size.num_decoder_layers, num_decoder_layers=size.num_decoder_layers,
+                        num_heads=size.num_heads, dropout_rate=size.dropout_rate, is_decoder=True,
+                        is_encoder_decoder=False, use_cache=True, pad_token_id=0, eos_token_id=1,
+                        decoder_start_token_id=0, tie_word_embeddings=False)
+
+    def encode(self, states, mask, segments):
+        return self.proj(states) + self.segment(segments), mask
+
+    def step(self, enc, mask, decoder_ids, past=None, use_cache: bool = False):
+        if use_cache and past is None:  # self- and cross-attention caches (a bare stack would share one)
+            from transformers.cache_utils import DynamicCache, EncoderDecoderCache
+
+            past = EncoderDecoderCache(DynamicCache(config=self.config), DynamicCache(config=self.config))
+        out = self.decoder(input_ids=decoder_ids, encoder_hidden_states=enc, encoder_attention_mask=mask,
+                           past_key_values=past, use_cache=use_cache)
+        hidden = out.last_hidden_state
+        return self.lm_head(hidden), hidden, (out.past_key_values if use_cache else None)
+
+
+class ShapeMoveT5(nn.Module):
+    def __init__(self, lm, beta_head: BetaHead, vocab, beta_weight: float = 1.0, encoder: str = "t5"):
+        super().__init__()
+        if encoder not in ENCODERS:
+            raise ShapeMoveError(f"unknown text encoder {encoder!r}: expected one of {', '.join(ENCODERS)}")
         self.lm = lm
         self.beta_head = beta_head
         self.vocab = vocab  # tokenizer.MotionVocab
         self.beta_weight = beta_weight
+        self.encoder_kind = encoder
+        self.info: dict = {}
+
+    @property
+    def d_model(self) -> int:
+        return self.lm.config.d_model
 
     # -- construction -------------------------------------------------------------------------
     @classmethod
     def build(cls, tokenizer, size: T5Size | None = None, base_model: Path | None = None, beta_weight: float = 1.0):
+        """A whole T5 (encoder-decoder) on ``tokenizer``: from scratch, or a local pretrained folder."""
         from transformers import T5Config, T5ForConditionalGeneration
 
         from .tokenizer import MotionVocab
@@ -76,17 +148,64 @@ class ShapeMoveT5(nn.Module):
                            decoder_start_token_id=tokenizer.pad_token_id, tie_word_embeddings=False)
             lm = T5ForConditionalGeneration(cfg)
         lm.resize_token_embeddings(len(tokenizer))
-        return cls(lm, BetaHead(lm.config.d_model), vocab, beta_weight)
+        return cls(lm, BetaHead(lm.config.d_model), vocab, beta_weight, "t5")
+
+    @classmethod
+    def build_minilm(cls, num_codes: int, size: T5Size | None = None, beta_weight: float = 1.0):
+        """A T5 decoder on the frozen MiniLM's states, writing ``num_codes`` motion codes (the FSQ's
+        codebook size)."""
+        from .text_encoder import HIDDEN
+        from .tokenizer import MotionVocab
+
+        vocab = MotionVocab.motion_only(num_codes)
+        lm = MiniLMDecoder(MiniLMDecoder.make_config(size or T5Size(), vocab.vocab_size), HIDDEN)
+        return cls(lm, BetaHead(lm.config.d_model), vocab, beta_weight, "minilm")
+
+    # -- inputs ---------------------------------------------------------------------------------
+    def inputs_for(self, reader, motion_texts: list[str], shape_texts: list[str | None]) -> tuple:
+        """The encoder inputs of a batch of prompts. ``reader``: the T5's tokenizer, or for MiniLM
+        the TextEncoder / a StateCache of it."""
+        if self.encoder_kind == "minilm":
+            return minilm_inputs(reader, motion_texts, shape_texts)
+        enc = reader([shapemove_prompt(m, s) for m, s in zip(motion_texts, shape_texts)], return_tensors="pt",
+                     padding=True, truncation=True, max_length=256)
+        return enc.input_ids, enc.attention_mask
+
+    def encode(self, *inputs):
+        """(encoder states (B, L, d_model), mask (B, L)) of ``inputs_for``'s inputs."""
+        if self.encoder_kind == "minilm":
+            return self.lm.encode(*inputs)
+        ids, mask = inputs
+        return self.lm.get_encoder()(input_ids=ids, attention_mask=mask).last_hidden_state, mask
+
+    def step(self, enc, mask, decoder_ids, past=None, use_cache: bool = False):
+        """Decoder logits (B, T, V), last hidden states (B, T, d) and the cache, for ``decoder_ids``
+        (all of them, or with ``past`` only the new ones)."""
+        if self.encoder_kind == "minilm":
+            return self.lm.step(enc, mask, decoder_ids, past, use_cache)
+        from transformers.modeling_outputs import BaseModelOutput
+
+        out = self.lm(encoder_outputs=BaseModelOutput(last_hidden_state=enc), attention_mask=mask,
+                      decoder_input_ids=decoder_ids, past_key_values=past, use_cache=use_cache,
+                      output_hidden_states=True)
+        return out.logits, out.decoder_hidden_states[-1], (out.past_key_values if use_cache else None)
 
     # -- training -----------------------------------------------------------------------------
-    def forward(self, input_ids, attention_mask, labels, betas=None):
-        """labels (B,L): [BETA] [SOM] codes [EOM] </s>, padded with -100 (text targets for the
-        motion-to-text task have no [BETA]). Returns dict(loss, ce, l1, betas_pred)."""
-        out = self.lm(input_ids=input_ids, attention_mask=attention_mask, labels=labels, output_hidden_states=True)
-        ce = out.loss
+    def forward(self, inputs_a, inputs_b, labels, betas=None, segments=None):
+        """``inputs_a``, ``inputs_b``: input ids + attention mask (T5), or MiniLM states + mask with
+        ``segments`` (minilm). labels (B,L): [BETA] [SOM] codes [EOM] </s>, padded with -100 (text
+        targets for the motion-to-text task have no [BETA]). Returns dict(loss, ce, l1, betas_pred)."""
+        if self.encoder_kind == "minilm":
+            enc, mask = self.lm.encode(inputs_a, inputs_b, segments)
+            start = torch.full_like(labels[:, :1], self.vocab.pad_id)
+            dec_in = torch.cat([start, labels[:, :-1].masked_fill(labels[:, :-1] < 0, self.vocab.pad_id)], 1)
+            logits, hidden, _ = self.lm.step(enc, mask, dec_in)
+            ce = F.cross_entropy(logits.reshape(-1, logits.shape[-1]).float(), labels.reshape(-1), ignore_index=-100)
+        else:
+            out = self.lm(input_ids=inputs_a, attention_mask=inputs_b, labels=labels, output_hidden_states=True)
+            ce, hidden = out.loss, out.decoder_hidden_states[-1]
         # decoder input is labels shifted right: position i+1 has labels[i] as input, so the state
         # whose INPUT is [BETA] sits one step after [BETA]'s position in labels
-        hidden = out.decoder_hidden_states[-1]
         is_beta = labels == self.vocab.beta_id
         has_beta = is_beta.any(1)
         l1 = ce.new_zeros(())
@@ -101,8 +220,9 @@ class ShapeMoveT5(nn.Module):
         return {"loss": ce + self.beta_weight * l1, "ce": ce.detach(), "l1": l1.detach(), "betas_pred": pred}
 
     # -- persistence --------------------------------------------------------------------------
-    def save(self, directory: Path, tokenizer, meta: dict | None = None) -> None:
-        """Atomic: written into ``directory.tmp`` then renamed over ``directory``."""
+    def save(self, directory: Path, tokenizer=None, meta: dict | None = None, known: dict | None = None) -> None:
+        """Atomic: written into ``directory.tmp`` then renamed over ``directory``. ``known``: the
+        training captions/actions and their MiniLM vectors (``known_texts.py``)."""
         import shutil
 
         from safetensors.torch import save_file
@@ -110,10 +230,27 @@ class ShapeMoveT5(nn.Module):
         directory = Path(directory)
         tmp = directory.with_name(directory.name + ".tmp")
         shutil.rmtree(tmp, ignore_errors=True)
-        self.lm.save_pretrained(str(tmp), safe_serialization=True)
-        tokenizer.save_pretrained(str(tmp))
+        info = {"format": FORMAT, "encoder": self.encoder_kind, "beta_weight": self.beta_weight,
+                "d_model": self.d_model, "num_codes": self.vocab.num_codes, **(meta or {})}
+        if self.encoder_kind == "minilm":
+            from .text_encoder import fingerprint
+
+            tmp.mkdir(parents=True)
+            save_file({k: v.contiguous() for k, v in self.lm.state_dict().items()}, str(tmp / "model.safetensors"),
+                      metadata={"format": "pt"})
+            (tmp / "config.json").write_text(self.lm.config.to_json_string())
+            info["text_encoder"] = fingerprint()
+        else:
+            if tokenizer is None:
+                raise ShapeMoveError("saving a T5 ShapeMove model needs its tokenizer")
+            self.lm.save_pretrained(str(tmp), safe_serialization=True)
+            tokenizer.save_pretrained(str(tmp))
+            info["tokenizer_sha256"] = _sha256(tmp / "tokenizer.json")
         save_file({k: v.contiguous() for k, v in self.beta_head.state_dict().items()}, str(tmp / "beta_head.safetensors"))
-        info = {"format": FORMAT, "beta_weight": self.beta_weight, "d_model": self.lm.config.d_model, **(meta or {})}
+        if known is not None:
+            from .known_texts import write_known
+
+            write_known(tmp, known)
         (tmp / "shapemove.json").write_text(json.dumps(info, indent=2, default=str))
         write_manifest(tmp)  # sha256 of every file: loading refuses a damaged or swapped file
         old = directory.with_name(directory.name + ".old")
@@ -125,28 +262,88 @@ class ShapeMoveT5(nn.Module):
 
     @classmethod
     def load(cls, directory: Path):
+        """(model in eval mode, text reader): the T5's tokenizer, or the verified MiniLM."""
         from safetensors.torch import load_file
-        from transformers import T5ForConditionalGeneration
-
-        from .tokenizer import MotionVocab, load_tokenizer
 
         directory = Path(directory)
         info_file = directory / "shapemove.json"
         if not info_file.is_file():
             raise ShapeMoveError(f"{directory} is not a ShapeMove T5 model (no shapemove.json)")
-        verify_manifest(directory, required=T5_FILES)
         with damaged_model_errors(directory):
             info = json.loads(info_file.read_text())
-            if not isinstance(info, dict) or info.get("format") != FORMAT:
-                raise ShapeMoveError(f"{directory}: unsupported model format "
-                                     f"{info.get('format') if isinstance(info, dict) else info!r} (expected {FORMAT})")
-            tok = load_tokenizer(directory)
-            lm = T5ForConditionalGeneration.from_pretrained(str(directory), local_files_only=True, dtype=torch.float32)
+        if not isinstance(info, dict) or info.get("format") not in (FORMAT, FORMAT_V1):
+            raise ShapeMoveError(f"{directory}: unsupported model format "
+                                 f"{info.get('format') if isinstance(info, dict) else info!r} (expected {FORMAT})")
+        encoder = info.get("encoder", "t5") if info["format"] == FORMAT else "t5"
+        if encoder not in ENCODERS:
+            raise ShapeMoveError(f"{directory}: unknown text encoder {encoder!r} in shapemove.json")
+        verify_manifest(directory, required=MINILM_FILES if encoder == "minilm" else T5_FILES)
+        with damaged_model_errors(directory):
+            if encoder == "minilm":
+                from transformers import T5Config
+
+                from .text_encoder import HIDDEN, check_fingerprint, load_text_encoder
+                from .tokenizer import MotionVocab
+
+                check_fingerprint(info.get("text_encoder"), str(directory))
+                reader = load_text_encoder()
+                cfg = T5Config.from_json_file(str(directory / "config.json"))
+                vocab = MotionVocab.motion_only(int(info.get("num_codes", 0)))
+                if cfg.vocab_size != vocab.vocab_size:
+                    raise ShapeMoveError(f"{directory}: config.json has {cfg.vocab_size} tokens, shapemove.json "
+                                         f"{info.get('num_codes')} motion codes; the folder is inconsistent")
+                lm = MiniLMDecoder(cfg, HIDDEN)
+                lm.load_state_dict({k: v.float() for k, v in load_file(str(directory / "model.safetensors")).items()})
+            else:
+                from transformers import T5ForConditionalGeneration
+
+                from .tokenizer import MotionVocab, load_tokenizer
+
+                recorded = info.get("tokenizer_sha256")
+                if recorded is not None and _sha256(directory / "tokenizer.json") != recorded:
+                    raise ShapeMoveError(f"{directory}: tokenizer.json is not the tokenizer this model was trained "
+                                         "with (sha256 differs); copy the whole model folder again")
+                reader = load_tokenizer(directory, num_codes=info.get("num_codes"))
+                lm = T5ForConditionalGeneration.from_pretrained(str(directory), local_files_only=True,
+                                                                dtype=torch.float32)
+                vocab = MotionVocab(reader, info.get("num_codes"))
+                if lm.config.vocab_size < vocab.vocab_size:
+                    raise ShapeMoveError(f"{directory}: the tokenizer has {vocab.vocab_size} tokens, the model "
+                                         f"only {lm.config.vocab_size}: tokenizer and model do not match")
             head = BetaHead(lm.config.d_model)
             head.load_state_dict({k: v.float() for k, v in load_file(str(directory / "beta_head.safetensors")).items()})
-            model = cls(lm, head, MotionVocab(tok), info.get("beta_weight", 1.0))
+        model = cls(lm, head, vocab, info.get("beta_weight", 1.0), encoder)
         model.info = info
-        return model.eval(), tok
+        return model.eval(), reader
+
+
+def minilm_inputs(reader, motion_texts: list[str], shape_texts: list[str | None]) -> tuple:
+    """(states (B, L, 384), mask (B, L), segments (B, L)): each sample's shape-text states
+    (segment 0, when it has one) followed by its motion-text states (segment 1)."""
+    from .text_encoder import HIDDEN
+
+    n = len(motion_texts)
+    ms, mm = reader.states(list(motion_texts))
+    has_shape = [i for i, s in enumerate(shape_texts) if s and str(s).strip()]
+    ss, sm = reader.states([shape_texts[i] for i in has_shape]) if has_shape else (None, None)
+    parts = []
+    for i in range(n):
+        m = ms[i][mm[i]]
+        if i in has_shape:
+            k = has_shape.index(i)
+            s = ss[k][sm[k]]
+            parts.append((torch.cat([s, m]), len(s)))
+        else:
+            parts.append((m, 0))
+    L = max(len(p) for p, _ in parts)
+    states = torch.zeros(n, L, HIDDEN)
+    mask = torch.zeros(n, L, dtype=torch.bool)
+    seg = torch.ones(n, L, dtype=torch.long)
+    for i, (p, k) in enumerate(parts):
+        states[i, : len(p)] = p
+        mask[i, : len(p)] = True
+        seg[i, :k] = 0
+    return states, mask, seg
 
 
 def size_from_dict(d: dict) -> T5Size:

@@ -4,7 +4,9 @@
 the FSQ indices. ``T2MExamples`` draws (input text, target tokens, betas) pairs: the input is the
 paper's "shape text + The person demonstrates a motion like: caption", the target
 ``[BETA] [SOM] codes [EOM]``; with ``m2t_share`` > 0 some examples are the reverse task
-(motion tokens in, caption out), the paper's motion-to-text pre-training.
+(motion tokens in, caption out), the paper's motion-to-text pre-training (T5 encoder only).
+For the MiniLM encoder the shape text and the caption are encoded as two segments
+(``minilm_inputs``), each from the frozen encoder's cached states.
 """
 from __future__ import annotations
 
@@ -82,11 +84,28 @@ class T2MExamples:
         shapes = self.shapes[cid]
         shape = None if (not shapes or rng.random() < self.no_shape_share) else rng.choice(shapes)
         return {"input": shapemove_prompt(caption, shape), "codes": codes.tolist(), "text": None,
-                "betas": self.betas[cid], "key": caption}
+                "betas": self.betas[cid], "key": caption, "motion_text": caption, "shape_text": shape}
 
 
 def collate(examples: list[dict], tok, vocab, max_input: int = 160):
+    """T5 encoder: (input_ids, attention_mask, labels, betas)."""
     enc = tok([e["input"] for e in examples], return_tensors="pt", padding=True, truncation=True, max_length=max_input)
+    labels, betas = _targets(examples, tok, vocab)
+    return enc.input_ids, enc.attention_mask, labels, betas
+
+
+def collate_minilm(examples: list[dict], states, vocab):
+    """MiniLM encoder: ((states, mask, segments), labels, betas); ``states``: a StateCache."""
+    from ..models.shapemove_t5 import minilm_inputs
+
+    if any(e["codes"] is None for e in examples):
+        raise ShapeMoveError("motion-to-text examples need the T5 encoder (set m2t_share to 0 for MiniLM)")
+    inputs = minilm_inputs(states, [e["motion_text"] for e in examples], [e["shape_text"] for e in examples])
+    labels, betas = _targets(examples, None, vocab)
+    return inputs, labels, betas
+
+
+def _targets(examples: list[dict], tok, vocab):
     targets = []
     for e in examples:
         if e["codes"] is not None:
@@ -98,4 +117,4 @@ def collate(examples: list[dict], tok, vocab, max_input: int = 160):
     for i, t in enumerate(targets):
         labels[i, : len(t)] = torch.tensor(t)
     betas = torch.stack([torch.as_tensor(e["betas"]) if e["betas"] is not None else torch.zeros(10) for e in examples])
-    return enc.input_ids, enc.attention_mask, labels, betas
+    return labels, betas

@@ -4,11 +4,17 @@
     torchrun --nproc_per_node 2 -m shapemove train t5 --data DATA --vae V --out R  # DDP
 
 1. the frozen SA-VAE turns every clip's normalized motion into FSQ tokens (cached in ``out``);
-2. a sentencepiece tokenizer is trained on the captions + shape texts (or the tokenizer of a
-   pretrained T5 folder given as ``base_model`` is extended);
-3. T5 + [BETA] head learn text -> [BETA] [SOM] codes [EOM] (+ optional motion-to-text examples).
+   the motion vocabulary is its FSQ codebook (levels [8,5,5,5] = 1000 codes);
+2. ``encoder="minilm"`` (default): the frozen pretrained MiniLM reads every caption and shape text
+   once (token states cached in memory), and a T5 decoder learns to cross-attend to them;
+   ``encoder="t5"``: a sentencepiece tokenizer is trained on the captions + shape texts and a whole
+   T5 learns from scratch (or the tokenizer of a pretrained T5 folder given as ``base_model`` is
+   extended and that T5 is fine-tuned);
+3. model + [BETA] head learn text -> [BETA] [SOM] codes [EOM] (+ optional motion-to-text examples,
+   T5 encoder only).
 Writes ``out/last.pt`` (full training state, atomic; ``resume=True`` continues from it) and, at
-the end, ``out/t5/`` (``save_pretrained`` safetensors + tokenizer + beta head + metadata).
+the end, ``out/t5/`` (weights + beta head + metadata, the T5's tokenizer, and the training captions
+and actions with their MiniLM vectors: ``known_texts.py``).
 """
 from __future__ import annotations
 
@@ -29,7 +35,7 @@ from ..models.tokenizer import add_motion_tokens, load_tokenizer, tokenizer_from
 from . import distributed
 from .run_log import record
 from .checkpoint import config_differences, load_checkpoint, save_checkpoint
-from .t5_dataset import T2MExamples, all_texts, collate, tokenize_clips
+from .t5_dataset import T2MExamples, all_texts, collate, collate_minilm, tokenize_clips
 from .train_vae import rng_state, set_rng_state
 
 KIND = "shapemove-t5"
@@ -46,7 +52,8 @@ class T5TrainConfig:
     grad_clip: float = 1.0
     beta_weight: float = 1.0
     max_codes: int = 50            # 10 s at 20 fps, 4x downsampling
-    m2t_share: float = 0.0         # share of motion-to-text examples (the paper's pre-training)
+    m2t_share: float = 0.0         # share of motion-to-text examples (the paper's pre-training; T5 encoder)
+    encoder: str = "minilm"        # "minilm" (frozen pretrained MiniLM + T5 decoder) or "t5" (whole T5)
     vocab_size: int = 2000
     seed: int = 0
     log_every: int = 50
@@ -56,6 +63,17 @@ class T5TrainConfig:
     def tiny(cls) -> "T5TrainConfig":
         return cls(size=asdict(T5Size.tiny()), steps=20, batch_size=4, warmup_steps=2, log_every=5, ckpt_every=10,
                    vocab_size=300, max_codes=16)
+
+    def validate(self, base_model=None) -> None:
+        if self.encoder not in ("minilm", "t5"):
+            raise ShapeMoveError(f"T5 config: encoder must be 'minilm' or 't5', got {self.encoder!r}")
+        if base_model is not None and self.encoder != "t5":
+            raise ShapeMoveError("--base-model is a pretrained T5 folder: use it with \"encoder\": \"t5\" "
+                                 "(the default encoder is the pretrained MiniLM)")
+        if self.encoder == "minilm" and self.m2t_share:
+            raise ShapeMoveError("motion-to-text examples (m2t_share) need the T5 encoder; set m2t_share to 0")
+        if self.steps < 1 or self.batch_size < 1 or self.max_codes < 1:
+            raise ShapeMoveError("T5 config: steps, batch_size and max_codes must be >= 1")
 
     @classmethod
     def load(cls, name_or_path: str | None) -> "T5TrainConfig":
@@ -91,6 +109,9 @@ def train_t5(data, vae, out, config: T5TrainConfig | None = None, base_model=Non
     c = config or T5TrainConfig()
     if steps is not None:
         c.steps = int(steps)
+    if base_model is not None and c.encoder == "minilm":
+        c.encoder = "t5"  # a pretrained T5 folder brings its own encoder
+    c.validate(base_model)
     data, out = Path(data), Path(out)
     dist = distributed.setup(device)
     try:
@@ -121,20 +142,32 @@ def _train(data, vae_path, out, c, base_model, resume, dist, progress, cancel, v
             tmp = out / "tokens.tmp.npz"
             np.savez(tmp, __vae__=np.array(vae_stamp), **tokens)
             os.replace(tmp, cache)
-    # -- 2. tokenizer ------------------------------------------------------------------------
-    tok_dir = out / "tokenizer"
-    if (tok_dir / "tokenizer.json").is_file():
-        tok = load_tokenizer(tok_dir)
-    elif base_model is not None:
-        tok = add_motion_tokens(load_tokenizer(Path(base_model)))
-    else:
-        texts = all_texts(data, read_split(data, "train"))
-        tok = tokenizer_from_sentencepiece(train_sentencepiece(texts, out / "spm" / "sp", c.vocab_size, c.seed))
-    if dist.is_main and not (tok_dir / "tokenizer.json").is_file():
-        tok.save_pretrained(str(tok_dir))
-    # -- 3. model, optimizer, resume ---------------------------------------------------------
+    num_codes = int(vae.quantizer.codebook_size)
+    # -- 2. text reader: MiniLM states of every training text, or the T5's tokenizer ------------
+    from ..models.text_encoder import StateCache, load_text_encoder
+
+    train_ids = read_split(data, "train")
+    states = StateCache(load_text_encoder())  # also gives the known captions' vectors at the end
     torch.manual_seed(c.seed)
-    model = ShapeMoveT5.build(tok, size_from_dict(c.size), base_model=base_model, beta_weight=c.beta_weight).to(dist.device)
+    if c.encoder == "minilm":
+        states.add(all_texts(data, train_ids), progress=dist.is_main and verbose)
+        tok = states
+        model = ShapeMoveT5.build_minilm(num_codes, size_from_dict(c.size), beta_weight=c.beta_weight)
+    else:
+        tok_dir = out / "tokenizer"
+        if (tok_dir / "tokenizer.json").is_file():
+            tok = load_tokenizer(tok_dir, num_codes=num_codes)
+        elif base_model is not None:
+            tok = add_motion_tokens(load_tokenizer(Path(base_model), require_json=False, num_codes=num_codes), num_codes)
+        else:
+            texts = all_texts(data, train_ids)
+            tok = tokenizer_from_sentencepiece(train_sentencepiece(texts, out / "spm" / "sp", c.vocab_size, c.seed),
+                                               num_codes)
+        if dist.is_main and not (tok_dir / "tokenizer.json").is_file():
+            tok.save_pretrained(str(tok_dir))
+        model = ShapeMoveT5.build(tok, size_from_dict(c.size), base_model=base_model, beta_weight=c.beta_weight)
+    # -- 3. model, optimizer, resume ---------------------------------------------------------
+    model = model.to(dist.device)
     optimizer = torch.optim.AdamW(model.parameters(), lr=c.lr, weight_decay=c.weight_decay)
     scheduler = torch.optim.lr_scheduler.LambdaLR(optimizer, lambda s: lr_at(s, c))
     step, rng = 0, random.Random(c.seed + 1000 * dist.rank)
@@ -155,7 +188,8 @@ def _train(data, vae_path, out, c, base_model, resume, dist, progress, cancel, v
         model = DDP(model, find_unused_parameters=True)
     train_set = T2MExamples(data, "train", tokens, c.max_codes, c.m2t_share)
     meta = {"vae": str(vae_path), "vae_body": vae.metadata.get("body"), "config": asdict(c),
-            "downsample": vae.cfg.downsample, "max_codes": c.max_codes, "data": str(data)}
+            "downsample": vae.cfg.downsample, "max_codes": c.max_codes, "data": str(data),
+            "base_model": str(base_model) if base_model is not None else None}
 
     def save(final: bool = False):
         if not dist.is_main:
@@ -165,7 +199,10 @@ def _train(data, vae_path, out, c, base_model, resume, dist, progress, cancel, v
                                "step": step, "rng": rng_state(), "py_rng_examples": rng.getstate()},
                         {"format": 1, "kind": KIND})
         if final:
-            raw.save(out / "t5", tok, meta | {"step": step})
+            from ..models.known_texts import build_known
+
+            raw.save(out / "t5", None if c.encoder == "minilm" else tok, meta | {"step": step},
+                     known=build_known(data, train_ids, states))
 
     bar = tqdm(total=c.steps, initial=step, desc="train t5", unit="step", disable=not (dist.is_main and verbose))
     metrics: dict = {"step": step}
@@ -175,8 +212,13 @@ def _train(data, vae_path, out, c, base_model, resume, dist, progress, cancel, v
         if distributed.broadcast_flag(bool(cancel and dist.is_main and cancel()), dist):
             break
         batch = [train_set.sample(rng) for _ in range(c.batch_size // dist.world_size)]
-        input_ids, attn, labels, betas = (t.to(dist.device) for t in collate(batch, tok, raw.vocab))
-        res = model(input_ids, attn, labels, betas)
+        if c.encoder == "minilm":
+            (x, mask, seg), labels, betas = collate_minilm(batch, states, raw.vocab)
+            res = model(x.to(dist.device), mask.to(dist.device), labels.to(dist.device), betas.to(dist.device),
+                        seg.to(dist.device))
+        else:
+            input_ids, attn, labels, betas = (t.to(dist.device) for t in collate(batch, tok, raw.vocab))
+            res = model(input_ids, attn, labels, betas)
         optimizer.zero_grad(set_to_none=True)
         res["loss"].backward()
         torch.nn.utils.clip_grad_norm_(raw.parameters(), c.grad_clip)
