@@ -6,6 +6,9 @@ pick a worker Python when Blender's has no torch, and remember which job each pa
 from __future__ import annotations
 
 from ..core.errors import ShapeMoveError
+from . import jobs
+from .paths import detect_python
+from .preferences import preferences
 
 RUNNING: dict[str, str] = {}  # panel kind ("generate", "train", ...) -> its running job id
 
@@ -20,10 +23,6 @@ def _ensure_ops() -> None:
 
 def _auto_python() -> bool:
     """Fill an empty 'Python environment' preference with a detected Python that has torch."""
-    from . import jobs
-    from .paths import detect_python
-    from .preferences import preferences
-
     prefs = preferences()
     if prefs is None or prefs.python_env or jobs.python_setting():
         return False
@@ -33,15 +32,13 @@ def _auto_python() -> bool:
         return False
     if not found:
         return False
-    prefs.python_env = found  # its update callback resets the runner
+    prefs.python_env = found  # the job manager starts a runner on the new Python at the next submit
     return True
 
 
 def submit_job(op: str, params: dict, *, kind: str | None = None, label: str | None = None, on_result=None,
                on_error=None, on_progress=None) -> str:
     """Start ``op`` -> job id; raises ShapeMoveError when no runner can be set up."""
-    from . import jobs
-
     _ensure_ops()
     mgr = jobs.manager()
 
@@ -69,14 +66,10 @@ def submit_job(op: str, params: dict, *, kind: str | None = None, label: str | N
 
 
 def running(kind: str) -> bool:
-    from . import jobs
-
     return kind in RUNNING and RUNNING[kind] in jobs.manager().jobs
 
 
 def cancel(kind: str) -> bool:
-    from . import jobs
-
     jid = RUNNING.get(kind)
     if jid is None:
         return False

@@ -20,6 +20,7 @@ import bpy
 from bpy.props import FloatProperty, StringProperty
 
 from ..core.worker.client import default_runner
+from .preferences import preferences
 
 POLL_INTERVAL = 0.1  # s between timer ticks while jobs run
 PYTHON_ENV_VAR = "SHAPEMOVE_PYTHON"
@@ -27,8 +28,6 @@ PYTHON_ENV_VAR = "SHAPEMOVE_PYTHON"
 
 def python_setting(context=None) -> str:
     """The preferences' Python environment (``python_env``), else $SHAPEMOVE_PYTHON, else ""."""
-    from .preferences import preferences
-
     try:
         prefs = preferences(context)
     except (AttributeError, RuntimeError):
@@ -54,6 +53,7 @@ class JobManager:
         self.jobs: dict[str, _Job] = {}
         self.status = ""
         self._progress_shown = False
+        self._python = python_setting() if runner is not None else None  # the Python the runner stands for
 
     @property
     def busy(self) -> bool:
@@ -62,8 +62,12 @@ class JobManager:
     def submit(self, op: str, params: dict | None = None, *, label: str | None = None, on_result=None,
                on_error=None, on_progress=None, on_log=None) -> str:
         """Start a job (raises ShapeMoveError when no runner can be set up) -> its id."""
+        python = python_setting()
+        if self.runner is not None and python != self._python:
+            self.set_runner(None)  # the Python environment preference changed: start the new one
         if self.runner is None:
-            self.runner = default_runner(python_setting())
+            self.runner = default_runner(python)
+            self._python = python
         jid = self.runner.submit(op, params)
         self.jobs[jid] = _Job(label or op, on_result, on_error, on_progress, on_log)
         self._set_status(f"{label or op}: started")
@@ -80,12 +84,14 @@ class JobManager:
     def set_runner(self, runner=None) -> None:
         """Stop the current runner (its jobs end with an error) and use ``runner`` (None: pick again
         at the next submit, e.g. after the Python environment preference changed)."""
-        old, self.runner = self.runner, None
+        old, self.runner, self._python = self.runner, None, None
         if old is not None:
             old.stop()
             for msg in old.poll():
                 self._dispatch(msg)
         self.runner = runner
+        if runner is not None:  # kept until the Python environment preference changes
+            self._python = python_setting()
 
     # -- timer --------------------------------------------------------------------------------
     def poll(self) -> float | None:

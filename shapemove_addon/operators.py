@@ -15,25 +15,23 @@ import numpy as np
 from bpy.props import BoolProperty, EnumProperty, IntProperty, StringProperty
 from bpy_extras.io_utils import ExportHelper, ImportHelper
 
+from ..core.constants import NUM_BETAS, is_openbody
 from ..core.errors import ShapeMoveError
 from ..core.scene.bodies import load_body
 from ..core.scene.motion_file import load_motion
-from . import job_submit, paths, semantic_shape, shape_sync
+from . import job_submit, paths, redecode, semantic_shape, shape_sync
 from .export import FORMATS, export_rig
+from .jobs import report_error
 from .preferences import body_spec, preferences, setting
 from .redecode import HAS_TOKENS_KEY, MOTION_FILE_KEY
+from .rig_state import current_betas, rig_body_spec, rig_of
 from .scene_build import SLIDER_RANGE, build_rig
 
 MEASUREMENT_PROPS = ("height_cm", "chest_cm", "waist_cm", "hip_cm")
 
 
 def active_rig(context):
-    return shape_sync.rig_of(context.active_object)
-
-
-def rig_body_spec(rig) -> str:
-    """The worker's "body" for a rig: openbody, or the SMPL file of the preferences."""
-    return "openbody" if rig is None or str(rig.get("shapemove_body_model", "")).startswith("openbody") else body_spec()
+    return rig_of(context.active_object)
 
 
 def store_measurements(rig, measurements: dict) -> None:
@@ -45,8 +43,6 @@ def store_measurements(rig, measurements: dict) -> None:
 
 def build_rig_from_file(path: str, name: str = "ShapeMove", measurements: dict | None = None):
     """From a job callback: build the rig through the (undoable) build operator; errors -> popup."""
-    from .jobs import report_error
-
     try:
         bpy.ops.shapemove.build_from_motion(filepath=str(path), rig_name=name)
     except RuntimeError as exc:  # the operator's ERROR report
@@ -95,7 +91,7 @@ class SHAPEMOVE_OT_build_from_motion(bpy.types.Operator, ImportHelper):
     def execute(self, context):
         try:
             motion = load_motion(self.filepath)
-            model_file = self.body_model_file or (body_spec(context) if not motion.body_model.startswith("openbody") else None)
+            model_file = self.body_model_file or (body_spec(context) if not is_openbody(motion.body_model) else None)
             if model_file == "openbody":
                 model_file = None
             rig = build_rig(context, motion, load_body(motion.body_model, model_file), name=self.rig_name,
@@ -179,7 +175,7 @@ class SHAPEMOVE_OT_random_shape(_RigOperator, bpy.types.Operator):
     def execute(self, context):
         rig = active_rig(context)
         rng = np.random.default_rng(None if self.seed < 0 else self.seed)
-        betas = np.clip(rng.normal(0.0, context.scene.shapemove.random_scale, shape_sync.NUM_BETAS),
+        betas = np.clip(rng.normal(0.0, context.scene.shapemove.random_scale, NUM_BETAS),
                         -SLIDER_RANGE, SLIDER_RANGE)
         try:
             semantic_shape.forget_phenotype(rig)
@@ -200,7 +196,7 @@ class SHAPEMOVE_OT_reset_shape(_RigOperator, bpy.types.Operator):
         rig = active_rig(context)
         try:
             semantic_shape.forget_phenotype(rig)
-            shape_sync.set_betas(rig, np.zeros(shape_sync.NUM_BETAS), context)
+            shape_sync.set_betas(rig, np.zeros(NUM_BETAS), context)
         except ShapeMoveError as exc:
             self.report({"ERROR"}, str(exc))
             return {"CANCELLED"}
@@ -250,7 +246,7 @@ class SHAPEMOVE_OT_measure(_JobOperator, _RigOperator, bpy.types.Operator):
             if target is not None and not msg.get("cancelled"):
                 store_measurements(target, msg["result"])
 
-        params = {"betas": shape_sync.current_betas(rig).tolist(), "body": rig_body_spec(rig)}
+        params = {"betas": current_betas(rig).tolist(), "body": rig_body_spec(rig)}
         job_submit.submit_job("measure", params, kind="measure", label="measure", on_result=done)
         return ""
 
@@ -268,8 +264,6 @@ class SHAPEMOVE_OT_redecode(_JobOperator, _RigOperator, bpy.types.Operator):
         return rig is not None and bool(rig.get(HAS_TOKENS_KEY))
 
     def start(self, context):
-        from . import redecode
-
         redecode.submit(active_rig(context))
         return "re-decoding..."
 
@@ -279,7 +273,7 @@ def _retarget_job(context, source: str, target_rig, name: str) -> None:
     params = {"source": source, "body": rig_body_spec(target_rig), "model": setting("active_model") or None,
               "out": str(paths.new_motion_path(name))}
     if target_rig is not None:
-        params["betas"] = shape_sync.current_betas(target_rig).tolist()
+        params["betas"] = current_betas(target_rig).tolist()
 
     def done(msg):
         if not msg.get("cancelled"):
@@ -308,7 +302,7 @@ class SHAPEMOVE_OT_retarget(_JobOperator, bpy.types.Operator):
             name = Path(source).stem
         else:
             arm = context.active_object
-            if arm is None or arm.type != "ARMATURE" or shape_sync.rig_of(arm) is arm:
+            if arm is None or arm.type != "ARMATURE" or rig_of(arm) is arm:
                 raise ShapeMoveError("make the armature whose action you want to retarget active (not a ShapeMove rig)")
             if arm.animation_data is None or arm.animation_data.action is None:
                 raise ShapeMoveError(f"{arm.name!r} has no action to retarget")

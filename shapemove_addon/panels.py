@@ -8,15 +8,15 @@ from __future__ import annotations
 
 import bpy
 
-from . import job_submit, semantic_shape
+from ..core.constants import NUM_BETAS
+from . import job_submit, jobs, semantic_shape
+from .preferences import setting
 from .redecode import HAS_TOKENS_KEY
-from .shape_sync import NUM_BETAS, rig_of
+from .rig_state import rig_of
 
 
 def _job_fraction(kind: str):
     """(fraction, status text) of the panel's running job, or None."""
-    from . import jobs
-
     if not job_submit.running(kind):
         return None
     mgr = jobs.manager()
@@ -190,8 +190,6 @@ class SHAPEMOVE_PT_train(_SubPanel, bpy.types.Panel):
     bl_options = {"DEFAULT_CLOSED"}
 
     def draw(self, context):
-        from .preferences import setting
-
         s = context.scene.shapemove
         col = self.layout.column()
         col.prop(s, "train_data")

@@ -15,6 +15,7 @@ from pathlib import Path
 import bpy
 
 from ..core.errors import ShapeMoveError
+from ..core.worker.client import torch_importable
 from .preferences import ADDON_ID, preferences
 
 HOME_ENV_VAR = "SHAPEMOVE_HOME"
@@ -108,8 +109,6 @@ def candidate_pythons() -> list[Path]:
 def detect_python() -> str:
     """"" when torch imports in this Python (jobs run in-process), else the first candidate
     Python where it imports; ShapeMoveError asking the user to set one when none works."""
-    from ..core.worker.client import torch_importable
-
     if torch_importable():
         return ""
     for exe in candidate_pythons():

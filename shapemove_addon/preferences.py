@@ -9,12 +9,6 @@ from bpy.props import EnumProperty, StringProperty
 ADDON_ID = __package__.rpartition(".")[0] or __package__
 
 
-def _python_changed(self, context):
-    from . import jobs
-
-    jobs.manager().set_runner(None)  # the next job starts with the new Python
-
-
 class ShapeMovePreferences(bpy.types.AddonPreferences):
     bl_idname = ADDON_ID
 
@@ -28,7 +22,7 @@ class ShapeMovePreferences(bpy.types.AddonPreferences):
         description="SMPL/SMPL-H/SMPL-X .npz or .pkl you downloaded (or the folder holding it)",
     )
     python_env: StringProperty(
-        name="Python environment", subtype="FILE_PATH", default="", update=_python_changed,
+        name="Python environment", subtype="FILE_PATH", default="",
         description="Python executable (or its virtual environment folder) with torch, used for generation, "
                     "retargeting, search and training. Empty: Blender's Python if torch imports there",
     )

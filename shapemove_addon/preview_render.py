@@ -11,7 +11,7 @@ import bpy
 import numpy as np
 from mathutils import Vector
 
-from .shape_sync import body_of
+from .rig_state import body_of
 
 BODY_COLOR = (0.85, 0.35, 0.25, 1.0)
 GROUND_COLOR = (0.55, 0.55, 0.55, 1.0)

@@ -11,16 +11,18 @@ import bpy
 from bpy.props import (BoolProperty, CollectionProperty, EnumProperty, FloatProperty, FloatVectorProperty,
                        IntProperty, PointerProperty, StringProperty)
 
+from ..core.constants import NUM_BETAS
 from . import semantic_shape, shape_sync
+from .rig_state import current_betas, rig_of
 
 
 def _get_betas(self):
-    rig = shape_sync.rig_of(self.id_data)
-    return [float(b) for b in shape_sync.current_betas(rig)] if rig else [0.0] * shape_sync.NUM_BETAS
+    rig = rig_of(self.id_data)
+    return [float(b) for b in current_betas(rig)] if rig else [0.0] * NUM_BETAS
 
 
 def _set_betas(self, values):
-    rig = shape_sync.rig_of(self.id_data)
+    rig = rig_of(self.id_data)
     if rig is None:
         return
     try:
@@ -33,11 +35,11 @@ def _phenotype_property(name: str):
     label, lo, hi, description = semantic_shape.PHENOTYPES[name]
 
     def get(self):
-        rig = shape_sync.rig_of(self.id_data)
+        rig = rig_of(self.id_data)
         return float(semantic_shape.phenotype_values(rig).get(name, (lo + hi) / 2)) if rig else (lo + hi) / 2
 
     def set_(self, value):
-        rig = shape_sync.rig_of(self.id_data)
+        rig = rig_of(self.id_data)
         if rig is None:
             return
         try:
@@ -56,7 +58,7 @@ _MEASURE = dict(min=0.0, precision=1, subtype="NONE", description="Measured on t
 class ShapeMoveObjectProperties(bpy.types.PropertyGroup):
     betas: FloatVectorProperty(
         name="Betas", description="Body shape (the body's shape keys beta_0..beta_9); bones follow",
-        size=shape_sync.NUM_BETAS, min=-5.0, max=5.0, soft_min=-5.0, soft_max=5.0, precision=3,
+        size=NUM_BETAS, min=-5.0, max=5.0, soft_min=-5.0, soft_max=5.0, precision=3,
         get=_get_betas, set=_set_betas,
     )
     height: _phenotype_property("height")
@@ -80,7 +82,7 @@ class ShapeMoveLibraryItem(bpy.types.PropertyGroup):
 
 
 def _is_rig(self, obj):
-    return shape_sync.rig_of(obj) is obj
+    return rig_of(obj) is obj
 
 
 class ShapeMoveSceneSettings(bpy.types.PropertyGroup):

@@ -11,9 +11,14 @@ from __future__ import annotations
 import bpy
 import numpy as np
 
+from ..core.scene.motion_file import load_motion
 from ..core.scene.rig_data import motion_channels_z_up
-from . import shape_sync
+from . import paths
+from .job_submit import submit_job
+from .jobs import report_error
 from .keyframes import write_pose_action
+from .preferences import setting
+from .rig_state import current_betas, rig_body_spec
 
 DEBOUNCE = 0.6  # s of quiet after the last slider move before a job starts
 MOTION_FILE_KEY = "shapemove_motion_file"
@@ -62,12 +67,8 @@ def _fire():
 
 def submit(rig) -> str:
     """Start the redecode job for the rig's current betas -> job id."""
-    from . import paths
-    from .job_submit import submit_job
-    from .preferences import setting
-
-    betas = shape_sync.current_betas(rig)
-    params = {"motion": rig[MOTION_FILE_KEY], "betas": betas.tolist(), "body": _body_spec(rig),
+    betas = current_betas(rig)
+    params = {"motion": rig[MOTION_FILE_KEY], "betas": betas.tolist(), "body": rig_body_spec(rig),
               "model": setting("active_model") or None,
               "out": str(paths.new_motion_path(f"{rig.name}_redecoded"))}
     name = rig.name
@@ -78,27 +79,17 @@ def submit(rig) -> str:
     return jid
 
 
-def _body_spec(rig) -> str:
-    from .preferences import body_spec
-
-    return "openbody" if str(rig.get("shapemove_body_model", "")).startswith("openbody") else body_spec()
-
-
 def _failed(name, msg) -> None:
-    from .jobs import report_error
-
     _inflight.pop(name, None)
     report_error(f"re-decoding {name} failed: {msg['message']}")
 
 
 def _answered(name, betas, msg) -> None:
-    from ..core.scene.motion_file import load_motion
-
     _inflight.pop(name, None)
     rig = bpy.data.objects.get(name)
     if rig is None or msg.get("cancelled"):
         return
-    if np.abs(shape_sync.current_betas(rig) - betas).max() > 1e-4:
+    if np.abs(current_betas(rig) - betas).max() > 1e-4:
         schedule(rig)  # the shape changed while the job ran
         return
     if name in _scheduled:

@@ -9,8 +9,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..core.constants import is_openbody
 from ..core.errors import ShapeMoveError
 from . import shape_sync
+from .rig_state import current_betas
 
 PHENOTYPE_KEY = "shapemove_phenotype"
 # name -> (label, soft min, soft max, description); the order of the panel
@@ -26,7 +28,7 @@ PHENOTYPES = {
 
 def semantic_body(rig):
     """The numpy body with the phenotype map for ``rig``'s body model, or None (not OpenBody)."""
-    if rig is None or not str(rig.get("shapemove_body_model", "")).startswith("openbody"):
+    if rig is None or not is_openbody(rig.get("shapemove_body_model", "")):
         return None
     from ..core.body.body_arrays import load_body_arrays
 
@@ -43,7 +45,7 @@ def phenotype_values(rig) -> dict:
     if stored is not None and len(stored) == len(body.phenotype_names):
         values = np.asarray(stored, dtype=np.float64)
     else:
-        values = body.phenotype_from_betas(shape_sync.current_betas(rig))
+        values = body.phenotype_from_betas(current_betas(rig))
     return dict(zip(body.phenotype_names, values.tolist()))
 
 
@@ -58,7 +60,7 @@ def set_phenotype(rig, name: str, value: float, context=None) -> np.ndarray:
     old = np.array([current[n] for n in body.phenotype_names])
     new = old.copy()
     new[body.phenotype_names.index(name)] = float(value)
-    betas = shape_sync.current_betas(rig) + (new - old) @ body.phenotype_matrix
+    betas = current_betas(rig) + (new - old) @ body.phenotype_matrix
     rig[PHENOTYPE_KEY] = new.tolist()
     shape_sync.set_betas(rig, betas, context)
     return betas

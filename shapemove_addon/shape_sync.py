@@ -13,37 +13,15 @@ import bpy
 import numpy as np
 from bpy.app.handlers import persistent
 
+from ..core.constants import NUM_BETAS
 from ..core.errors import ShapeMoveError
 from ..core.scene.shape_keys import rest_joints_for
+from . import redecode
 from .bone_placement import place_bones
+from .rig_state import body_of, current_betas, placed_betas, rig_of
 from .scene_build import RIG_MARK, SLIDER_RANGE
 
-NUM_BETAS = 10
 TOLERANCE = 1e-6
-
-
-def rig_of(obj):
-    """The ShapeMove armature for ``obj`` (the armature itself or its body mesh), or None."""
-    for cand in (obj, getattr(obj, "parent", None)):
-        if cand is not None and cand.type == "ARMATURE" and cand.get(RIG_MARK):
-            return cand
-    return None
-
-
-def body_of(rig):
-    body = rig.get("shapemove_body")
-    return body if isinstance(body, bpy.types.Object) and body.type == "MESH" else None
-
-
-def current_betas(rig) -> np.ndarray:
-    """(10,) the body's shape-key values (zeros for missing keys)."""
-    body = body_of(rig)
-    keys = body.data.shape_keys.key_blocks if body and body.data.shape_keys else {}
-    return np.array([keys[f"beta_{i}"].value if f"beta_{i}" in keys else 0.0 for i in range(NUM_BETAS)])
-
-
-def placed_betas(rig) -> np.ndarray:
-    return np.asarray(rig.get("shapemove_betas", [0.0] * NUM_BETAS), dtype=np.float64)
 
 
 def set_betas(rig, betas, context=None) -> None:
@@ -77,8 +55,6 @@ def on_betas_changed(obj, context=None) -> None:
     place_bones(context, rig, rest_joints_for(jt, jd, betas), names, parents)
     rig["shapemove_betas"] = betas.tolist()
     context.scene.frame_set(context.scene.frame_current)  # re-evaluate the rebased action
-    from . import redecode
-
     redecode.schedule(rig)
 
 
@@ -131,6 +107,4 @@ def unregister():
     if bpy.app.timers.is_registered(_run_pending):
         bpy.app.timers.unregister(_run_pending)
     _pending.clear()
-    from . import redecode
-
     redecode.unregister()

@@ -80,10 +80,33 @@ def test_bvh_and_amc_bombs(tmp_path):
     match.append("larger than 64 MB")
     # 7. a 50 MB hierarchy of junk tokens
     add("junk.bvh", "HIERARCHY\nROOT a\n{\n" + "x " * 5_000_000 + "\nMOTION\n", expect="BVH hierarchy is")
+    # 8. DeepMimic: a 100 MB file is refused unread; deep nesting is a sentence
+    dm = tmp_path / "huge.txt"
+    with open(dm, "wb") as fh:
+        fh.truncate(100 * 2**20)
+    cases.append({"path": str(dm), "asf": None})
+    match.append("are refused")
+    add("nested.txt", '{"Loop": "none", "Frames": ' + "[" * 200000 + "]" * 200000 + "}", expect="not a DeepMimic motion")
     results = run_limited(cases, timeout_s=30, mem_bytes=GB)
     assert len(results) == len(cases)
     for r, m in zip(results, match):
         _check([r], [m])
+
+
+def test_deepmimic_at_its_size_limit_stays_under_1_gb(tmp_path):
+    """The largest DeepMimic file the reader accepts (just under its byte limit) loads in < 1 GB."""
+    from shapemove.core.io import deepmimic
+
+    row = [1 / 30, 0.0, 0.85, 0.0] + [1.0, 0.0, 0.0, 0.0] * 4 + [-0.3] + [1.0, 0.0, 0.0, 0.0] * 2 + [0.3] + \
+          [1.0, 0.0, 0.0, 0.0] + [-0.3] + [1.0, 0.0, 0.0, 0.0] * 2 + [0.3]
+    assert len(row) == 44
+    line = "    [" + ", ".join(f"{v:.6f}" for v in row) + "],\n"
+    n = min(int(0.95 * deepmimic.MAX_BYTES) // len(line), deepmimic.MAX_FRAMES - 1)
+    p = tmp_path / "big.txt"
+    p.write_text('{\n"Loop": "none",\n"Frames":\n[\n' + line * n + line.rstrip(",\n") + "\n]\n}\n")
+    (r,) = run_limited([{"path": str(p), "asf": None}], timeout_s=30, mem_bytes=GB)
+    assert r["outcome"] in ("ok", "ShapeMoveError"), r
+    assert r["max_rss"] < GB and r["seconds"] < 30, r
 
 
 def test_asf_with_many_bones_is_fast(tmp_path):

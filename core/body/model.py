@@ -11,11 +11,11 @@ from dataclasses import dataclass
 import numpy as np
 import torch
 
+from ..constants import NUM_BETAS
 from ..geometry.torch_ops import forward_kinematics
 from .kinematics import as_rotation_matrices, linear_blend_skinning, skinning_transforms
 from .skeleton import JOINT_NAMES, PARENTS
 
-NUM_BETAS = 10
 
 
 @dataclass

@@ -24,6 +24,7 @@ JOINT_INDEX = {name: i for i, name in enumerate(JOINT_NAMES)}
 # HumanML3D conventions (indices into the 22 body joints)
 FOOT_LEFT = [7, 10]    # left ankle, left foot
 FOOT_RIGHT = [8, 11]   # right ankle, right foot
+FOOT_JOINTS = [7, 8, 10, 11]  # left ankle, right ankle, left foot, right foot: contacts and floor height
 FACE_JOINTS = [2, 1, 17, 16]  # r_hip, l_hip, r_shoulder, l_shoulder: defines the facing direction
 
 # Bones of the 22-joint body as (parent, child) pairs, used by bone-length losses and metrics.

@@ -23,12 +23,12 @@ from pathlib import Path
 
 import numpy as np
 
+from ..constants import FPS
 from ..errors import ShapeMoveError
 from .shape_text import shape_texts
 from .sources import ClipSource, discover, open_source
 from .splits import split_of
 
-FPS = 20
 MIN_FRAMES = 24          # 1.2 s; the SA-VAE trains on the clips of >= 64 frames, the T5 on all
 AUGMENT_SHARE = 0.5      # fraction of Bandai clips that get one copy on a sampled body
 AUGMENT_BETA_CLIP = 2.5  # sampled betas ~ N(0,1) clipped to +-2.5

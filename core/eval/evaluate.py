@@ -10,6 +10,7 @@ import weakref
 import numpy as np
 import torch
 
+from ..constants import FPS
 from ..errors import ShapeMoveError
 from . import bones, physics, stability
 
@@ -79,7 +80,7 @@ def mesh_motion(body, betas, rotations, transl, chunk: int = CHUNK, mass: stabil
     }
 
 
-def evaluate_motion(body, betas, rotations, transl, joints=None, target_betas=None, fps: float = 20.0,
+def evaluate_motion(body, betas, rotations, transl, joints=None, target_betas=None, fps: float = FPS,
                     no_contact: str = "unstable", skate_params: dict | None = None) -> dict:
     """Metrics of one clip performed by ``body`` with shape ``betas``.
 

@@ -28,12 +28,12 @@ from pathlib import Path
 
 import numpy as np
 
+from ..constants import FPS
 from ..errors import ShapeMoveError
 
 KEYS = ("r_precision_top1", "r_precision_top3", "matching_score", "fid", "penetrate_cm", "float_cm", "skate_pct",
         "dyn_stable_pct", "height_err_cm", "waist_err_cm", "clips")
 PHYSICS = ("penetrate_cm", "float_cm", "skate_pct", "dyn_stable_pct")
-FPS = 20
 
 
 def load_clips(data, split: str = "test", max_clips: int | None = None, seed: int = 0) -> list[dict]:

@@ -31,6 +31,7 @@ from typing import NamedTuple
 import numpy as np
 import torch
 
+from ..body.skeleton import FOOT_JOINTS as FOOT_JOINT_IDS  # 7, 8, 10, 11 (FOOT_JOINTS here: by side)
 from ..errors import ShapeMoveError
 
 GROUND_TOL = 0.005          # m, penetrate / float tolerance (HUMOS)
@@ -40,7 +41,6 @@ SKATE_WINDOW = 5            # frames (GMD)
 GMD_SKATE = {"height": CONTACT_HEIGHT, "max_step": SKATE_STEP, "window": SKATE_WINDOW}
 STRICT_SKATE = {"height": CONTACT_HEIGHT, "max_step": 0.0025, "window": 1}
 FOOT_JOINTS = {"left": (7, 10), "right": (8, 11)}   # ankle, foot (SMPL order)
-FOOT_JOINT_IDS = [7, 8, 10, 11]
 
 
 class Stat(NamedTuple):

@@ -15,6 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..constants import FPS
 from ..errors import ShapeMoveError
 from .evaluate import evaluate_motion
 from .report import aggregate
@@ -35,7 +36,7 @@ def source_motion(data, clip):
     if not p.is_file():
         raise ShapeMoveError(f"{data}: no clip {clip!r} (new_joints/{clip}.npy missing)")
     joints = np.load(p).astype(np.float32)
-    return Motion22(joints=joints, fps=20.0, source=str(clip), subject="", offsets=np.zeros((22, 3)))
+    return Motion22(joints=joints, fps=float(FPS), source=str(clip), subject="", offsets=np.zeros((22, 3)))
 
 
 def _score(body, motion, betas) -> dict:
@@ -62,7 +63,7 @@ def compare_retargeting(data, checkpoint, clips, target_betas_list, body=None, i
     rows = {"savae": [], "naive": []}
     for i, clip in enumerate(clips):
         joints, name = source_joints(source_motion(data, clip), body)
-        src = Motion22(joints=joints, fps=20.0, source=name, subject="", offsets=np.zeros((22, 3)))  # read once
+        src = Motion22(joints=joints, fps=float(FPS), source=name, subject="", offsets=np.zeros((22, 3)))  # read once
         codes = encode_source(joints, vae, body, ik_refine_iters)
         for betas in targets:
             rows["savae"].append(_score(body, decode_tokens(codes, vae, body, betas, ik_refine_iters), betas))

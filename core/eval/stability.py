@@ -34,10 +34,10 @@ from collections import defaultdict
 import numpy as np
 import torch
 
+from ..constants import FPS
 from ..errors import ShapeMoveError
 
 GRAVITY = 9.81
-FPS = 20.0
 SUPPORT_HEIGHT = 0.05      # m (HUMOS CONTACT_THRESH)
 SUPPORT_STEP = 0.02        # m per frame (HUMOS VELOCITY_THRESH)
 _DIRECTIONS = np.stack([np.cos(np.arange(32) * np.pi / 16), np.sin(np.arange(32) * np.pi / 16)], axis=1)

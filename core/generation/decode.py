@@ -5,10 +5,11 @@ from __future__ import annotations
 import numpy as np
 import torch
 
+from ..body.skeleton import FOOT_JOINTS
+from ..constants import FPS
 from ..errors import ShapeMoveError
 from ..scene.motion_file import Motion
 
-FPS = 20
 
 
 def check_betas(betas) -> np.ndarray:
@@ -33,7 +34,7 @@ def decode_tokens(codes: list[int], vae, body, betas, ik_refine_iters: int = 10,
         feats = vae.denormalize(vae.decode_long(vae.quantizer.indices_to_codes(idx), b))[0]
         joints = joints_from_features(feats.double()).float().numpy()
         rest = body.rest_joints(b)[0].numpy()
-    joints[..., 1] -= joints[:, [7, 8, 10, 11], 1].min()
+    joints[..., 1] -= joints[:, FOOT_JOINTS, 1].min()
     ik = solve_ik(joints, rest, refine_iters=ik_refine_iters)
     poses = matrix_to_axis_angle(ik.rotations).astype(np.float32)
     m = Motion(joints=joints, betas=b[0].numpy(), poses=poses, transl=np.asarray(ik.transl, np.float32),

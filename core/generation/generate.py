@@ -16,12 +16,12 @@ from dataclasses import dataclass
 import numpy as np
 import torch
 
+from ..constants import FPS
 from ..errors import ShapeMoveError
 from ..scene.motion_file import Motion
 from .decode import decode_tokens
 from .prompts import check_prompt
 
-FPS = 20
 
 
 @dataclass

@@ -22,12 +22,12 @@ from pathlib import Path
 import numpy as np
 import torch
 
+from ..constants import FPS
 from ..errors import ShapeMoveError
 from ..io.mocap import Motion22
 from ..scene.motion_file import Motion, validate
 from .decode import check_betas, decode_tokens
 
-FPS = 20
 
 
 def savae_checkpoint(path=None) -> Path:

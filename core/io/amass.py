@@ -21,7 +21,7 @@ from ..geometry.fk import bone_offsets, forward_kinematics
 from ..geometry.rotations import axis_angle_to_matrix
 from ..body.skeleton import JOINT_NAMES, NUM_BODY_JOINTS, PARENTS
 from ..errors import ShapeMoveError
-from .mocap import Mocap, finish_mocap
+from .mocap_clip import Mocap, finish_mocap
 from .units_axes import to_y_up
 
 

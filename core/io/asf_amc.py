@@ -23,7 +23,7 @@ from ..errors import ShapeMoveError
 from ..geometry.fk import forward_kinematics, joints_from_offsets
 from ..geometry.rotations import axis_rotation
 from .limits import MAX_HIERARCHY_BYTES, MAX_JOINT_FRAMES, check_joint_frames, parse_floats, read_text
-from .mocap import Mocap, finish_mocap
+from .mocap_clip import Mocap, finish_mocap
 
 INCH = 0.0254
 MAX_VALUE = 1e7

@@ -15,7 +15,7 @@ from ..errors import ShapeMoveError
 from ..geometry.fk import forward_kinematics, joints_from_offsets
 from ..geometry.rotations import axis_rotation
 from .limits import MAX_HIERARCHY_BYTES, check_joint_frames, parse_floats, read_text
-from .mocap import Mocap, finish_mocap
+from .mocap_clip import Mocap, finish_mocap
 
 CHANNELS = {"xposition": ("p", 0), "yposition": ("p", 1), "zposition": ("p", 2),
             "xrotation": ("r", "x"), "yrotation": ("r", "y"), "zrotation": ("r", "z")}

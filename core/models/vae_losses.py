@@ -9,12 +9,11 @@ from __future__ import annotations
 import torch
 import torch.nn.functional as F
 
-from ..body.skeleton import BODY_BONES, FOOT_LEFT, FOOT_RIGHT
+from ..body.skeleton import BODY_BONES, FOOT_JOINTS, FOOT_LEFT, FOOT_RIGHT
 from ..motion.features import feature_slices, joints_from_features
 
 CONTACT_SLICE = feature_slices["contacts"]
 CONTACT_JOINTS = FOOT_LEFT + FOOT_RIGHT   # joints of the 4 contact channels: 7, 10, 8, 11
-FOOT_JOINTS = [7, 8, 10, 11]
 _PARENT = [p for p, _ in BODY_BONES]
 _CHILD = [c for _, c in BODY_BONES]
 

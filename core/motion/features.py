@@ -38,7 +38,6 @@ from .skeleton_ops import canonicalize, facing_directions, heading_angles, smoot
 
 NUM_JOINTS = 22
 FEATURE_DIM = 263
-FPS = 20
 
 feature_slices = {
     "root_rot_vel": slice(0, 1),

@@ -2,6 +2,7 @@
 ``BodyArrays`` that the scene builder needs)."""
 from __future__ import annotations
 
+from ..constants import is_openbody
 from ..errors import ShapeMoveError
 
 
@@ -21,7 +22,7 @@ def load_body(name: str, model_file=None):
         from .capsule_body import capsule_body
 
         return capsule_body()
-    if name.startswith("openbody"):
+    if is_openbody(name):
         body = loader("openbody")
     elif model_file:
         body = loader(model_file)

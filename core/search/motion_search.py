@@ -20,6 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..constants import FPS
 from ..errors import ShapeMoveError
 
 INDEX_NAME = ".shapemove_index.npz"
@@ -103,13 +104,13 @@ def load_motion_features(path: Path) -> tuple[np.ndarray, str]:
                 return np.asarray(z["features"], np.float32), caption
             if "joints" in z.files:
                 joints = np.asarray(z["joints"], np.float32)
-                fps = float(z["fps"]) if "fps" in z.files else 20.0
+                fps = float(z["fps"]) if "fps" in z.files else float(FPS)
                 if joints.ndim != 3 or joints.shape[1] < 22 or joints.shape[2] != 3:
                     raise ShapeMoveError(f"joints must be (T,22,3), got {joints.shape}")
-                if abs(fps - 20.0) > 1e-3:
+                if abs(fps - FPS) > 1e-3:
                     from ..io.resample import resample_positions
 
-                    joints = resample_positions(joints[:, :22], fps, 20.0)
+                    joints = resample_positions(joints[:, :22], fps, FPS)
                 return features_from_joints(joints[:, :22]), caption
         from ..io.mocap import load_smpl22  # an AMASS file
 

@@ -14,8 +14,11 @@ from pathlib import Path
 
 import numpy as np
 
+from ..constants import FPS
 from ..errors import ShapeMoveError
-from .ops import param
+from ..io.mocap import Motion22
+from ..scene.motion_file import load_motion, save_motion
+from .op_support import JobCancelled, param
 
 TRAIN_KINDS = ("vae", "t5", "tma")
 _GENERATORS: dict = {}
@@ -77,8 +80,6 @@ def generate(params, progress, cancel) -> dict:
     "temperature", "top_k", "model" (folder, optional), "body", "out" (.npz)} -> the motion file
     written, its facts and the body's measurements (cm)."""
     from ..generation.generate import Request
-    from ..scene.motion_file import save_motion
-    from .runner import JobCancelled
 
     op = "generate"
     out = _out_path(params, op)
@@ -104,7 +105,6 @@ def generate(params, progress, cancel) -> dict:
 def redecode(params, progress, cancel) -> dict:
     """params {"motion" (.npz with tokens), "betas" (10), "model", "body", "out"} -> the same tokens
     decoded for the new body, written to ``out``."""
-    from ..scene.motion_file import load_motion, save_motion
 
     op = "redecode"
     out = _out_path(params, op)
@@ -127,7 +127,6 @@ def retarget(params, progress, cancel) -> dict:
     from ..body.fit import bone_lengths, fit_betas_to_bone_lengths
     from ..body.load import load_body_model
     from ..generation.retarget import load_vae, naive_retarget, retarget as savae_retarget, source_joints
-    from ..scene.motion_file import save_motion
 
     op = "retarget"
     out = _out_path(params, op)
@@ -152,7 +151,6 @@ def retarget(params, progress, cancel) -> dict:
             if method == "savae":
                 raise
     if cancel():
-        from .runner import JobCancelled
 
         raise JobCancelled
     progress(0.3, "retargeting" + (" through the SA-VAE" if vae is not None else " (naive: no SA-VAE model)"))
@@ -166,7 +164,6 @@ def _library_clip(path: Path):
     """A search library's clip that is not a mocap file -> Motion22 (20 fps): a dataset's
     ``new_joint_vecs/ID.npy`` (HumanML3D features) or a ``.npz`` with ``joints`` (T,22,3) or
     ``features`` (T,263). Mocap files (.bvh, .amc, AMASS .npz) are returned unchanged."""
-    from ..io.mocap import Motion22
     from ..motion.features import joints_from_features
 
     joints = None
@@ -187,7 +184,7 @@ def _library_clip(path: Path):
             raise ShapeMoveError(f"{path}: unreadable ({exc})") from None
     if joints is None:
         return path
-    return Motion22(joints=np.asarray(joints, np.float64), fps=20.0, source=str(path), subject=path.stem,
+    return Motion22(joints=np.asarray(joints, np.float64), fps=float(FPS), source=str(path), subject=path.stem,
                     offsets=np.zeros((22, 3)))
 
 

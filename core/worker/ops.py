@@ -16,30 +16,7 @@ from contextlib import redirect_stderr
 from pathlib import Path
 
 from ..errors import ShapeMoveError
-
-_REQUIRED = object()
-
-
-def param(params: dict, op: str, name: str, types, default=_REQUIRED):
-    """params[name] checked against ``types`` (a type or tuple); missing -> default or an error."""
-    if name not in params or params[name] is None:
-        if default is _REQUIRED:
-            raise ShapeMoveError(f"op {op!r}: missing parameter {name!r}")
-        return default
-    value = params[name]
-    types = types if isinstance(types, tuple) else (types,)
-    if isinstance(value, bool) and bool not in types or not isinstance(value, types):
-        want = " or ".join(t.__name__ for t in types)
-        raise ShapeMoveError(f"op {op!r}: parameter {name!r} must be {want}, got {type(value).__name__}")
-    return value
-
-
-def _str_list(params, op, name, default=_REQUIRED):
-    value = param(params, op, name, list, default)
-    if value is not None and not all(isinstance(v, str) for v in value):
-        raise ShapeMoveError(f"op {op!r}: parameter {name!r} must be a list of strings")
-    return value
-
+from .op_support import param, str_list
 
 # -- ops ---------------------------------------------------------------------------------------
 def env_info(params, progress, cancel) -> dict:
@@ -99,11 +76,11 @@ def build_dataset(params, progress, cancel) -> dict:
     from ..data.build import AUGMENT_SHARE, build_dataset as _build
 
     op = "build_dataset"
-    sources = [Path(s) for s in _str_list(params, op, "sources")]
+    sources = [Path(s) for s in str_list(params, op, "sources")]
     body = load_body_model(param(params, op, "body", str, None))
     report = _build(sources, Path(param(params, op, "out", str)), body=body,
                     augment_share=float(param(params, op, "augment_share", (int, float), AUGMENT_SHARE)),
-                    limit=param(params, op, "limit", int, None), only=_str_list(params, op, "only", None),
+                    limit=param(params, op, "limit", int, None), only=str_list(params, op, "only", None),
                     progress=progress, cancel=cancel, verbose=False)
     return {**dataclasses.asdict(report), "summary": report.summary()}
 
@@ -146,7 +123,7 @@ def cli(params, progress, cancel) -> dict:
     Commands have no cancel hook: a cancelled cli job still runs to its end."""
     from ...cli import COMMANDS, main
 
-    argv = _str_list(params, "cli", "argv")
+    argv = str_list(params, "cli", "argv")
     if not argv or argv[0] not in COMMANDS or argv[0] == "worker":
         known = ", ".join(c for c in COMMANDS if c != "worker")
         raise ShapeMoveError(f"op 'cli': argv must start with a command ({known}), got {argv[:1]}")

@@ -19,12 +19,10 @@ from dataclasses import dataclass, field
 
 from ..errors import ShapeMoveError
 from . import protocol as P
+from .op_support import JobCancelled
+from .ops import default_jobs, panel_ops_problem
 
 PROGRESS_INTERVAL = 0.05  # s: progress calls closer together than this are dropped (except 100%)
-
-
-class JobCancelled(Exception):
-    """A job may raise this when it sees cancel() is true; it ends as a cancelled result."""
 
 
 @dataclass
@@ -38,8 +36,6 @@ class _Job:
 
 class JobRunner:
     def __init__(self, emit, jobs: dict | None = None):
-        from .ops import default_jobs
-
         self.emit = emit
         self.jobs = default_jobs() if jobs is None else jobs
         self._queue: deque[_Job] = deque()
@@ -72,8 +68,6 @@ class JobRunner:
             self.emit(P.result(req.id, {"shutdown": True}))
             return False
         elif req.op not in self.jobs:
-            from .ops import panel_ops_problem
-
             note = f" ({panel_ops_problem()})" if panel_ops_problem() else ""
             self.emit(P.error(req.id, f"unknown op {req.op!r}; known ops: "
                                       f"{', '.join(sorted([*P.CONTROL_OPS, *self.jobs]))}{note}"))
