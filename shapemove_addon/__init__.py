@@ -6,9 +6,10 @@ from __future__ import annotations
 
 import bpy
 
-from . import jobs, operators, panels, preferences, properties, shape_sync
+from . import jobs, operators, panels, preferences, properties, rig_retarget, shape_sync
 
-classes = (*properties.classes, *preferences.classes, *jobs.classes, *operators.classes, *panels.classes)
+classes = (*properties.classes, *preferences.classes, *jobs.classes, *operators.classes, *panels.classes,
+           *rig_retarget.classes)
 
 
 def register():
@@ -17,9 +18,11 @@ def register():
     properties.register()
     shape_sync.register()
     jobs.register()
+    rig_retarget.register()
 
 
 def unregister():
+    rig_retarget.unregister()
     jobs.unregister()
     shape_sync.unregister()
     properties.unregister()
