@@ -30,7 +30,6 @@ import numpy as np
 
 from ..errors import ShapeMoveError
 
-SIDES = ("left", "right")
 LEG_WORDS = ("leg", "thigh", "knee", "calf", "shin", "foot", "toe", "ankle", "femur", "tibia", "hip")
 ARM_WORDS = ("arm", "hand", "shoulder", "clav", "elbow", "wrist", "humerus", "radius", "shldr", "collar",
              "finger", "thumb", "index", "pinky", "palm")
@@ -152,13 +151,6 @@ def _pair_side(a: str, b: str) -> int:
 def _has_word(name, words) -> bool:
     low = _words(name).lower()
     return any(w in low for w in words)
-
-
-def _is_end(tree, j) -> bool:
-    """An End Site / bone tail (``<parent>_End``) or a name saying 'end/top/nub'."""
-    p = tree.parents[j]
-    low = _words(tree.names[j]).lower()
-    return (p >= 0 and low == _words(tree.names[p]).lower() + "_end") or _has_word(tree.names[j], END_WORDS)
 
 
 def _prune(tree: _Tree, keep: int = 5):
