@@ -31,10 +31,9 @@ import numpy as np
 
 from ..body.skeleton import JOINT_NAMES, NUM_BODY_JOINTS
 from ..errors import ShapeMoveError
+from .rig import SPINE_JOINTS, Rig, normalize
 
 SMPL22 = JOINT_NAMES[:NUM_BODY_JOINTS]
-
-SPINE_JOINTS = ("pelvis", "spine1", "spine2", "spine3")
 
 
 @dataclass(frozen=True)
@@ -89,19 +88,6 @@ def _side(rule, s):
     return tuple(fill(x) if isinstance(x, str) else x for x in rule)
 
 
-@dataclass(frozen=True)
-class Rig:
-    """How one family of skeletons maps to SMPL22. ``chain``: spine points from the hips upward
-    (the mid-hips point is prepended automatically; names in ``optional`` may be missing)."""
-
-    name: str
-    rules: dict
-    chain: tuple
-    neck: str
-    head: str
-    optional: tuple = ()
-
-
 def _rig(name, chain, neck, head, limbs, optional=()):
     rules = dict(limbs)
     rules["neck"] = neck
@@ -138,13 +124,6 @@ RIGS = [
          _limbs("{S}_hip", "{S}_knee", "{S}_ankle", "{S}_toe",
                 ("lerp", "neck", "{S}_shoulder", 0.45), "{S}_shoulder", "{S}_elbow", "{S}_wrist")),
 ]
-
-
-def normalize(name: str) -> str:
-    """Case-folded joint name without a namespace prefix (``mixamorig:LeftArm`` -> ``leftarm``)."""
-    for sep in (":", "|"):
-        name = name.rsplit(sep, 1)[-1]
-    return name.strip().lower()
 
 
 def _rule_names(rule) -> list[str]:

@@ -29,6 +29,7 @@ import re
 import numpy as np
 
 from ..errors import ShapeMoveError
+from .rig import SPINE_JOINTS, Rig, normalize
 
 LEG_WORDS = ("leg", "thigh", "knee", "calf", "shin", "foot", "toe", "ankle", "femur", "tibia", "hip")
 ARM_WORDS = ("arm", "hand", "shoulder", "clav", "elbow", "wrist", "humerus", "radius", "shldr", "collar",
@@ -286,8 +287,6 @@ def _head_neck(tree, spine_path, head_path, scale):
 def match_humanoid(names, parents, rest, rig_name: str = "auto"):
     """A ``rig_map.Rig`` for a humanoid skeleton of any naming: names (J,), parents (J,) with
     parents[j] < j, rest (J,3) joint positions in the rest pose (any unit, any up axis)."""
-    from .rig_map import Rig, SPINE_JOINTS, normalize
-
     tree = _Tree(names, parents, rest)
     norm = [normalize(n) for n in tree.names]
     extent = float(np.ptp(tree.rest, axis=0).max()) if len(tree.names) else 0.0
