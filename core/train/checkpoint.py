@@ -98,7 +98,10 @@ def load_checkpoint(path, map_location="cpu", **expect) -> dict:
     try:
         ckpt = torch.load(path, map_location=map_location, weights_only=True)
     except Exception as exc:  # truncated/corrupt/unrelated file
-        raise ShapeMoveError(f"{path}: cannot read checkpoint ({type(exc).__name__}: {exc})") from exc
+        text = " ".join(str(exc).split())
+        text = text if len(text) <= 160 else text[:157] + "..."
+        raise ShapeMoveError(f"{path}: cannot read checkpoint ({type(exc).__name__}: {text}); a damaged file, or one "
+                             "holding code (refused: only tensors and plain values are loaded)") from None
     if not isinstance(ckpt, dict):
         raise ShapeMoveError(f"{path}: not a ShapeMove checkpoint")
     check_metadata(ckpt.get("metadata"), str(path), **expect)
