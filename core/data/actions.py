@@ -40,8 +40,9 @@ _LIST = [
     _a("walk backward", "locomotion", ["walks backward", "walks backwards"],
        [r"\bwalk\w*\s+backwards?\b", r"\bbackwards? walk"]),
     _a("sidestep", "locomotion", ["walks sideways", "sidesteps", "steps to the side"],
-       [r"\bside ?steps?\b", r"\bwalk\w*\s+(to the )?sideways\b", r"\bsideways steps?\b", r"\bwalk\w* sideways"]),
-    _a("turn", "locomotion", ["turns around", "walks and turns"],
+       [r"\bside ?steps?\b", r"\bwalk\w*\s+(to the )?sideways\b", r"\bsideways steps?\b", r"\bwalk\w* sideways",
+        r"\bsteps? (to the )?side(ways)?\b"]),
+    _a("turn", "locomotion", ["turns around", "turns to face the other way"],
        [r"\bturn(s|ing|ed)?\b(?! step)"]),
     _a("walk in a circle", "locomotion", ["walks in a circle", "goes around in a circle"],
        [r"\bin (a )?circles?\b", r"\bleft circle\b", r"\bcircle walk"]),
@@ -62,13 +63,13 @@ _LIST = [
     _a("jump forward", "acrobatics", ["jumps forward", "does a long jump"],
        [r"\b(forward|far|long) jumps?\b", r"\bjump\w*\s+(\w+ )?forward", r"\bjump\w* far\b", r"\bmakes a far jump"]),
     _a("spin jump", "acrobatics", ["jumps and turns in the air", "does a spinning jump"],
-       [r"\bjump ?turn", r"\bjump\w* (up )?(and|while) (turn|spin)", r"^(90|180|270|360)\b(?![- ]?degree)",
+       [r"\bjump ?turn", r"\bjump\w* (up )?(and|while) (turn|spin)", r"\bspinning jump", r"^(90|180|270|360)\b(?![- ]?degree)",
         r"\b(90|180|270|360)[- ]?(degrees? )?(\w+ ){0,3}jump"]),
     _a("hop", "acrobatics", ["hops", "hops on both feet"], [r"\bhop(s|ping|ped)?\b"]),
     _a("jumping jacks", "exercise", ["does jumping jacks"], [r"\bjumping[- ]jacks?\b"]),
     _a("backflip", "acrobatics", ["does a backflip", "flips backward"], [r"\bback ?flip", r"\bflip\w* backwards?"]),
-    _a("sideflip", "acrobatics", ["does a side flip", "flips sideways"], [r"\bside ?flip"]),
-    _a("cartwheel", "acrobatics", ["does a cartwheel", "turns a cartwheel"], [r"\bcartwheel"]),
+    _a("sideflip", "acrobatics", ["does a side flip", "flips sideways"], [r"\bside ?flip", r"\bflip\w* sideways"]),
+    _a("cartwheel", "acrobatics", ["does a cartwheel", "turns a cartwheel"], [r"\bcartwheel", r"\bturn\w* a cartwheel"]),
     _a("roll", "floor", ["rolls on the ground", "does a forward roll"], [r"\broll(s|ing|ed)?\b(?! de)"]),
     _a("get up", "floor", ["gets up from the ground", "stands up from the floor"],
        [r"\bget(s|ting)? up\b", r"\bstand(s|ing)? up\b", r"\bgetup\b"]),
@@ -93,7 +94,7 @@ _LIST = [
     _a("elbow to knee", "exercise", ["touches each elbow to the opposite knee"],
        [r"\belbow\w* to (the )?(opposite )?knees?"]),
     _a("arm circles", "exercise", ["rotates both arms", "makes circles with the arms"],
-       [r"\brotat\w* (both )?arms", r"\barm circles"]),
+       [r"\brotat\w* (both )?arms", r"\barm circles", r"\bcircl\w* (both |the )?arms", r"\bcircles with the arms"]),
     _a("balance", "exercise", ["balances on one leg"], [r"\bbalanc"]),
     # gestures
     _a("wave", "gesture", ["waves", "waves a hand"], [r"\bwav(e|es|ing)\b"]),
@@ -105,13 +106,13 @@ _LIST = [
     _a("beckon", "gesture", ["beckons someone to come over", "calls someone over with a hand"],
        [r"\bbeckon", r"\bcall\w* (someone|somebody)"]),
     _a("guide", "gesture", ["guides someone with an open hand", "shows the way with a hand"],
-       [r"\bguid(e|es|ing)\b"]),
+       [r"\bguid(e|es|ing)\b", r"\bshows? the way"]),
     # combat
     _a("punch", "combat", ["throws punches", "punches"], [r"\bpunch", r"\bstrike\b", r"\bbox(es|ing)\b", r"\bjab"]),
     _a("kick", "combat", ["kicks", "kicks with one leg"], [r"\bkick(s|ing|ed)?\b"]),
     _a("spin kick", "combat", ["does a spinning kick", "does a spin kick"],
        [r"\bspin ?kick", r"\bspinning kick", r"\broundhouse"]),
-    _a("slash", "combat", ["slashes with a sword", "swings a sword"], [r"\bslash", r"\bsword"]),
+    _a("slash", "combat", ["slashes with a sword", "swings a sword"], [r"\bslash", r"\bsword", r"\bswing\w* (a |the )?sword"]),
     # sport
     _a("kick ball", "sport", ["kicks a ball"], [r"\bkick\w* (a |the )?(soccer )?ball", r"\bsoccer"]),
     _a("throw", "sport", ["throws a ball"], [r"\bthrow\w* (a |the )?(\w+ )?ball", r"\bthrowbasketball"]),
@@ -122,7 +123,7 @@ _LIST = [
        [r"\bdanc(e|es|ing|er)\b", r"\bsalsa", r"\blambada", r"\blindy ?hop"]),
     _a("ballet", "dance", ["does ballet moves", "dances ballet"],
        [r"\bballet", r"\barabesque", r"\bjetes?\b", r"\bglissade", r"\bplie\b", r"\bpirouettes?\b"]),
-    _a("spin", "dance", ["spins around", "turns on the spot"], [r"\bspin(s|ning)?\b", r"\bwhirl", r"\bpirouettes?\b"]),
+    _a("spin", "dance", ["spins around", "turns on the spot"], [r"\bspin(s|ning)?\b", r"\bwhirl", r"\bpirouettes?\b", r"\bturns? on the spot"]),
     _a("pose", "dance", ["holds a pose", "strikes a pose"], [r"\bposes?\b", r"\byoga"]),
     _a("wash", "gesture", ["washes", "takes a shower"], [r"\bwash", r"\bshower"]),
 ]
@@ -138,8 +139,23 @@ def action(name: str) -> Action:
         raise ShapeMoveError(f"unknown action {name!r}; known: {', '.join(ACTIONS)}") from None
 
 
+# a specific action -> the generic ones its words also name ("walks in a circle": walk)
+GENERIC_OF = {"walk in a figure eight": ("walk",), "walk in a circle": ("walk",), "zombie walk": ("walk",),
+              "limp": ("walk",), "sneak": ("walk",), "walk backward": ("walk",), "jump forward": ("jump",),
+              "spin jump": ("jump", "spin"), "kick ball": ("kick",), "spin kick": ("kick", "spin"),
+              "ballet": ("dance",), "wave goodbye": ("wave",), "cartwheel": ("turn",), "slash": ("swing",)}
+
+
+def specific(acts: list[str]) -> list[str]:
+    """Drop the generic actions of the specific ones also present (["walk", "limp"] -> ["limp"])."""
+    drop = {g for a in acts for g in GENERIC_OF.get(a, ())}
+    return [a for a in acts if a not in drop]
+
+
 def find_actions(text: str) -> list[str]:
-    """The canonical actions a text names, in order of appearance (longer overlapping match wins)."""
+    """The canonical actions a text names, in order of appearance (longer overlapping match wins),
+    except that a specific action comes before the generic one it implies ("walks with a limp":
+    limp, walk)."""
     text = split_words(text)
     hits = []  # (start, -length, name, end)
     for name, rx in _COMPILED:
@@ -157,7 +173,8 @@ def find_actions(text: str) -> list[str]:
     for _, name in sorted(found):
         if name not in out:
             out.append(name)
-    return out
+    first = specific(out)
+    return first + [a for a in out if a not in first]
 
 
 def split_words(text: str) -> str:

@@ -13,7 +13,7 @@ from __future__ import annotations
 import hashlib
 import re
 
-from .actions import ACTIONS, find_actions, split_words
+from .actions import ACTIONS, find_actions, specific, split_words
 
 N_CAPTIONS = 6
 
@@ -307,18 +307,6 @@ def cmu_styles(description: str) -> list[str]:
             out.append(CMU_STYLES[key])
             text = text.replace(f" {key} ", " ")
     return out
-
-
-# a specific action and the generic one its words also match ("WalkDigital8": walk + figure eight)
-_GENERIC_OF = {"walk in a figure eight": "walk", "walk in a circle": "walk", "zombie walk": "walk", "limp": "walk",
-               "walk backward": "walk", "jump forward": "jump", "spin jump": "jump", "kick ball": "kick",
-               "spin kick": "kick", "ballet": "dance", "wave goodbye": "wave"}
-
-
-def specific(acts: list[str]) -> list[str]:
-    """Drop a generic action when a more specific one of it is also named."""
-    drop = {_GENERIC_OF[a] for a in acts if a in _GENERIC_OF}
-    return [a for a in acts if a not in drop]
 
 
 def description_actions(desc: str) -> tuple[list[str], list[str]]:

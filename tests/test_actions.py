@@ -1,0 +1,64 @@
+"""The canonical action vocabulary (core/data/actions.py) and the known-actions count of a dataset."""
+import json
+
+import pytest
+
+from shapemove.core.data.actions import ACTIONS, action, clip_actions, find_actions, known_actions, specific
+from shapemove.core.errors import ShapeMoveError
+
+
+def test_vocabulary():
+    assert 55 <= len(ACTIONS) <= 65
+    for a in ACTIONS.values():
+        assert a.phrases and a.patterns and a.group
+        for phrase in a.phrases:  # every phrase the captions write is recognised as its own action
+            assert find_actions(phrase)[0] == a.name, (a.name, phrase)
+    assert action("cartwheel").name == "cartwheel"
+    with pytest.raises(ShapeMoveError, match="unknown action"):
+        action("moonwalk")
+
+
+@pytest.mark.parametrize("text, expected", [
+    ("jumping jacks, side twists, squats, jog", ["jumping jacks", "side twist", "squat", "jog"]),
+    ("A person walks backward", ["walk backward"]),
+    ("WalkDigital8", ["walk in a figure eight", "walk"]),
+    ("A human jumps while turning to its left hand side", ["spin jump"]),
+    ("soccer - kick ball", ["kick ball"]),
+    ("someone waves goodbye", ["wave goodbye"]),
+    ("A person is walking forward with swinging arms", ["walk"]),
+    ("turns around 180 degrees", ["turn"]),
+    ("The person does a 360 clockwise jump", ["spin jump"]),
+    ("a purple teapot", []),
+])
+def test_find_actions(text, expected):
+    assert find_actions(text) == expected
+
+
+def test_specific_drops_generic():
+    assert specific(["walk", "limp"]) == ["limp"] and specific(["walk", "wave"]) == ["walk", "wave"]
+
+
+def test_clip_actions_per_source():
+    assert clip_actions("bandai", {"content": "walk-turn-left", "style": "happy"}, []) == ["walk", "turn"]
+    assert clip_actions("hdm05", {"class": "kickLFront1Reps"}, []) == ["kick"]
+    assert clip_actions("hdm05", {"class": "jogLeftCircle4StepsRstart"}, []) == ["jog", "walk in a circle"]
+    assert clip_actions("deepmimic", {"motion": "long_walk2_mirror"}, []) == ["walk"]
+    assert clip_actions("deepmimic", {"motion": "getup_facedown"}, []) == ["get up"]
+    assert clip_actions("cmu", {"description": "dance - small jetes, pirouette"}, [])[:2] == ["dance", "ballet"]
+    assert clip_actions("user", {}, ["Someone does a cartwheel."]) == ["cartwheel"]
+
+
+def test_known_actions_counts_a_built_dataset(tmp_path):
+    (tmp_path / "meta").mkdir()
+    metas = [("a", "train", ["walk"]), ("b", "train", ["walk", "wave"]), ("c", "test", ["cartwheel"]),
+             ("d", "train", ["wave", "wave"])]
+    for cid, split, acts in metas:
+        (tmp_path / "meta" / f"{cid}.json").write_text(json.dumps({"id": cid, "split": split,
+                                                                   "labels": {"actions": acts}}))
+    assert known_actions(tmp_path) == [("walk", 2), ("wave", 2), ("cartwheel", 1)]
+    assert known_actions(tmp_path, split="train") == [("walk", 2), ("wave", 2)]
+    (tmp_path / "meta.jsonl").write_text("".join(json.dumps({"split": "train", "labels": {"actions": ["kick"]}}) + "\n"
+                                                 for _ in range(3)))
+    assert known_actions(tmp_path) == [("kick", 3)]                       # meta.jsonl wins when present
+    with pytest.raises(ShapeMoveError, match="not a built dataset"):
+        known_actions(tmp_path / "nothing")
