@@ -102,10 +102,10 @@ class ClipProcessor:
         return joints
 
     def fit(self, joints: np.ndarray) -> np.ndarray:
-        from ..body.fit import bone_lengths, fit_betas_to_bone_lengths
+        from ..body.fit import fit_betas_to_clip
 
-        # the subject's bone lengths: the median over frames is robust to marker noise
-        fit = fit_betas_to_bone_lengths(self.body, np.median(bone_lengths(joints), 0), reg=FIT_REG)
+        # a plausible body with the least IK joint error for this clip (bone lengths, then layout)
+        fit = fit_betas_to_clip(self.body, joints)
         return np.asarray(fit.betas, dtype=np.float32)
 
     def pose_on(self, rotations: np.ndarray, root: np.ndarray, betas: np.ndarray, scale: float):
