@@ -361,9 +361,8 @@ def _gn_structure(parents):
     """Sparsity of the refinement's Jacobian. Rows: the 22 joints, then the 22 bones (by child
     joint). Blocks (row, column): a joint k and each strict ancestor j of it that has a child in the
     22-joint body (the leaves' rotations move no body joint), the same for the bone ending at k,
-    and joint k with the root translation (last column). Returns (rows, columns, kinds, movers,
-    triples) with kind 0 joint/ancestor, 1 bone/ancestor, 2 translation, and triples = pairs of
-    blocks in the same row (for J^T W J)."""
+    and joint k with the root translation (last column). Returns (rows, columns, kinds, ancestors,
+    movers), kind 0 joint/ancestor, 1 bone/ancestor, 2 translation."""
     n = NUM_BODY_JOINTS
     movers = [j for j in range(n) if any(parents[c] == j for c in range(1, n))]
     col = {j: i for i, j in enumerate(movers)}
@@ -392,17 +391,18 @@ def _fk_world(rot: torch.Tensor, offs: torch.Tensor, parents, transl: torch.Tens
     return torch.stack(P, 1), torch.stack(G, 1)
 
 
-def refine(rot0, transl0, target, rest, parents, iters: int = 2, end_weight: float = 3.0,
-           bone_weight: float = 1.0, free_turn_deg: float = 30.0, huber: float = 5e-3, damping: float = 1e-3, tol: float = 1e-3):
+def refine(rot0, transl0, target, rest, parents, iters: int = 2, end_weight: float = 3.0, bone_weight: float = 1.0,
+           free_turn_deg: float = 30.0, huber: float = 5e-3, damping: float = 1e-3, tol: float = 1e-3):
     """Up to ``iters`` damped Gauss-Newton steps per frame, batched over frames, on
 
-        sum_k w_k |FK_k - target_k|  +  bone_weight^2 / 2 x sum_b |bone_b - L_b u_b|^2 / 1 cm
+        sum_k w_k huber(|FK_k - target_k|)  +  bone_weight^2 / 2 x sum_b (|bone_b - L_b u_b| - f_b)+^2 / 1 cm
 
-    (w: ankles, feet and wrists ``end_weight``, contacts matter most; bone_b: the posed bone of
-    length L_b, u_b the target bone's direction, for the bones ``bone_turn_deg`` counts): the joint
-    distances as iteratively reweighted least squares (weights 1 / distance), the bone term keeps the
-    bones pointing as in the targets, so a body with other proportions spreads its misses instead
-    of folding a chain to reach them. Closed-form Jacobian: turning joint j's subtree by a small
+    (w: ankles, feet and wrists ``end_weight``, contacts matter most; huber: quadratic below
+    ``huber`` metres, linear above, as iteratively reweighted least squares; bone_b: the posed bone
+    of length L_b, u_b the target bone's direction, for the bones ``bone_turn_deg`` counts; f_b the
+    tip distance of a ``free_turn_deg`` turn): bones turn freely up to ``free_turn_deg`` from the
+    targets' and are held beyond, so a body with other proportions spreads its misses instead of
+    folding a chain to reach them. Closed-form Jacobian: turning joint j's subtree by a small
     world rotation w moves a descendant k by w x (p_k - p_j); the root translation moves all. One
     (T,54,54) Cholesky solve per step; ``damping`` (Levenberg-Marquardt, relative to the diagonal).
     A frame keeps its pose when a step does not lower its loss; stops early when the total loss
