@@ -34,8 +34,38 @@ def test_layout_and_contents(tiny_dataset, openbody):
         shape_lines = (root / "shape_texts" / f"{cid}.txt").read_text().splitlines()
         assert shape_lines[0].startswith("A person standing") and shape_lines[1].startswith(("a ", "an "))
         assert m["fps"] == 20 and m["frames"] == len(j) and m["licence"]
-        # feet on the floor: the lowest foot joint over the clip is at y = 0
-        assert j[:, [7, 8, 10, 11], 1].min() == pytest.approx(0.0, abs=1e-5)
+        # foot contacts: stored per frame, and they are the features' 4 contact channels
+        c = np.load(root / "contacts" / f"{cid}.npy")
+        assert c.dtype == np.uint8 and c.shape == (len(j), 4) and set(np.unique(c)) <= {0, 1}
+        np.testing.assert_array_equal(f[:, 259:263], c[:-1][:, [0, 2, 1, 3]])
+        # the features keep the heights: decoding them gives the stored joints' heights back
+        np.testing.assert_allclose(joints_from_features(f)[..., 1], j[:-1, :, 1], atol=1e-4)
+
+
+def test_feet_stand_on_the_mesh_soles(tiny_dataset, openbody):
+    """Checked on the full posed mesh (not the builder's sole probe): the file's joints are FK of its
+    (betas, poses, transl); on frames with a foot contact the lowest vertex is on the floor; no
+    frame has the mesh under the floor; planted feet do not slide."""
+    root = Path(tiny_dataset)
+    lows, contact_lows, slides = [], [], []
+    for cid in _ids(root, "train") + _ids(root, "val") + _ids(root, "test"):
+        j = np.load(root / "new_joints" / f"{cid}.npy")
+        c = np.load(root / "contacts" / f"{cid}.npy").astype(bool)
+        with torch.no_grad():
+            out = openbody(torch.as_tensor(np.load(root / "betas" / f"{cid}.npy"))[None].expand(len(j), -1),
+                           torch.as_tensor(np.load(root / "poses" / f"{cid}.npy")),
+                           torch.as_tensor(np.load(root / "transl" / f"{cid}.npy")))
+        assert np.abs(out.joints[:, :22].numpy() - j).max() < 1e-3, cid
+        low = out.vertices[..., 1].min(1).values.numpy()
+        lows.append(low)
+        contact_lows.append(low[c.any(1)])
+        step = np.linalg.norm(np.diff(j[:, [7, 8, 10, 11]][..., [0, 2]], axis=0), axis=-1)  # (T-1,4)
+        slides.append(step[c[:-1] & c[1:]])
+    low, on, slide = np.concatenate(lows), np.concatenate(contact_lows), np.concatenate(slides)
+    assert on.size > 0.3 * low.size
+    assert np.abs(on).max() < 0.002 and np.abs(on).mean() < 0.0005        # soles on the floor
+    assert low.min() > -0.002 and np.maximum(-low, 0).mean() < 0.0005       # paper penetrate <= 0.05 cm
+    assert np.median(slide) < 0.002 and np.mean(slide) < 0.005              # planted: < 2 mm/frame typical
 
 
 def test_shape_aware_bones_match_the_fitted_body_and_normalized_the_canonical(tiny_dataset, openbody):

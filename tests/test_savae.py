@@ -79,7 +79,7 @@ def test_config_json(tmp_path):
     p.write_text(json.dumps({"base": "small", "width": 64, "loss": {"bone": 2.0}, "train": {"milestones": [0.5]}}))
     c = SAVAEConfig.load(str(p))
     assert (c.width, c.depth, c.loss.bone, c.train.milestones, c.train.batch_size) == (64, 3, 2.0, (0.5,), 32)
-    for bad in ({"widht": 3}, {"loss": {"nope": 1}}, {"loss": {"dyn_stability": 1.0}}, {"base": "huge"}):
+    for bad in ({"widht": 3}, {"loss": {"nope": 1}}, {"loss": {"dyn_stability": -1.0}}, {"base": "huge"}):
         p.write_text(json.dumps(bad))
         with pytest.raises(ShapeMoveError):
             SAVAEConfig.load(str(p))

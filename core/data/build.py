@@ -38,7 +38,7 @@ AUGMENT_BETA_CLIP = 2.5  # sampled betas ~ N(0,1) clipped to +-2.5
 FIT_REG = 4e-4
 
 SUBDIRS = ["new_joints", "new_joint_vecs", "norm_joints", "norm_joint_vecs", "betas", "poses", "transl",
-           "texts", "shape_texts", "meta"]
+           "contacts", "texts", "shape_texts", "meta"]
 
 
 def _save_npy(path: Path, arr: np.ndarray) -> None:
@@ -81,6 +81,7 @@ class ClipProcessor:
         self.ik_refine_iters = ik_refine_iters
         self.rest0 = self.body.rest_joints(None)[0].numpy()
         self._measured: dict[bytes, dict] = {}  # clips of one subject share betas: measure once
+        self._probes: dict = {}
 
     def measure(self, betas: np.ndarray) -> dict:
         from ..body.measure import measure
@@ -108,50 +109,98 @@ class ClipProcessor:
         fit = fit_betas_to_clip(self.body, joints)
         return np.asarray(fit.betas, dtype=np.float32)
 
-    def pose_on(self, rotations: np.ndarray, root: np.ndarray, betas: np.ndarray, scale: float):
-        """FK of the body with ``betas`` with its root on the trajectory ``root`` (T,3) scaled by
-        ``scale`` (stride follows leg length); then the lowest foot joint is put on the floor."""
+    def probe(self, betas: np.ndarray):
+        """The ``soles.GroundProbe`` of the body with ``betas`` (cached: clips of a subject share it)."""
+        from ..body.soles import GroundProbe
+
+        key = np.asarray(betas, np.float32).tobytes()
+        if key not in self._probes:
+            if len(self._probes) > 32:
+                self._probes.clear()
+            self._probes[key] = GroundProbe(self.body, np.asarray(betas, np.float32))
+        return self._probes[key]
+
+    def contacts(self, joints: np.ndarray) -> np.ndarray:
+        """(T,4) uint8 foot contacts of joints 7, 8, 10, 11 detected on the source mocap."""
+        from ..motion.contacts import detect_contacts
+
+        return detect_contacts(joints, FPS)
+
+    def pose_on(self, rotations: np.ndarray, root: np.ndarray, betas: np.ndarray, scale: float,
+                contacts: np.ndarray | None = None) -> np.ndarray:
+        """(T,22,3) joints: FK of the body with ``betas`` for local ``rotations`` (T,24,3,3) with
+        its root on the trajectory ``root`` (T,3) scaled by ``scale`` (stride follows leg length),
+        then grounded on the MESH: where a foot is in contact (``contacts`` (T,4) of joints 7, 8,
+        10, 11; None = never) its lowest vertex is on y = 0, elsewhere the body keeps its height
+        relative to the contact frames around it and never goes under the floor
+        (``plant.ground_shift``). ``BodyModel(betas, rotations, joints[:, 0] - rest[0])``
+        reproduces the result."""
         import torch
 
+        from ..body.plant import ground_shift
         from ..geometry.torch_ops import forward_kinematics
 
         rest = self.body.rest_joints(torch.as_tensor(betas)[None])  # (1,24,3)
         R = torch.as_tensor(rotations, dtype=torch.float32)
         joints, _ = forward_kinematics(R, rest.expand(R.shape[0], -1, -1), self.body.parents)
         joints = joints[:, :22].numpy() - rest[0, 0].numpy() + (root * scale)[:, None, :]
-        joints[..., 1] -= joints[:, [7, 8, 10, 11], 1].min()
+        per_foot, _, low_all = self.probe(betas).lowest(rotations, joints[:, 0] - rest[0, 0].numpy())
+        c = np.zeros((len(joints), 4), np.uint8) if contacts is None else contacts
+        joints[..., 1] += ground_shift(per_foot, low_all, c)[:, None]
         return joints.astype(np.float32)
 
+    @staticmethod
+    def features(joints: np.ndarray, rotations: np.ndarray, contacts: np.ndarray) -> np.ndarray:
+        """(T-1,263) HumanML3D features of (T,22,3) joints grounded on the mesh (``pose_on``: heights
+        kept as they are) with local ``rotations`` (T,>=22,3,3); the 4 foot-contact channels hold
+        ``contacts`` (T,4) of joints 7, 8, 10, 11."""
+        from ..motion.contacts import to_feature_order
+        from ..motion.features import feature_slices, features_from_joints
+
+        f = features_from_joints(joints, rotations[:, :22], keep_height=True)
+        f[:, feature_slices["contacts"]] = to_feature_order(contacts[:-1]).astype(np.float32)
+        return f
+
     def process(self, joints: np.ndarray, betas: np.ndarray | None = None):
-        """Arrays of one clip (its 22 joints at 20 fps) on the body ``betas`` (the fitted body when None)."""
+        """Arrays of one clip (its 22 joints at 20 fps) on the body ``betas`` (the fitted body when None).
+
+        Contacts are detected on the mocap, the contact joints' IK targets planted on the fitted
+        body's soles (``plant.plant_targets``), the IK solved, and every posed copy grounded on
+        its own mesh (``pose_on``)."""
         import torch
 
         from ..body.ik import solve_ik
-        from ..motion.features import features_from_joints
+        from ..body.plant import plant_targets
+        from ..geometry.rotations import matrix_to_axis_angle
+        from ..geometry.torch_ops import forward_kinematics
 
+        contacts = self.contacts(joints)
         fitted = self.fit(joints)
         rest = self.body.rest_joints(torch.as_tensor(fitted)[None])[0].numpy()
-        ik = solve_ik(joints, rest, refine_iters=self.ik_refine_iters)
+        targets, floor = plant_targets(joints, contacts, self.probe(fitted).sole_offsets)
+        ik = solve_ik(targets, rest, refine_iters=self.ik_refine_iters)
         rot = np.asarray(ik.rotations, dtype=np.float32)
         root = np.asarray(ik.transl, dtype=np.float32) + rest[0]  # world root trajectory (T,3)
+        # IK error against the mocap itself (ik.joint_error is against the planted targets)
+        fk, _ = forward_kinematics(torch.as_tensor(rot), torch.as_tensor(rest)[None].expand(len(rot), -1, -1),
+                                   self.body.parents)
+        fk = fk[:, :22].numpy() + ik.transl[:, None]
+        ik_error_cm = float(np.linalg.norm(fk - (np.asarray(joints, np.float64) - [0.0, floor, 0.0]), axis=-1).mean()) * 100
         target = fitted if betas is None else betas.astype(np.float32)
         rest_t = self.body.rest_joints(torch.as_tensor(target)[None])[0].numpy()
         pelvis_h = lambda r: r[0, 1] - min(r[7, 1], r[8, 1], r[10, 1], r[11, 1])  # noqa: E731
         s_target = pelvis_h(rest_t) / pelvis_h(rest)
         s_norm = pelvis_h(self.rest0) / pelvis_h(rest)
-        shaped = self.pose_on(rot, root, target, s_target if betas is not None else 1.0)
-        normal = self.pose_on(rot, root, np.zeros(10, np.float32), s_norm)
-        local22 = rot[:, :22]
-        from ..geometry.rotations import matrix_to_axis_angle
-
+        shaped = self.pose_on(rot, root, target, s_target if betas is not None else 1.0, contacts)
+        normal = self.pose_on(rot, root, np.zeros(10, np.float32), s_norm, contacts)
         m = self.measure(target)
         return {
-            "new_joints": shaped, "new_joint_vecs": features_from_joints(shaped, local22),
-            "norm_joints": normal, "norm_joint_vecs": features_from_joints(normal, local22),
-            "betas": target,
+            "new_joints": shaped, "new_joint_vecs": self.features(shaped, rot, contacts),
+            "norm_joints": normal, "norm_joint_vecs": self.features(normal, rot, contacts),
+            "betas": target, "contacts": contacts,
             "poses": matrix_to_axis_angle(rot).astype(np.float32),
             "transl": shaped[:, 0] - rest_t[0],  # BodyModel.forward(target, poses, transl) -> shaped
-            "ik_error_cm": float(ik.mean_error_cm),
+            "ik_error_cm": ik_error_cm, "ik_target_error_cm": float(ik.mean_error_cm),
             "measure": m,
         }
 
@@ -159,6 +208,7 @@ class ClipProcessor:
 def _write_clip(out: Path, cid: str, arrays: dict, clip: ClipSource, split: str, extra: dict) -> None:
     for key in ("new_joints", "new_joint_vecs", "norm_joints", "norm_joint_vecs", "betas", "poses", "transl"):
         _save_npy(out / key / f"{cid}.npy", np.asarray(arrays[key], dtype=np.float32))
+    _save_npy(out / "contacts" / f"{cid}.npy", np.asarray(arrays["contacts"], dtype=np.uint8))
     _save_text(out / "texts" / f"{cid}.txt", "\n".join(clip.captions) + "\n")
     m = arrays["measure"]
     _save_text(out / "shape_texts" / f"{cid}.txt", "\n".join(shape_texts(m, cid)) + "\n")

@@ -31,7 +31,7 @@ class LossWeights:
     floating: float = 0.5     # lowest foot joint above the target's, on contact frames (m)
     slide: float = 0.5        # horizontal foot speed while the target foot is in contact (m/frame)
     penetrate: float = 1.0    # depth of joints below y = 0 (m)
-    dyn_stability: float = 0.0  # HUMOS dynamic-stability term: not implemented, must stay 0
+    dyn_stability: float = 0.0  # HUMOS dynamic stability: ZMP outside the contact feet (m); off by default
 
 
 @dataclass
@@ -128,8 +128,8 @@ class SAVAEConfig:
             raise ShapeMoveError(f"{p}: not valid JSON ({exc})") from exc
 
     def validate(self) -> None:
-        if self.loss.dyn_stability:
-            raise ShapeMoveError("loss.dyn_stability (HUMOS dynamic stability) is not implemented; set it to 0")
+        if self.loss.dyn_stability < 0:
+            raise ShapeMoveError("loss.dyn_stability (HUMOS dynamic stability) must be >= 0")
         if self.train.window % self.downsample:
             raise ShapeMoveError(f"train.window must be a multiple of {self.downsample}")
         if self.train.decay not in ("step", "cosine", "none"):

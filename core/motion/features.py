@@ -107,7 +107,7 @@ def local_rotations_from_joints(joints: np.ndarray, heading: np.ndarray, rest_jo
 
 
 def features_from_joints(joints, local_rotations=None, feet_thre: float = 0.002,
-                         rest_joints=None, smooth_sigma: float = 20.0) -> np.ndarray:
+                         rest_joints=None, smooth_sigma: float = 20.0, keep_height: bool = False) -> np.ndarray:
     """Joint positions -> HumanML3D features.
 
     joints (T, 22, 3) metres, Y up, 20 fps (extra joints beyond 22 are ignored);
@@ -116,8 +116,10 @@ def features_from_joints(joints, local_rotations=None, feet_thre: float = 0.002,
     ``rest_joints``); feet_thre threshold on the squared per-frame displacement (m^2).
     Returns (T-1, 263) float32. Only the 21 non-root rotations are stored, and those are unchanged
     by the canonicalising turn about Y, so given rotations are used as they are.
+    ``keep_height``: keep the given heights instead of putting the lowest joint on y = 0 (for
+    joints already grounded on the body's mesh: its soles are below the joints).
     """
-    pos = canonicalize(joints)
+    pos = canonicalize(joints, keep_height)
     T = len(pos)
     if local_rotations is not None:
         local_rotations = np.asarray(local_rotations, dtype=np.float64)

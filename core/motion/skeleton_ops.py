@@ -71,14 +71,17 @@ def smooth_directions(forward: np.ndarray, sigma: float) -> np.ndarray:
     return np.where(ok, smooth / np.where(ok, norm, 1.0), forward)
 
 
-def canonicalize(joints) -> np.ndarray:
+def canonicalize(joints, keep_height: bool = False) -> np.ndarray:
     """Put a clip in HumanML3D's canonical place (no skeleton retarget).
 
     (T, 22, 3) metres -> (T, 22, 3) float64: the floor (lowest joint over the clip) at y = 0, the
     first frame's root at x = z = 0, and the first frame facing +Z (rotation about Y).
+    ``keep_height``: leave the heights as given (a clip already grounded on its mesh's soles,
+    whose lowest joint is above the floor).
     """
     joints = check_joints(joints).copy()
-    joints[..., 1] -= floor_height(joints)
+    if not keep_height:
+        joints[..., 1] -= floor_height(joints)
     joints[..., [0, 2]] -= joints[0, 0, [0, 2]]
     theta0 = heading_angles(facing_directions(joints[:1]))[0]
     rot = yaw_matrix(-theta0)

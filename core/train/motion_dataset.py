@@ -18,6 +18,8 @@ from torch.utils.data import Dataset, DistributedSampler
 
 from ..errors import ShapeMoveError
 
+CONTACT_ORDER = [0, 2, 1, 3]   # stored contacts (joints 7, 8, 10, 11) -> feature channels (7, 10, 8, 11)
+
 
 def load_stats(root) -> tuple[np.ndarray, np.ndarray]:
     """Mean/Std (263,) float32 of a dataset folder."""
@@ -52,6 +54,7 @@ class MotionClips(Dataset):
         if not self.root.is_dir():
             raise ShapeMoveError(f"dataset folder not found: {self.root}")
         self.window, self.seed = window, seed
+        self.has_contacts = (self.root / "contacts").is_dir()
         self.mean, self.std = load_stats(self.root)
         self.ids, self.lengths, self.skipped = [], [], []
         for cid in read_split(self.root, split):
@@ -83,7 +86,13 @@ class MotionClips(Dataset):
         x = (self._load("norm_joint_vecs", cid, start) - self.mean) / self.std
         y = (self._load("new_joint_vecs", cid, start) - self.mean) / self.std
         betas = self._load("betas", cid).reshape(-1)
-        return {"x": torch.from_numpy(x), "y": torch.from_numpy(y), "betas": torch.from_numpy(betas)}
+        item = {"x": torch.from_numpy(x), "y": torch.from_numpy(y), "betas": torch.from_numpy(betas)}
+        if self.has_contacts:
+            c = self._load("contacts", cid, start)
+            if c.shape != (self.window, 4):
+                raise ShapeMoveError(f"{self.root}: clip '{cid}': contacts/{cid}.npy must be (frames, 4), got {c.shape}")
+            item["contacts"] = torch.from_numpy(c[:, CONTACT_ORDER])
+        return item
 
 
 class BatchStream:

@@ -81,6 +81,21 @@ def target_bones(body, betas: torch.Tensor) -> torch.Tensor | None:
         return bone_lengths(body.rest_joints(betas.detach().cpu())[:, :22]).to(betas.device)
 
 
+def body_soles(body, betas: torch.Tensor) -> torch.Tensor:
+    """(B, 4) sole offsets of joints 7, 8, 10, 11 of ``body`` with ``betas`` (B, 10): the ground
+    losses act on the soles of the target body. On the CPU, as ``target_bones``."""
+    from ..body.soles import sole_offsets
+
+    return sole_offsets(body, betas.detach().cpu()).to(betas.device)
+
+
+def batch_losses(model_out: dict, b: dict, model, cfg, body) -> dict:
+    """``vae_losses`` of one batch: target bones and sole offsets of the batch's bodies, the
+    dataset's stored contacts when it has them."""
+    return vae_losses(model_out["recon"], b["y"], model.mean, model.std, cfg.loss, target_bones(body, b["betas"]),
+                      body_soles(body, b["betas"]), b.get("contacts"))
+
+
 def _to(batch: dict, device) -> dict:
     return {k: v.to(device, non_blocking=True) for k, v in batch.items()}
 
@@ -98,7 +113,7 @@ def evaluate(model: SAVAE, dataset: MotionClips, cfg: SAVAEConfig, device, body=
         items = [dataset[key] for key in keys[k:k + bs]]
         b = _to({name: torch.stack([it[name] for it in items]) for name in items[0]}, device)
         out = model(b["x"], b["betas"])
-        losses = vae_losses(out["recon"], b["y"], model.mean, model.std, cfg.loss, target_bones(body, b["betas"]))
+        losses = batch_losses(out, b, model, cfg, body)
         for name, v in losses.items():
             sums[name] = sums.get(name, 0.0) + float(v) * len(items)
         n += len(items)
@@ -190,7 +205,7 @@ def _train(data, out, cfg, t, resume, body, dist, progress, cancel, verbose) -> 
             break
         b = _to(next(batch_iter), dist.device)
         result = model(b["x"], b["betas"])
-        losses = vae_losses(result["recon"], b["y"], raw.mean, raw.std, cfg.loss, target_bones(body, b["betas"]))
+        losses = batch_losses(result, b, raw, cfg, body)
         optimizer.zero_grad(set_to_none=True)
         losses["total"].backward()
         if t.grad_clip:

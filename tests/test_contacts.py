@@ -1,0 +1,111 @@
+"""Foot contacts (detection with hysteresis), planted IK targets, grounding on the mesh soles."""
+import numpy as np
+import pytest
+import torch
+
+from shapemove.core.body.plant import ground_shift, plant_targets, source_floor
+from shapemove.core.body.soles import GroundProbe, sole_offsets
+from shapemove.core.errors import ShapeMoveError
+from shapemove.core.motion.contacts import detect_contacts, runs, to_feature_order
+
+
+def _standing(openbody, T):
+    j = openbody.rest_joints(None)[0, :22].double().numpy()
+    return np.repeat(j[None], T, 0)
+
+
+def test_detects_a_step_with_hysteresis(openbody):
+    """Left foot planted 10 frames, swings 10 frames (10 cm up, 1 m/s), planted again; right foot
+    planted throughout."""
+    T = 30
+    j = _standing(openbody, T)
+    lift = np.zeros(T)
+    lift[10:20] = 0.10 * np.sin(np.linspace(0, np.pi, 12)[1:-1])
+    fwd = np.clip((np.arange(T) - 9) * 0.05, 0, 0.5)              # 1 m/s at 20 fps while swinging
+    for k in (7, 10):
+        j[:, k, 1] += lift
+        j[:, k, 2] += fwd
+    c = detect_contacts(j)
+    assert c.dtype == np.uint8 and c.shape == (T, 4)
+    assert c[:, 1].all() and c[:, 3].all()                         # right ankle, right foot
+    for col in (0, 2):                                             # left ankle, left foot
+        assert runs(c[:, col]) == [(0, 10), (20, 30)]
+    # hysteresis: a foot that rises to 5 cm slowly stays in contact (exit at 6 cm) ...
+    j2 = _standing(openbody, T)
+    j2[:, [7, 10], 1] += np.clip((np.arange(T) - 9) * 0.01, 0, 0.05)[:, None]   # 0.2 m/s up to 5 cm, held
+    assert detect_contacts(j2)[:, [0, 2]].all()
+    # ... but one that starts there (and never was below 4 cm) is not in contact
+    j3 = _standing(openbody, T)
+    j3[:, [7, 10], 1] += 0.05
+    assert not detect_contacts(j3)[:, 0].any()
+    with pytest.raises(ShapeMoveError):
+        detect_contacts(np.zeros((5, 10, 3)))
+    assert to_feature_order(np.array([1, 2, 3, 4])).tolist() == [1, 3, 2, 4]
+
+
+def test_plant_targets_fix_contact_joints_on_the_soles(openbody):
+    T = 20
+    j = _standing(openbody, T) + [0.0, 0.3, 0.0]                   # source floor 30 cm up
+    j[:, 7, 0] += np.arange(T) * 0.004                             # left heel slides 4 mm/frame in contact
+    c = np.zeros((T, 4), np.uint8)
+    c[2:12, 0] = 1
+    c[:, 1] = 1
+    off = np.array([0.07, 0.07, 0.025, 0.025])
+    tgt, floor = plant_targets(j, c, off)
+    assert floor == pytest.approx(source_floor(j, c, off))
+    rest_h = j[0, [7, 8], 1] - 0.3
+    assert floor == pytest.approx(0.3 + float(np.median(np.r_[rest_h[0] - 0.07, rest_h[1] - 0.07])), abs=1e-6)
+    planted = tgt[2:12, 7]
+    assert np.ptp(planted[:, 0]) < 1e-12 and np.ptp(planted[:, 2]) < 1e-12
+    assert planted[0, 0] == pytest.approx(j[2:12, 7, 0].mean())
+    np.testing.assert_allclose(planted[:, 1], 0.07)
+    np.testing.assert_allclose(tgt[:, 8, 1], 0.07)
+    # outside the run the change fades out within FADE frames, the other joints are untouched
+    assert np.allclose(tgt[17:, 7], j[17:, 7] - [0, floor, 0])
+    assert np.abs(tgt[12, 7] - (j[12, 7] - [0, floor, 0])).max() > 0
+    np.testing.assert_allclose(tgt[:, 0], j[:, 0] - [0, floor, 0])
+
+
+def test_ground_shift():
+    per_foot = np.array([[0.02, 0.10], [0.03, 0.10], [0.10, 0.10], [0.10, 0.01], [0.10, -0.01]])
+    lowest_all = per_foot.min(1)
+    c = np.zeros((5, 4), np.uint8)
+    c[:2, 0] = 1                                                   # left heel: frames 0, 1
+    c[3:, 3] = 1                                                   # right toe: frames 3, 4
+    s = ground_shift(per_foot, lowest_all, c)
+    np.testing.assert_allclose(s, [-0.02, -0.03, -0.02, -0.01, 0.01])   # frame 2 interpolated
+    # no contact: one shift for the clip; never under the floor
+    s = ground_shift(per_foot, lowest_all, np.zeros((5, 4)))
+    np.testing.assert_allclose(s, np.full(5, 0.01))
+    c2 = np.zeros((5, 4), np.uint8)
+    c2[:, 0] = 1
+    s = ground_shift(per_foot, lowest_all, c2)                    # the swinging right foot dips below
+    assert (lowest_all + s >= -1e-12).all() and s[4] == pytest.approx(0.01)
+
+
+def test_soles_match_the_full_mesh(openbody):
+    """Sole offsets and the probe's lowest points against the posed full mesh (BodyModel)."""
+    betas = torch.tensor([[1.5, -1.0, 0.5, 0, 0, 0.3, 0, 0, 0, -0.5]])
+    rest = openbody(betas)
+    lab = openbody.skin_weights.argmax(1)
+    v = rest.vertices[0].numpy()
+    want = [rest.joints[0, j, 1].item() - v[lab == j, 1].min() for j in (7, 8, 10, 11)]
+    np.testing.assert_allclose(sole_offsets(openbody, betas)[0].numpy(), want, atol=1e-6)
+    assert 0.05 < want[0] < 0.11 and 0.01 < want[2] < 0.05
+    # a posed clip: ankles flexed, knees bent, root moving
+    T = 6
+    g = torch.Generator().manual_seed(0)
+    aa = torch.randn(T, 24, 3, generator=g) * 0.3
+    transl = torch.randn(T, 3, generator=g) * 0.1
+    out = openbody(betas.expand(T, -1), aa, transl)
+    probe = GroundProbe(openbody, betas[0].numpy())
+    from shapemove.core.geometry.torch_ops import axis_angle_to_matrix
+
+    per_foot, feet, low = probe.lowest(axis_angle_to_matrix(aa.double()).numpy(), transl.numpy())
+    mesh = out.vertices[..., 1].numpy()
+    foot_l = np.isin(lab, [7, 10])
+    foot_r = np.isin(lab, [8, 11])
+    np.testing.assert_allclose(per_foot[:, 0], mesh[:, foot_l].min(1), atol=2e-4)
+    np.testing.assert_allclose(per_foot[:, 1], mesh[:, foot_r].min(1), atol=2e-4)
+    # the body sample is sparse: never below the true lowest point, and close to it
+    assert (low >= mesh.min(1) - 2e-4).all() and (low - mesh.min(1)).max() < 0.03
