@@ -142,3 +142,34 @@ def test_real_sized_clip_still_loads(tmp_path):
     (r,) = run_limited([{"path": str(p), "asf": None}], timeout_s=30, mem_bytes=GB)
     assert r["outcome"] == "ok", r
     assert r["max_rss"] < GB
+
+
+def test_amass_npz_bombs_and_pickles(tmp_path):
+    """AMASS .npz: a header declaring 80 GB of poses and a pickled array are refused unread."""
+    import io
+    import zipfile
+
+    from shapemove.core.errors import ShapeMoveError
+    from shapemove.core.io.amass import read_amass_npz
+
+    p = tmp_path / "bomb.npz"
+    np.savez(p, trans=np.zeros((10, 3)), mocap_framerate=np.array(120.0))
+    buf = io.BytesIO()
+    np.lib.format.write_array_header_1_0(buf, {"descr": "<f8", "fortran_order": False, "shape": (10**8, 100)})
+    with zipfile.ZipFile(p, "a") as zf:
+        zf.writestr("poses.npy", buf.getvalue())
+    with pytest.raises(ShapeMoveError, match="MB, more than any AMASS motion file"):
+        read_amass_npz(p)
+    marker = tmp_path / "marker"
+
+    class Evil:
+        def __reduce__(self):
+            return exec, (f"open({str(marker)!r}, 'w').close()",)
+
+    np.savez(p, poses=np.array([Evil()], dtype=object), trans=np.zeros((1, 3)), mocap_framerate=np.array(120.0))
+    with pytest.raises(ShapeMoveError, match="poses is a pickled Python object"):
+        read_amass_npz(p)
+    assert not marker.exists()
+    p.write_bytes(b"PK\x03\x04 truncated")
+    with pytest.raises(ShapeMoveError, match="not a readable AMASS motion file"):
+        read_amass_npz(p)

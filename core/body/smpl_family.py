@@ -177,34 +177,6 @@ def _check_sizes(arrays: dict) -> None:
                          f"({MAX_ARRAY_BYTES // 2**20} MB)")
 
 
-def _read_npz(path: Path, wanted) -> dict:
-    """The wanted arrays of an .npz: each header checked first; pickled (object) arrays refused."""
-    out, declared = {}, {}
-    with zipfile.ZipFile(path) as zf:
-        names = set(zf.namelist())
-        for k in wanted:
-            member = f"{k}.npy"
-            if member not in names:
-                continue
-            with zf.open(member) as fh:
-                version = np.lib.format.read_magic(fh)
-                shape, _, dtype = np.lib.format._read_array_header(fh, version, max_header_size=10000)
-            if dtype.hasobject and k == "gender":
-                continue  # optional: a pickled gender is skipped, never unpickled
-            if dtype.hasobject:
-                raise ValueError(f"{k} is a pickled Python object; pickles inside .npz files are never loaded - "
-                                 f"save {k} as a plain (dense) array, e.g. np.savez(..., {k}=matrix.toarray())")
-            declared[k] = shape
-        total = sum(int(np.prod(s, dtype=np.float64)) * 8 for s in declared.values())
-        if total > MAX_ARRAY_BYTES:
-            raise ValueError(f"its arrays would take {total / 2**20:.0f} MB, more than any SMPL-family model "
-                             f"({MAX_ARRAY_BYTES // 2**20} MB)")
-        for k in declared:
-            with zf.open(f"{k}.npy") as fh:
-                out[k] = np.lib.format.read_array(fh, allow_pickle=False, max_header_size=10000)
-    return out
-
-
 def read_model_file(path: str | Path) -> dict:
     """Read an SMPL-family ``.npz`` / ``.pkl`` into a dict of numpy arrays (only the keys we use)."""
     path = Path(path).expanduser()
@@ -215,7 +187,9 @@ def read_model_file(path: str | Path) -> dict:
     wanted = REQUIRED_KEYS + ("posedirs", "gender")
     try:
         if path.suffix.lower() == ".npz":
-            raw = _read_npz(path, wanted)
+            from ..io.npz_read import read_npz
+
+            raw = read_npz(path, wanted, MAX_ARRAY_BYTES, skip_objects=("gender",), what="SMPL-family model")
         else:
             size = path.stat().st_size
             if size > MAX_PICKLE_BYTES:
@@ -228,8 +202,8 @@ def read_model_file(path: str | Path) -> dict:
             raw = {k: raw[k] for k in wanted if k in raw}
         out = {k: _plain(v, k) for k, v in raw.items()}
         _check_sizes({k: v for k, v in out.items() if k != "gender"})
-    except ShapeMoveError:
-        raise
+    except ShapeMoveError as exc:  # from read_npz: "PATH: what is wrong"
+        raise ShapeMoveError(f"could not read body model file {exc}. {HOW_TO}") from None
     except MemoryError:
         raise ShapeMoveError(f"could not read body model file {path}: it does not fit in memory. {HOW_TO}") from None
     except (OSError, ValueError, TypeError, EOFError, KeyError, AttributeError, IndexError, ImportError,

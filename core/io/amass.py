@@ -11,7 +11,6 @@ SMPL-family model (``is_smpl_family``); other models use their mean shape unless
 """
 from __future__ import annotations
 
-import zipfile
 from pathlib import Path
 
 import numpy as np
@@ -38,12 +37,12 @@ def is_smpl_family(model) -> bool:
 
 def read_amass_npz(path) -> dict:
     """The arrays of an AMASS file, checked: poses (T,66), trans (T,3), betas (10,), fps, gender."""
+    from .limits import check_joint_frames
+    from .npz_read import read_npz
+
     path = Path(path)
-    try:
-        with np.load(path, allow_pickle=False) as z:
-            data = {k: z[k] for k in z.files}
-    except (OSError, ValueError, zipfile.BadZipFile, EOFError) as exc:
-        raise ShapeMoveError(f"{path}: not a readable .npz file ({exc})") from None
+    data = read_npz(path, ("poses", "trans", "betas", "mocap_framerate", "mocap_frame_rate", "gender"),
+                    max_bytes=256 * 2**20, skip_objects=("gender",), what="AMASS motion file")
     for key in ("poses", "trans"):
         if key not in data:
             raise ShapeMoveError(f"{path}: AMASS file has no {key!r} array (keys: {', '.join(data)})")
@@ -53,6 +52,7 @@ def read_amass_npz(path) -> dict:
         raise ShapeMoveError(f"{path}: 'poses' must be (T, >=66), got {poses.shape}")
     if trans.shape != (len(poses), 3):
         raise ShapeMoveError(f"{path}: 'trans' must be ({len(poses)}, 3), got {trans.shape}")
+    check_joint_frames(len(poses), NUM_BODY_JOINTS, path, "AMASS clip")
     fps = data.get("mocap_framerate", data.get("mocap_frame_rate"))
     if fps is None:
         raise ShapeMoveError(f"{path}: AMASS file has no 'mocap_framerate'")
