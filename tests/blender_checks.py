@@ -83,9 +83,9 @@ def _user_dir():
 import torch  # noqa: E402  (after the install check above)
 
 
-def check_rig(label, motion_path, lbs=True):
+def check_rig(label, motion_path, lbs=True, model_file=""):
     motion = ext("core.scene.motion_file").load_motion(motion_path)
-    body = ext("core.scene.bodies").load_body(motion.body_model)
+    body = ext("core.scene.bodies").load_body(motion.body_model, model_file or None)
     axes = ext("core.scene.axes")
     names = list(ext("core.body.skeleton").JOINT_NAMES)
     res: dict = {}
@@ -95,7 +95,7 @@ def check_rig(label, motion_path, lbs=True):
     bpy.context.scene.collection.objects.link(bystander)
     bystander.location = (1.0, 2.0, 3.0)
     before = set(bpy.data.objects)
-    r = bpy.ops.shapemove.build_from_motion(filepath=motion_path)
+    r = bpy.ops.shapemove.build_from_motion(filepath=motion_path, body_model_file=model_file)
     new = set(bpy.data.objects) - before
     res["result"] = sorted(r)
     res["new_objects"] = sorted((o.name, o.type) for o in new)
@@ -148,7 +148,7 @@ def check_rig(label, motion_path, lbs=True):
 
 @timed("capsule")
 def _capsule():
-    motion, body, arm, mesh_obj = check_rig("capsule", CONFIG["motion"])
+    motion, body, arm, mesh_obj = check_rig("capsule", CONFIG["motion"], model_file=CONFIG["capsule_model"])
     res = RESULTS["capsule"]
     names = list(ext("core.body.skeleton").JOINT_NAMES)
     axes = ext("core.scene.axes")
@@ -212,7 +212,7 @@ def _failure():
     # 2. a failure half-way (the target collection is not in the view layer, so the bones cannot be
     #    edited): everything created so far is removed again
     motion = ext("core.scene.motion_file").load_motion(CONFIG["motion"])
-    body = ext("core.scene.bodies").load_body(motion.body_model)
+    body = ext("core.scene.bodies").load_body(motion.body_model, CONFIG["capsule_model"])
     loose = bpy.data.collections.new("NotInScene")
     before = datablock_counts()
     try:
@@ -266,7 +266,7 @@ if CONFIG.get("cli_blend"):
         from shapemove.cli import main
 
         out, png = CONFIG["cli_blend"], os.path.join(CONFIG["render_dir"], "cli.png")
-        code = main(["blend", "--motion", CONFIG["motion"], "--out", out, "--render", png, "--frame", "5",
+        code = main(["blend", "--motion", CONFIG["motion"], "--body-model-file", CONFIG["capsule_model"], "--out", out, "--render", png, "--frame", "5",
                      "--resolution", "64", "48"])
         res = {"exit": code, "png": os.path.isfile(png), "blend": os.path.isfile(out)}
         bpy.ops.wm.open_mainfile(filepath=out)

@@ -2,6 +2,7 @@
 with a reason when the archives are absent, and fail instead when SHAPEMOVE_REQUIRE_DATA=1 (CI)."""
 from __future__ import annotations
 
+import importlib
 import os
 
 import pytest
@@ -19,7 +20,16 @@ REQUIRE_DATA = os.environ.get("SHAPEMOVE_REQUIRE_DATA") == "1"
 def need_data(reason: str):
     if REQUIRE_DATA:
         pytest.fail(f"SHAPEMOVE_REQUIRE_DATA=1 but {reason}")
-    pytest.skip(reason)
+    pytest.skip(reason, allow_module_level=True)
+
+
+def need_module(name: str, reason: str | None = None):
+    """Import a module a test needs: skip with a reason when it is missing, fail instead when
+    SHAPEMOVE_REQUIRE_DATA=1 (CI installs everything, so a missing module there is a failure)."""
+    try:
+        return importlib.import_module(name)
+    except ImportError as exc:
+        need_data(reason or f"needs the Python module {name!r} ({exc})")
 
 
 @pytest.fixture(scope="session")

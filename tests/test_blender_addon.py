@@ -15,12 +15,13 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import need_module
 
 from shapemove.core.body.skeleton import JOINT_NAMES, PARENTS
 from shapemove.core.scene.capsule_body import capsule_body
 from shapemove.core.scene.motion_file import make_motion, save_motion
 
-pytest.importorskip("bpy", reason="needs the bpy module (pip install bpy==5.0.1)")
+need_module("bpy", "needs the bpy module (pip install bpy==5.0.1)")
 pytestmark = pytest.mark.blender
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -37,6 +38,15 @@ def _wavy_motion(body, frames, betas, seed=0):
     return make_motion(body, poses, transl, betas, fps=20, prompt="a test motion")
 
 
+def _smpl_format_file(body, path) -> str:
+    """``body`` written as an SMPL model file (the keys of the official .npz): the extension
+    loads a test body the way it loads a user's SMPL file, there is no test body by name."""
+    np.savez(path, v_template=body.v_template.numpy(), shapedirs=body.shapedirs.numpy(),
+             J_regressor=body.j_regressor.numpy(), weights=body.skin_weights, f=body.faces,
+             kintree_table=np.stack([np.where(PARENTS < 0, 2 ** 32 - 1, PARENTS), np.arange(len(PARENTS))]))
+    return str(path)
+
+
 @pytest.fixture(scope="module")
 def blender(tmp_path_factory, openbody):
     d = tmp_path_factory.mktemp("blender")
@@ -44,7 +54,9 @@ def blender(tmp_path_factory, openbody):
     builder = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(builder)
     capsule = capsule_body()
+    capsule_model = _smpl_format_file(capsule, d / "capsule_neutral.npz")  # loads as "smpl-neutral"
     motion = _wavy_motion(capsule, FRAMES, np.array([0.5, 0, 0, 0, 0, 0, 0, 0, 0, 0.3]))
+    motion.body_model = "smpl-neutral"
     save_motion(d / "capsule.npz", motion)
     ob_motion = _wavy_motion(openbody, 12, np.random.default_rng(1).normal(0, 1, 10), seed=2)
     save_motion(d / "openbody.npz", ob_motion)
@@ -52,6 +64,7 @@ def blender(tmp_path_factory, openbody):
     save_motion(d / "bad.npz", motion)
     (d / "render").mkdir()
     config = dict(zip=str(builder.build(d / "dist")), motion=str(d / "capsule.npz"), bad_motion=str(d / "bad.npz"),
+                  capsule_model=capsule_model,
                   openbody_motion=str(d / "openbody.npz"), user_resources=str(d / "user"),
                   results=str(d / "results.json"), render_dir=str(d / "render"), cli_blend=str(d / "cli" / "s.blend"))
     (d / "config.json").write_text(json.dumps(config))

@@ -342,7 +342,6 @@ def test_bad_input_raises_shapemove_error(body):
 
 # -- the real body model --------------------------------------------------------------------------
 def test_openbody_standing_still(request):
-    pytest.importorskip("shapemove.core.body.openbody", reason="OpenBody is not built yet")
     ob = request.getfixturevalue("openbody")
     mass = MassModel(ob.faces, ob.skin_weights)
     rest = ob.rest_vertices()[0]

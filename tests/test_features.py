@@ -8,11 +8,11 @@ import pytest
 import torch
 
 from shapemove.core.errors import ShapeMoveError
+from shapemove.core.geometry.rotations import matrix_to_rot6d, rot6d_to_matrix, rotation_between, yaw_matrix
+from shapemove.core.io.mocap import load_smpl22
 from shapemove.core.motion import (canonicalize, feature_slices, features_from_joints,
                                    joints_from_features, local_rotations_from_joints, mean_std)
 from shapemove.core.motion.features import T2M_RAW_OFFSETS, _CHILD, _PARENTS
-from shapemove.core.geometry.rotations import (matrix_to_rot6d, rot6d_to_matrix, rotation_between,
-                                             yaw_matrix)
 from shapemove.core.motion.skeleton_ops import gaussian_smooth
 
 S = feature_slices
@@ -161,7 +161,7 @@ def test_bad_input_is_a_shapemove_error():
 
 
 def test_gaussian_matches_scipy():
-    scipy_ndimage = pytest.importorskip("scipy.ndimage")
+    import scipy.ndimage as scipy_ndimage
     x = np.random.default_rng(2).normal(size=(50, 3))  # shorter than the 81-frame radius too
     for sigma in (20.0, 3.0):
         np.testing.assert_allclose(gaussian_smooth(x, sigma),
@@ -189,18 +189,9 @@ CLIPS = ["bandai/dataset-2/data/dataset-2_walk-turn-left_active_041.bvh",
          "bandai/dataset-1/data/dataset-1_bow_active_001.bvh"]
 
 
-def _load(path: Path) -> np.ndarray:
-    """The project's loader when it is complete, else the minimal Bandai reader below."""
-    try:
-        from shapemove.core.io.mocap import load_smpl22
-        return np.asarray(load_smpl22(path, fps=20).joints, dtype=np.float64)
-    except ImportError:  # core/io/mocap.py or one of its readers not written yet
-        return _load_bandai_bvh(path)
-
-
 @pytest.fixture(scope="module")
 def real_clips(mocap_root):
-    return [_load(Path(mocap_root) / c) for c in CLIPS]
+    return [np.asarray(load_smpl22(Path(mocap_root) / c, fps=20).joints, dtype=np.float64) for c in CLIPS]
 
 
 def test_round_trip_on_real_clips(real_clips):
@@ -248,76 +239,3 @@ def test_swing_rotations_reproduce_bone_directions(real_clips):
             got = np.einsum("tij,j->ti", world[j], rest_dir)
             bone = joints[:, c] - joints[:, j]
             np.testing.assert_allclose(got, bone / np.linalg.norm(bone, axis=-1, keepdims=True), atol=1e-6)
-
-
-# ---------------------------------------------------------------- minimal Bandai BVH reader
-# (used until core/io/mocap.py provides load_smpl22): centimetres, Y up, 6 channels per joint.
-
-_BANDAI_TO_SMPL = {"Hips": 0, "UpperLeg_L": 1, "UpperLeg_R": 2, "Spine": 3, "LowerLeg_L": 4,
-                   "LowerLeg_R": 5, "Chest": 6, "Foot_L": 7, "Foot_R": 8, "Toes_L": 10, "Toes_R": 11,
-                   "Neck": 12, "Shoulder_L": 13, "Shoulder_R": 14, "Head": 15, "UpperArm_L": 16,
-                   "UpperArm_R": 17, "LowerArm_L": 18, "LowerArm_R": 19, "Hand_L": 20, "Hand_R": 21}
-
-
-def _axis_rotation(axis: str, degrees: np.ndarray) -> np.ndarray:
-    a = np.radians(degrees)
-    c, s, one, zero = np.cos(a), np.sin(a), np.ones_like(a), np.zeros_like(a)
-    m = {"X": [one, zero, zero, zero, c, -s, zero, s, c],
-         "Y": [c, zero, s, zero, one, zero, -s, zero, c],
-         "Z": [c, -s, zero, s, c, zero, zero, zero, one]}[axis]
-    return np.stack(m, -1).reshape(a.shape + (3, 3))
-
-
-def _load_bandai_bvh(path: Path, fps: int = 20) -> np.ndarray:
-    tokens = Path(path).read_text().split()
-    names, parents, offsets, channels, stack, current, i = [], [], [], [], [], None, 0
-    while tokens[i] != "MOTION":
-        tok = tokens[i]
-        if tok in ("ROOT", "JOINT"):
-            names.append(tokens[i + 1])
-            parents.append(stack[-1] if stack else -1)
-            current, i = len(names) - 1, i + 2
-        elif tok == "End":
-            current, i = None, i + 2
-        elif tok == "{":
-            stack.append(current)
-            i += 1
-        elif tok == "}":
-            stack.pop()
-            i += 1
-        elif tok == "OFFSET":
-            if current is not None:
-                offsets.append([float(v) for v in tokens[i + 1:i + 4]])
-            i += 4
-        elif tok == "CHANNELS":
-            n = int(tokens[i + 1])
-            channels.append(tokens[i + 2:i + 2 + n])
-            i += 2 + n
-        else:
-            i += 1
-    frames, dt = int(tokens[i + 2]), float(tokens[i + 5])
-    data = np.array(tokens[i + 6:], dtype=np.float64).reshape(frames, -1)
-    rots, poss, col = [], [], 0
-    for j, chans in enumerate(channels):
-        values = data[:, col:col + len(chans)]
-        col += len(chans)
-        t = np.tile(offsets[j], (frames, 1))
-        r = np.broadcast_to(np.eye(3), (frames, 3, 3))
-        for k, ch in enumerate(chans):
-            if ch.endswith("position"):
-                t[:, "XYZ".index(ch[0])] = values[:, k]
-            else:
-                r = r @ _axis_rotation(ch[0], values[:, k])
-        p = parents[j]
-        rots.append(r if p < 0 else rots[p] @ r)
-        poss.append(t if p < 0 else poss[p] + np.einsum("tij,tj->ti", rots[p], t))
-    pos = np.stack(poss, 1) / 100.0
-    out = np.zeros((frames, 22, 3))
-    for name, k in _BANDAI_TO_SMPL.items():
-        out[:, k] = pos[:, names.index(name)]
-    out[:, 9] = 0.5 * (out[:, 6] + out[:, 12])  # spine3 between chest and neck
-    src = np.arange(frames) * dt
-    dst = np.arange(0.0, src[-1] + 1e-9, 1.0 / fps)
-    idx = np.clip(np.searchsorted(src, dst, side="right") - 1, 0, frames - 2)
-    w = ((dst - src[idx]) / dt)[:, None, None]
-    return (1 - w) * out[idx] + w * out[idx + 1]

@@ -87,7 +87,6 @@ def test_amass_errors(tmp_path):
 
 
 def test_amass_default_body_is_openbody(tmp_path):
-    pytest.importorskip("shapemove.core.body.openbody")
     poses = np.zeros((2, 66))
     poses[:, 0] = np.pi / 2
     m = load_amass(_npz(tmp_path / "o.npz", poses, np.zeros((2, 3))))

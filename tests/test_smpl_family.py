@@ -146,14 +146,9 @@ def test_factory_caches_and_resolves(smpl_files, tmp_path):
 
 
 def test_factory_openbody():
-    try:
-        from shapemove.core.body.openbody import OpenBody
-    except ImportError:
-        pytest.skip("core/body/openbody.py not written yet")
-    try:
-        body = load_body_model()
-    except ShapeMoveError as exc:
-        pytest.skip(f"OpenBody asset missing: {exc}")
+    from shapemove.core.body.openbody import OpenBody
+
+    body = load_body_model()
     assert isinstance(body, OpenBody) and load_body_model("openbody") is body
 
 

@@ -12,18 +12,16 @@ It cannot pose a body (no ``forward``): motions are made in the worker.
 """
 from __future__ import annotations
 
-import zipfile
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from ..constants import NUM_BETAS
 from ..errors import ShapeMoveError
+from .openbody_asset import DEFAULT_PATH, MODEL_ID, PhenotypeMap, read_openbody
 from .skeleton import JOINT_NAMES, PARENTS
 
-NUM_BETAS = 10
-OPENBODY_PATH = Path(__file__).resolve().parents[2] / "assets" / "openbody.npz"
-OPENBODY_ID = "openbody-v1"
 
 
 @dataclass
@@ -34,11 +32,7 @@ class BodyArrays:
     j_regressor: np.ndarray   # (24,V)
     skin_weights: np.ndarray  # (V,24)
     faces: np.ndarray         # (F,3) int64
-    phenotype_names: list = field(default_factory=list)       # OpenBody only (else empty)
-    phenotype_ranges: np.ndarray | None = None                 # (P,2) slider min, max
-    phenotype_defaults: np.ndarray | None = None               # (P,)
-    phenotype_intercept: np.ndarray | None = None              # (10,)
-    phenotype_matrix: np.ndarray | None = None                 # (P,10)
+    phenotype_map: PhenotypeMap | None = None                  # OpenBody only
 
     joint_names = JOINT_NAMES
     num_betas = NUM_BETAS
@@ -62,7 +56,16 @@ class BodyArrays:
 
     @property
     def has_phenotypes(self) -> bool:
-        return self.phenotype_matrix is not None
+        return self.phenotype_map is not None
+
+    @property
+    def phenotype_names(self) -> list:
+        return self.phenotype_map.names if self.phenotype_map is not None else []
+
+    @property
+    def phenotype_matrix(self) -> np.ndarray | None:
+        """(P,10): the change of betas per unit of each slider."""
+        return self.phenotype_map.matrix if self.phenotype_map is not None else None
 
     # -- shape ---------------------------------------------------------------------------------
     def _betas(self, betas) -> np.ndarray:
@@ -93,53 +96,23 @@ class BodyArrays:
             raise ShapeMoveError(f"body model {self.name!r} has no semantic sliders (only OpenBody has them)")
 
     def betas_from_phenotype(self, phenotype) -> np.ndarray:
-        """(..., P) phenotype values (order ``phenotype_names``) -> (..., 10) betas (the asset's linear map)."""
+        """(..., P) phenotype values (order ``phenotype_names``) or a dict -> (..., 10) betas."""
         self._need_phenotypes()
-        p = np.asarray(phenotype, dtype=np.float64)
-        if p.shape[-1:] != (len(self.phenotype_names),) or not np.isfinite(p).all():
-            raise ShapeMoveError(f"phenotype must be {len(self.phenotype_names)} finite values "
-                                 f"({', '.join(self.phenotype_names)}), got shape {p.shape}")
-        return self.phenotype_intercept + p @ self.phenotype_matrix
+        return self.phenotype_map.to_betas(phenotype)
 
     def phenotype_from_betas(self, betas) -> np.ndarray:
-        """(10,) betas -> (P,) the phenotype whose betas are closest (least squares), clipped to
-        the slider ranges: where the semantic sliders start for a body made elsewhere."""
+        """(10,) betas -> (P,) the closest sliders, clipped to their ranges."""
         self._need_phenotypes()
-        b = self._betas(betas)[0]
-        p, *_ = np.linalg.lstsq(self.phenotype_matrix.T, b - self.phenotype_intercept, rcond=None)
-        return np.clip(p, self.phenotype_ranges[:, 0], self.phenotype_ranges[:, 1])
-
-
-def _read_npz(path: Path, what: str) -> dict:
-    try:
-        with np.load(path, allow_pickle=False) as z:
-            return {k: z[k] for k in z.files}
-    except (OSError, ValueError, zipfile.BadZipFile, EOFError) as exc:
-        raise ShapeMoveError(f"{what} {path} is unreadable ({exc})") from None
+        return self.phenotype_map.from_betas(self._betas(betas)[0])
 
 
 def load_openbody_arrays(path=None) -> BodyArrays:
-    """The bundled OpenBody asset (assets/openbody.npz) as BodyArrays, phenotype map included."""
-    path = Path(path) if path is not None else OPENBODY_PATH
-    if not path.is_file():
-        raise ShapeMoveError(f"OpenBody asset not found at {path}; rebuild it with tools/build_openbody.py")
-    d = _read_npz(path, "OpenBody asset")
-    need = ["model_id", "v_template", "shapedirs", "j_regressor", "skin_weights", "faces", "joint_names"]
-    missing = [k for k in need if k not in d]
-    if missing:
-        raise ShapeMoveError(f"OpenBody asset {path} lacks {', '.join(missing)}")
-    if list(d["joint_names"]) != JOINT_NAMES:
-        raise ShapeMoveError(f"OpenBody asset {path} has joints out of SMPL order")
-    ph = "phenotype_matrix" in d
-    return BodyArrays(
-        name=str(d["model_id"]), v_template=d["v_template"], shapedirs=d["shapedirs"], j_regressor=d["j_regressor"],
-        skin_weights=d["skin_weights"], faces=d["faces"],
-        phenotype_names=[str(n) for n in d["phenotype_names"]] if ph else [],
-        phenotype_ranges=np.asarray(d["phenotype_ranges"], np.float64) if ph else None,
-        phenotype_defaults=np.asarray(d["phenotype_defaults"], np.float64) if ph else None,
-        phenotype_intercept=np.asarray(d["phenotype_intercept"], np.float64) if ph else None,
-        phenotype_matrix=np.asarray(d["phenotype_matrix"], np.float64) if ph else None,
-    )
+    """The bundled OpenBody asset (assets/openbody.npz) as BodyArrays, phenotype map included:
+    the same validated arrays as the torch ``OpenBody`` (``openbody_asset.read_openbody``)."""
+    d = read_openbody(path)
+    return BodyArrays(name=str(d["model_id"]), v_template=d["v_template"], shapedirs=d["shapedirs"],
+                      j_regressor=d["j_regressor"], skin_weights=d["skin_weights"], faces=d["faces"],
+                      phenotype_map=PhenotypeMap(d))
 
 
 def load_smpl_arrays(path) -> BodyArrays:
@@ -167,10 +140,10 @@ _CACHE: dict = {}
 
 
 def load_body_arrays(spec=None) -> BodyArrays:
-    """None / "openbody" / "openbody-v1" -> OpenBody; otherwise a path to an SMPL-family file or
+    """None / "openbody" / the OpenBody id -> OpenBody; otherwise a path to an SMPL-family file or
     folder. Cached per spec and file modification time (don't modify the result in place)."""
-    if spec is None or str(spec).strip().lower() in ("", "openbody", OPENBODY_ID):
-        key = ("openbody", OPENBODY_PATH.stat().st_mtime_ns if OPENBODY_PATH.is_file() else 0)
+    if spec is None or str(spec).strip().lower() in ("", "openbody", MODEL_ID):
+        key = ("openbody", DEFAULT_PATH.stat().st_mtime_ns if DEFAULT_PATH.is_file() else 0)
         loader = load_openbody_arrays
         arg = None
     else:

@@ -7,21 +7,13 @@ from ..errors import ShapeMoveError
 
 
 def load_body(name: str, model_file=None):
-    """"openbody-*" -> the bundled OpenBody; "capsule-v1" -> the procedural capsule body;
-    an SMPL-family id ("smplx-male", ...) needs ``model_file`` (the user's own model file).
+    """"openbody-*" -> the bundled OpenBody; an SMPL-family id ("smplx-male", ...) needs
+    ``model_file`` (the user's own model file). Test bodies (the capsule) are not known by name.
     Without torch (Blender's own Python) the same arrays come as numpy ``BodyArrays``."""
     try:
         from ..body.load import load_body_model as loader
-        missing = None
-    except ImportError as exc:
+    except ImportError:
         from ..body.body_arrays import load_body_arrays as loader
-        missing = exc.name or "torch"
-    if name == "capsule-v1":
-        if missing:
-            raise ShapeMoveError(f"the capsule test body needs {missing}")
-        from .capsule_body import capsule_body
-
-        return capsule_body()
     if is_openbody(name):
         body = loader("openbody")
     elif model_file:
