@@ -273,3 +273,33 @@ def test_errors_name_the_missing_part():
     sub_parents = [idx[parents[i]] if parents[i] >= 0 else -1 for i in keep]
     with pytest.raises(ShapeMoveError, match="no toe"):
         detect_rig([names[i] for i in keep], sub_parents, rest[keep])
+
+
+REAL_CLIPS = ["bandai/dataset-1/data/dataset-1_walk_active_001.bvh", "cmu/bvh/02/02_01.bvh",
+              "cmu/asfamc/02/02_01.amc", "hdm05/bd/HDM_bd_kickLFront1Reps_001_120.amc"]
+
+
+@pytest.mark.parametrize("rel", REAL_CLIPS)
+def test_real_rigs_match_their_table_by_shape(mocap_root, rel):
+    """The archives' own skeletons (Bandai, Daz-style CMU BVH, CMU and HDM05 ASF), matched by shape
+    with their names and again with every joint renamed (End Sites keep the readers' `<joint>_End`):
+    the 22 SMPL joints agree with the hand-made table mapping within 1 mm over the clip's first
+    200 frames. Known difference: renamed ASF rigs put the wrist at `lhand` (where the fingers
+    fork), 8-10 cm past the table's `lwrist`."""
+    from shapemove.core.geometry.fk import joints_from_offsets
+    from shapemove.core.io.mocap import load_mocap
+    from shapemove.core.io.rig_map import pose_candidates
+
+    m = load_mocap(mocap_root / rel)
+    pos = m.positions[:200]
+    table = detect_rig(m.names)
+    want = mapping_matrix(table, m.names, pos) @ pos
+    poses = pose_candidates(joints_from_offsets(m.offsets, m.parents), m.positions)
+    short = [f"j{k:03d}" for k in range(len(m.names))]
+    renamed = [short[p] + "_End" if n.endswith("_End") else short[k] for k, (n, p) in enumerate(zip(m.names, m.parents))]
+    for names in (m.names, renamed):
+        rig = match_humanoid(names, m.parents, poses)
+        got = mapping_matrix(rig, names, pos) @ pos
+        err = np.linalg.norm(got - want, axis=-1).max(0)
+        skip = [20, 21] if names is renamed and rel.endswith(".amc") else []
+        assert np.delete(err, skip).max() < 1e-3, (rel, names is renamed, np.round(err * 100, 1))

@@ -74,10 +74,11 @@ def mocap_to_smpl22(mocap: Mocap, fps: float = FPS, drop_tpose: bool = True) -> 
     """Map a Mocap to SMPL22 positions, cut a T-pose lead-in, resample to ``fps``."""
     from ..body.skeleton import PARENTS
     from .resample import resample_positions
-    from .rig_map import detect_rig, mapping_matrix
+    from .rig_map import detect_rig, mapping_matrix, pose_candidates
     from .tpose import tpose_lead_in
 
-    rig = detect_rig(mocap.names, mocap.parents, joints_from_offsets(mocap.offsets, mocap.parents))
+    rig = detect_rig(mocap.names, mocap.parents,
+                     pose_candidates(joints_from_offsets(mocap.offsets, mocap.parents), mocap.positions))
     W = mapping_matrix(rig, mocap.names, mocap.positions)
     joints = np.matmul(W, mocap.positions)
     cut = tpose_lead_in(joints, mocap.fps) if drop_tpose else 0

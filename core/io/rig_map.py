@@ -144,7 +144,7 @@ def _required(rig: Rig) -> dict:
 
 def find_rig(names, parents=None, rest=None) -> Rig | None:
     """The first rig whose every rule resolves against ``names``, else None. With ``parents``
-    (J,) and ``rest`` (J,3) rest positions, a skeleton absent from the tables is matched by its
+    (J,) and ``rest`` (J,3) rest positions (or (K,J,3) poses to try, ``pose_candidates``), a skeleton absent from the tables is matched by its
     shape (``skeleton_match.match_humanoid``); None when that fails too."""
     rig = _find_rig(tuple(names))
     if rig is None and parents is not None and rest is not None:
@@ -153,6 +153,14 @@ def find_rig(names, parents=None, rest=None) -> Rig | None:
         except ShapeMoveError:
             return None
     return rig
+
+
+def pose_candidates(rest, positions) -> np.ndarray:
+    """(K,J,3) poses to match an unknown skeleton on: its rest pose, then its first and middle
+    frames (for rigs whose offsets do not stand, the motion does)."""
+    positions = np.asarray(positions, dtype=np.float64)
+    picks = [np.asarray(rest, dtype=np.float64)] + ([positions[0], positions[len(positions) // 2]] if len(positions) else [])
+    return np.stack(picks)
 
 
 def _match(names, parents, rest) -> Rig:

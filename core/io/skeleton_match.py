@@ -35,11 +35,16 @@ LEG_WORDS = ("leg", "thigh", "knee", "calf", "shin", "foot", "toe", "ankle", "fe
 ARM_WORDS = ("arm", "hand", "shoulder", "clav", "elbow", "wrist", "humerus", "radius", "shldr", "collar",
              "finger", "thumb", "index", "pinky", "palm")
 END_WORDS = ("end", "top", "nub", "site", "tip")
-THIGH_OVER_SHIN = 1.0     # hip->knee / knee->ankle of adults (0.9-1.1)
+THIGH_OVER_SHIN = 0.95    # hip->knee / knee->ankle of adults (0.8-1.05 in the archives' rigs)
 UPPER_OVER_FOREARM = 1.05  # shoulder->elbow / elbow->wrist
 UPPER_ARM_OVER_LEG = 0.34  # shoulder->elbow / (hip->knee->ankle) of adults
 FOREARM_OVER_LEG = 0.33    # elbow->wrist / (hip->knee->ankle)
-COLLAR_OUT = 0.45          # SMPL's collar joint: this fraction of the way from the mid-line to the shoulder
+COLLAR_OUT = 0.45
+# words that name a role's joint (a soft preference: geometry still decides between several)
+ROLE_WORDS = {"hip": ("thigh", "upleg", "upperleg", "femur"), "knee": ("shin", "calf", "knee", "lowerleg", "tibia"),
+              "shoulder": ("upperarm", "upper_arm", "humerus", "shldr"),
+              "elbow": ("forearm", "lowerarm", "radius", "elbow"), "wrist": ("wrist", "hand")}
+HELPER_WORDS = ("twist", "roll", "helper", "end", "nub", "tip")          # SMPL's collar joint: this fraction of the way from the mid-line to the shoulder
 
 
 class _Tree:
@@ -149,9 +154,26 @@ def _pair_side(a: str, b: str) -> int:
     return 1 if pair == "lr" else -1 if pair == "rl" else 0
 
 
+def _role_miss(tree, chain_part, j, role) -> float:
+    """0 when ``j`` has a name of ``role`` or no joint of ``chain_part`` has one; else 1. For the
+    wrist, 'wrist' names win over 'hand' names (ASF: lwrist, then lhand)."""
+    words = ROLE_WORDS[role]
+    for group in ((("wrist",), ("hand",)) if role == "wrist" else (words,)):
+        named = [c for c in chain_part if _has_word(tree.names[c], group) and not _has_word(tree.names[c], HELPER_WORDS)]
+        if named:
+            return 0.0 if j in named[:1] or (role != "wrist" and j in named) else 1.0
+    return 0.0
+
+
 def _has_word(name, words) -> bool:
     low = _words(name).lower()
     return any(w in low for w in words)
+
+
+def _is_end(tree, j) -> bool:
+    """An End Site as the mocap readers name it (``<parent>_End``), or a bone tail likewise."""
+    p = tree.parents[j]
+    return p >= 0 and _words(tree.names[j]).lower() == _words(tree.names[p]).lower() + "_end"
 
 
 def _prune(tree: _Tree, keep: int = 5):
@@ -193,12 +215,16 @@ def _leg(tree, hub, leaf, up, scale):
     P = tree.rest
     names = tree.names
     pts = [P[hub]] + [P[c] for c in chain]
-    ankle_i = None
+    ends = []  # chain indices ending a descending segment
     for i in range(1, len(pts)):
         s = pts[i] - pts[i - 1]
         n = np.linalg.norm(s)
         if n > 0.01 * scale and -np.dot(s, up) > 0.5 * n:
-            ankle_i = i - 1  # index into chain
+            ends.append(i - 1)
+    past = lambda k: max((np.linalg.norm(P[c] - P[chain[k]]) for c in chain[k + 1:]), default=0.0)  # noqa: E731
+    ankle_i = ends[-1] if ends else None
+    if len(ends) >= 2 and past(ends[-1]) < 0.02 * scale and past(ends[-2]) < 0.25 * scale:
+        ankle_i = ends[-2]  # a frame with the heel up: the toe is the last joint going down, not the ankle
     if ankle_i is None or ankle_i < 2:
         raise ShapeMoveError(f"the leg ending at {names[leaf]!r} has no downward thigh and shin in the rest pose "
                              "(stand the skeleton upright, or use a bone-mapping preset)")
@@ -218,7 +244,10 @@ def _leg(tree, hub, leaf, up, scale):
         la, lb = np.linalg.norm(a), np.linalg.norm(b)
         if la < 0.05 * scale or lb < 0.05 * scale:
             continue
+        if hi + 1 < ki and np.linalg.norm(P[chain[hi + 1]] - P[hip]) < 0.1 * la:
+            continue  # a tiny bone follows: the hip joint is the next one (Daz lButtock -> lThigh)
         cost = abs(np.log(la / lb / THIGH_OVER_SHIN)) + (1 - np.dot(a, b) / (la * lb))
+        cost += _role_miss(tree, chain[:ankle_i], hip, "hip") + _role_miss(tree, chain[:ankle_i], knee, "knee")
         cost += 2.0 * (1 - (la + lb) / span)  # thigh + shin make most of the leg (not two halves of a shin)
         cost += 1.0 if np.linalg.norm(P[hip] - P[hub]) < 0.03 * scale else 0.0
         if best is None or cost < best[0]:
@@ -246,6 +275,9 @@ def _arm(tree, hub, leaf, up, scale, leg3):
         cost += 1.0 - (la + lb) / span  # upper arm + forearm make most of the arm (not two halves of one)
         cost += abs(np.log(la / leg3 / UPPER_ARM_OVER_LEG)) + abs(np.log(lb / leg3 / FOREARM_OVER_LEG))
         cost += 0.5 * max(0.0, hand / lb - 1.0)  # a hand longer than the forearm: wrist too early
+        cost += sum(_role_miss(tree, chain, j, r) for j, r in ((s, "shoulder"), (e, "elbow"), (w, "wrist")))
+        cost -= 0.3 if len(tree.children[w]) >= 2 else 0.0  # fingers branch at the hand
+        cost += 0.3 if si == 0 else 0.0  # humanoid rigs have a clavicle before the shoulder
         cost += 1.0 if np.linalg.norm(_lateral(P[s] - P[hub], up)) < 0.03 * scale else 0.0
         if best is None or cost < best[0]:
             best = (cost, si, ei, wi)
@@ -269,6 +301,10 @@ def _head_neck(tree, spine_path, head_path, scale):
     named = [j for j in head_path if _has_word(names[j], ("head",)) and not _has_word(names[j], END_WORDS)]
     if named:
         head = named[-1]
+    elif any(len(tree.children[j]) >= 2 for j in head_path[:-1]):
+        head = [j for j in head_path[:-1] if len(tree.children[j]) >= 2][-1]  # eyes, jaw and top fork there
+    elif _is_end(tree, head_path[-1]) and len(head_path) >= 2:
+        head = head_path[-2]  # a reader's End Site (``<joint>_End``) or an armature's bone tail
     else:  # by shape: drop tiny end sites; a long last segment is the skull (joint -> top of head)
         path = list(head_path)
         while len(path) > 1 and tree.length[path[-1]] < 0.03 * scale:
@@ -286,7 +322,22 @@ def _head_neck(tree, spine_path, head_path, scale):
 
 def match_humanoid(names, parents, rest, rig_name: str = "auto"):
     """A ``rig_map.Rig`` for a humanoid skeleton of any naming: names (J,), parents (J,) with
-    parents[j] < j, rest (J,3) joint positions in the rest pose (any unit, any up axis)."""
+    parents[j] < j, rest (J,3) joint positions in the rest pose (any unit, any up axis), or
+    (K,J,3) candidate poses tried in turn (a rig whose rest pose lies on its back, like Bandai's
+    offsets, still stands in its first frame); the first pose that matches wins."""
+    poses = np.asarray(rest, dtype=np.float64)
+    if poses.ndim != 3:
+        return _match_pose(names, parents, poses, rig_name)
+    first = None
+    for pose in poses:
+        try:
+            return _match_pose(names, parents, pose, rig_name)
+        except ShapeMoveError as exc:
+            first = first or exc
+    raise first if first else ShapeMoveError("no pose given to match the skeleton on")
+
+
+def _match_pose(names, parents, rest, rig_name):
     tree = _Tree(names, parents, rest)
     norm = [normalize(n) for n in tree.names]
     extent = float(np.ptp(tree.rest, axis=0).max()) if len(tree.names) else 0.0
@@ -382,6 +433,9 @@ def match_humanoid(names, parents, rest, rig_name: str = "auto"):
     arm_l, arm_r = order(arm_parts, arms, hub_a, "shoulder")
     base = tree.lca(hub_l, hub_a)  # where the legs' branch meets the spine (the legs' hub, or above it)
     spine_path = [base] + tree.down_path(base, hub_a) if hub_a != base else [base]
+    mid_hips = 0.5 * (tree.rest[leg_l["hip"]] + tree.rest[leg_r["hip"]])
+    if len(spine_path) > 1 and np.dot(tree.rest[base] - mid_hips, up) < -0.01 * leg3:
+        spine_path = spine_path[1:]  # a root below the hip joints (Daz's `hip`) is not on the spine
     head, neck, spine = _head_neck(tree, spine_path, tree.down_path(hub_a, head_leaf), leg_len)
 
     if len(set(norm)) != len(norm):

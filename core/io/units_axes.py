@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .rig_map import find_rig, mapping_matrix
+from .rig_map import find_rig, mapping_matrix, pose_candidates
 
 UNITS = {"m": 1.0, "cm": 0.01, "mm": 0.001, "inch": 0.0254}
 LEG_M = 0.80     # hip->knee->ankle of an adult, metres
@@ -30,7 +30,7 @@ _TO_Y_UP = {
 def smpl22_or_none(names, positions, parents=None, rest=None):
     """SMPL22 positions (T,22,3) of a sample of frames, or None for a rig we cannot map (with
     ``parents`` and ``rest`` positions, a rig absent from the tables is matched by its shape)."""
-    rig = find_rig(names, parents, rest)
+    rig = find_rig(names, parents, None if rest is None else pose_candidates(rest, positions))
     if rig is None:
         return None
     pos = _sample(positions)
@@ -80,7 +80,7 @@ def detect_up_axis(names, positions: np.ndarray, rest: np.ndarray | None = None,
     the frames where the subject stands upright vote (a clip that lies on the floor still has some);
     else the median ankles->head direction. ``parents`` lets a rig absent from the tables be
     matched by its shape."""
-    rig = find_rig(names, parents, rest)
+    rig = find_rig(names, parents, None if rest is None else pose_candidates(rest, positions))
     if rig is None:
         ext = np.median(np.ptp(_sample(positions), axis=1), axis=0)
         return "XYZ"[int(np.argmax(ext))] if np.all(np.isfinite(ext)) else "Y"
