@@ -71,3 +71,12 @@ def test_bad_input():
         fsq.indices_to_codes(torch.tensor([1000]))
     with pytest.raises(ShapeMoveError, match="channels"):
         fsq.codes_to_indices(torch.zeros(3, 5))
+
+
+def test_default_codebook_is_the_motion_vocabulary():
+    from shapemove.core.constants import FSQ_LEVELS, NUM_CODES
+    from shapemove.core.models.savae import SAVAEConfig
+    from shapemove.core.models.tokenizer import motion_tokens
+
+    assert FSQ(SAVAEConfig().levels).codebook_size == NUM_CODES == 8 * 5 * 5 * 5 == len(motion_tokens())
+    assert FSQ().levels_list == list(FSQ_LEVELS)

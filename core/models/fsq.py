@@ -12,6 +12,7 @@ import math
 import torch
 from torch import nn
 
+from ..constants import FSQ_LEVELS
 from ..errors import ShapeMoveError
 
 
@@ -23,7 +24,7 @@ def round_ste(z: torch.Tensor) -> torch.Tensor:
 class FSQ(nn.Module):
     """Quantizer over the last dimension. ``forward(z)`` -> (codes, indices) for z (..., C)."""
 
-    def __init__(self, levels=(8, 5, 5, 5), eps: float = 1e-3):
+    def __init__(self, levels=FSQ_LEVELS, eps: float = 1e-3):
         super().__init__()
         levels = [int(x) for x in levels]
         if not levels or min(levels) < 2:

@@ -16,6 +16,7 @@ from pathlib import Path
 import torch
 from torch import nn
 
+from ..constants import FSQ_LEVELS
 from ..errors import ShapeMoveError
 from .decoder import Decoder
 from .encoder import Encoder
@@ -60,7 +61,7 @@ class TrainSettings:
 class SAVAEConfig:
     feature_dim: int = 263
     num_betas: int = 10
-    levels: tuple = (8, 5, 5, 5)
+    levels: tuple = FSQ_LEVELS
     width: int = 512
     depth: int = 3
     dilation_growth: int = 3

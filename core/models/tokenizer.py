@@ -14,9 +14,9 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from ..constants import NUM_CODES  # the default FSQ codebook; models record their own count
 from ..errors import ShapeMoveError
 
-NUM_CODES = 1000  # FSQ levels [8,5,5,5]; models record their own count
 SOM, EOM, BETA = "[SOM]", "[EOM]", "[BETA]"
 MOTION_TOKENS = [f"[MID_{i}]" for i in range(NUM_CODES)]
 MAX_CODES_LIMIT = 1 << 16
