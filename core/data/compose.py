@@ -9,11 +9,13 @@ smoothstep weight. FK, grounding on the mesh and the HumanML3D features come fro
 ``ClipProcessor`` (``pose_on``, ``features``), so a composed clip is written exactly like a built
 one (``build._write_clip``) and ``build.finalize`` refreshes the split lists and Mean/Std.
 
-Only training clips (not augmented, not composed) are joined, and composed clips go to the
-training split, so validation/test clips never leak into training. Captions say "X, then Y" in
-several phrasings ("a person walks forward, then waves.", "first a person walks forward, then
-waves.", "a person walks forward and then waves.", "a person walks forward before waving.", ...),
-with X and Y taken from the clips' own generated captions; meta ``labels["actions"]`` lists A's
+Pairs: A's main action is drawn with probability ~ sqrt(number of clips with it) (so rare actions
+such as a cartwheel appear in compositions without drowning the common ones), then a clip of it; B
+likewise among the other actions. Only training clips (not augmented, not composed) are joined,
+and composed clips go to the training split, so validation/test clips never leak into training.
+Captions say "X, then Y" in several phrasings ("a person walks forward, then waves.", "first a
+person walks forward, then waves.", "a person walks forward and then waves.", "a person walks
+forward before waving.", ...), with X and Y taken from the clips' own generated captions; meta ``labels["actions"]`` lists A's
 actions then B's; ``composed_from`` names both clips. Deterministic for a given ``seed``.
 """
 from __future__ import annotations
@@ -186,14 +188,23 @@ def compose_dataset(data, count: int, seed: int = 0, body=None, verbose: bool = 
     if len(cands) < 2:
         raise ShapeMoveError(f"{data}: needs at least 2 training clips with action labels to compose")
     rng = np.random.default_rng(seed)
+    by_action: dict[str, list[dict]] = {}
+    for m in cands:
+        by_action.setdefault(m["labels"]["actions"][0], []).append(m)
+    names = sorted(by_action)
+    weight = np.sqrt([len(by_action[a]) for a in names])   # rare actions get more than their share
     proc = ClipProcessor(body)
     written = []
     for i in tqdm(range(count), desc="composing", unit="clip", disable=not verbose):
         cid = f"comp{seed}_{i:05d}"
-        ma = cands[int(rng.integers(len(cands)))]
-        main_a = ma["labels"]["actions"][0]
-        others = [m for m in cands if m["labels"]["actions"][0] != main_a] or cands
-        mb = others[int(rng.integers(len(others)))]
+        ia = int(rng.choice(len(names), p=weight / weight.sum()))
+        wb = weight.copy()
+        if len(names) > 1:
+            wb[ia] = 0.0
+        ib = int(rng.choice(len(names), p=wb / wb.sum()))
+        ma = by_action[names[ia]][int(rng.integers(len(by_action[names[ia]])))]
+        mb = by_action[names[ib]][int(rng.integers(len(by_action[names[ib]])))]
+        main_a = names[ia]
         if (data / "meta" / f"{cid}.json").exists():
             continue
         a = load_part(data, ma["id"], ma, proc.body, first=True)
