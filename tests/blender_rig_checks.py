@@ -86,6 +86,11 @@ def main(cfg):
         results[case["name"] + "__rest"] = J
         info[case["name"]] = {"mapping": mapping, "action": obj.animation_data.action.name,
                               "fps": scene.render.fps / scene.render.fps_base, "frame_end": scene.frame_end}
+        if case.get("preset_file"):  # the Save / Load operators round-trip the map through JSON
+            assert bpy.ops.shapemove.rig_map_save(filepath=case["preset_file"]) == {"FINISHED"}
+            obj.shapemove_bone_map.clear()
+            assert bpy.ops.shapemove.rig_map_load(filepath=case["preset_file"]) == {"FINISHED"}
+            info[case["name"]]["reloaded_map"] = rig_retarget.stored_map(obj)
         if case.get("save_blend"):
             obj.animation_data.action = None
             obj.shapemove_bone_map.clear()

@@ -53,6 +53,7 @@ def baked(tmp_path_factory):
     paths = {k: str(save_motion(d / f"{k}.npz", m)) for k, m in motions.items()}
     cases = [dict(c) for c in CASES]
     cases[1]["save_blend"] = str(d / "mixamo_in.blend")
+    cases[3]["preset_file"] = str(d / "unnamed_map.json")
     cfg = dict(motions=paths, cases=cases, out=str(d / "results.npz"), info=str(d / "info.json"),
                headless=dict(motion=paths["wavy"], blend=str(d / "mixamo_in.blend"), armature="mixamo_T",
                              out=str(d / "headless_out.blend"), plant_feet=False))
@@ -82,6 +83,13 @@ def test_blender_bake_follows_the_scaled_source(baked, name, scale):
     assert np.abs(offset[:2]).max() < 0.5 * MM
     err = np.abs(diff - offset).max()
     assert err < 0.5 * MM, (name, err)
+
+
+def test_blender_bone_map_saved_and_loaded_by_the_operators(baked):
+    info = baked["info"]["unnamed_A"]
+    assert info["reloaded_map"] == info["mapping"] and len(info["mapping"]) == 22
+    saved = json.loads((baked["dir"] / "unnamed_map.json").read_text())
+    assert saved["format"] == "shapemove-bone-map" and saved["bones"]["left_hip"] == [info["mapping"]["left_hip"]]
 
 
 def test_blender_bake_on_a_turned_moved_scaled_object(baked):

@@ -303,3 +303,16 @@ def test_real_rigs_match_their_table_by_shape(mocap_root, rel):
         err = np.linalg.norm(got - want, axis=-1).max(0)
         skip = [20, 21] if names is renamed and rel.endswith(".amc") else []
         assert np.delete(err, skip).max() < 1e-3, (rel, names is renamed, np.round(err * 100, 1))
+
+
+def test_bvh_of_a_half_body_says_what_is_missing(tmp_path):
+    """An upper body only (no legs): the import error says a humanoid needs feet, not a joint list."""
+    names, parents, rest = fancy_rig(fingers=False, twists=False)
+    keep = [i for i, n in enumerate(names) if not any(k in n for k in ("Thigh", "Calf", "Foot", "Toe"))]
+    idx = {old: new for new, old in enumerate(keep)}
+    sub = [names[i] for i in keep]
+    par = [idx[parents[i]] if parents[i] >= 0 else -1 for i in keep]
+    path = tmp_path / "half.bvh"
+    path.write_text(bvh_text(sub, par, 100 * rest[keep], still_motion(100 * rest[keep][0], len(sub), 10)))
+    with pytest.raises(ShapeMoveError, match=r"unknown skeleton .*two feet, two hands and a head"):
+        load_smpl22(path)

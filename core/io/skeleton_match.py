@@ -393,9 +393,10 @@ def _match_pose(names, parents, rest, rig_name):
         short = [x for x in ends if tree.dist(hub, x) < 0.4 * leg_len]
         if short:
             raise ShapeMoveError(
-                f"cannot find a humanoid: the longest limb ends are {', '.join(tree.names[j] for j in leaves)}, "
-                f"and {tree.names[short[0]]!r} is far too short for an {label}; a humanoid needs five ends, "
-                "two feet, two hands and a head (a whole-body skeleton, or a bone-mapping preset)")
+                f"cannot find a humanoid: its longest limb ends are {', '.join(tree.names[j] for j in leaves)}, "
+                f"and the best fit would make {tree.names[short[0]]!r} an {label} "
+                f"{tree.dist(hub, short[0]) / leg_len:.0%} as long as the legs; a humanoid needs five ends, two "
+                "feet, two hands and a head (a whole-body skeleton, or a bone-mapping preset)")
     if any(tree.lca(hub_a, x) != hub_a for x in (*arms, head_leaf)) \
             or any(tree.lca(hub_l, x) != hub_l for x in legs):
         raise ShapeMoveError(f"cannot find a humanoid: the arms ({tree.names[arms[0]]}, {tree.names[arms[1]]}) do "
