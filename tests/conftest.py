@@ -15,6 +15,8 @@ except ImportError:  # pragma: no cover
     pass
 
 REQUIRE_DATA = os.environ.get("SHAPEMOVE_REQUIRE_DATA") == "1"
+# run in their own process by blender_inside.run (bpy must start with a temporary user folder)
+collect_ignore = ["in_blender"]
 
 
 def need_data(reason: str):
