@@ -58,7 +58,9 @@ def _cache_valid(archive: Path, marker: Path) -> bool:
             return True
         # written by an older version (the path only): valid if unpacked after the archive last changed
         if text == str(archive) and marker.stat().st_mtime_ns >= archive.stat().st_mtime_ns:
-            marker.write_text(cache_key(archive))
+            from ..atomic import atomic_write_text
+
+            atomic_write_text(marker, cache_key(archive))
             return True
     except OSError:
         return False
