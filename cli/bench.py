@@ -1,4 +1,4 @@
-"""`python -m shapemove bench [all|ik|keys|generate|train] [--json OUT]`.
+"""`python -m shapemove bench [all|ik|keys|sliders|generate|train] [--json OUT]`.
 
 Each benchmark lives in ``bench/<name>.py`` with ``run(quick: bool) -> dict`` and prints its own
 baseline (measured in the same run) and the ratio. ``all`` runs them in order and merges the dicts.
@@ -8,7 +8,7 @@ from __future__ import annotations
 import importlib
 from pathlib import Path
 
-BENCHES = ["ik", "keys", "generate", "train"]
+BENCHES = ["ik", "keys", "sliders", "generate", "train"]
 
 
 def add_arguments(p):

@@ -13,7 +13,7 @@ import numpy as np
 
 from ..core.scene.motion_file import load_motion
 from ..core.scene.rig_data import motion_channels_z_up
-from . import paths
+from . import grounding, paths
 from .job_submit import submit_job
 from .jobs import report_error
 from .keyframes import write_pose_action
@@ -100,9 +100,11 @@ def _answered(name, betas, msg) -> None:
 
 def apply_motion(rig, motion) -> bpy.types.Action:
     """Replace the rig's action with ``motion``'s keys (same action name; the old one is removed
-    when nothing else uses it). The bones must already sit on the rest joints of motion.betas."""
+    when nothing else uses it). The bones must already sit on the rest joints of motion.betas.
+    The motion is moved up or down as a whole so its lowest mesh-sole point is on the floor."""
     rotations, transl = motion_channels_z_up(motion.poses, motion.transl)
     names = rig["shapemove_joint_names"].split("\n")
+    transl = transl + [0.0, 0.0, grounding.floor_shift(rig, names, current_betas(rig), rotations, transl)]
     anim = rig.animation_data
     old = anim.action if anim is not None else None
     name = old.name if old is not None else f"{rig.name}_motion"

@@ -36,7 +36,7 @@ def current_betas(rig) -> np.ndarray:
 
 def placed_betas(rig) -> np.ndarray:
     """(10,) the betas the bones were last placed for."""
-    return np.asarray(rig.get("shapemove_betas", [0.0] * NUM_BETAS), dtype=np.float64)
+    return np.array(rig.get("shapemove_betas", [0.0] * NUM_BETAS), dtype=np.float64)  # a copy, not a view of the ID property
 
 
 def rig_body_spec(rig) -> str:

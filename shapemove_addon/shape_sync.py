@@ -16,7 +16,7 @@ from bpy.app.handlers import persistent
 from ..core.constants import NUM_BETAS
 from ..core.errors import ShapeMoveError
 from ..core.scene.shape_keys import rest_joints_for
-from . import redecode
+from . import grounding, redecode
 from .bone_placement import place_bones
 from .rig_state import body_of, current_betas, placed_betas, rig_of
 from .scene_build import RIG_MARK, SLIDER_RANGE
@@ -41,18 +41,25 @@ def on_betas_changed(obj, context=None) -> None:
     """Hook run whenever a rig's betas change: re-place the bones on the new rest joints.
 
     The armature's keyed local rotations are kept (rebased onto the new bone frames), so the same
-    motion now plays on the new body at once; when the rig has motion tokens, a debounced job then
-    re-decodes the motion for the new body (``redecode.schedule``) and replaces the keys."""
+    motion now plays on the new body at once, and the root is moved up or down frame by frame so
+    the mesh soles stay where they were (``grounding``); when the rig has motion tokens, a
+    debounced job then re-decodes the motion for the new body (``redecode.schedule``) and
+    replaces the keys."""
     rig = rig_of(obj)
     if rig is None:
         return
     context = context or bpy.context
     betas = current_betas(rig)
-    jt = np.asarray(rig["shapemove_joint_template"], dtype=np.float64).reshape(-1, 3)
-    jd = np.asarray(rig["shapemove_joint_shapedirs"], dtype=np.float64).reshape(len(jt), 3, NUM_BETAS)
+    jt = np.array(rig["shapemove_joint_template"], dtype=np.float64).reshape(-1, 3)
+    jd = np.array(rig["shapemove_joint_shapedirs"], dtype=np.float64).reshape(len(jt), 3, NUM_BETAS)
     names = rig["shapemove_joint_names"].split("\n")
     parents = [int(p) for p in rig["shapemove_parents"]]
-    place_bones(context, rig, rest_joints_for(jt, jd, betas), names, parents)
+    keys = place_bones(context, rig, rest_joints_for(jt, jd, betas), names, parents)
+    if keys is not None:  # feet on the floor: each frame's lowest sole point stays where it was
+        rotations, offsets = grounding.keyed_pose(keys.quats, keys.locations, keys.rest)
+        shift = grounding.shape_change_shift(rig, names, placed_betas(rig), betas, rotations, offsets)
+        if shift is not None and np.abs(shift).max() > 1e-7:
+            keys.set_locations(keys.locations + shift[:, None] * keys.rest[0][2])  # armature Z in the root's frame
     rig["shapemove_betas"] = betas.tolist()
     context.scene.frame_set(context.scene.frame_current)  # re-evaluate the rebased action
     redecode.schedule(rig)

@@ -107,6 +107,16 @@ def matrix_to_axis_angle(rot) -> np.ndarray:
     return v * scale
 
 
+def quaternion_multiply(a, b) -> np.ndarray:
+    """Hamilton product of quaternions (..., 4) (w, x, y, z), broadcast: the rotation b, then a."""
+    a = np.asarray(a, dtype=np.float64)
+    b = np.asarray(b, dtype=np.float64)
+    aw, ax, ay, az = np.moveaxis(a, -1, 0)
+    bw, bx, by, bz = np.moveaxis(b, -1, 0)
+    return np.stack([aw * bw - ax * bx - ay * by - az * bz, aw * bx + ax * bw + ay * bz - az * by,
+                     aw * by - ax * bz + ay * bw + az * bx, aw * bz + ax * by - ay * bx + az * bw], -1)
+
+
 def make_continuous(quats) -> np.ndarray:
     """(T, ..., 4) -> the same rotations with signs chosen so consecutive frames have a
     non-negative dot product (no 360-degree swings when interpolating between keys)."""

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..geometry.rotations import make_continuous, matrix_to_quaternion, quaternion_to_matrix
+from ..geometry.rotations import make_continuous, matrix_to_quaternion, quaternion_multiply
 
 
 def pose_bone_quaternions(local_rotations, bone_rest) -> np.ndarray:
@@ -27,14 +27,16 @@ def root_locations(transl, root_rest) -> np.ndarray:
 
 
 def rebase_quaternions(quats, old_rest, new_rest) -> np.ndarray:
-    """Pose-bone quaternions (T,4) keyed against rest frame ``old_rest`` (3,3) -> the quaternions
-    giving the same armature-space rotation against ``new_rest`` (the bone's rest moved)."""
-    d = np.asarray(new_rest, dtype=np.float64).T @ np.asarray(old_rest, dtype=np.float64)
-    rot = d @ quaternion_to_matrix(quats) @ d.T
-    return make_continuous(matrix_to_quaternion(rot))
+    """Pose-bone quaternions (..., T, 4) keyed against rest frames ``old_rest`` (..., 3, 3) -> the
+    quaternions giving the same armature-space rotation against ``new_rest`` (the bone's rest moved):
+    Q' = D Q D^T with D = new^T old, as the quaternion product d q d*. Each key keeps its sign, so
+    continuous keys stay continuous; the rest frames should be orthonormal (float64)."""
+    d = np.swapaxes(np.asarray(new_rest, dtype=np.float64), -1, -2) @ np.asarray(old_rest, dtype=np.float64)
+    qd = matrix_to_quaternion(d)[..., None, :]  # one per bone, broadcast over frames
+    return quaternion_multiply(quaternion_multiply(qd, quats), qd * np.array([1.0, -1.0, -1.0, -1.0]))
 
 
 def rebase_locations(locations, old_rest, new_rest) -> np.ndarray:
     """Root ``location`` keys (T,3) against ``old_rest`` -> the same offset against ``new_rest``."""
-    d = np.asarray(new_rest, dtype=np.float64).T @ np.asarray(old_rest, dtype=np.float64)
+    d = np.swapaxes(np.asarray(new_rest, dtype=np.float64), -1, -2) @ np.asarray(old_rest, dtype=np.float64)
     return np.asarray(locations, dtype=np.float64) @ d.T
