@@ -29,16 +29,10 @@ from pathlib import Path
 import numpy as np
 import torch
 
-FORMAT_VERSION = 1
-MODEL_ID = "openbody-v1"
-NUM_BETAS = 10
-
-JOINT_NAMES = [
-    "pelvis", "left_hip", "right_hip", "spine1", "left_knee", "right_knee", "spine2",
-    "left_ankle", "right_ankle", "spine3", "left_foot", "right_foot", "neck",
-    "left_collar", "right_collar", "head", "left_shoulder", "right_shoulder",
-    "left_elbow", "right_elbow", "left_wrist", "right_wrist", "left_hand", "right_hand",
-]
+from shapemove.core.body.openbody_asset import FORMAT_VERSION, MODEL_ID  # the asset's id: one home
+from shapemove.core.body.skeleton import JOINT_NAMES
+from shapemove.core.constants import NUM_BETAS
+from shapemove.core.geometry.rotations import rotation_between
 
 # Anny (MakeHuman) axes -> ShapeMove axes: Anny is Z up and faces -Y; (x, y, z) -> (x, z, -y).
 ANNY_TO_SM = np.array([[1.0, 0, 0], [0, 0, 1.0], [0, -1.0, 0]])
@@ -131,21 +125,6 @@ def anny_rest(model, kw: dict) -> tuple[np.ndarray, np.ndarray]:
 
 
 # -- T-pose -------------------------------------------------------------------------------------------
-def rotation_between(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """(n,3),(3,) -> (n,3,3) minimal rotations taking direction a onto direction b."""
-    a = a / np.linalg.norm(a, axis=-1, keepdims=True)
-    b = np.broadcast_to(b / np.linalg.norm(b), a.shape)
-    axis = np.cross(a, b)
-    s = np.linalg.norm(axis, axis=-1)
-    c = (a * b).sum(-1)
-    k = axis / np.maximum(s, 1e-12)[:, None]
-    K = np.zeros(a.shape[:-1] + (3, 3))
-    K[:, 0, 1], K[:, 0, 2], K[:, 1, 2] = -k[:, 2], k[:, 1], -k[:, 0]
-    K = K - K.transpose(0, 2, 1)
-    ang = np.arctan2(s, c)[:, None, None]
-    return np.eye(3) + np.sin(ang) * K + (1 - np.cos(ang)) * K @ K
-
-
 class Rigid:
     """Batched rigid transforms x -> R x + t."""
 
