@@ -71,7 +71,11 @@ def main(cfg):
             J = reproportion(J)
             J[:, 2] -= J[[10, 11], 2].min() - 0.02
         bones = SCHEMES[case["scheme"]](J, np.random.default_rng(case.get("seed", 0)))
-        obj = build_armature(case["name"], bones, case.get("matrix_world", np.eye(4).tolist()))
+        M = np.asarray(case.get("matrix_world", np.eye(4).tolist()), dtype=np.float64)
+        if case.get("data_in_object_space"):  # bones given in world space: store them in the object's space
+            inv = np.linalg.inv(M)
+            bones = [(n, p, inv[:3, :3] @ h + inv[:3, 3], inv[:3, :3] @ t + inv[:3, 3], r, d) for n, p, h, t, r, d in bones]
+        obj = build_armature(case["name"], bones, M)
         scene = bpy.context.scene
         scene.shapemove_rig.target = obj
         scene.shapemove_rig.preset = case.get("preset", "AUTO")

@@ -1,7 +1,7 @@
 """Retargeting onto the user's armature inside real Blender (bpy module): Rigify / Mixamo / CC /
 unnamed armatures built in the test, in T- and A-poses with random bone rolls, a turned and moved
-armature object, mapped by the "Map Bones" operator and baked by "Bake onto Rig" (keys through
-the action's channelbag); the world positions of the mapped bones that Blender evaluates are
+armature object, an FBX-style one (Y-up centimetre data, object turned and scaled 0.01), mapped
+by the "Map Bones" operator and baked by "Bake onto Rig" (keys through the action's channelbag); the world positions of the mapped bones that Blender evaluates are
 compared with the source motion's joints, scaled. Also the headless `retarget-rig` command.
 
 The Blender part runs in one subprocess (tests/blender_rig_checks.py)."""
@@ -41,6 +41,8 @@ CASES = [
     dict(name="unnamed_A", scheme="unnamed", pose="A", scale=1.2, motion="wavy", seed=4),
     dict(name="mixamo_turned", scheme="mixamo", pose="A", scale=0.5, motion="wavy", seed=5,
          matrix_world=_turned(90, [2.0, -1.0, 0.0], 2.0).tolist()),
+    dict(name="fbx_style", scheme="mixamo", pose="A", scale=1.0, motion="wavy", seed=7, data_in_object_space=True,
+         matrix_world=[[0.01, 0, 0, 0], [0, 0, -0.01, 0], [0, 0.01, 0, 0], [0, 0, 0, 1]]),
     dict(name="planted", scheme="rigify", pose="A", scale=1.0, motion="planted", seed=6, reproportion=True,
          plant_feet=True),
 ]
@@ -69,7 +71,8 @@ def _scaled_source(motion, scale, matrix=np.eye(3)):
     return scale * z_up(motion.joints.astype(np.float64)) @ matrix.T
 
 
-@pytest.mark.parametrize("name,scale", [("rigify_A", 1.1), ("mixamo_T", 0.9), ("cc_A", 1.0), ("unnamed_A", 1.2)])
+@pytest.mark.parametrize("name,scale", [("rigify_A", 1.1), ("mixamo_T", 0.9), ("cc_A", 1.0), ("unnamed_A", 1.2),
+                                        ("fbx_style", 1.0)])
 def test_blender_bake_follows_the_scaled_source(baked, name, scale):
     """Every mapped joint within 0.5 mm of the
     source joint x scale, up to one constant vertical offset (floor to floor)."""

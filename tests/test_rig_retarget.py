@@ -150,3 +150,24 @@ def test_bad_maps_are_refused():
         check_map({**mapping, "head": "Skull"}, arm.names)
     with pytest.raises(ShapeMoveError, match="plays both"):
         check_map({**mapping, "head": mapping["neck"]}, arm.names)
+
+
+def test_fbx_style_armature_y_up_in_centimetres():
+    """Mixamo FBX imports: bone data Y up in centimetres, the object turned +90 degrees about X
+    and scaled 0.01. The bake works in world space, so the result is the same as for a Z-up rig."""
+    m = wavy_motion(REST_JOINTS, 20)
+    J = posed_joints(REST_JOINTS[:22], scale=1.0, pose="A")
+    M = np.eye(4)
+    M[:3, :3] = 0.01 * np.array([[1, 0, 0], [0, 0, -1], [0, 1, 0]])   # data Y-up cm -> world Z-up m
+    inv = np.linalg.inv(M)
+    bones = SCHEMES["mixamo"](J, np.random.default_rng(7))
+    data = [(n, p, inv[:3, :3] @ h + inv[:3, 3], inv[:3, :3] @ t + inv[:3, 3], r, d) for n, p, h, t, r, d in bones]
+    arm = armature_rest(data, matrix_world=M)
+    mapping, how = map_armature(arm)
+    bake = retarget_to_armature(m, arm, mapping, plant_feet=False)
+    src = z_up(m.joints.astype(np.float64))
+    d = bake.joints - src
+    assert how == "preset Mixamo" and abs(bake.scale - 1) < 1e-6 and abs(bake.heading) < 1e-6
+    assert np.abs(d - d.reshape(-1, 3).mean(0)).max() < 0.1 * MM
+    # the keyed root offset is in the armature's own (centimetre) units
+    assert np.abs(bake.root_offset).max() > 10

@@ -144,8 +144,9 @@ def _required(rig: Rig) -> dict:
 
 def find_rig(names, parents=None, rest=None) -> Rig | None:
     """The first rig whose every rule resolves against ``names``, else None. With ``parents``
-    (J,) and ``rest`` (J,3) rest positions (or (K,J,3) poses to try, ``pose_candidates``), a skeleton absent from the tables is matched by its
-    shape (``skeleton_match.match_humanoid``); None when that fails too."""
+    (J,) and ``rest`` (J,3) rest positions (or (K,J,3) poses to try, ``pose_candidates``), a
+    skeleton absent from the tables is matched by its shape (``skeleton_match.match_humanoid``);
+    None when that fails too."""
     rig = _find_rig(tuple(names))
     if rig is None and parents is not None and rest is not None:
         try:

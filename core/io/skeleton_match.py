@@ -39,12 +39,12 @@ THIGH_OVER_SHIN = 0.95    # hip->knee / knee->ankle of adults (0.8-1.05 in the a
 UPPER_OVER_FOREARM = 1.05  # shoulder->elbow / elbow->wrist
 UPPER_ARM_OVER_LEG = 0.34  # shoulder->elbow / (hip->knee->ankle) of adults
 FOREARM_OVER_LEG = 0.33    # elbow->wrist / (hip->knee->ankle)
-COLLAR_OUT = 0.45
+COLLAR_OUT = 0.45  # SMPL's collar joint: this fraction of the way from the mid-line to the shoulder
 # words that name a role's joint (a soft preference: geometry still decides between several)
 ROLE_WORDS = {"hip": ("thigh", "upleg", "upperleg", "femur"), "knee": ("shin", "calf", "knee", "lowerleg", "tibia"),
               "shoulder": ("upperarm", "upper_arm", "humerus", "shldr"),
               "elbow": ("forearm", "lowerarm", "radius", "elbow"), "wrist": ("wrist", "hand")}
-HELPER_WORDS = ("twist", "roll", "helper", "end", "nub", "tip")          # SMPL's collar joint: this fraction of the way from the mid-line to the shoulder
+HELPER_WORDS = ("twist", "roll", "helper", "end", "nub", "tip")
 
 
 class _Tree:
