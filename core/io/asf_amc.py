@@ -21,7 +21,7 @@ import numpy as np
 
 from ..errors import ShapeMoveError
 from ..geometry.fk import forward_kinematics, joints_from_offsets
-from ..geometry.rotations import axis_rotation
+from ..geometry.rotations import euler_matrix
 from .limits import MAX_HIERARCHY_BYTES, MAX_JOINT_FRAMES, check_joint_frames, parse_floats, read_text
 from .mocap_clip import Mocap, finish_mocap
 
@@ -59,12 +59,8 @@ class Skeleton:
 def fixed_axes_matrix(order: str, angles) -> np.ndarray:
     """Rotation about fixed axes applied in ``order`` (e.g. 'XYZ' -> Rz @ Ry @ Rx); angles (...,3)
     radians given in X,Y,Z slots."""
-    angles = np.asarray(angles, dtype=np.float64)
-    out = np.broadcast_to(np.eye(3), (*angles.shape[:-1], 3, 3)).copy()
-    for ax in order.upper():
-        k = "XYZ".index(ax)
-        out = axis_rotation(ax.lower(), angles[..., k]) @ out
-    return out
+    outer_first = order.upper()[::-1]  # the last rotation applied is the outermost factor
+    return euler_matrix(outer_first.lower(), np.asarray(angles, dtype=np.float64)[..., ["XYZ".index(a) for a in outer_first]])
 
 
 def _floats(parts, n, what, source):
