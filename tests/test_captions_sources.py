@@ -104,6 +104,8 @@ def test_splits_hold_out_subjects_and_are_stable():
     assert 0.07 < splits.count("test") / len(ids) < 0.13
     assert 0.03 < splits.count("val") / len(ids) < 0.07
     assert splits == [split_of(i, "bandai-dataset-1", "bandai") for i in ids]
+    # DeepMimic: one clip per action, mirrored copies -> all training data
+    assert {split_of(f"deepmimic_{m}", "deepmimic", "deepmimic") for m in ("backflip", "long_walk2", "zombie_walk")} == {"train"}
 
 
 def test_discover_shared_layout(mocap_root):
