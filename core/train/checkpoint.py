@@ -98,7 +98,7 @@ def load_checkpoint(path, map_location="cpu", **expect) -> dict:
     try:
         ckpt = torch.load(path, map_location=map_location, weights_only=True)
     except Exception as exc:  # truncated/corrupt/unrelated file
-        text = " ".join(str(exc).split())
+        text = " ".join(str(exc).split()).split(" In PyTorch 2.6")[0]  # drop torch's advice to disable the check
         text = text if len(text) <= 160 else text[:157] + "..."
         raise ShapeMoveError(f"{path}: cannot read checkpoint ({type(exc).__name__}: {text}); a damaged file, or one "
                              "holding code (refused: only tensors and plain values are loaded)") from None
