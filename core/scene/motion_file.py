@@ -3,7 +3,12 @@
 Keys: ``joints`` (T,22,3) metres Y-up, ``betas`` (10,), ``poses`` (T,24,3) axis-angle local
 rotations (SMPL convention, relative to the body's rest pose), ``transl`` (T,3) root offset as in
 ``BodyModel.forward`` (posed joints = FK(rest joints) + transl), ``fps``, ``body_model`` (id such as
-"openbody-v1"); optional ``prompt`` (str), ``tokens`` and ``features`` (arrays).
+"openbody-v1"); optional ``prompt`` (str), ``tokens`` and ``features`` (arrays), ``network_joints``
+(T,22,3: the joints the SA-VAE decoded, before IK and grounding) and ``contacts`` (T,4 uint8: foot
+contacts of joints 7, 8, 10, 11 that were planted).
+
+A motion file is self-consistent: ``joints`` are the body's joints posed by (betas, poses, transl)
+(``make_motion`` computes them; ``check_consistent`` verifies it), which is what the rig plays.
 """
 from __future__ import annotations
 
@@ -27,6 +32,8 @@ class Motion:
     prompt: str | None = None
     tokens: np.ndarray | None = None
     features: np.ndarray | None = None
+    network_joints: np.ndarray | None = None
+    contacts: np.ndarray | None = None
 
     @property
     def num_frames(self) -> int:
@@ -66,6 +73,31 @@ def validate(m: Motion) -> None:
     for name in ("poses", "transl", "betas"):
         if not np.isfinite(getattr(m, name)).all():
             raise ShapeMoveError(f"bad motion: {name} contains NaN or infinite values")
+    if m.network_joints is not None and (m.network_joints.shape != (T, NUM_BODY_JOINTS, 3)
+                                         or not np.isfinite(m.network_joints).all()):
+        raise ShapeMoveError(f"bad motion: network_joints must be finite ({T},{NUM_BODY_JOINTS},3), "
+                             f"got {m.network_joints.shape}")
+    if m.contacts is not None and m.contacts.shape != (T, 4):
+        raise ShapeMoveError(f"bad motion: contacts must be ({T},4), got {m.contacts.shape}")
+
+
+def fk_joints(body, m: Motion) -> np.ndarray:
+    """(T,22,3) joints of ``body`` posed by the motion's (betas, poses, transl)."""
+    import torch
+
+    with torch.no_grad():
+        out = body.forward(torch.as_tensor(m.betas)[None], torch.as_tensor(m.poses), torch.as_tensor(m.transl))
+    return out.joints[:, :NUM_BODY_JOINTS].numpy()
+
+
+def check_consistent(body, m: Motion, tol: float = 1e-3) -> float:
+    """Largest distance (m) between the motion's ``joints`` and FK of its pose on ``body``;
+    ShapeMoveError when above ``tol`` (the file's joints would not be what the rig plays)."""
+    err = float(np.abs(fk_joints(body, m) - m.joints).max()) if m.num_frames else 0.0
+    if not err <= tol:
+        raise ShapeMoveError(f"bad motion: joints differ from the posed body by {err * 100:.2f} cm "
+                             f"(more than {tol * 100:.2f} cm); rebuild them with make_motion")
+    return err
 
 
 def save_motion(path, m: Motion) -> Path:
@@ -76,7 +108,7 @@ def save_motion(path, m: Motion) -> Path:
                   fps=np.float32(m.fps), body_model=np.str_(m.body_model))
     if m.prompt is not None:
         arrays["prompt"] = np.str_(m.prompt)
-    for name in ("tokens", "features"):
+    for name in ("tokens", "features", "network_joints", "contacts"):
         if getattr(m, name) is not None:
             arrays[name] = np.asarray(getattr(m, name))
     from ..atomic import atomic_path
@@ -92,11 +124,12 @@ def load_motion(path) -> Motion:
     path = Path(path)
     if not path.is_file():
         raise ShapeMoveError(f"motion file not found: {path}")
-    try:
-        with np.load(path, allow_pickle=False) as z:
-            data = {k: z[k] for k in z.files}
-    except Exception as exc:  # corrupt zip, not an npz, pickled objects
-        raise ShapeMoveError(f"cannot read motion file {path}: {exc}") from None
+    from ..io.npz_read import read_npz
+
+    try:  # headers checked and sizes capped before allocating; pickled arrays refused
+        data = read_npz(path, max_bytes=512 * 2**20, what="motion file")
+    except ShapeMoveError as exc:
+        raise ShapeMoveError(f"cannot read motion file {exc}") from None
     missing = [k for k in ("joints", "betas", "poses", "transl", "fps", "body_model") if k not in data]
     if missing:
         raise ShapeMoveError(f"motion file {path} lacks {', '.join(missing)}")
@@ -104,6 +137,8 @@ def load_motion(path) -> Motion:
                poses=data["poses"].astype(np.float32), transl=data["transl"].astype(np.float32),
                fps=float(data["fps"]), body_model=str(data["body_model"]),
                prompt=str(data["prompt"]) if "prompt" in data else None,
-               tokens=data.get("tokens"), features=data.get("features"))
+               tokens=data.get("tokens"), features=data.get("features"),
+               network_joints=data["network_joints"].astype(np.float32) if "network_joints" in data else None,
+               contacts=data["contacts"].astype(np.uint8) if "contacts" in data else None)
     validate(m)
     return m
