@@ -24,7 +24,7 @@ from .export import FORMATS, export_rig
 from .jobs import report_error
 from .preferences import body_spec, preferences, setting
 from .redecode import HAS_TOKENS_KEY, MOTION_FILE_KEY
-from .rig_state import current_betas, rig_body_spec, rig_of
+from .rig_state import PHYSICS_KEY, current_betas, rig_body_spec, rig_of
 from .scene_build import SLIDER_RANGE, build_rig
 
 MEASUREMENT_PROPS = ("height_cm", "chest_cm", "waist_cm", "hip_cm")
@@ -41,7 +41,13 @@ def store_measurements(rig, measurements: dict) -> None:
             setattr(rig.shapemove, prop, float(value))
 
 
-def build_rig_from_file(path: str, name: str = "ShapeMove", measurements: dict | None = None):
+def store_physics(rig, physics: dict) -> None:
+    """Keep the job's physics figures (penetrate_cm, float_cm, skate_pct, dyn_stable_pct) on the rig."""
+    rig[PHYSICS_KEY] = {k: float(v) for k, v in physics.items() if isinstance(v, (int, float))}
+
+
+def build_rig_from_file(path: str, name: str = "ShapeMove", measurements: dict | None = None,
+                        physics: dict | None = None):
     """From a job callback: build the rig through the (undoable) build operator; errors -> popup."""
     try:
         bpy.ops.shapemove.build_from_motion(filepath=str(path), rig_name=name)
@@ -51,7 +57,17 @@ def build_rig_from_file(path: str, name: str = "ShapeMove", measurements: dict |
     rig = active_rig(bpy.context)
     if rig is not None and measurements:
         store_measurements(rig, measurements)
+    if rig is not None and physics:
+        store_physics(rig, physics)
     return rig
+
+
+def on_generated(name: str, msg: dict):
+    """The generate job's answer: build the rig, with its measurements and physics figures."""
+    if msg.get("cancelled"):
+        return None
+    r = msg["result"]
+    return build_rig_from_file(r["path"], name, r.get("measurements"), r.get("physics"))
 
 
 class _JobOperator:
@@ -131,12 +147,8 @@ class SHAPEMOVE_OT_generate(_JobOperator, bpy.types.Operator):
                   "out": str(paths.new_motion_path(prompt))}
         name = paths.slug(prompt, 24)
 
-        def done(msg):
-            if not msg.get("cancelled"):
-                r = msg["result"]
-                build_rig_from_file(r["path"], name, r.get("measurements"))
-
-        job_submit.submit_job("generate", params, kind="generate", label="generate", on_result=done)
+        job_submit.submit_job("generate", params, kind="generate", label="generate",
+                              on_result=lambda msg: on_generated(name, msg))
         return "generating..."
 
 

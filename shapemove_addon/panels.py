@@ -12,7 +12,7 @@ from ..core.constants import NUM_BETAS
 from . import job_submit, jobs, semantic_shape
 from .preferences import setting
 from .redecode import HAS_TOKENS_KEY
-from .rig_state import rig_of
+from .rig_state import PHYSICS_KEY, rig_of
 
 
 def _job_fraction(kind: str):
@@ -85,6 +85,34 @@ class SHAPEMOVE_PT_generate(_SubPanel, bpy.types.Panel):
         row.prop(s, "seed")
         row.prop(s, "temperature")
         draw_job(col, "generate", "shapemove.generate", "Generate")
+        rig = rig_of(context.active_object)
+        if rig is not None:
+            draw_result(col, rig)
+
+
+# (custom property key, label, format) of the physics figures a generation leaves on its rig
+PHYSICS_FIGURES = (("penetrate_cm", "Penetrate", "{:.2f} cm"), ("float_cm", "Float", "{:.2f} cm"),
+                   ("skate_pct", "Skate", "{:.1f} %"), ("dyn_stable_pct", "Stability", "{:.0f} %"))
+MEASUREMENTS = (("height_cm", "Height"), ("chest_cm", "Chest"), ("waist_cm", "Waist"), ("hip_cm", "Hips"))
+
+
+def draw_result(layout, rig) -> None:
+    """The active rig's motion physics (from its generation) and body measurements, if known."""
+    physics = rig.get(PHYSICS_KEY) or {}
+    m = rig.shapemove
+    if not physics and m.height_cm <= 0:
+        return
+    box = layout.box()
+    box.label(text=rig.name, icon="ARMATURE_DATA")
+    if physics:
+        grid = box.grid_flow(columns=2, align=True)
+        for key, label, fmt in PHYSICS_FIGURES:
+            if key in physics:
+                grid.label(text=f"{label}: {fmt.format(physics[key])}")
+    if m.height_cm > 0:
+        grid = box.grid_flow(columns=2, align=True)
+        for prop, label in MEASUREMENTS:
+            grid.label(text=f"{label}: {getattr(m, prop):.1f} cm")
 
 
 class SHAPEMOVE_PT_shape(_SubPanel, bpy.types.Panel):

@@ -14,6 +14,9 @@ from .preferences import body_spec
 from .scene_build import RIG_MARK
 
 
+PHYSICS_KEY = "shapemove_physics"  # a generated motion's physics figures (the generate job's, stored by the operator)
+
+
 def rig_of(obj):
     """The ShapeMove armature for ``obj`` (the armature itself or its body mesh), or None."""
     for cand in (obj, getattr(obj, "parent", None)):

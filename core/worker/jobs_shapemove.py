@@ -68,6 +68,21 @@ def _measurements(body, betas) -> dict:
         return {}
 
 
+PANEL_PHYSICS = ("penetrate_cm", "float_cm", "skate_pct", "dyn_stable_pct")  # what the Generate panel shows
+
+
+def _physics(body, motion) -> dict:
+    """The motion's physics figures on its own body (core/eval: mesh penetration and floating in
+    cm, foot skating in % of frames, dynamic stability in % of frames); {} if they cannot be had."""
+    from ..eval.generate_eval import physics
+
+    try:
+        res = physics(body, motion.betas, motion.poses, motion.transl)
+    except ShapeMoveError:
+        return {}
+    return {k: round(float(res[k]), 3) for k in PANEL_PHYSICS if np.isfinite(res.get(k, np.nan))}
+
+
 def _motion_facts(path: Path, motion) -> dict:
     return {"path": str(path), "frames": motion.num_frames, "fps": float(motion.fps),
             "betas": [float(b) for b in motion.betas], "body_model": motion.body_model,
@@ -97,9 +112,11 @@ def generate(params, progress, cancel) -> dict:
     if not motions:
         raise JobCancelled
     save_motion(out, motions[0])
+    progress(0.9, "checking the physics")
+    phys = _physics(gen.body, motions[0])
     progress(1.0, "done")
     return {**_motion_facts(out, motions[0]), "measurements": _measurements(gen.body, motions[0].betas),
-            "ik_error_cm": float(getattr(motions[0], "ik_error_cm", 0.0))}
+            "physics": phys, "ik_error_cm": float(getattr(motions[0], "ik_error_cm", 0.0))}
 
 
 def redecode(params, progress, cancel) -> dict:
