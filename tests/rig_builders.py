@@ -137,7 +137,24 @@ def unnamed(J, rng):
     return [(rename[n], rename.get(p), h, t, r, d) for n, p, h, t, r, d in bones]
 
 
-SCHEMES = {"rigify": rigify, "mixamo": mixamo, "cc": cc, "unnamed": unnamed}
+def daz(J, rng):
+    """Daz/Poser style: a `hip` root below the hip joints, buttock bones, no toe bone, eyes."""
+    low = 0.5 * (J[1] + J[2]) - [0, 0, 0.03]
+    spec = [("hip", None, low, J[3], True), ("abdomen", "hip", 3, 6, True), ("chest", "abdomen", 6, 12, True),
+            ("neck", "chest", 12, 15, True), ("head", "neck", 15, _head_top(J), True)]
+    for s, x in (("l", 0.03), ("r", -0.03)):
+        spec.append((f"{s}Eye", "head", J[15] + [x, -0.08, 0.06], J[15] + [x, -0.1, 0.06], True))
+    for s, side in (("l", LEFT), ("r", RIGHT)):
+        h, k, a, f = side["hip"], side["knee"], side["ankle"], side["foot"]
+        c, sh, e, w = side["collar"], side["shoulder"], side["elbow"], side["wrist"]
+        spec += [(f"{s}Buttock", "hip", low, h, True), (f"{s}Thigh", f"{s}Buttock", h, k, True),
+                 (f"{s}Shin", f"{s}Thigh", k, a, True), (f"{s}Foot", f"{s}Shin", a, f, True),
+                 (f"{s}Collar", "chest", c, sh, True), (f"{s}Shldr", f"{s}Collar", sh, e, True),
+                 (f"{s}ForeArm", f"{s}Shldr", e, w, True), (f"{s}Hand", f"{s}ForeArm", w, _hand_tip(J, side), True)]
+    return _bones_from(J, spec, rng)
+
+
+SCHEMES = {"rigify": rigify, "mixamo": mixamo, "cc": cc, "unnamed": unnamed, "daz": daz}
 # the bone that plays each SMPL joint in each scheme (the truth the mapping must find)
 TRUTH = {
     "mixamo": {"pelvis": "mixamorig:Hips", "left_hip": "mixamorig:LeftUpLeg", "left_knee": "mixamorig:LeftLeg",

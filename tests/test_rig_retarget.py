@@ -171,3 +171,23 @@ def test_fbx_style_armature_y_up_in_centimetres():
     assert np.abs(d - d.reshape(-1, 3).mean(0)).max() < 0.1 * MM
     # the keyed root offset is in the armature's own (centimetre) units
     assert np.abs(bake.root_offset).max() > 10
+
+
+def test_daz_style_rig_with_fewer_spine_bones():
+    """A `hip` root below the hip joints, two spine bones (abdomen, chest = spine2 + spine3), no toe
+    bone: the legs hang from `hip` (the bone the bake moves), the spine bones take the joints their
+    heads sit on, and the rig follows: legs exactly, the upper body (which lacks spine3) within 2.5 cm."""
+    m = wavy_motion(REST_JOINTS, 40)
+    arm = _target("daz", pose="A", scale=1.0, seed=3)
+    mapping, how = map_armature(arm)
+    assert how == "matched by shape"
+    assert mapping["pelvis"] == "hip" and mapping["spine1"] == "abdomen" and mapping["spine2"] == "chest"
+    assert "spine3" not in mapping and "left_foot" not in mapping and mapping["left_hip"] == "lThigh"
+    bake = retarget_to_armature(m, arm, mapping, plant_feet=False)
+    src = z_up(m.joints.astype(np.float64))
+    d = bake.joints - src
+    legs = [1, 2, 4, 5, 7, 8]
+    off = d[:, legs].reshape(-1, 3).mean(0)
+    assert np.abs(d[:, legs] - off).max() < 0.1 * MM
+    upper = [SMPL22.index(j) for j in mapping if j not in ("pelvis",) and SMPL22.index(j) not in legs]
+    assert np.abs(d[:, upper] - off).max() < 25 * MM

@@ -20,12 +20,14 @@ import numpy as np
 
 from ..body.skeleton import JOINT_NAMES, NUM_BODY_JOINTS
 from ..errors import ShapeMoveError
-from ..io.rig_map import normalize
+from ..io.rig_map import OPENBODY_LAYOUT, SPINE_JOINTS, normalize
 
 SMPL22 = tuple(JOINT_NAMES[:NUM_BODY_JOINTS])
 PRESET_DIR = Path(__file__).with_name("rig_presets")
 PRESET_FORMAT = "shapemove-bone-map"
 MAX_PRESET_BYTES = 256 * 1024
+# where the body's spine joints sit along the mid-hips -> neck arc (rig_map's body layout)
+SPINE_FRACTIONS = {j: f for j, f in zip(SPINE_JOINTS, OPENBODY_LAYOUT.spine) if j != "pelvis"}
 # joints a bake cannot do without (root motion, legs for the scale and the feet, arms)
 REQUIRED = ("pelvis", "left_hip", "right_hip", "left_knee", "right_knee", "left_ankle", "right_ankle")
 TAIL_SUFFIX = "_End"
@@ -108,20 +110,42 @@ def auto_map(arm: ArmatureRest) -> dict:
             continue
         if bone in bones:
             out[joint] = bone
-    spine = list(rig.chain[:-1])
+    spine = [b for b in rig.chain[:-1] if b in bones]
     if spine:
-        out["pelvis"] = spine[0]
-    middle = spine[1:]
-    if middle:
-        picks = {"spine1": middle[0], "spine3": middle[-1]}
-        if len(middle) >= 3:
-            picks["spine2"] = middle[len(middle) // 2]
-        out.update({k: v for k, v in picks.items() if v in bones})
+        # the pelvis bone: the one both the legs and the spine hang from (the bake moves it)
+        def chain_up(name):
+            out_, j = [], arm.index(name)
+            while j >= 0:
+                out_.append(arm.names[j])
+                j = int(arm.parents[j])
+            return out_
+        above_legs = set(chain_up(out["left_hip"])) & set(chain_up(out["right_hip"])) if "left_hip" in out else set()
+        out["pelvis"] = next((b for b in chain_up(spine[0]) if b in above_legs), spine[0])
+    out.update(_spine_picks(arm, [b for b in spine if b != out.get("pelvis")], out))
     # a collar that is the chest itself (no clavicle bone) plays no joint of its own
     for side in ("left", "right"):
         if out.get(f"{side}_collar") in (out.get("spine3"), out.get("neck"), out.get("pelvis")):
             out.pop(f"{side}_collar")
     return {j: out[j] for j in SMPL22 if j in out}
+
+
+def _spine_picks(arm: ArmatureRest, middle, out) -> dict:
+    """spine1/2/3 -> the spine bones between the pelvis and the neck whose heads sit nearest the
+    body's spine joints along the mid-hips -> neck arc (a rig with fewer spine bones leaves some out)."""
+    if not middle or not all(j in out for j in ("left_hip", "right_hip", "neck")):
+        return {}
+    mid_hips = 0.5 * (arm.heads[arm.index(out["left_hip"])] + arm.heads[arm.index(out["right_hip"])])
+    pts = [mid_hips] + [arm.heads[arm.index(b)] for b in [*middle, out["neck"]]]
+    arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(pts, axis=0), axis=-1))])
+    if not arc[-1] > 0:
+        return {}
+    frac = arc[1:-1] / arc[-1]
+    best = {}
+    for joint, f in SPINE_FRACTIONS.items():
+        k = int(np.argmin(np.abs(frac - f)))
+        if middle[k] not in best or abs(frac[k] - f) < abs(frac[k] - SPINE_FRACTIONS[best[middle[k]]]):
+            best[middle[k]] = joint
+    return {joint: bone for bone, joint in best.items()}
 
 
 def _check_preset(data, source) -> dict:

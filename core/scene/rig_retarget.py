@@ -10,7 +10,9 @@ For every mapped bone b playing SMPL joint j (``bone_map``):
   nothing mapped below (wrists, head, toes) keep their rest relation to their parent joint.
 - **Rotation**: world rotation of bone b at frame t = G_j(t) Q_b B_b, with G_j the source
   joint's world rotation from its rest pose and B_b the bone's rest orientation; the source is
-  first turned about the vertical so its forward is the armature's forward.
+  first turned about the vertical so its forward is the armature's forward. A bone spanning
+  unmapped source joints (one chest bone for spine2 + spine3) is swung further so that it points
+  from joint j at the source's next mapped joint.
 - **Root motion and height** are scaled by s = target leg length / source leg length (hip ->
   knee -> ankle); the source floor (y = 0) lands on the armature's floor (the object origin's
   height) with the difference of ankle heights over the soles corrected; the pelvis bone's
@@ -218,6 +220,14 @@ def retarget_to_armature(motion, arm: ArmatureRest, mapping: dict, plant_feet: b
                 a = PAR22[a]
             Q[j] = Q[a] if a >= 0 else np.eye(3)
     world = {bone_of[j]: G[:, j] @ Q[j] @ tgt.rest[bone_of[j]] for j in bone_of}
+    # a bone that spans unmapped joints (Daz's chest: spine2 + spine3) turns by them too: its
+    # direction follows the source's joint -> mapped joint below, the rest of its turn is joint j's
+    for j in bone_of:
+        below = next((c for c in DOWN.get(j, ()) if c in bone_of), None)
+        if below is None or below == DOWN[j][0]:
+            continue
+        moved = np.einsum("tij,j->ti", G[:, j], rest[below] - rest[j])
+        world[bone_of[j]] = rotation_between(moved, P[:, below] - P[:, j]) @ world[bone_of[j]]
 
     # the pelvis bone's head: the scaled source pelvis plus its rest offset, turning with the pelvis
     mid_t = 0.5 * (H_t[bone_of[1]] + H_t[bone_of[2]])
