@@ -1,8 +1,8 @@
 """A numpy-only view of a body model, for Blender's Python where torch is usually missing.
 
 ``BodyArrays`` holds the same arrays as ``BodyModel`` (float64, metres, Y up, SMPL 24 joints) and
-computes the rest shape without torch: rest_joints(betas), rest_vertices(betas), shape-key
-coordinates, plus OpenBody's phenotype map (semantic sliders -> betas). It has the attribute names
+computes the rest shape without torch: rest_joints(betas), rest_vertices(betas), plus OpenBody's
+phenotype map (semantic sliders -> betas; ``openbody_asset.PhenotypeMap``). It has the attribute names
 ``core.scene.rig_data`` reads (name, num_betas, v_template, shapedirs, joint_template,
 joint_shapedirs, skin_weights, faces, parents), so the scene builder takes it like a BodyModel.
 It cannot pose a body (no ``forward``): motions are made in the worker.
@@ -85,10 +85,6 @@ class BodyArrays:
     def rest_vertices(self, betas=None) -> np.ndarray:
         """betas (10,) or (B,10) -> (B,V,3) rest-pose vertices."""
         return self.v_template + np.einsum("vcb,nb->nvc", self.shapedirs, self._betas(betas))
-
-    def shape_key_coords(self) -> np.ndarray:
-        """(10,V,3): absolute coordinates of shape key i = template + shapedirs[..., i]."""
-        return self.v_template[None] + np.moveaxis(self.shapedirs, -1, 0)
 
     # -- semantic sliders (OpenBody) ---------------------------------------------------------
     def _need_phenotypes(self):
