@@ -100,3 +100,16 @@ def test_compose_errors(tmp_path):
         cp.compose_dataset(tmp_path, 3)
     with pytest.raises(ShapeMoveError, match="at least 1"):
         cp.compose_dataset(tmp_path, 0)
+
+
+def test_only_upright_ends_are_joined(tmp_path):
+    (tmp_path / "new_joints").mkdir()
+    stand = np.zeros((5, 22, 3))
+    stand[:, 0, 1], stand[:, 15, 1] = 0.95, 1.55          # pelvis 0.95 m, head 0.6 m above it
+    lying = stand.copy()
+    lying[-1, 0, 1], lying[-1, 15, 1] = 0.15, 0.2         # ends on the floor
+    np.save(tmp_path / "new_joints" / "s.npy", stand)
+    np.save(tmp_path / "new_joints" / "l.npy", lying)
+    meta = {"measure": {"leg_length_cm": 90.0}}
+    assert cp.upright(tmp_path, dict(meta, id="s"), end=True) and cp.upright(tmp_path, dict(meta, id="s"), end=False)
+    assert cp.upright(tmp_path, dict(meta, id="l"), end=False) and not cp.upright(tmp_path, dict(meta, id="l"), end=True)

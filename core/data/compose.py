@@ -11,12 +11,13 @@ one (``build._write_clip``) and ``build.finalize`` refreshes the split lists and
 
 Pairs: A's main action is drawn with probability ~ sqrt(number of clips with it) (so rare actions
 such as a cartwheel appear in compositions without drowning the common ones), then a clip of it; B
-likewise among the other actions. Only training clips (not augmented, not composed) are joined,
-and composed clips go to the training split, so validation/test clips never leak into training.
-Captions say "X, then Y" in several phrasings ("a person walks forward, then waves.", "first a
-person walks forward, then waves.", "a person walks forward and then waves.", "a person walks
-forward before waving.", ...), with X and Y taken from the clips' own generated captions; meta ``labels["actions"]`` lists A's
-actions then B's; ``composed_from`` names both clips. Deterministic for a given ``seed``.
+likewise among the other actions; a pair is redrawn unless A ends and B starts upright
+(``upright``). Only training clips (not augmented, not composed) are joined, and composed clips go
+to the training split, so validation/test clips never leak into training. Captions say "X, then
+Y" in several phrasings ("a person walks forward, then waves.", "first a person walks forward,
+then waves.", "a person walks forward and then waves.", "a person walks forward before waving.",
+...), with X and Y taken from the clips' own generated captions; meta ``labels["actions"]`` lists
+A's actions then B's; ``composed_from`` names both clips. Deterministic for a given ``seed``.
 """
 from __future__ import annotations
 
@@ -165,6 +166,16 @@ def compose_arrays(proc, a: Part, b: Part) -> dict:
     }
 
 
+def upright(data: Path, meta: dict, end: bool) -> bool:
+    """Whether the clip's last (``end``) or first frame stands upright: pelvis at >= 75 % of the
+    leg length above the floor and the head >= 35 % of it above the pelvis. A transition of 0.5 s
+    cannot get a body up from the floor, so only upright ends are joined."""
+    j = np.load(data / "new_joints" / f"{meta['id']}.npy", mmap_mode="r")
+    f = np.asarray(j[-1 if end else 0], dtype=np.float64)
+    leg = float((meta.get("measure") or {}).get("leg_length_cm", 85.0)) / 100.0
+    return f[0, 1] >= 0.75 * leg and f[15, 1] - f[0, 1] >= 0.35 * leg
+
+
 def _candidates(data: Path) -> list[dict]:
     metas = [json.loads(p.read_text(encoding="utf-8")) for p in sorted((data / "meta").glob("*.json"))]
     return [m for m in metas if m.get("split") == "train" and not m.get("augmented_from")
@@ -194,9 +205,10 @@ def compose_dataset(data, count: int, seed: int = 0, body=None, verbose: bool = 
     names = sorted(by_action)
     weight = np.sqrt([len(by_action[a]) for a in names])   # rare actions get more than their share
     proc = ClipProcessor(body)
-    written = []
-    for i in tqdm(range(count), desc="composing", unit="clip", disable=not verbose):
-        cid = f"comp{seed}_{i:05d}"
+    written, skipped, i, draws = [], 0, 0, 0
+    bar = tqdm(total=count, desc="composing", unit="clip", disable=not verbose)
+    while i < count and draws < 50 * count:
+        draws += 1
         ia = int(rng.choice(len(names), p=weight / weight.sum()))
         wb = weight.copy()
         if len(names) > 1:
@@ -205,6 +217,12 @@ def compose_dataset(data, count: int, seed: int = 0, body=None, verbose: bool = 
         ma = by_action[names[ia]][int(rng.integers(len(by_action[names[ia]])))]
         mb = by_action[names[ib]][int(rng.integers(len(by_action[names[ib]])))]
         main_a = names[ia]
+        if not (upright(data, ma, end=True) and upright(data, mb, end=False)):
+            skipped += 1
+            continue
+        cid = f"comp{seed}_{i:05d}"
+        i += 1
+        bar.update(1)
         if (data / "meta" / f"{cid}.json").exists():
             continue
         a = load_part(data, ma["id"], ma, proc.body, first=True)
@@ -217,5 +235,8 @@ def compose_dataset(data, count: int, seed: int = 0, body=None, verbose: bool = 
         arrays = compose_arrays(proc, a, b)
         _write_clip(data, cid, arrays, src, "train", {"composed_from": [a.id, b.id], "blend_frames": BLEND_FRAMES})
         written.append(cid)
+    bar.close()
     finalize(data)
+    if verbose and skipped:
+        print(f"{skipped} drawn pairs skipped: a part starts or ends off its feet (lying, crawling)")
     return written
