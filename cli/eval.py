@@ -16,7 +16,6 @@ Adding a kind: write ``add_KIND(subparsers)`` (setting ``_run``) and list it in 
 from __future__ import annotations
 
 import importlib
-import json
 import math
 from pathlib import Path
 
