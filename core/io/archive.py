@@ -174,7 +174,11 @@ def unpack(archive: Path, dest: Path) -> Path:
             _extract_tar(archive, tmp, budget)
         (tmp / ".unpacked").write_text(cache_key(archive))
         shutil.rmtree(dest, ignore_errors=True)
-        os.replace(tmp, dest)
+        try:
+            os.replace(tmp, dest)
+        except OSError:
+            if not _cache_valid(archive, dest / ".unpacked"):  # another process unpacked it meanwhile: use that
+                raise
     except ShapeMoveError:
         raise
     except (tarfile.TarError, zipfile.BadZipFile, zipfile.LargeZipFile, EOFError, ValueError, lzma.LZMAError,
