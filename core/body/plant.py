@@ -17,6 +17,8 @@ in the capture slide and hover on the body, and a body grounded by its lowest fo
 """
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from ..motion.contacts import CONTACT_IDS, runs
@@ -75,3 +77,83 @@ def ground_shift(per_foot, lowest_all, contacts) -> np.ndarray:
     else:
         shift = np.full(len(c), -low_all.min())
     return np.maximum(shift, -low_all)
+
+
+GATE_HEIGHT = 0.08   # m: a predicted contact whose sole is higher than this is not planted
+
+
+@dataclass
+class Planted:
+    rotations: np.ndarray   # (T,24,3,3) local rotations
+    transl: np.ndarray      # (T,3) as BodyModel.forward: posed joints = FK(rest) + transl
+    contacts: np.ndarray    # (T,4) uint8 of joints 7, 8, 10, 11 (after gating)
+    ik_error_cm: float      # mean distance of the posed joints to ``joints`` (floor removed)
+
+
+def gate_contacts(joints, contacts, sole_offsets, max_height: float = GATE_HEIGHT) -> np.ndarray:
+    """Predicted contacts (e.g. a decoder's contact channels) kept only where the joint's sole is
+    within ``max_height`` of the floor that the contacts imply (``source_floor``); runs shorter
+    than 2 frames dropped. (T,22,3), (T,4) -> (T,4) uint8."""
+    from ..motion.contacts import MIN_RUN
+
+    c = np.asarray(contacts).astype(bool)
+    j = np.asarray(joints, dtype=np.float64)
+    h = j[:, CONTACT_IDS, 1] - np.asarray(sole_offsets)[None] - source_floor(j, c, sole_offsets)
+    c &= h < max_height
+    for k in range(4):
+        for s, e in runs(c[:, k]):
+            if e - s < MIN_RUN:
+                c[s:e, k] = False
+    return c.astype(np.uint8)
+
+
+def plant_motion(body, betas, joints, contacts, refine_iters: int = 10, gate: bool = True) -> Planted:
+    """Joint positions (T,22,3) (e.g. decoded by the SA-VAE) -> rotations and translation of
+    ``body`` with ``betas`` whose feet in ``contacts`` (T,4) are planted and whose mesh stands on
+    the floor: ``plant_targets`` + ``ik.solve_ik`` + ``ground_shift`` on the body's sole probe.
+    ``gate``: drop contacts whose sole is far above the floor first (``gate_contacts``)."""
+    import torch
+
+    from .ik import solve_ik
+    from .soles import GroundProbe
+
+    b = np.asarray(betas, dtype=np.float32).reshape(-1)
+    probe = GroundProbe(body, b)
+    j = np.asarray(joints, dtype=np.float64)
+    c = gate_contacts(j, contacts, probe.sole_offsets) if gate else np.asarray(contacts, np.uint8)
+    targets, floor = plant_targets(j, c, probe.sole_offsets)
+    with torch.no_grad():
+        rest = body.rest_joints(torch.as_tensor(b)[None])[0].numpy()
+    ik = solve_ik(targets, rest, refine_iters=refine_iters)
+    transl = np.asarray(ik.transl, dtype=np.float64).copy()
+    per_foot, _, low = probe.lowest(ik.rotations, transl)
+    shift = ground_shift(per_foot, low, c)
+    transl[:, 1] += shift
+    posed = _posed(ik, rest, body.parents)   # error against the input joints (floor removed)
+    posed[..., 1] += shift[:, None]
+    ref = j - [0.0, floor, 0.0]
+    err = float(np.linalg.norm(posed - ref, axis=-1).mean()) * 100
+    return Planted(rotations=np.asarray(ik.rotations, np.float32), transl=transl.astype(np.float32),
+                   contacts=c, ik_error_cm=err)
+
+
+def _posed(ik, rest, parents) -> np.ndarray:
+    import torch
+
+    from ..geometry.torch_ops import forward_kinematics
+
+    with torch.no_grad():
+        pos, _ = forward_kinematics(torch.as_tensor(ik.rotations, dtype=torch.float64),
+                                    torch.as_tensor(rest, dtype=torch.float64)[None].expand(len(ik.rotations), -1, -1),
+                                    parents)
+    return pos[:, :22].numpy() + np.asarray(ik.transl, dtype=np.float64)[:, None]
+
+
+def contacts_from_features(features) -> np.ndarray:
+    """(T,263) HumanML3D features (de-normalized) -> (T,4) uint8 contacts of joints 7, 8, 10, 11
+    from the 4 contact channels (> 0.5)."""
+    from ..motion.contacts import FEATURE_ORDER
+    from ..motion.features import feature_slices
+
+    f = np.asarray(features, dtype=np.float64)
+    return (f[:, feature_slices["contacts"]] > 0.5)[:, FEATURE_ORDER].astype(np.uint8)

@@ -161,17 +161,16 @@ class ClipProcessor:
         f[:, feature_slices["contacts"]] = to_feature_order(contacts[:-1]).astype(np.float32)
         return f
 
-    def process(self, joints: np.ndarray, betas: np.ndarray | None = None):
-        """Arrays of one clip (its 22 joints at 20 fps) on the body ``betas`` (the fitted body when None).
-
-        Contacts are detected on the mocap, the contact joints' IK targets planted on the fitted
-        body's soles (``plant.plant_targets``), the IK solved, and every posed copy grounded on
-        its own mesh (``pose_on``)."""
+    def solve(self, joints: np.ndarray) -> dict:
+        """The subject's side of a clip (22 joints at 20 fps): contacts detected on the mocap, betas
+        fitted, contact joints' IK targets planted on that body's soles (``plant.plant_targets``),
+        IK solved. Returns {"contacts" (T,4) uint8, "betas" (10,) fitted, "rotations" (T,24,3,3),
+        "root" (T,3) world root trajectory, "rest" (24,3) rest joints of the fitted body,
+        "ik_error_cm" (vs the mocap), "ik_target_error_cm" (vs the planted targets)}."""
         import torch
 
         from ..body.ik import solve_ik
         from ..body.plant import plant_targets
-        from ..geometry.rotations import matrix_to_axis_angle
         from ..geometry.torch_ops import forward_kinematics
 
         contacts = self.contacts(joints)
@@ -180,19 +179,40 @@ class ClipProcessor:
         targets, floor = plant_targets(joints, contacts, self.probe(fitted).sole_offsets)
         ik = solve_ik(targets, rest, refine_iters=self.ik_refine_iters)
         rot = np.asarray(ik.rotations, dtype=np.float32)
-        root = np.asarray(ik.transl, dtype=np.float32) + rest[0]  # world root trajectory (T,3)
-        # IK error against the mocap itself (ik.joint_error is against the planted targets)
         fk, _ = forward_kinematics(torch.as_tensor(rot), torch.as_tensor(rest)[None].expand(len(rot), -1, -1),
                                    self.body.parents)
         fk = fk[:, :22].numpy() + ik.transl[:, None]
-        ik_error_cm = float(np.linalg.norm(fk - (np.asarray(joints, np.float64) - [0.0, floor, 0.0]), axis=-1).mean()) * 100
-        target = fitted if betas is None else betas.astype(np.float32)
-        rest_t = self.body.rest_joints(torch.as_tensor(target)[None])[0].numpy()
+        mocap = np.asarray(joints, np.float64) - [0.0, floor, 0.0]
+        return {"contacts": contacts, "betas": fitted, "rotations": rot, "rest": rest,
+                "root": np.asarray(ik.transl, dtype=np.float32) + rest[0],
+                "ik_error_cm": float(np.linalg.norm(fk - mocap, axis=-1).mean()) * 100,
+                "ik_target_error_cm": float(ik.mean_error_cm)}
+
+    def stride_scale(self, rest_from: np.ndarray, betas_to: np.ndarray | None) -> float:
+        """Root-trajectory scale moving a motion from the body with rest joints ``rest_from`` (24,3)
+        to the body ``betas_to`` (None = the canonical body): the pelvis-height (leg length) ratio."""
+        import torch
+
+        rest_to = self.rest0 if betas_to is None else self.body.rest_joints(torch.as_tensor(betas_to)[None])[0].numpy()
         pelvis_h = lambda r: r[0, 1] - min(r[7, 1], r[8, 1], r[10, 1], r[11, 1])  # noqa: E731
-        s_target = pelvis_h(rest_t) / pelvis_h(rest)
-        s_norm = pelvis_h(self.rest0) / pelvis_h(rest)
-        shaped = self.pose_on(rot, root, target, s_target if betas is not None else 1.0, contacts)
-        normal = self.pose_on(rot, root, np.zeros(10, np.float32), s_norm, contacts)
+        return float(pelvis_h(rest_to) / pelvis_h(rest_from))
+
+    def process(self, joints: np.ndarray, betas: np.ndarray | None = None):
+        """Arrays of one clip (its 22 joints at 20 fps) on the body ``betas`` (the fitted body when None).
+
+        ``solve`` (contacts, fit, planted IK), then the shape-aware copy on the target body and the
+        normalized copy on the canonical body, each grounded on its own mesh (``pose_on``)."""
+        import torch
+
+        from ..geometry.rotations import matrix_to_axis_angle
+
+        sol = self.solve(joints)
+        rot, root, contacts = sol["rotations"], sol["root"], sol["contacts"]
+        target = sol["betas"] if betas is None else betas.astype(np.float32)
+        rest_t = self.body.rest_joints(torch.as_tensor(target)[None])[0].numpy()
+        scale = self.stride_scale(sol["rest"], target) if betas is not None else 1.0
+        shaped = self.pose_on(rot, root, target, scale, contacts)
+        normal = self.pose_on(rot, root, np.zeros(10, np.float32), self.stride_scale(sol["rest"], None), contacts)
         m = self.measure(target)
         return {
             "new_joints": shaped, "new_joint_vecs": self.features(shaped, rot, contacts),
@@ -200,7 +220,7 @@ class ClipProcessor:
             "betas": target, "contacts": contacts,
             "poses": matrix_to_axis_angle(rot).astype(np.float32),
             "transl": shaped[:, 0] - rest_t[0],  # BodyModel.forward(target, poses, transl) -> shaped
-            "ik_error_cm": ik_error_cm, "ik_target_error_cm": float(ik.mean_error_cm),
+            "ik_error_cm": sol["ik_error_cm"], "ik_target_error_cm": sol["ik_target_error_cm"],
             "measure": m,
         }
 

@@ -16,7 +16,8 @@ from . import bones, physics, stability
 
 CHUNK = 64
 _MASS_MODELS: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
-METRIC_KEYS = ("penetrate_cm", "float_cm", "skate_pct", "bone_var_mm", "bone_err_mm", "dyn_stable_pct", "zmp_out_cm")
+METRIC_KEYS = ("penetrate_cm", "float_cm", "skate_pct", "bone_var_mm", "bone_err_mm", "dyn_stable_pct", "zmp_out_cm",
+               "penetrate_all_cm", "float_all_cm")
 
 
 def _betas(betas) -> torch.Tensor:
@@ -103,6 +104,8 @@ def evaluate_motion(body, betas, rotations, transl, joints=None, target_betas=No
     stab = stability.dynamic_stability(stability.zmp(m["com"], fps=fps), m["hulls"], no_contact=no_contact)
     return {
         "penetrate_cm": pen.value, "float_cm": flo.value, "skate_pct": sk.value,
+        "penetrate_all_cm": physics.penetrate_all(m["lowest"]).value,
+        "float_all_cm": physics.floating_all(m["lowest"]).value,
         "bone_var_mm": bones.bone_length_variance_mm(j),
         "bone_err_mm": bones.bone_length_error_mm(j, target),
         "dyn_stable_pct": stab["dyn_stable_pct"], "zmp_out_cm": stab["zmp_out_cm"],
@@ -119,6 +122,7 @@ def evaluate_joints(joints, target_lengths=None, sole_offsets=None) -> dict:
     pen, flo, sk = physics.penetrate(low), physics.floating(low), physics.skate_from_joints(j)
     return {
         "penetrate_cm": pen.value, "float_cm": flo.value, "skate_pct": sk.value,
+        "penetrate_all_cm": physics.penetrate_all(low).value, "float_all_cm": physics.floating_all(low).value,
         "bone_var_mm": bones.bone_length_variance_mm(j),
         "bone_err_mm": float("nan") if target_lengths is None else bones.bone_length_error_mm(j, target_lengths),
         "dyn_stable_pct": float("nan"), "zmp_out_cm": float("nan"),

@@ -23,6 +23,10 @@ Definitions (as in HUMOS's ``all_physics_metrics``, which implements the PhysDif
   frame, no window) flags any slide over 5 cm/s, e.g. a planted foot sliding 1 cm per frame, but
   on real mocap it also flags most swing-phase frames where the foot passes low over the ground
   (CMU walking 02_01, foot joints: 91 % strict vs 21 % GMD), so it is not the default.
+
+The paper's tables (ShapeMove, HUMOS, PhysDiff) average penetrate and float over ALL frames (0 on a
+frame without it), no tolerance: ``penetrate_all`` / ``floating_all``; ``evaluate_motion`` reports
+both definitions (``penetrate_cm``/``float_cm`` and ``penetrate_all_cm``/``float_all_cm``).
 """
 from __future__ import annotations
 
@@ -96,6 +100,20 @@ def floating(lowest, tol: float = GROUND_TOL) -> Stat:
     h = np.asarray(lowest, dtype=np.float64)
     hit = h > tol
     return Stat(float(h[hit].mean() * 100) if hit.any() else 0.0, int(hit.sum()))
+
+
+def penetrate_all(lowest) -> Stat:
+    """The paper's penetrate (PhysDiff/HUMOS tables): mean over ALL frames of the lowest point's
+    depth below y = 0 (cm; 0 on frames above it), no tolerance."""
+    h = np.asarray(lowest, dtype=np.float64)
+    return Stat(float(np.maximum(-h, 0).mean() * 100) if h.size else 0.0, int(h.size))
+
+
+def floating_all(lowest) -> Stat:
+    """The paper's float: mean over ALL frames of the lowest point's height above y = 0 (cm; 0 on
+    frames below it), no tolerance."""
+    h = np.asarray(lowest, dtype=np.float64)
+    return Stat(float(np.maximum(h, 0).mean() * 100) if h.size else 0.0, int(h.size))
 
 
 def _window_mean(x: np.ndarray, window: int) -> np.ndarray:

@@ -31,7 +31,8 @@ from .bones import mpjpe_mm
 from .evaluate import evaluate_motion
 from .report import aggregate
 
-KEYS = ("mpjpe_mm", "mpjpe_local_mm", "bone_err_mm", "penetrate_cm", "float_cm", "skate_pct", "dyn_stable_pct")
+KEYS = ("mpjpe_mm", "mpjpe_local_mm", "bone_err_mm", "penetrate_cm", "float_cm", "skate_pct", "dyn_stable_pct",
+        "penetrate_all_cm", "float_all_cm")  # *_all_cm: the paper's definitions (mean over all frames)
 
 
 def _body(body):

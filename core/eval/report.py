@@ -15,6 +15,8 @@ from ..errors import ShapeMoveError
 METRICS = {
     "penetrate_cm": ("Penetrate", "cm", "lower", "n_penetrate"),
     "float_cm": ("Float", "cm", "lower", "n_float"),
+    "penetrate_all_cm": ("Penetrate (paper: all frames)", "cm", "lower", "n_frames"),
+    "float_all_cm": ("Float (paper: all frames)", "cm", "lower", "n_frames"),
     "skate_pct": ("Skate", "%", "lower", "n_skate"),
     "bone_var_mm": ("Bone length var.", "mm", "lower", "n_frames"),
     "bone_err_mm": ("Bone length err.", "mm", "lower", "n_frames"),

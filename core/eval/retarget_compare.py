@@ -20,7 +20,7 @@ from ..errors import ShapeMoveError
 from .evaluate import evaluate_motion
 from .report import aggregate
 
-KEYS = ("bone_err_mm", "penetrate_cm", "float_cm", "skate_pct", "dyn_stable_pct")
+KEYS = ("bone_err_mm", "penetrate_cm", "float_cm", "skate_pct", "dyn_stable_pct", "penetrate_all_cm", "float_all_cm")
 
 
 def source_motion(data, clip):
@@ -43,7 +43,8 @@ def _score(body, motion, betas) -> dict:
     from ..geometry.rotations import axis_angle_to_matrix
 
     rot = axis_angle_to_matrix(motion.poses)
-    return evaluate_motion(body, betas, rot, motion.transl, joints=motion.joints, target_betas=betas)
+    joints = motion.network_joints if motion.network_joints is not None else motion.joints  # decoded, if any
+    return evaluate_motion(body, betas, rot, motion.transl, joints=joints, target_betas=betas)
 
 
 def compare_retargeting(data, checkpoint, clips, target_betas_list, body=None, ik_refine_iters: int = 10,

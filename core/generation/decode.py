@@ -5,7 +5,6 @@ from __future__ import annotations
 import numpy as np
 import torch
 
-from ..body.skeleton import FOOT_JOINTS
 from ..constants import FPS
 from ..errors import ShapeMoveError
 from ..scene.motion_file import Motion
@@ -21,9 +20,11 @@ def check_betas(betas) -> np.ndarray:
 
 def decode_tokens(codes: list[int], vae, body, betas, ik_refine_iters: int = 10, prompt: str | None = None) -> Motion:
     """Motion tokens + betas (10,) -> Motion on ``body``: SA-VAE ``decode_long`` with the body's
-    shape, joints from the features, lowest foot on the floor, IK onto the body."""
-    from ..body.ik import solve_ik
-    from ..geometry.rotations import matrix_to_axis_angle
+    shape, joints from the features, then ``plant.plant_motion``: the feet the decoder's contact
+    channels mark are planted (one fixed point per contact run, soles on y = 0), IK onto the body,
+    and the posed mesh grounded frame by frame on its soles. The Motion's ``joints`` are FK of its
+    pose (what the rig plays); the decoder's own joints are kept as ``network_joints``."""
+    from ..body.plant import contacts_from_features
     from ..motion.features import joints_from_features
 
     if not codes:
@@ -33,12 +34,22 @@ def decode_tokens(codes: list[int], vae, body, betas, ik_refine_iters: int = 10,
         idx = torch.as_tensor(codes, dtype=torch.long)[None]
         feats = vae.denormalize(vae.decode_long(vae.quantizer.indices_to_codes(idx), b))[0]
         joints = joints_from_features(feats.double()).float().numpy()
-        rest = body.rest_joints(b)[0].numpy()
-    joints[..., 1] -= joints[:, FOOT_JOINTS, 1].min()
-    ik = solve_ik(joints, rest, refine_iters=ik_refine_iters)
-    poses = matrix_to_axis_angle(ik.rotations).astype(np.float32)
-    m = Motion(joints=joints, betas=b[0].numpy(), poses=poses, transl=np.asarray(ik.transl, np.float32),
-               fps=float(FPS), body_model=body.name, prompt=prompt, tokens=np.asarray(codes, np.int16),
-               features=feats.numpy().astype(np.float32))
-    m.ik_error_cm = float(ik.mean_error_cm)
+    return motion_from_joints(body, b[0].numpy(), joints, contacts_from_features(feats.numpy()), ik_refine_iters,
+                              prompt=prompt, tokens=np.asarray(codes, np.int16), features=feats.numpy().astype(np.float32))
+
+
+def motion_from_joints(body, betas, joints, contacts, ik_refine_iters: int = 10, prompt: str | None = None,
+                       **extra) -> Motion:
+    """(T,22,3) joint positions + (T,4) foot contacts of joints 7, 8, 10, 11 -> self-consistent
+    Motion on ``body`` with ``betas``: contacts planted, mesh grounded (``plant.plant_motion``);
+    ``extra``: tokens, features (stored as they are)."""
+    from ..body.plant import plant_motion
+    from ..geometry.rotations import matrix_to_axis_angle
+    from ..scene.motion_file import make_motion
+
+    planted = plant_motion(body, betas, joints, contacts, refine_iters=ik_refine_iters)
+    poses = matrix_to_axis_angle(planted.rotations).astype(np.float32)
+    m = make_motion(body, poses, planted.transl, betas, fps=float(FPS), prompt=prompt,
+                    network_joints=np.asarray(joints, np.float32), contacts=planted.contacts, **extra)
+    m.ik_error_cm = planted.ik_error_cm
     return m

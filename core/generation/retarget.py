@@ -7,12 +7,13 @@
      to its bone lengths, IK onto that body, the same rotations on the canonical body (betas = 0,
      stride scaled by the pelvis height) -> canonical HumanML3D features;
   3. SA-VAE encode -> motion tokens; decode them with the NEW betas -> shape-aware features ->
-     joints -> IK onto the new body (``decode_tokens``, the generator's decoding), so feet stay planted and bones
+     joints -> the feet the decoder marks in contact planted, IK onto the new body, the mesh grounded
+     on its soles (``decode_tokens``, the generator's decoding), so feet stay planted and bones
      take the new body's lengths. The Motion keeps its tokens: ``Generator.redecode`` moves it
      to yet another body.
 ``naive_retarget(motion, body, betas)``: the subject's local rotations copied onto the new body,
-the root trajectory scaled by the leg-length (pelvis height) ratio, lowest foot put back on the
-floor (exactly the builder's augmentation). Bones are the new body's, but feet slide and float
+the root trajectory scaled by the leg-length (pelvis height) ratio, the clip's lowest mesh point put
+on the floor (one offset, no contacts). Bones are the new body's, but feet slide, sink and float
 wherever the proportions differ.
 """
 from __future__ import annotations
@@ -25,7 +26,7 @@ import torch
 from ..constants import FPS
 from ..errors import ShapeMoveError
 from ..io.mocap import Motion22
-from ..scene.motion_file import Motion, validate
+from ..scene.motion_file import Motion, make_motion, validate
 from .decode import check_betas, decode_tokens
 
 
@@ -113,11 +114,16 @@ def retarget(motion, vae, body, betas, ik_refine_iters: int = 10) -> Motion:
 
 def naive_retarget(motion, body, betas, ik_refine_iters: int = 10) -> Motion:
     """Local rotations copied from the subject's IK onto the body ``betas``; root trajectory
-    scaled by the pelvis-height (leg length) ratio; lowest foot joint on the floor. T frames."""
+    scaled by the pelvis-height (leg length) ratio; the clip's lowest mesh point put on the floor
+    (one offset for the whole clip: no contact handling). T frames."""
     betas = check_betas(betas)
     joints, _ = source_joints(motion, body)
-    a = processor(body, ik_refine_iters).process(joints, betas)
-    out = Motion(joints=a["new_joints"], betas=betas, poses=a["poses"], transl=np.asarray(a["transl"], np.float32),
-                 fps=float(FPS), body_model=body.name)
-    validate(out)
-    return out
+    proc = processor(body, ik_refine_iters)
+    sol = proc.solve(joints)
+    shaped = proc.pose_on(sol["rotations"], sol["root"], betas, proc.stride_scale(sol["rest"], betas), None)
+    with torch.no_grad():
+        rest = body.rest_joints(torch.as_tensor(betas)[None])[0].numpy()
+    from ..geometry.rotations import matrix_to_axis_angle
+
+    return make_motion(body, matrix_to_axis_angle(sol["rotations"]).astype(np.float32), shaped[:, 0] - rest[0],
+                       betas, fps=float(FPS))
