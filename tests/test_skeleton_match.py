@@ -285,21 +285,24 @@ def test_real_rigs_match_their_table_by_shape(mocap_root, rel):
     with their names and again with every joint renamed (End Sites keep the readers' `<joint>_End`):
     the 22 SMPL joints agree with the hand-made table mapping within 1 mm over the clip's first
     200 frames. Known difference: renamed ASF rigs put the wrist at `lhand` (where the fingers
-    fork), 8-10 cm past the table's `lwrist`."""
+    fork), 8-10 cm past the table's `lwrist`. Compared without the layout's upper-body anchoring
+    (``rig_map.ANCHORED``: only table rigs known to need it get it)."""
     from shapemove.core.geometry.fk import joints_from_offsets
     from shapemove.core.io.mocap import load_mocap
-    from shapemove.core.io.rig_map import pose_candidates
+    from shapemove.core.io.rig_map import DEFAULT_LAYOUT, BodyLayout, pose_candidates
+
+    layout = BodyLayout(spine=DEFAULT_LAYOUT.spine, hip_width=DEFAULT_LAYOUT.hip_width)
 
     m = load_mocap(mocap_root / rel)
     pos = m.positions[:200]
     table = detect_rig(m.names)
-    want = mapping_matrix(table, m.names, pos) @ pos
+    want = mapping_matrix(table, m.names, pos, layout) @ pos
     poses = pose_candidates(joints_from_offsets(m.offsets, m.parents), m.positions)
     short = [f"j{k:03d}" for k in range(len(m.names))]
     renamed = [short[p] + "_End" if n.endswith("_End") else short[k] for k, (n, p) in enumerate(zip(m.names, m.parents))]
     for names in (m.names, renamed):
         rig = match_humanoid(names, m.parents, poses)
-        got = mapping_matrix(rig, names, pos) @ pos
+        got = mapping_matrix(rig, names, pos, layout) @ pos
         err = np.linalg.norm(got - want, axis=-1).max(0)
         skip = [20, 21] if names is renamed and rel.endswith(".amc") else []
         assert np.delete(err, skip).max() < 1e-3, (rel, names is renamed, np.round(err * 100, 1))
@@ -316,3 +319,23 @@ def test_bvh_of_a_half_body_says_what_is_missing(tmp_path):
     path.write_text(bvh_text(sub, par, 100 * rest[keep], still_motion(100 * rest[keep][0], len(sub), 10)))
     with pytest.raises(ShapeMoveError, match=r"unknown skeleton .*two feet, two hands and a head"):
         load_smpl22(path)
+
+
+@pytest.mark.parametrize("shape", ["chain", "star", "random"])
+def test_hostile_skeleton_shapes_fail_fast(shape):
+    """2000-joint chains, stars and random trees: a clear error in well under a second (the pruning
+    is O(J log J)); more joints than MAX_JOINTS are refused unread."""
+    import time
+
+    from shapemove.core.io.skeleton_match import MAX_JOINTS
+
+    rng = np.random.default_rng(0)
+    J = 2000
+    parents = {"chain": np.arange(-1, J - 1), "star": np.r_[-1, np.zeros(J - 1, int)],
+               "random": np.r_[-1, [rng.integers(0, j) for j in range(1, J)]]}[shape]
+    t = time.perf_counter()
+    with pytest.raises(ShapeMoveError):
+        match_humanoid([f"j{k}" for k in range(J)], parents, rng.normal(size=(J, 3)))
+    assert time.perf_counter() - t < 1.0
+    with pytest.raises(ShapeMoveError, match="more than the"):
+        match_humanoid([f"j{k}" for k in range(MAX_JOINTS + 1)], np.arange(-1, MAX_JOINTS), np.zeros((MAX_JOINTS + 1, 3)))

@@ -23,6 +23,7 @@ The result is a ``rig_map.Rig`` whose rules name the skeleton's own joints. Fail
 """
 from __future__ import annotations
 
+import heapq
 import itertools
 import re
 
@@ -45,6 +46,8 @@ ROLE_WORDS = {"hip": ("thigh", "upleg", "upperleg", "femur"), "knee": ("shin", "
               "shoulder": ("upperarm", "upper_arm", "humerus", "shldr"),
               "elbow": ("forearm", "lowerarm", "radius", "elbow"), "wrist": ("wrist", "hand")}
 HELPER_WORDS = ("twist", "roll", "helper", "end", "nub", "tip")
+MAX_JOINTS = 2000  # shape matching is quadratic in the leaf count: bound the work on hostile files
+MAX_CHAIN = 48     # joints from a branch point to a limb's end (a leg or arm with more is not one)
 
 
 class _Tree:
@@ -177,41 +180,65 @@ def _is_end(tree, j) -> bool:
 
 
 def _prune(tree: _Tree, keep: int = 5):
-    """Alive joints after removing the shortest leaf branches until ``keep`` ends remain."""
-    roots = [j for j in range(len(tree.names)) if tree.parents[j] < 0]
-    size = {r: 0 for r in roots}
-    for j in range(len(tree.names)):
-        size[tree.ancestors(j)[-1]] += 1
-    root = max(roots, key=lambda r: size[r])
-    alive = np.zeros(len(tree.names), bool)
-    for j in range(len(tree.names)):
-        alive[j] = tree.ancestors(j)[-1] == root
-    kids = lambda j: [c for c in tree.children[j] if alive[c]]  # noqa: E731
+    """Alive joints after removing the shortest leaf branches until ``keep`` ends remain (in the
+    biggest tree when there are several roots). A leaf branch runs from a leaf up to the nearest
+    joint with another child; lengths only grow as branches merge, so stale heap entries are
+    recomputed when they surface (O(J log J) for any tree shape)."""
+    J = len(tree.names)
+    root_of = np.empty(J, dtype=np.int64)
+    for j in range(J):
+        p = tree.parents[j]
+        root_of[j] = j if p < 0 else root_of[p]
+    root = int(np.bincount(root_of, minlength=J).argmax())
+    alive = root_of == root
+    nkids = np.zeros(J, dtype=np.int64)
+    for j in np.flatnonzero(alive):
+        if tree.parents[j] >= 0:
+            nkids[tree.parents[j]] += 1
 
     def branch(leaf):  # joints from the leaf up to (not including) the branch point, and the length
         path, j = [], leaf
-        while j != root and len(kids(tree.parents[j])) == 1:
+        while j != root and nkids[tree.parents[j]] == 1:
             path.append(j)
             j = int(tree.parents[j])
         if j != root:
             path.append(j)
-        return path, tree.cum[leaf] - tree.cum[int(tree.parents[path[-1]])] if path else 0.0
+        return path, (tree.cum[leaf] - tree.cum[int(tree.parents[path[-1]])]) if path else 0.0
 
-    while True:
-        leaves = [j for j in np.flatnonzero(alive) if j != root and not kids(j)]
-        if len(leaves) <= keep:
-            return root, alive, leaves
-        branches = [branch(leaf) for leaf in leaves]
-        path, _ = min(branches, key=lambda b: b[1])
+    leaves = [int(j) for j in np.flatnonzero(alive) if j != root and nkids[j] == 0]
+    heap = [(branch(j)[1], j) for j in leaves]
+    heapq.heapify(heap)
+    count = len(leaves)
+    while count > keep and heap:
+        length, leaf = heapq.heappop(heap)
+        if not alive[leaf]:
+            continue
+        path, now = branch(leaf)
+        if now != length:
+            heapq.heappush(heap, (now, leaf))
+            continue
+        if not path:
+            break
         alive[path] = False
+        nkids[tree.parents[path[-1]]] -= 1
+        count -= 1
+    leaves = [int(j) for j in np.flatnonzero(alive) if j != root and nkids[j] == 0]
+    return root, alive, leaves
 
 
 def _lateral(v, up):
     return v - np.dot(v, up) * up
 
 
+def _too_long(tree, chain, what):
+    if len(chain) > MAX_CHAIN:
+        raise ShapeMoveError(f"the {what} ending at {tree.names[chain[-1]]!r} is a chain of {len(chain)} joints, "
+                             f"more than {MAX_CHAIN}: not a humanoid limb (give a bone-mapping preset)")
+
+
 def _leg(tree, hub, leaf, up, scale):
     chain = tree.down_path(hub, leaf)
+    _too_long(tree, chain, "leg")
     P = tree.rest
     names = tree.names
     pts = [P[hub]] + [P[c] for c in chain]
@@ -260,6 +287,7 @@ def _leg(tree, hub, leaf, up, scale):
 
 def _arm(tree, hub, leaf, up, scale, leg3):
     chain = tree.down_path(hub, leaf)
+    _too_long(tree, chain, "arm")
     P = tree.rest
     names = tree.names
     best = None
@@ -338,6 +366,9 @@ def match_humanoid(names, parents, rest, rig_name: str = "auto"):
 
 
 def _match_pose(names, parents, rest, rig_name):
+    if len(names) > MAX_JOINTS:
+        raise ShapeMoveError(f"the skeleton has {len(names)} joints, more than the {MAX_JOINTS} a shape match "
+                             "looks at: give a bone-mapping preset")
     tree = _Tree(names, parents, rest)
     norm = [normalize(n) for n in tree.names]
     extent = float(np.ptp(tree.rest, axis=0).max()) if len(tree.names) else 0.0
