@@ -149,3 +149,41 @@ def test_unknown_rig_lists_missing_smpl_joints():
     assert "left_elbow" not in msg
     with pytest.raises(ShapeMoveError, match="pelvis"):
         detect_rig(["a", "b", "c"])
+
+
+BANDAI = {"Hips": 0, "Spine": 3, "Chest": 6, "Neck": 12, "Head": 15, "UpperLeg_L": 1, "LowerLeg_L": 4,
+          "Foot_L": 7, "Toes_L": 10, "UpperLeg_R": 2, "LowerLeg_R": 5, "Foot_R": 8, "Toes_R": 11,
+          "Shoulder_L": 13, "UpperArm_L": 16, "LowerArm_L": 18, "Hand_L": 20,
+          "Shoulder_R": 14, "UpperArm_R": 17, "LowerArm_R": 19, "Hand_R": 21}
+
+
+def test_anchored_rig_gets_the_bodys_neck_head_and_collars(openbody):
+    """A Bandai rig standing on OpenBody's joints, but with its Neck 3 cm low, its Head 4 cm long and
+    its clavicle roots on the mid-line (how loosely such rigs place them): the mapped neck, head and
+    collars land near OpenBody's (within 1.5-2 cm: each stays on its rig bone's line, the clavicle
+    root moved to the mid-line tilts that line), not on the rig's 3-6 cm off; the limbs stay the rig's joints exactly; without the
+    ``upper`` layout the rig's own joints come back."""
+    from shapemove.core.io.rig_map import ANCHORED
+
+    assert "bandai" in ANCHORED and "cmu_asf" not in ANCHORED
+    rest = openbody.rest_joints()[0].double().numpy()
+    measured = body_layout(rest)
+    np.testing.assert_allclose(OPENBODY_LAYOUT.upper, measured.upper, atol=1e-3)
+    names = list(BANDAI)
+    src = np.stack([rest[BANDAI[n]] for n in names])
+    up = rest[15] - rest[12]
+    src[names.index("Neck")] -= 0.3 * up                      # ~3 cm low
+    src[names.index("Head")] += 0.4 * up                      # ~4 cm past OpenBody's head joint
+    src[names.index("Shoulder_L"), 0] = src[names.index("Shoulder_R"), 0] = 0.0
+    j22, rig = map_positions(names, src[None], layout=measured)
+    assert rig.name == "bandai"
+    err = np.linalg.norm(j22[0] - rest[:22], axis=-1)
+    assert err[12] < 0.015 and err[13] < 0.015 and err[14] < 0.015 and err[15] < 0.02, np.round(err * 100, 2)
+    for i in [1, 2, 4, 5, 7, 8, 10, 11, 16, 17, 18, 19, 20, 21]:
+        np.testing.assert_allclose(j22[0, i], rest[i], atol=1e-12)
+    plain, _ = map_positions(names, src[None], layout=BodyLayout(spine=measured.spine))
+    np.testing.assert_allclose(plain[0, [12, 13, 15]], src[[names.index(n) for n in ("Neck", "Shoulder_L", "Head")]],
+                               atol=1e-12)
+    # scale-free: the same skeleton in centimetres maps to the same joints x 100
+    cm, _ = map_positions(names, 100 * src[None], layout=measured)
+    np.testing.assert_allclose(cm, 100 * j22, atol=1e-9)
