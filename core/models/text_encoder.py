@@ -241,7 +241,7 @@ class StateCache:
         self.states_of: dict[str, torch.Tensor] = {}
 
     def add(self, texts, batch: int = 64, progress: bool = False) -> None:
-        todo = sorted({str(t) for t in texts} - set(self.states_of), key=len)  # similar lengths: less padding
+        todo = sorted({str(t) for t in texts if str(t) not in self.states_of}, key=len)  # similar lengths together
         if not todo:
             return
         from tqdm import tqdm
