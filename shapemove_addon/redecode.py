@@ -101,10 +101,10 @@ def _answered(name, betas, msg) -> None:
 def apply_motion(rig, motion) -> bpy.types.Action:
     """Replace the rig's action with ``motion``'s keys (same action name; the old one is removed
     when nothing else uses it). The bones must already sit on the rest joints of motion.betas.
-    The motion is moved up or down as a whole so its lowest mesh-sole point is on the floor."""
+    (A decoded motion is already grounded on the body's mesh by core's decode.)"""
     rotations, transl = motion_channels_z_up(motion.poses, motion.transl)
     names = rig["shapemove_joint_names"].split("\n")
-    transl = transl + [0.0, 0.0, grounding.floor_shift(rig, names, current_betas(rig), rotations, transl)]
+    grounding.forget_contacts(rig)  # a new motion: its contacts are detected at the next shape change
     anim = rig.animation_data
     old = anim.action if anim is not None else None
     name = old.name if old is not None else f"{rig.name}_motion"

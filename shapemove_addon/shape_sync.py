@@ -42,7 +42,7 @@ def on_betas_changed(obj, context=None) -> None:
 
     The armature's keyed local rotations are kept (rebased onto the new bone frames), so the same
     motion now plays on the new body at once, and the root is moved up or down frame by frame so
-    the mesh soles stay where they were (``grounding``); when the rig has motion tokens, a
+    the feet stand on the new body's mesh soles (``grounding``); when the rig has motion tokens, a
     debounced job then re-decodes the motion for the new body (``redecode.schedule``) and
     replaces the keys."""
     rig = rig_of(obj)
@@ -55,11 +55,8 @@ def on_betas_changed(obj, context=None) -> None:
     names = rig["shapemove_joint_names"].split("\n")
     parents = [int(p) for p in rig["shapemove_parents"]]
     keys = place_bones(context, rig, rest_joints_for(jt, jd, betas), names, parents)
-    if keys is not None:  # feet on the floor: each frame's lowest sole point stays where it was
-        rotations, offsets = grounding.keyed_pose(keys.quats, keys.locations, keys.rest)
-        shift = grounding.shape_change_shift(rig, names, placed_betas(rig), betas, rotations, offsets)
-        if shift is not None and np.abs(shift).max() > 1e-7:
-            keys.set_locations(keys.locations + shift[:, None] * keys.rest[0][2])  # armature Z in the root's frame
+    if keys is not None:  # feet on the floor of the new body's mesh
+        grounding.ground_keys(rig, names, placed_betas(rig), betas, keys)
     rig["shapemove_betas"] = betas.tolist()
     context.scene.frame_set(context.scene.frame_current)  # re-evaluate the rebased action
     redecode.schedule(rig)

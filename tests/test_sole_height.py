@@ -1,22 +1,15 @@
-"""Sole heights from the skinned sole vertices (core/scene/sole_height.py) against the body
-model's own skinning of the whole mesh."""
+"""Lowest heights from a few skinned vertices (core/scene/sole_height.py) against the body model's
+own skinning of the whole mesh, and grounding a shape change with core.body.plant.ground_shift."""
 from __future__ import annotations
 
 import numpy as np
 import pytest
 import torch
 
+from shapemove.core.body.plant import ground_shift
 from shapemove.core.body.skeleton import PARENTS
 from shapemove.core.geometry.rotations import axis_angle_to_matrix
-from shapemove.core.scene.sole_height import floor_shift, lowest_sole_heights, shape_change_shift, sole_vertices
-
-
-def _pose(frames=15, seed=0):
-    rng = np.random.default_rng(seed)
-    t = np.arange(frames)[:, None, None]
-    poses = rng.normal(0, 0.35, (1, 24, 3)) * np.sin(0.3 * t + rng.uniform(0, 6, (1, 24, 3)))
-    transl = np.stack([0.03 * t[:, 0, 0], 0.05 * np.sin(0.4 * t[:, 0, 0]), 0.02 * t[:, 0, 0]], -1)
-    return poses, transl
+from shapemove.core.scene.sole_height import SOLE_BAND, lowest_heights, sole_vertices
 
 
 def _forward(body, betas, poses, transl):
@@ -26,80 +19,83 @@ def _forward(body, betas, poses, transl):
     return out.vertices.numpy().astype(np.float64)
 
 
-def _lowest(body, betas, poses, transl, idx):
-    b = torch.as_tensor(betas, dtype=torch.float32)[None]
+def _rest(body, betas):
+    """(rest joints, rest vertices) for betas (10,) or (B,10), float64."""
+    b = torch.as_tensor(np.asarray(betas), dtype=torch.float32).reshape(-1, 10)
     with torch.no_grad():
-        rest_j = body.rest_joints(b)[0].numpy()
-        rest_v = body.rest_vertices(b)[0].numpy()
-    return lowest_sole_heights(axis_angle_to_matrix(poses), transl, rest_j, PARENTS, rest_v[idx],
-                               np.asarray(body.skin_weights)[idx], up=1)
+        j, v = body.rest_joints(b).numpy().astype(np.float64), body.rest_vertices(b).numpy().astype(np.float64)
+    return (j[0], v[0]) if np.ndim(betas) == 1 else (j, v)
 
 
-def test_sole_vertices_are_the_feet(openbody):
-    with torch.no_grad():
-        rest = openbody.rest_vertices(torch.zeros(1, 10))[0].numpy()
+def _feet(body):
+    """Sole vertex ids and their group: 0 left foot, 1 right foot (dominant skin joint)."""
+    _, rest = _rest(body, np.zeros(10))
+    w = np.asarray(body.skin_weights)
+    ids = sole_vertices(rest, w, up=1)
+    return ids, np.isin(w[ids].argmax(1), [8, 11]).astype(int)
+
+
+def test_sole_vertices_are_the_feet_and_enough(openbody):
+    _, rest = _rest(openbody, np.zeros(10))
     w = np.asarray(openbody.skin_weights)
     idx = sole_vertices(rest, w, up=1)
-    band = np.flatnonzero(rest[:, 1] <= rest[:, 1].min() + 0.03)
+    band = np.flatnonzero(rest[:, 1] <= rest[:, 1].min() + SOLE_BAND)
     assert 20 < len(idx) < 0.5 * len(band) and set(idx) <= set(band)
-    feet = w[idx][:, [7, 8, 10, 11]].sum(1)
-    assert feet.min() > 0.5  # every sole vertex is mostly skinned to an ankle or a foot joint
+    assert w[idx][:, [7, 8, 10, 11]].sum(1).min() > 0.5  # all on an ankle or a foot joint
     # the few kept vertices give the same lowest point as the whole band, in any pose
-    rng = np.random.default_rng(4)
-    rot = axis_angle_to_matrix(rng.normal(0, 0.6, (100, 24, 3)))
-    joints = openbody.rest_joints(torch.zeros(1, 10))[0].numpy()
+    rot = axis_angle_to_matrix(np.random.default_rng(4).normal(0, 0.6, (100, 24, 3)))
+    joints, _ = _rest(openbody, np.zeros(10))
     args = (rot, np.zeros((100, 3)), joints, PARENTS)
-    full = lowest_sole_heights(*args, rest[band], w[band], up=1)
-    assert np.abs(lowest_sole_heights(*args, rest[idx], w[idx], up=1) - full).max() < 1e-4
+    full = lowest_heights(*args, rest[band], w[band], 1, np.zeros(len(band), int))
+    assert np.abs(lowest_heights(*args, rest[idx], w[idx], 1, np.zeros(len(idx), int)) - full).max() < 1e-4
 
 
-def test_lowest_sole_heights_match_the_skinned_mesh(openbody):
-    betas = np.random.default_rng(1).normal(0, 1, 10)
-    poses, transl = _pose()
-    with torch.no_grad():
-        rest = openbody.rest_vertices(torch.as_tensor(betas, dtype=torch.float32)[None])[0].numpy()
-    idx = sole_vertices(rest, openbody.skin_weights, up=1)
-    mine = _lowest(openbody, betas, poses, transl, idx)
+def test_lowest_heights_match_the_skinned_mesh(openbody):
+    rng = np.random.default_rng(1)
+    betas = rng.normal(0, 1, 10)
+    t = np.arange(15)[:, None, None]
+    poses = rng.normal(0, 0.35, (1, 24, 3)) * np.sin(0.3 * t + rng.uniform(0, 6, (1, 24, 3)))
+    transl = np.stack([0.03 * t[:, 0, 0], 0.05 * np.sin(0.4 * t[:, 0, 0]), 0.02 * t[:, 0, 0]], -1)
+    joints, rest = _rest(openbody, betas)
+    ids, side = _feet(openbody)
+    sample = np.arange(0, len(rest), 37)
+    pts, groups = np.r_[ids, sample], np.r_[side, np.full(len(sample), 2)]
+    mine = lowest_heights(axis_angle_to_matrix(poses), transl, joints, PARENTS, rest[pts],
+                          np.asarray(openbody.skin_weights)[pts], 1, groups)
     verts = _forward(openbody, betas, poses, transl)
-    assert np.abs(mine - verts[:, idx, 1].min(1)).max() < 1e-5
-    # standing poses: the soles are the lowest part of the whole body
-    assert np.abs(mine - verts[:, :, 1].min(1)).max() < 0.05
+    for g in range(3):
+        assert np.abs(mine[:, g] - verts[:, pts[groups == g], 1].min(1)).max() < 1e-5
+    # both bodies of a batch in one call
+    joints2, rest2 = _rest(openbody, np.stack([betas, np.zeros(10)]))
+    both = lowest_heights(axis_angle_to_matrix(poses), transl, joints2, PARENTS, rest2[:, pts],
+                          np.asarray(openbody.skin_weights)[pts], 1, groups)
+    assert both.shape == (2, 15, 3) and np.abs(both[0] - mine).max() < 1e-7
 
 
-def _squat(frames=10):
-    """Knees and hips bending deeper frame by frame, the root fixed: the soles leave the floor."""
+def test_a_taller_body_is_grounded_frame_by_frame_on_its_soles(openbody):
+    # a squat in place, grounded on every frame for the first body, both feet in contact throughout
+    frames = 10
     poses = np.zeros((frames, 24, 3))
     bend = np.linspace(0, 1.4, frames)
     poses[:, [1, 2], 0] = -bend[:, None]
     poses[:, [4, 5], 0] = 2 * bend[:, None]
     poses[:, [7, 8], 0] = -0.5 * bend[:, None]
-    return poses, np.zeros((frames, 3))
-
-
-def test_shifts_keep_and_put_the_soles_on_the_floor(openbody):
-    poses, transl = _squat()
     b0, b1 = np.zeros(10), np.zeros(10)
     b1[0] = 2.5
-    with torch.no_grad():
-        rest = openbody.rest_vertices(torch.zeros(1, 10))[0].numpy()
-    idx = sole_vertices(rest, openbody.skin_weights, up=1)
-    # a squat grounded frame by frame for the first body (what a real motion does)
-    per_frame = -_lowest(openbody, b0, poses, transl, idx)
-    grounded = transl + per_frame[:, None] * [0.0, 1.0, 0.0]
-    low0 = _lowest(openbody, b0, poses, grounded, idx)
-    assert np.abs(_forward(openbody, b0, poses, grounded)[:, idx, 1].min(1)).max() < 1e-5
-    assert floor_shift(low0 + 0.02) == pytest.approx(-0.02, abs=1e-9)
-    # a taller body, same keys: its soles go through the floor in the deep squat ...
-    low1 = _lowest(openbody, b1, poses, grounded, idx)
-    assert np.abs(low1).max() > 0.02
-    shift = shape_change_shift(low0, low1)
-    # ... and the per-frame root shift puts them back on it in every frame
-    after = _forward(openbody, b1, poses, grounded + shift[:, None] * [0.0, 1.0, 0.0])
-    assert np.abs(after[:, idx, 1].min(1)).max() < 1e-5
-    # both bodies in one batched call give the same heights
-    b = torch.as_tensor(np.stack([b0, b1]), dtype=torch.float32)
-    with torch.no_grad():
-        joints, verts = openbody.rest_joints(b).numpy(), openbody.rest_vertices(b).numpy()
-    both = lowest_sole_heights(axis_angle_to_matrix(poses), grounded, joints, PARENTS, verts[:, idx],
-                               np.asarray(openbody.skin_weights)[idx], up=1)
-    assert np.abs(both - np.stack([low0, low1])).max() < 1e-9
+    ids, side = _feet(openbody)
+    w = np.asarray(openbody.skin_weights)[ids]
+    contacts = np.ones((frames, 4), np.uint8)
+
+    def low(betas, transl):
+        joints, rest = _rest(openbody, betas)
+        return lowest_heights(axis_angle_to_matrix(poses), transl, joints, PARENTS, rest[ids], w, 1, side)
+
+    transl = np.zeros((frames, 3))
+    transl[:, 1] += ground_shift(low(b0, transl), low(b0, transl).min(1), contacts)
+    assert np.abs(_forward(openbody, b0, poses, transl)[:, ids, 1].min(1)).max() < 1e-5
+    # the same keys on a taller body: its soles go through the floor in the deep squat ...
+    assert np.abs(low(b1, transl).min(1)).max() > 0.02
+    # ... and plant's ground shift, from these heights, puts them back on it in every frame
+    transl[:, 1] += ground_shift(low(b1, transl), low(b1, transl).min(1), contacts)
+    assert np.abs(_forward(openbody, b1, poses, transl)[:, ids, 1].min(1)).max() < 1e-5
+    assert ground_shift(low(b1, transl), low(b1, transl).min(1), contacts) == pytest.approx(0.0, abs=1e-9)

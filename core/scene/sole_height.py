@@ -1,12 +1,11 @@
-"""How high the body's soles are, frame by frame, from the skinned mesh (numpy, no torch).
+"""How low the body's mesh reaches, frame by frame, from a few skinned vertices (numpy, no torch).
 
-The feet of a rig stay on the floor after a shape change when its root is moved up or down, frame
-by frame, by the change of the lowest sole point (``shape_change_shift``): a foot that touched the
-floor still touches it, a jump keeps its clearance. A new motion is put on the floor as a whole
-(``floor_shift``). Only the sole vertices are skinned: those within
-``SOLE_BAND`` of the lowest point of the rest mesh (soles, heels and toe tips in the rest
-pose) that can be the lowest point (``sole_vertices``), with their full skin weights, so the
-heights are exact.
+A rig's feet are kept on the floor after a shape change by ``core.body.plant.ground_shift``,
+which needs, per frame, the lowest point of each foot's sole and of the whole body. Those come
+from here for any pose of the keyed motion: the sole vertices (``sole_vertices``: within
+``SOLE_BAND`` of the lowest rest vertex, reduced to those that can ever be lowest) and a sparse
+sample of the rest of the body, skinned with their full weights (``lowest_heights``), so the
+sole heights are exact.
 
 Axes are the caller's (``up`` names the vertical axis: 1 for Y-up data, 2 for Blender's Z-up
 armature space). Units metres.
@@ -62,21 +61,24 @@ def _ancestors(cols, parents) -> list:
     return sorted(need)
 
 
-def lowest_sole_heights(rotations, root_offsets, rest_joints, parents, sole_rest, sole_weights, up: int) -> np.ndarray:
-    """Height of the lowest sole vertex in every frame.
+def lowest_heights(rotations, root_offsets, rest_joints, parents, points_rest, weights, up: int, groups) -> np.ndarray:
+    """Height of the lowest point of each group of skinned points, in every frame.
 
     rotations (T,J,3,3) local joint rotations (each joint's rest frame aligned with the axes);
     root_offsets (T,3) how far the root has moved from its rest position; rest_joints (...,J,3);
-    sole_rest (...,n,3) rest positions of the sole vertices for the same body (a leading batch
-    axis, e.g. two bodies, is evaluated in one pass); sole_weights (n,J) their skin weights.
-    Linear blend skinning with normalised weights, as Blender's Armature modifier and BodyModel.
-    Returns (...,T) metres along ``up``.
+    points_rest (...,n,3) rest positions of the points on the same body (a leading batch axis,
+    e.g. two bodies, is evaluated in one pass); weights (n,J) their skin weights; groups (n,) int
+    group of each point, 0..G-1. Linear blend skinning with normalised weights, as Blender's
+    Armature modifier and BodyModel. Returns (...,T,G) metres along ``up``.
     """
     rest_joints = np.asarray(rest_joints, dtype=np.float64)
-    v = np.asarray(sole_rest, dtype=np.float64)
-    w = np.asarray(sole_weights, dtype=np.float64)
+    groups = np.asarray(groups, dtype=np.int64)
+    order = np.argsort(groups, kind="stable")  # each group one contiguous slice
+    groups = groups[order]
+    v = np.asarray(points_rest, dtype=np.float64)[..., order, :]
+    w = np.asarray(weights, dtype=np.float64)[order]
     w = w / np.maximum(w.sum(1, keepdims=True), 1e-12)
-    cols = np.flatnonzero(np.abs(w).sum(0) > 0)  # only the joints the soles follow ...
+    cols = np.flatnonzero(np.abs(w).sum(0) > 0)  # only the joints the points follow ...
     sub = _ancestors(cols, parents)  # ... and their chains to the root
     index = {j: i for i, j in enumerate(sub)}
     sub_parents = [index[int(parents[j])] if parents[j] >= 0 else -1 for j in sub]
@@ -86,18 +88,13 @@ def lowest_sole_heights(rotations, root_offsets, rest_joints, parents, sole_rest
     c = [index[int(j)] for j in cols]
     w = w[:, cols]
     a = world[..., c, up, :]  # (...,T,c,3): the up row of each joint's world rotation
-    # h_ti = sum_j w_ij (a_tj . (v_i - J_j) + pos_tj,up), as four (T,c) x (c,n) products
-    h = (pos[..., c, up] - (a * rest_joints[..., None, cols, :]).sum(-1)) @ w.T
+    # h_ti = sum_j w_ij (a_tj . (v_i - J_j) + pos_tj,up), as four (T,c) x (c,n) products; float32
+    # for speed (heights of a few metres: 0.1 um steps)
+    f32 = np.float32
+    h = (pos[..., c, up] - (a * rest_joints[..., None, cols, :]).sum(-1)).astype(f32) @ w.T.astype(f32)
     for k in range(3):
-        h += a[..., k] @ np.swapaxes(w * v[..., :, k:k + 1], -1, -2)
-    return h.min(axis=-1) + np.asarray(root_offsets, dtype=np.float64)[:, up]
-
-
-def shape_change_shift(lowest_before, lowest_after) -> np.ndarray:
-    """(T,) vertical root shift per frame that keeps the lowest sole point where it was."""
-    return np.asarray(lowest_before, dtype=np.float64) - np.asarray(lowest_after, dtype=np.float64)
-
-
-def floor_shift(lowest) -> float:
-    """Vertical root shift that puts the lowest sole point of the motion on the floor (0)."""
-    return float(-np.min(lowest))
+        h += a[..., k].astype(f32) @ np.swapaxes(w * v[..., :, k:k + 1], -1, -2).astype(f32)
+    bounds = np.searchsorted(groups, np.arange(int(groups.max()) + 2))
+    out = np.stack([h[..., s:e].min(axis=-1) if e > s else np.full(h.shape[:-1], np.inf, f32)
+                    for s, e in zip(bounds[:-1], bounds[1:])], -1).astype(np.float64)
+    return out + np.asarray(root_offsets, dtype=np.float64)[:, up, None]
