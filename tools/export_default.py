@@ -19,6 +19,7 @@ import torch
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT.parent))
+from shapemove.core.model_files import write_manifest  # noqa: E402
 
 
 def half_state(obj):
