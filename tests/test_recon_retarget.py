@@ -11,7 +11,7 @@ from shapemove.core.errors import ShapeMoveError
 
 RUN_CLIP = "dataset-1_run_happy_001"  # 93 frames; the tiny dataset also holds its augmented copy
 RECON_KEYS = {"mpjpe_mm", "mpjpe_local_mm", "bone_err_mm", "penetrate_cm", "float_cm", "skate_pct", "dyn_stable_pct",
-              "penetrate_all_cm", "float_all_cm", "code_usage_pct", "clips"}
+              "penetrate_all_cm", "float_all_cm", "skate_joints_pct", "code_usage_pct", "clips"}
 
 
 @pytest.fixture(scope="module")

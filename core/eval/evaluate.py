@@ -17,7 +17,7 @@ from . import bones, physics, stability
 CHUNK = 64
 _MASS_MODELS: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
 METRIC_KEYS = ("penetrate_cm", "float_cm", "skate_pct", "bone_var_mm", "bone_err_mm", "dyn_stable_pct", "zmp_out_cm",
-               "penetrate_all_cm", "float_all_cm")
+               "penetrate_all_cm", "float_all_cm", "skate_joints_pct")
 
 
 def _betas(betas) -> torch.Tensor:
@@ -106,6 +106,7 @@ def evaluate_motion(body, betas, rotations, transl, joints=None, target_betas=No
         "penetrate_cm": pen.value, "float_cm": flo.value, "skate_pct": sk.value,
         "penetrate_all_cm": physics.penetrate_all(m["lowest"]).value,
         "float_all_cm": physics.floating_all(m["lowest"]).value,
+        "skate_joints_pct": physics.skate_from_joints(m["joints"][:, :22]).value,  # GMD: the foot joints
         "bone_var_mm": bones.bone_length_variance_mm(j),
         "bone_err_mm": bones.bone_length_error_mm(j, target),
         "dyn_stable_pct": stab["dyn_stable_pct"], "zmp_out_cm": stab["zmp_out_cm"],
@@ -123,6 +124,7 @@ def evaluate_joints(joints, target_lengths=None, sole_offsets=None) -> dict:
     return {
         "penetrate_cm": pen.value, "float_cm": flo.value, "skate_pct": sk.value,
         "penetrate_all_cm": physics.penetrate_all(low).value, "float_all_cm": physics.floating_all(low).value,
+        "skate_joints_pct": sk.value,
         "bone_var_mm": bones.bone_length_variance_mm(j),
         "bone_err_mm": float("nan") if target_lengths is None else bones.bone_length_error_mm(j, target_lengths),
         "dyn_stable_pct": float("nan"), "zmp_out_cm": float("nan"),

@@ -32,8 +32,9 @@ from ..constants import FPS
 from ..errors import ShapeMoveError
 
 KEYS = ("r_precision_top1", "r_precision_top3", "matching_score", "fid", "penetrate_cm", "float_cm", "skate_pct",
-        "dyn_stable_pct", "height_err_cm", "waist_err_cm", "clips", "penetrate_all_cm", "float_all_cm")
-PHYSICS = ("penetrate_cm", "float_cm", "skate_pct", "dyn_stable_pct", "penetrate_all_cm", "float_all_cm")
+        "dyn_stable_pct", "height_err_cm", "waist_err_cm", "clips", "penetrate_all_cm", "float_all_cm",
+        "skate_joints_pct")
+PHYSICS = ("penetrate_cm", "float_cm", "skate_pct", "dyn_stable_pct", "penetrate_all_cm", "float_all_cm", "skate_joints_pct")
 
 
 def load_clips(data, split: str = "test", max_clips: int | None = None, seed: int = 0) -> list[dict]:
@@ -161,6 +162,7 @@ LABELS = {
     "float_cm": ("Float (cm)", "lower"), "skate_pct": ("Skate (%)", "lower"),
     "penetrate_all_cm": ("Penetrate, paper: all frames (cm)", "lower"),
     "float_all_cm": ("Float, paper: all frames (cm)", "lower"),
+    "skate_joints_pct": ("Skate, GMD on the foot joints (%)", "lower"),
     "dyn_stable_pct": ("Dyn. stability (%)", "higher"), "height_err_cm": ("Height error (cm)", "lower"),
     "waist_err_cm": ("Waist error (cm)", "lower"),
 }

@@ -32,7 +32,7 @@ from .evaluate import evaluate_motion
 from .report import aggregate
 
 KEYS = ("mpjpe_mm", "mpjpe_local_mm", "bone_err_mm", "penetrate_cm", "float_cm", "skate_pct", "dyn_stable_pct",
-        "penetrate_all_cm", "float_all_cm")  # *_all_cm: the paper's definitions (mean over all frames)
+        "penetrate_all_cm", "float_all_cm", "skate_joints_pct")  # *_all_cm: the paper's (mean over all frames)
 
 
 def _body(body):

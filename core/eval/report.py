@@ -17,6 +17,7 @@ METRICS = {
     "float_cm": ("Float", "cm", "lower", "n_float"),
     "penetrate_all_cm": ("Penetrate (paper: all frames)", "cm", "lower", "n_frames"),
     "float_all_cm": ("Float (paper: all frames)", "cm", "lower", "n_frames"),
+    "skate_joints_pct": ("Skate (GMD: foot joints)", "%", "lower", "n_skate"),
     "skate_pct": ("Skate", "%", "lower", "n_skate"),
     "bone_var_mm": ("Bone length var.", "mm", "lower", "n_frames"),
     "bone_err_mm": ("Bone length err.", "mm", "lower", "n_frames"),

@@ -20,7 +20,8 @@ from ..errors import ShapeMoveError
 from .evaluate import evaluate_motion
 from .report import aggregate
 
-KEYS = ("bone_err_mm", "penetrate_cm", "float_cm", "skate_pct", "dyn_stable_pct", "penetrate_all_cm", "float_all_cm")
+KEYS = ("bone_err_mm", "penetrate_cm", "float_cm", "skate_pct", "dyn_stable_pct", "penetrate_all_cm", "float_all_cm",
+        "skate_joints_pct")
 
 
 def source_motion(data, clip):
