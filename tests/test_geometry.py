@@ -101,3 +101,27 @@ def test_torch_twins_match_numpy(seed):
     p, _ = torch_ops.forward_kinematics(torch_ops.axis_angle_to_matrix(x), torch.as_tensor(rest), PARENTS)
     p[0, 20].sum().backward()
     assert torch.isfinite(x.grad).all() and x.grad[0, 0].abs().sum() > 0
+
+
+def test_torch_shortest_arc_frame_and_offset_fk_match_numpy():
+    rng = np.random.default_rng(7)
+    u, v = rng.normal(size=(50, 3)), rng.normal(size=(50, 3))
+    u[0], v[0] = [0, 0, 2.0], [0, 0, -1.0]   # opposite: a half turn
+    u[1], v[1] = [1.0, 1, 1], [3.0, 3, 3]     # parallel: identity; the frame needs its fallback
+    rot_t = torch_ops.rotation_between(torch.as_tensor(u), torch.as_tensor(v)).numpy()
+    vn = v / np.linalg.norm(v, axis=-1, keepdims=True)
+    np.testing.assert_allclose(np.einsum("nij,nj->ni", rot_t, u / np.linalg.norm(u, axis=-1, keepdims=True)), vn, atol=1e-9)
+    np.testing.assert_allclose(rot_t[1:], R.rotation_between(u, v)[1:], atol=1e-9)  # half turns: any axis
+    f_np = R.orthonormal_frame(u, v)
+    np.testing.assert_allclose(torch_ops.orthonormal_frame(torch.as_tensor(u), torch.as_tensor(v)).numpy(), f_np, atol=1e-12)
+    np.testing.assert_allclose(np.einsum("nji,njk->nik", f_np, f_np), np.broadcast_to(np.eye(3), (50, 3, 3)), atol=1e-12)
+    assert np.allclose(np.linalg.det(f_np), 1.0) and np.allclose(f_np[..., 0], u / np.linalg.norm(u, axis=-1, keepdims=True))
+    # FK from bone offsets + a root translation == FK of the rest moved by it, on the first 22 joints
+    rest = rng.normal(size=(24, 3))
+    rot = R.axis_angle_to_matrix(_rotvecs(3 * 24, seed=7).reshape(3, 24, 3))
+    transl = rng.normal(size=(3, 3))
+    pos, world = torch_ops.forward_kinematics_offsets(torch.as_tensor(rot[:, :22]), torch.as_tensor(fk.bone_offsets(rest, PARENTS)),
+                                                      PARENTS, torch.as_tensor(transl))
+    pos_np, world_np = fk.forward_kinematics(rot, rest, PARENTS)
+    np.testing.assert_allclose(pos.numpy(), pos_np[:, :22] + transl[:, None], atol=1e-12)
+    np.testing.assert_allclose(world.numpy(), world_np[:, :22], atol=1e-12)

@@ -34,7 +34,8 @@ import numpy as np
 import torch
 
 from ..errors import ShapeMoveError
-from ..geometry.torch_ops import axis_angle_to_matrix, forward_kinematics
+from ..geometry.torch_ops import (axis_angle_to_matrix, forward_kinematics, forward_kinematics_offsets, orthonormal_frame,
+                                  rotation_between)
 from .skeleton import NUM_BODY_JOINTS, NUM_JOINTS, PARENTS
 
 # (limb root, hinge joint, end joint, hinge axis in the rest pose; positive angle = flexion)
@@ -68,41 +69,9 @@ def _unit(v: torch.Tensor) -> torch.Tensor:
     return v / torch.linalg.norm(v, dim=-1, keepdim=True).clamp_min(_EPS)
 
 
-def _frame(a: torch.Tensor, b: torch.Tensor) -> torch.Tensor:
-    """Orthonormal frame (...,3,3) with columns [a, b orthogonalised to a, a x b]."""
-    e1 = _unit(a)
-    b = b - (b * e1).sum(-1, keepdim=True) * e1
-    # b parallel to a: any perpendicular will do
-    alt = torch.where(e1[..., :1].abs() < 0.9, torch.tensor([1.0, 0, 0], dtype=a.dtype),
-                      torch.tensor([0, 1.0, 0], dtype=a.dtype))
-    alt = alt - (alt * e1).sum(-1, keepdim=True) * e1
-    bad = torch.linalg.norm(b, dim=-1, keepdim=True) < 1e-7
-    e2 = _unit(torch.where(bad, alt, b))
-    return torch.stack([e1, e2, torch.cross(e1, e2, dim=-1)], dim=-1)
-
-
 def _align_two(a1, a2, b1, b2) -> torch.Tensor:
     """Rotation taking a1 exactly onto b1's direction and a2 as close as possible to b2."""
-    return _frame(b1, b2) @ _frame(a1, a2).transpose(-1, -2)
-
-
-def _swing(a: torch.Tensor, b: torch.Tensor) -> torch.Tensor:
-    """Minimal rotation (...,3,3) taking direction a onto direction b."""
-    a, b = _unit(a), _unit(b)
-    v = torch.cross(a, b, dim=-1)
-    c = (a * b).sum(-1)
-    x, y, z = v.unbind(-1)
-    zero = torch.zeros_like(x)
-    k = torch.stack([zero, -z, y, z, zero, -x, -y, x, zero], -1).reshape(*v.shape[:-1], 3, 3)
-    eye = torch.eye(3, dtype=a.dtype).expand(k.shape)
-    rot = eye + k + (k @ k) / (1 + c).clamp_min(1e-6)[..., None, None]
-    # (anti)parallel: half-turn about an axis perpendicular to a
-    anti = c < -1 + 1e-6
-    if anti.any():
-        p = _frame(a, torch.ones_like(a))[..., 1]
-        half = 2 * p[..., :, None] * p[..., None, :] - eye
-        rot = torch.where(anti[..., None, None], half, rot)
-    return rot
+    return orthonormal_frame(b1, b2) @ orthonormal_frame(a1, a2).transpose(-1, -2)
 
 
 def _kabsch(src: torch.Tensor, dst: torch.Tensor, weight: torch.Tensor | None = None) -> torch.Tensor:
@@ -161,18 +130,6 @@ def _prepare(joints, rest_joints, parents):
 def _fk(rot: torch.Tensor, rest: torch.Tensor, parents, transl: torch.Tensor) -> torch.Tensor:
     pos, _ = forward_kinematics(rot, rest.expand(rot.shape[0], -1, -1), parents)
     return pos[:, :NUM_BODY_JOINTS] + transl[:, None]
-
-
-def _fk_fast(rot: torch.Tensor, offs: torch.Tensor, parents, transl: torch.Tensor) -> torch.Tensor:
-    """The 22 body joints (T,22,3) of ``forward_kinematics`` + transl, with 3x3 rotations and
-    bone offsets instead of 4x4 transforms (about half the work and autograd graph)."""
-    G = [rot[:, 0]]
-    P = [offs[0].expand(rot.shape[0], 3) + transl]
-    for j in range(1, NUM_BODY_JOINTS):
-        p = parents[j]
-        P.append(P[p] + G[p] @ offs[j])
-        G.append(G[p] @ rot[:, j])
-    return torch.stack(P, 1)
 
 
 def _result(rot, transl, target, rest, parents) -> IKResult:
@@ -280,7 +237,7 @@ def analytic_ik(target: torch.Tensor, rest: torch.Tensor, parents, max_turn_deg:
             h = hinge_axis[hinge_of[j][0]]
             G[j] = _align_two(offs[ch[0]].expand(T, 3), h.expand(T, 3), aim[:, 0] - P[j], G[p] @ h)
         else:
-            G[j] = _swing(G[p] @ offs[ch[0]], aim[:, 0] - P[j]) @ G[p]
+            G[j] = rotation_between(G[p] @ offs[ch[0]], aim[:, 0] - P[j]) @ G[p]
     rot = torch.stack([G[0]] + [G[parents[j]].transpose(-1, -2) @ G[j] for j in range(1, NUM_JOINTS)], 1)
     return rot, P[0] - rest[0]
 
@@ -303,7 +260,7 @@ def _limb_root(limb, h, offs, t_mid, t_end, pj, gp):
     _, mid, end, _ = limb
     a = _unit(offs[mid])
     bj = _unit(_place_mid(pj, t_mid, t_end, offs[mid], offs[end]) - pj)
-    g0 = _swing(gp @ a, bj) @ gp
+    g0 = rotation_between(gp @ a, bj) @ gp
     u = g0 @ h                                     # hinge axis with the minimal twist
     p_mid = pj + torch.linalg.norm(offs[mid]) * bj  # where FK will put the knee/elbow
     bk = _unit(t_end - p_mid)
@@ -380,17 +337,6 @@ def _gn_structure(parents):
     return rows, cols, kinds, anc, torch.tensor(movers)
 
 
-def _fk_world(rot: torch.Tensor, offs: torch.Tensor, parents, transl: torch.Tensor):
-    """FK of the 22 body joints without autograd: positions (T,22,3) and world rotations (T,22,3,3)."""
-    G = [rot[:, 0]]
-    P = [offs[0].expand(rot.shape[0], 3) + transl]
-    for j in range(1, NUM_BODY_JOINTS):
-        p = parents[j]
-        P.append(P[p] + G[p] @ offs[j])
-        G.append(G[p] @ rot[:, j])
-    return torch.stack(P, 1), torch.stack(G, 1)
-
-
 def refine(rot0, transl0, target, rest, parents, iters: int = 2, end_weight: float = 3.0, bone_weight: float = 1.0,
            free_turn_deg: float = 30.0, huber: float = 5e-3, damping: float = 1e-3, tol: float = 1e-3):
     """Up to ``iters`` damped Gauss-Newton steps per frame, batched over frames, on
@@ -437,7 +383,7 @@ def refine(rot0, transl0, target, rest, parents, iters: int = 2, end_weight: flo
         return res, bres, dist, loss
 
     rot, tr = rot0.clone(), transl0.clone()
-    pos, G = _fk_world(rot, offs, parents, tr)
+    pos, G = forward_kinematics_offsets(rot[:, :NUM_BODY_JOINTS], offs, parents, tr)
     res, bres, dist, loss = terms(pos)
     lam = torch.full((T,), damping, dtype=torch.float32)  # per frame: up when a step fails
     for _ in range(iters):
@@ -473,7 +419,7 @@ def refine(rot0, transl0, target, rest, parents, iters: int = 2, end_weight: flo
         new_rot = rot.clone()
         new_rot[:, :n] = rot[:, :n] @ axis_angle_to_matrix(local)
         new_tr = tr + step[:, m * 3:]
-        new_pos, new_G = _fk_world(new_rot, offs, parents, new_tr)
+        new_pos, new_G = forward_kinematics_offsets(new_rot[:, :NUM_BODY_JOINTS], offs, parents, new_tr)
         new_res, new_bres, new_dist, new_loss = terms(new_pos)
         ok = new_loss < loss
         lam = torch.where(ok, lam / 3, lam * 10).clamp(1e-6, 1e6)

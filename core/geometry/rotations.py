@@ -183,3 +183,19 @@ def rotation_between(u, v) -> np.ndarray:
         perp /= np.linalg.norm(perp, axis=-1, keepdims=True)
         q = np.where(opposite[..., None], np.concatenate([np.zeros_like(cos)[..., None], perp], -1), q)
     return quaternion_to_matrix(q)
+
+
+def orthonormal_frame(a, b) -> np.ndarray:
+    """(..., 3, 3) frame with columns [a, b made orthogonal to a, a x b] (unit); for b parallel to
+    a any perpendicular is used. ``orthonormal_frame(b1, b2) @ orthonormal_frame(a1, a2).T`` takes
+    a1 onto b1's direction and a2 as close as it can to b2."""
+    a = np.asarray(a, dtype=np.float64)
+    b = np.asarray(b, dtype=np.float64)
+    a, b = np.broadcast_arrays(a, b)
+    e1 = a / np.linalg.norm(a, axis=-1, keepdims=True).clip(1e-9)
+    b = b - (b * e1).sum(-1, keepdims=True) * e1
+    alt = np.where(np.abs(e1[..., :1]) < 0.9, [1.0, 0, 0], [0, 1.0, 0])
+    alt = alt - (alt * e1).sum(-1, keepdims=True) * e1
+    e2 = np.where(np.linalg.norm(b, axis=-1, keepdims=True) < 1e-7, alt, b)
+    e2 = e2 / np.linalg.norm(e2, axis=-1, keepdims=True).clip(1e-9)
+    return np.stack([e1, e2, np.cross(e1, e2)], axis=-1)

@@ -33,7 +33,8 @@ import numpy as np
 
 from ..body.skeleton import PARENTS
 from ..errors import ShapeMoveError
-from ..geometry.rotations import axis_angle_to_matrix, make_continuous, matrix_to_quaternion, rotation_between
+from ..geometry.rotations import (axis_angle_to_matrix, make_continuous, matrix_to_quaternion, orthonormal_frame,
+                                 rotation_between)
 from ..motion.contacts import detect_contacts, floor_levels, runs
 from .axes import Y_UP_TO_Z_UP
 from .bone_map import SMPL22, ArmatureRest, check_map
@@ -82,13 +83,6 @@ def source_skeleton(motion):
         off = np.einsum("tji,tj->ti", G[:, p], P[:, j] - P[:, p]).mean(0)
         rest[j] = rest[p] + off
     return P, G, rest
-
-
-def _frame(d, s):
-    e1 = d / max(np.linalg.norm(d), 1e-12)
-    e2 = s - np.dot(s, e1) * e1
-    e2 = e2 / max(np.linalg.norm(e2), 1e-12)
-    return np.stack([e1, e2, np.cross(e1, e2)], axis=1)
 
 
 def _yaw(a):
@@ -212,7 +206,7 @@ def retarget_to_armature(motion, arm: ArmatureRest, mapping: dict, plant_feet: b
         d_s = rest[below] - rest[j]
         d_t = H_t[bone_of[below]] - H_t[bone_of[j]]
         sec = left if abs(np.dot(d_s, f_t)) > 0.8 * np.linalg.norm(d_s) else f_t
-        Q[j] = _frame(d_s, sec) @ _frame(d_t, sec).T
+        Q[j] = orthonormal_frame(d_s, sec) @ orthonormal_frame(d_t, sec).T
     for j in range(22):
         if j in bone_of and j not in Q:
             a = PAR22[j]
