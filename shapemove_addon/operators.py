@@ -70,8 +70,9 @@ def on_generated(name: str, msg: dict):
     return build_rig_from_file(r["path"], name, r.get("measurements"), r.get("physics"))
 
 
-class _JobOperator:
-    """execute -> self.start(context) (returns a message); ShapeMoveError -> ERROR report."""
+class ReportingOperator:
+    """execute -> self.start(context) (returns a message or None); ShapeMoveError -> ERROR report.
+    The one execute of the add-on's operators that only report (rig_retarget's too)."""
 
     def execute(self, context):
         try:
@@ -126,7 +127,7 @@ class SHAPEMOVE_OT_build_from_motion(bpy.types.Operator, ImportHelper):
 
 
 # -- generate ------------------------------------------------------------------------------------
-class SHAPEMOVE_OT_generate(_JobOperator, bpy.types.Operator):
+class SHAPEMOVE_OT_generate(ReportingOperator, bpy.types.Operator):
     """Generate a body shape and a motion from the prompt (runs in the background)"""
 
     bl_idname = "shapemove.generate"
@@ -215,7 +216,7 @@ class SHAPEMOVE_OT_reset_shape(_RigOperator, bpy.types.Operator):
         return {"FINISHED"}
 
 
-class SHAPEMOVE_OT_shape_from_text(_JobOperator, _RigOperator, bpy.types.Operator):
+class SHAPEMOVE_OT_shape_from_text(ReportingOperator, _RigOperator, bpy.types.Operator):
     """Set the active rig's shape from a sentence with measurements (height, chest, waist, ...)"""
 
     bl_idname = "shapemove.shape_from_text"
@@ -242,7 +243,7 @@ class SHAPEMOVE_OT_shape_from_text(_JobOperator, _RigOperator, bpy.types.Operato
         return "fitting the shape..."
 
 
-class SHAPEMOVE_OT_measure(_JobOperator, _RigOperator, bpy.types.Operator):
+class SHAPEMOVE_OT_measure(ReportingOperator, _RigOperator, bpy.types.Operator):
     """Measure the active rig's body (height, chest, waist, hip in cm)"""
 
     bl_idname = "shapemove.measure"
@@ -263,7 +264,7 @@ class SHAPEMOVE_OT_measure(_JobOperator, _RigOperator, bpy.types.Operator):
         return ""
 
 
-class SHAPEMOVE_OT_redecode(_JobOperator, _RigOperator, bpy.types.Operator):
+class SHAPEMOVE_OT_redecode(ReportingOperator, _RigOperator, bpy.types.Operator):
     """Decode the rig's motion tokens again for its current body"""
 
     bl_idname = "shapemove.redecode"
@@ -294,7 +295,7 @@ def _retarget_job(context, source: str, target_rig, name: str) -> None:
     job_submit.submit_job("retarget", params, kind="retarget", label=f"retarget {Path(source).name}", on_result=done)
 
 
-class SHAPEMOVE_OT_retarget(_JobOperator, bpy.types.Operator):
+class SHAPEMOVE_OT_retarget(ReportingOperator, bpy.types.Operator):
     """Put a mocap clip (BVH, ASF/AMC, AMASS) or the active armature's action on a ShapeMove body"""
 
     bl_idname = "shapemove.retarget"
@@ -336,7 +337,7 @@ def _export_plain_bvh(context, arm, path: str) -> None:
 
 
 # -- library -------------------------------------------------------------------------------------
-class SHAPEMOVE_OT_library_search(_JobOperator, bpy.types.Operator):
+class SHAPEMOVE_OT_library_search(ReportingOperator, bpy.types.Operator):
     """Rank the motions of the library folder by the query (text-motion alignment model)"""
 
     bl_idname = "shapemove.library_search"
@@ -413,7 +414,7 @@ class SHAPEMOVE_OT_library_import(bpy.types.Operator):
 
 
 # -- train ---------------------------------------------------------------------------------------
-class SHAPEMOVE_OT_train(_JobOperator, bpy.types.Operator):
+class SHAPEMOVE_OT_train(ReportingOperator, bpy.types.Operator):
     """Train a model part on a dataset folder (runs in the background; cancel keeps a checkpoint)"""
 
     bl_idname = "shapemove.train"

@@ -22,6 +22,7 @@ from ..core.scene.bone_map import (SMPL22, ArmatureRest, apply_preset, builtin_p
 from ..core.scene.motion_file import load_motion
 from ..core.scene.rig_retarget import retarget_to_armature
 from .keyframes import write_pose_action
+from .operators import ReportingOperator
 from .panels import _SubPanel
 from .redecode import MOTION_FILE_KEY
 from .rig_state import rig_of
@@ -187,30 +188,18 @@ def _target(context):
     return obj
 
 
-class _Reporting:
-    def execute(self, context):
-        try:
-            message = self.run(context)
-        except ShapeMoveError as exc:
-            self.report({"ERROR"}, str(exc))
-            return {"CANCELLED"}
-        if message:
-            self.report({"INFO"}, message)
-        return {"FINISHED"}
-
-
-class SHAPEMOVE_OT_rig_map_auto(_Reporting, bpy.types.Operator):
+class SHAPEMOVE_OT_rig_map_auto(ReportingOperator, bpy.types.Operator):
     """Find which bone of your rig plays which body joint (the chosen preset, or automatic)"""
     bl_idname = "shapemove.rig_map_auto"
     bl_label = "Map Bones"
     bl_options = {"REGISTER", "UNDO"}
 
-    def run(self, context):
+    def start(self, context):
         s = context.scene.shapemove_rig
         return auto_map_object(_target(context), None if s.preset == "AUTO" else s.preset)
 
 
-class SHAPEMOVE_OT_rig_map_load(_Reporting, ImportHelper, bpy.types.Operator):
+class SHAPEMOVE_OT_rig_map_load(ReportingOperator, ImportHelper, bpy.types.Operator):
     """Load a bone map preset (.json)"""
     bl_idname = "shapemove.rig_map_load"
     bl_label = "Load Bone Map"
@@ -218,7 +207,7 @@ class SHAPEMOVE_OT_rig_map_load(_Reporting, ImportHelper, bpy.types.Operator):
     filename_ext = ".json"
     filter_glob: StringProperty(default="*.json", options={"HIDDEN"})
 
-    def run(self, context):
+    def start(self, context):
         obj = _target(context)
         arm = read_armature(obj)
         preset = load_preset(self.filepath)
@@ -227,14 +216,14 @@ class SHAPEMOVE_OT_rig_map_load(_Reporting, ImportHelper, bpy.types.Operator):
         return f"{preset['name']}: {len(mapping)} of 22 joints mapped"
 
 
-class SHAPEMOVE_OT_rig_map_save(_Reporting, ExportHelper, bpy.types.Operator):
+class SHAPEMOVE_OT_rig_map_save(ReportingOperator, ExportHelper, bpy.types.Operator):
     """Save the bone map as a preset (.json) to use on other rigs with these bone names"""
     bl_idname = "shapemove.rig_map_save"
     bl_label = "Save Bone Map"
     filename_ext = ".json"
     filter_glob: StringProperty(default="*.json", options={"HIDDEN"})
 
-    def run(self, context):
+    def start(self, context):
         obj = _target(context)
         mapping = stored_map(obj)
         if not mapping:
@@ -243,14 +232,14 @@ class SHAPEMOVE_OT_rig_map_save(_Reporting, ExportHelper, bpy.types.Operator):
         return f"saved {len(mapping)} joints to {path}"
 
 
-class SHAPEMOVE_OT_retarget_rig(_Reporting, bpy.types.Operator):
+class SHAPEMOVE_OT_retarget_rig(ReportingOperator, bpy.types.Operator):
     """Bake the motion onto your rig: a new action on the mapped bones, root motion and height scaled
     to your rig's legs, feet planted"""
     bl_idname = "shapemove.retarget_rig"
     bl_label = "Bake onto Rig"
     bl_options = {"REGISTER", "UNDO"}
 
-    def run(self, context):
+    def start(self, context):
         s = context.scene.shapemove_rig
         obj = _target(context)
         path = bpy.path.abspath(s.motion_path) if s.motion_path else motion_file_of(s.source_rig or context.active_object)
