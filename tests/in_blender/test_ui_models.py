@@ -51,6 +51,10 @@ def test_generate_builds_a_rig_from_the_job(generated):
     assert sorted(o.type for o in generated) == ["ARMATURE", "MESH"] and bpy.context.active_object == rig
     assert rig.get("shapemove_has_tokens") and keyed_frames(rig) == 40  # 2 s at 20 fps
     assert 120 < rig.shapemove.height_cm < 220  # the measurements came back with the motion
+    # ... and the motion's physics figures (core/eval), for the Generate panel
+    physics = dict(rig["shapemove_physics"])
+    assert set(physics) <= {"penetrate_cm", "float_cm", "skate_pct", "dyn_stable_pct"} and "float_cm" in physics
+    assert all(v >= 0 for v in physics.values())
     # written under the extension's user folder (bpy.utils.extension_path_user), not the package
     assert os.path.dirname(rig["shapemove_motion_file"]) == os.path.join(
         CONFIG["user_resources"], "extensions", ".user", "user_default", "shapemove", "data")
