@@ -43,7 +43,7 @@ def run(args) -> int:
     info = build_scene_file(motion, gen.body, args.out / "shapemove.blend", args.out / "preview.png", frames=args.frames)
     m = measure(gen.body, motion.betas)
     print(f"prompt:      {motion.prompt}")
-    print(f"shape text:  {args.shape_text}  (body from: {getattr(motion, 'shape_source', '[BETA] head')})")
+    print(f"shape text:  {args.shape_text}  (body from: {motion.shape_source or '[BETA] head'})")
     print(f"motion:      {motion.num_frames} frames at {motion.fps:g} fps ({motion.num_frames / motion.fps:.1f} s), "
           f"{len(motion.tokens)} tokens, generated in {t1 - t0:.1f} s")
     print(f"body:        {shape_adjectives(m)}: " + ", ".join(f"{k.replace('_cm', '').replace('_', ' ')} {v:.0f} cm"

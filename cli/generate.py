@@ -44,5 +44,5 @@ def run(args) -> int:
     m = measure(gen.body, motion.betas)
     print(f"wrote {args.out}: {motion.num_frames} frames ({motion.num_frames / motion.fps:.1f} s), "
           f"{len(motion.tokens)} tokens, IK error {motion.ik_error_cm:.2f} cm")
-    print(f"body ({getattr(motion, 'shape_source', '[BETA] head')}): " + ", ".join(f"{k.replace('_cm', '')} {v:.0f} cm" for k, v in m.items()))
+    print(f"body ({motion.shape_source or '[BETA] head'}): " + ", ".join(f"{k.replace('_cm', '')} {v:.0f} cm" for k, v in m.items()))
     return 0

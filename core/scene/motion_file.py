@@ -12,7 +12,7 @@ A motion file is self-consistent: ``joints`` are the body's joints posed by (bet
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -34,6 +34,11 @@ class Motion:
     features: np.ndarray | None = None
     network_joints: np.ndarray | None = None
     contacts: np.ndarray | None = None
+    # run-time facts of a generated motion, not stored in the file
+    ik_error_cm: float | None = None        # decode: mean IK error of the planted joints
+    shape_source: str | None = None         # generate: "[BETA] head", "measurements" or "given"
+    warnings: list[str] = field(default_factory=list)  # generate: the prompt check's warnings
+    prompt_check: object | None = None      # generate: generation.prompts' check of the prompt
 
     @property
     def num_frames(self) -> int:

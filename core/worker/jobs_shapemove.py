@@ -116,7 +116,7 @@ def generate(params, progress, cancel) -> dict:
     phys = _physics(gen.body, motions[0])
     progress(1.0, "done")
     return {**_motion_facts(out, motions[0]), "measurements": _measurements(gen.body, motions[0].betas),
-            "physics": phys, "ik_error_cm": float(getattr(motions[0], "ik_error_cm", 0.0))}
+            "physics": phys, "ik_error_cm": float(motions[0].ik_error_cm or 0.0)}
 
 
 def redecode(params, progress, cancel) -> dict:
