@@ -15,7 +15,7 @@ from bpy.app.handlers import persistent
 
 from ..core.constants import NUM_BETAS
 from ..core.errors import ShapeMoveError
-from ..core.scene.shape_keys import rest_joints_for
+from ..core.body.body_arrays import rest_joints_for
 from . import grounding, redecode
 from .bone_placement import place_bones
 from .rig_state import body_of, current_betas, placed_betas, rig_of

@@ -23,6 +23,14 @@ from .openbody_asset import DEFAULT_PATH, MODEL_ID, PhenotypeMap, read_openbody
 from .skeleton import JOINT_NAMES, PARENTS
 
 
+def rest_joints_for(joint_template, joint_shapedirs, betas) -> np.ndarray:
+    """J(betas) of a linear body model: joint_template (J,3), joint_shapedirs (J,3,K), betas (..., K)
+    -> (..., J, 3) rest joints (float64). The one numpy definition (the torch one is
+    ``BodyModel.rest_joints``); any axes convention, as long as template and dirs share it."""
+    t = np.asarray(joint_template, dtype=np.float64)
+    d = np.asarray(joint_shapedirs, dtype=np.float64)
+    return t + np.einsum("jck,...k->...jc", d, np.asarray(betas, dtype=np.float64))
+
 
 @dataclass
 class BodyArrays:
@@ -80,7 +88,7 @@ class BodyArrays:
 
     def rest_joints(self, betas=None) -> np.ndarray:
         """betas (10,) or (B,10) -> (B,24,3) rest-pose joints."""
-        return self.joint_template + np.einsum("jcb,nb->njc", self.joint_shapedirs, self._betas(betas))
+        return rest_joints_for(self.joint_template, self.joint_shapedirs, self._betas(betas))
 
     def rest_vertices(self, betas=None) -> np.ndarray:
         """betas (10,) or (B,10) -> (B,V,3) rest-pose vertices."""

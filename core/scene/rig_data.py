@@ -8,12 +8,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..body.body_arrays import rest_joints_for
 from ..body.skeleton import JOINT_NAMES, PARENTS
 from ..errors import ShapeMoveError
 from ..geometry.rotations import axis_angle_to_matrix
 from .axes import Y_UP_TO_Z_UP, points_to_z_up, rotations_to_z_up
 from .bones import BoneLayout, bone_layout
-from .shape_keys import rest_joints_for, shape_key_coords
+from .shape_keys import shape_key_coords
 
 
 @dataclass
