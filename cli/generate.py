@@ -41,6 +41,10 @@ def run(args) -> int:
     motion = gen.generate_batch([Request(args.prompt, args.shape_text, betas, args.seconds, args.seed, args.temperature,
                                          args.top_k, args.shape_from)])[0]
     save_motion(args.out, motion)
+    import sys
+
+    for w in motion.warnings:  # a prompt far from the training captions
+        print(f"warning: {w}", file=sys.stderr)
     m = measure(gen.body, motion.betas)
     print(f"wrote {args.out}: {motion.num_frames} frames ({motion.num_frames / motion.fps:.1f} s), "
           f"{len(motion.tokens)} tokens, IK error {motion.ik_error_cm:.2f} cm")

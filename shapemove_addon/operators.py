@@ -67,7 +67,10 @@ def on_generated(name: str, msg: dict):
     if msg.get("cancelled"):
         return None
     r = msg["result"]
-    return build_rig_from_file(r["path"], name, r.get("measurements"), r.get("physics"))
+    rig = build_rig_from_file(r["path"], name, r.get("measurements"), r.get("physics"))
+    if rig is not None and r.get("warnings"):  # far from the training data: the panel names the closest actions
+        rig["shapemove_nearest_actions"] = [str(a) for a in r.get("nearest_actions") or []][:3] or ["?"]
+    return rig
 
 
 class ReportingOperator:

@@ -9,6 +9,7 @@ from __future__ import annotations
 import bpy
 
 from ..core.constants import NUM_BETAS
+from ..core.generation.model_bundle import known_actions
 from . import job_submit, jobs, semantic_shape
 from .preferences import setting
 from .redecode import HAS_TOKENS_KEY
@@ -75,6 +76,9 @@ class SHAPEMOVE_PT_generate(_SubPanel, bpy.types.Panel):
         s = context.scene.shapemove
         col = self.layout.column()
         col.prop(s, "prompt", text="")
+        known = known_actions(setting("active_model") or None, 10)  # what the model was trained on
+        if known:
+            col.label(text="Knows: " + ", ".join(known), icon="INFO")
         col.prop(s, "shape_text")
         row = col.row(align=True)
         row.prop(s, "use_seconds", text="")
@@ -100,10 +104,13 @@ def draw_result(layout, rig) -> None:
     """The active rig's motion physics (from its generation) and body measurements, if known."""
     physics = rig.get(PHYSICS_KEY) or {}
     m = rig.shapemove
-    if not physics and m.height_cm <= 0:
+    nearest = list(rig.get("shapemove_nearest_actions") or [])  # the prompt was far from the training data
+    if not physics and m.height_cm <= 0 and not nearest:
         return
     box = layout.box()
     box.label(text=rig.name, icon="ARMATURE_DATA")
+    if nearest:
+        box.label(text="Prompt unlike the training data; closest: " + ", ".join(nearest), icon="ERROR")
     if physics:
         grid = box.grid_flow(columns=2, align=True)
         for key, label, fmt in PHYSICS_FIGURES:

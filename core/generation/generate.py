@@ -61,6 +61,9 @@ class Generator:
         self.body = body if body is not None and not isinstance(body, str) else load_body_model(body)
         self.vae = load_savae(files["savae"], body=self.body)
         self.t5, self.tok = (ShapeMoveT5.load(files["t5"]) if files["t5"].is_dir() else (None, None))
+        from ..models.known_texts import read_known
+
+        self.known = read_known(files["t5"]) if self.t5 is not None else None  # training captions + actions
         self.ik_refine_iters = ik_refine_iters
         self.max_codes = int(getattr(self.t5, "info", {}).get("max_codes", 50)) if self.t5 else 50
 
@@ -90,6 +93,37 @@ class Generator:
             betas.append(out.betas[0])
         return codes, torch.stack(betas)
 
+    # -- what the model knows ----------------------------------------------------------------
+    @property
+    def known_actions(self) -> list[str]:
+        """The actions of the model's training data, most frequent first ([] for older models)."""
+        return self.known.action_names if self.known is not None else []
+
+    def _text_encoder(self):
+        if self.t5 is not None and self.t5.encoder_kind == "minilm":
+            return self.tok
+        from ..models.text_encoder import load_text_encoder
+
+        return load_text_encoder()
+
+    def check_text(self, prompt: str, what: str = "prompt"):
+        """Refuse text the model cannot read (mostly unknown characters / <unk>); return the
+        ``PromptCheck`` of a prompt against the training captions (None for older models): its
+        similarity, nearest known actions and a warning when it is far from all of them."""
+        if self.t5 is None:
+            return None
+        if self.t5.encoder_kind == "minilm" or self.known is not None:
+            unknown = self._text_encoder().unknown_share(prompt)
+        else:  # a T5 on its own sentencepiece vocabulary
+            ids = [i for i in self.tok(prompt).input_ids if i != self.tok.eos_token_id]
+            unknown = sum(i == self.tok.unk_token_id for i in ids) / max(1, len(ids))
+        if unknown > 0.5:
+            raise ShapeMoveError(f"the {what} {prompt!r} is mostly characters the text encoder does not know "
+                                 f"({100 * unknown:.0f}% unknown); describe it in English words")
+        if what != "prompt" or self.known is None:
+            return None
+        return self.known.check(prompt, self._text_encoder())
+
     # -- motion ------------------------------------------------------------------------------
     def decode_motion(self, codes: list[int], betas: np.ndarray, prompt: str | None = None) -> Motion:
         """Tokens + body shape -> Motion on the body model (SA-VAE decode, joints, IK)."""
@@ -106,14 +140,25 @@ class Generator:
             r.prompt = check_prompt(r.prompt)
             r.shape_text = check_prompt(r.shape_text, "shape text", allow_empty=True) or None
             r.seed, r.temperature, r.top_k = check_sampling(r.seed, r.temperature, r.top_k)
+        checks = []
+        for r in reqs:  # every text checked before any generation
+            checks.append(self.check_text(r.prompt))
+            if r.shape_text:
+                self.check_text(r.shape_text, "shape text")
+                if r.betas is None and r.shape_from == "auto":
+                    from ..body.shape_from_measurements import shape_targets
+
+                    shape_targets(r.shape_text, self.body)  # impossible numbers: refused before generating
         out = []
-        for i, r in enumerate(reqs):
+        for i, (r, check) in enumerate(zip(reqs, checks)):
             if cancel is not None and cancel():
                 break
             codes, pred = self.tokens_for([r])
             betas, source = self.body_shape(r, pred[0].numpy())
             motion = self.decode_motion(codes[0], betas, prompt=r.prompt)
             motion.shape_source = source
+            motion.warnings = [check.warning] if check is not None and check.warning else []
+            motion.prompt_check = check
             out.append(motion)
             if progress is not None:
                 progress((i + 1) / len(reqs), r.prompt)
@@ -122,16 +167,15 @@ class Generator:
     def body_shape(self, r: Request, predicted: np.ndarray) -> tuple[np.ndarray, str]:
         """The betas for a request and where they came from: explicit betas; else, when the shape
         text states measurements or size words ("190 cm tall", "tall, heavy-set"), a body fitted to
-        those numbers on the mesh (exact where the text is explicit); else the T5's [BETA] head."""
-        from ..body.shape_from_measurements import betas_for_measurements, targets_from_shape_text
+        those numbers (milliseconds: girths from the body's precomputed regression); else the
+        T5's [BETA] head. Numbers that no body has ("5000 cm tall", "waist 0 cm", "-170 cm") are
+        refused with a ShapeMoveError, never replaced by a guess."""
+        from ..body.shape_from_measurements import betas_for_measurements, shape_targets
 
         if r.betas is not None:
             return np.asarray(r.betas, np.float32), "given"
         if r.shape_text and r.shape_from == "auto":
-            try:
-                targets = targets_from_shape_text(r.shape_text, self.body)
-            except ShapeMoveError:  # free text the fit does not read: the model's reading of it
-                targets = {}
+            targets = shape_targets(r.shape_text, self.body)  # None: free text, the model's reading of it
             if targets:
                 return np.asarray(betas_for_measurements(self.body, targets), np.float32), "measurements"
         return np.asarray(predicted, np.float32), "[BETA] head"

@@ -30,3 +30,30 @@ def model_files(d: Path) -> dict:
     if not files["savae"].is_file():
         raise ShapeMoveError(f"{d} has no savae.pt (the SA-VAE): train one with `python -m shapemove train vae`")
     return files
+
+
+MAX_KNOWN_BYTES = 64 << 20
+
+
+def known_actions(model_dir=None, limit: int | None = None) -> list[str]:
+    """The actions a model folder's T5 was trained on, most frequent first (``t5/known_texts.json``,
+    written at training time); [] for folders without it. Plain JSON, no torch: the Blender panel
+    reads it to suggest prompts."""
+    import json
+
+    try:
+        f = resolve_model_dir(model_dir) / "t5" / "known_texts.json"
+        if not f.is_file() or f.stat().st_size > MAX_KNOWN_BYTES:
+            return []
+        key = (str(f), f.stat().st_mtime_ns)
+        if key not in _known_cache:  # panels redraw often: read each file once
+            actions = json.loads(f.read_text(encoding="utf-8")).get("actions", [])
+            _known_cache.clear()
+            _known_cache[key] = [str(a[0]) for a in actions if isinstance(a, list) and a and isinstance(a[0], str)]
+        names = _known_cache[key]
+    except (OSError, ValueError, AttributeError, ShapeMoveError):
+        return []
+    return names[:limit] if limit else list(names)
+
+
+_known_cache: dict = {}

@@ -8,9 +8,13 @@ stored in the model folder so that generation can tell a user when a prompt is f
     report.warning  # "nothing like 'a person does a cartwheel' in the training data; closest known actions: roll, jump"
 
 A prompt is "known" when its MiniLM cosine similarity to the nearest training caption reaches
-``NEAR`` (calibrated on held-out paraphrases of the training actions vs prompts of actions the data
-does not hold; see ``bench/generate.py``). The nearest actions are ranked by the best similarity
-among each action's captions.
+``NEAR``. Sentence similarity separates in- and out-of-data prompts only roughly: against captions
+of the action vocabulary, held-out paraphrases (configs/heldout_paraphrases.json) have a median
+nearest-caption similarity of 0.53 (10th percentile 0.38), prompts of activities the data does not
+hold (violin, cooking, kites, gibberish) a median of 0.45 with the clearly foreign ones below 0.4.
+``NEAR`` = 0.40 keeps false warnings on real paraphrases near 10 %; ``bench generate`` prints the
+rates for a trained model. The nearest actions are ranked by the best similarity among each
+action's captions and are always reported.
 """
 from __future__ import annotations
 
@@ -22,7 +26,7 @@ import torch
 
 from ..errors import ShapeMoveError
 
-NEAR = 0.55           # below this cosine similarity to every training caption: warn
+NEAR = 0.40           # below this cosine similarity to every training caption: warn
 MAX_KNOWN = 50_000    # captions kept (bounded file size)
 JSON_NAME, VECTORS_NAME = "known_texts.json", "known_texts.safetensors"
 

@@ -115,8 +115,11 @@ def generate(params, progress, cancel) -> dict:
     progress(0.9, "checking the physics")
     phys = _physics(gen.body, motions[0])
     progress(1.0, "done")
+    check = motions[0].prompt_check
     return {**_motion_facts(out, motions[0]), "measurements": _measurements(gen.body, motions[0].betas),
-            "physics": phys, "ik_error_cm": float(motions[0].ik_error_cm or 0.0)}
+            "physics": phys, "ik_error_cm": float(motions[0].ik_error_cm or 0.0),
+            "warnings": list(motions[0].warnings),
+            "nearest_actions": list(check.nearest_actions) if check is not None else []}
 
 
 def redecode(params, progress, cancel) -> dict:
