@@ -6,9 +6,9 @@ frame headless with Workbench. Needs the ``bpy`` module (pip install bpy) in thi
 """
 from __future__ import annotations
 
-import os
 from pathlib import Path
 
+from ..core.atomic import atomic_path
 from ..core.errors import ShapeMoveError
 
 
@@ -50,9 +50,7 @@ def run(args) -> int:
         args.render.parent.mkdir(parents=True, exist_ok=True)
         render_frame(scene, frame, args.render.resolve())
         print(f"rendered frame {frame} to {args.render}")
-    args.out.parent.mkdir(parents=True, exist_ok=True)
-    tmp = args.out.with_name(args.out.stem + ".tmp.blend")
-    bpy.ops.wm.save_as_mainfile(filepath=str(tmp.resolve()), compress=True)
-    os.replace(tmp, args.out)
+    with atomic_path(args.out, suffix=".blend") as tmp:
+        bpy.ops.wm.save_as_mainfile(filepath=str(tmp.resolve()), compress=True)
     print(f"wrote {args.out}")
     return 0

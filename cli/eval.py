@@ -16,22 +16,9 @@ Adding a kind: write ``add_KIND(subparsers)`` (setting ``_run``) and list it in 
 from __future__ import annotations
 
 import importlib
-import math
 from pathlib import Path
 
-
-def write_json(path: Path, result: dict) -> Path:
-    """Write ``result`` as JSON atomically; non-finite floats become null (valid JSON)."""
-    def clean(v):
-        if isinstance(v, dict):
-            return {k: clean(x) for k, x in v.items()}
-        if isinstance(v, (list, tuple)):
-            return [clean(x) for x in v]
-        return None if isinstance(v, float) and not math.isfinite(v) else v
-
-    from ..core.atomic import atomic_write_json
-
-    return atomic_write_json(path, clean(result))
+from ..core.atomic import atomic_write_json
 
 
 # -- eval recon ------------------------------------------------------------------------------------
@@ -69,7 +56,7 @@ def run_recon(args) -> int:
                             max_clips=args.max_clips, progress=progress, per_clip=clips)
     finally:
         bar.close()
-    write_json(args.json, result)
+    atomic_write_json(args.json, result, nan_to_null=True)
     print_table({**result, "frames": sum(c["frames"] for c in clips)}, result["ground_truth"],
                 title=f"SA-VAE reconstruction, {args.split} split", name="reconstruction")
     print(f"codebook usage: {result['code_usage_pct']:.1f}%   wrote {args.json}")

@@ -7,6 +7,7 @@ nothing half-written and no ``*.tmp`` is left behind, and the old file (if any) 
     with atomic_path(out) as tmp:          # any writer that takes a path
         torch.save(obj, tmp)
     atomic_write_bytes(path, data); atomic_write_text(path, text); atomic_write_json(path, obj)
+    atomic_write_json(path, metrics, nan_to_null=True)   # NaN/inf -> null: valid JSON
     atomic_save_npy(path, array)           # np.save without pickles
 """
 from __future__ import annotations
@@ -14,6 +15,7 @@ from __future__ import annotations
 import contextlib
 import errno
 import json
+import math
 import os
 from pathlib import Path
 
@@ -88,8 +90,19 @@ def atomic_write_text(path, text: str, encoding: str = "utf-8") -> Path:
     return atomic_write_bytes(path, text.encode(encoding))
 
 
-def atomic_write_json(path, obj, indent: int | None = 2, **kwargs) -> Path:
-    return atomic_write_text(path, json.dumps(obj, indent=indent, **kwargs) + "\n")
+def json_safe(obj):
+    """``obj`` with every non-finite float (NaN, inf) inside dicts, lists and tuples made None,
+    so the JSON is valid (``json.dumps`` would write NaN)."""
+    if isinstance(obj, dict):
+        return {k: json_safe(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [json_safe(v) for v in obj]
+    return None if isinstance(obj, float) and not math.isfinite(obj) else obj
+
+
+def atomic_write_json(path, obj, indent: int | None = 2, nan_to_null: bool = False, **kwargs) -> Path:
+    """``obj`` as JSON (+ newline); ``nan_to_null``: non-finite floats written as null (``json_safe``)."""
+    return atomic_write_text(path, json.dumps(json_safe(obj) if nan_to_null else obj, indent=indent, **kwargs) + "\n")
 
 
 def atomic_save_npy(path, array) -> Path:

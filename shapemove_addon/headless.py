@@ -2,23 +2,21 @@
 `render` commands. A fresh factory scene per motion; outputs written atomically."""
 from __future__ import annotations
 
-import os
 import tempfile
 from pathlib import Path
 
 import bpy
 import numpy as np
 
+from ..core.atomic import atomic_path
 from .preview_render import add_preview_stage, render_frame
 from .scene_build import build_rig
 
 
 def save_blend(path: Path) -> Path:
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(path.stem + ".tmp.blend")
-    bpy.ops.wm.save_as_mainfile(filepath=str(tmp.resolve()), compress=True, copy=True)
-    os.replace(tmp, path)
+    with atomic_path(path, suffix=".blend") as tmp:
+        bpy.ops.wm.save_as_mainfile(filepath=str(tmp.resolve()), compress=True, copy=True)
     return path
 
 
@@ -40,13 +38,10 @@ def write_strip(frames: list[np.ndarray], path: Path) -> Path:
     img = bpy.data.images.new("shapemove_strip", w, h, alpha=True)
     try:
         img.pixels.foreach_set(strip.ravel())
-        path = Path(path)
-        path.parent.mkdir(parents=True, exist_ok=True)
-        tmp = path.with_name(path.stem + ".tmp.png")
-        img.filepath_raw = str(tmp)
-        img.file_format = "PNG"
-        img.save()
-        os.replace(tmp, path)
+        with atomic_path(path, suffix=".png") as tmp:
+            img.filepath_raw = str(tmp)
+            img.file_format = "PNG"
+            img.save()
     finally:
         bpy.data.images.remove(img)
     return path
@@ -88,9 +83,8 @@ def render_video(blend: Path, mp4: Path) -> Path:
     r.ffmpeg.format = "MPEG4"
     r.ffmpeg.codec = "H264"
     mp4 = Path(mp4)
-    tmp = mp4.with_name(mp4.stem + ".tmp.mp4")
-    r.filepath = str(tmp.resolve())
-    r.use_file_extension = False
-    bpy.ops.render.render(animation=True)
-    os.replace(tmp, mp4)
+    with atomic_path(mp4, suffix=".mp4") as tmp:
+        r.filepath = str(tmp.resolve())
+        r.use_file_extension = False
+        bpy.ops.render.render(animation=True)
     return mp4

@@ -73,6 +73,15 @@ def test_atomic_write_keeps_old_file_and_leaves_no_tmp_on_failure(tmp_path):
     assert sorted(x.name for x in tmp_path.iterdir()) == ["out.json"]
 
 
+def test_json_with_nan_is_written_as_valid_json(tmp_path):
+    import json
+
+    res = {"a": float("nan"), "b": [1.5, float("inf"), (float("-inf"), 2)], "c": {"d": np.float64("nan"), "e": "x"}}
+    p = atomic_write_json(tmp_path / "r.json", res, nan_to_null=True)
+    assert json.loads(p.read_text()) == {"a": None, "b": [1.5, None, [None, 2]], "c": {"d": None, "e": "x"}}
+    assert "NaN" in atomic_write_json(tmp_path / "raw.json", res).read_text()  # only when asked
+
+
 def test_read_only_folder(tmp_path, monkeypatch):
     """Root ignores permission bits, so the read-only file system is simulated at os.replace."""
     real = os.replace

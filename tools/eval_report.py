@@ -10,9 +10,10 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
 import re
 from pathlib import Path
+
+from shapemove.core.atomic import atomic_write_text
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -86,9 +87,7 @@ def main(argv=None) -> int:
         text = replace_block(text, "recon", recon_table(json.loads(args.recon.read_text()), untrained))
     if args.generate.is_file():
         text = replace_block(text, "generate", generate_table(json.loads(args.generate.read_text())))
-    tmp = args.readme.with_name(args.readme.name + ".tmp")
-    tmp.write_text(text, encoding="utf-8")
-    os.replace(tmp, args.readme)
+    atomic_write_text(args.readme, text)
     print(f"updated the evaluation tables in {args.readme}")
     return 0
 

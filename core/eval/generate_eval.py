@@ -20,14 +20,13 @@ For every clip the prompt is one of its captions (chosen with ``seed``) and its 
 """
 from __future__ import annotations
 
-import json
 import math
-import os
 import warnings
 from pathlib import Path
 
 import numpy as np
 
+from ..atomic import atomic_write_json
 from ..constants import FPS
 from ..errors import ShapeMoveError
 
@@ -192,18 +191,6 @@ def add_arguments(p) -> None:
     p.add_argument("--quiet", action="store_true", help="no progress bar")
 
 
-def write_json(path, res: dict) -> Path:
-    """``res`` as JSON, atomically; non-finite floats become null."""
-    clean = lambda v: ({k: clean(x) for k, x in v.items()} if isinstance(v, dict)  # noqa: E731
-                       else None if isinstance(v, float) and not math.isfinite(v) else v)
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text(json.dumps(clean(res), indent=2) + "\n")
-    os.replace(tmp, path)
-    return path
-
-
 def from_cli(args) -> int:
     """`python -m shapemove eval generate` (see ``add_arguments``): prints the table, writes the JSON."""
     from tqdm import tqdm
@@ -222,5 +209,5 @@ def from_cli(args) -> int:
         bar.close()
     print(format_results(res, f"Text-to-motion evaluation, {split} split"))
     if getattr(args, "json", None):
-        print(f"wrote {write_json(args.json, res)}")
+        print(f"wrote {atomic_write_json(args.json, res, nan_to_null=True)}")
     return 0

@@ -14,12 +14,12 @@ from __future__ import annotations
 
 import hashlib
 import json
-import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
+from ..atomic import atomic_path
 from ..constants import FPS
 from ..errors import ShapeMoveError
 
@@ -190,14 +190,13 @@ def index_library(folder, tma=None, use_cache: bool = True, progress=None) -> Li
 
 
 def _save_index(cache: Path, key: str, index: LibraryIndex) -> None:
-    tmp = cache.with_name(cache.name + ".tmp.npz")
     try:
-        np.savez(tmp, key=np.array(key), ids=np.array(index.ids, dtype=str), paths=np.array(index.paths, dtype=str),
-                 captions=np.array(index.captions, dtype=str), embeddings=index.embeddings,
-                 skipped=np.array(json.dumps(index.skipped)))
-        os.replace(tmp, cache)
-    except OSError:  # a read-only library is still searchable, just not cached
-        tmp.unlink(missing_ok=True)
+        with atomic_path(cache, suffix=".npz") as tmp:
+            np.savez(tmp, key=np.array(key), ids=np.array(index.ids, dtype=str), paths=np.array(index.paths, dtype=str),
+                     captions=np.array(index.captions, dtype=str), embeddings=index.embeddings,
+                     skipped=np.array(json.dumps(index.skipped)))
+    except ShapeMoveError:  # a read-only library is still searchable, just not cached
+        pass
 
 
 def check_query(query, top_k: int = 10) -> str:

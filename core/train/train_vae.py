@@ -12,9 +12,7 @@ ends with the same parameters as an uninterrupted one.
 from __future__ import annotations
 
 import copy
-import json
 import math
-import os
 import random
 import time
 from pathlib import Path
@@ -24,6 +22,7 @@ import torch
 from torch.nn.parallel import DistributedDataParallel as DDP
 from torch.utils.data import DataLoader
 
+from ..atomic import atomic_write_json
 from ..errors import ShapeMoveError
 from ..models.savae import SAVAE, SAVAEConfig, TrainSettings
 from ..models.vae_losses import bone_lengths, vae_losses
@@ -187,10 +186,7 @@ def _train(data, out, cfg, t, resume, body, dist, progress, cancel, verbose) -> 
             save_checkpoint(out / "savae.pt", {"model": raw.state_dict()}, meta)
 
     if dist.is_main:
-        out.mkdir(parents=True, exist_ok=True)
-        tmp = out / "config.json.tmp"
-        tmp.write_text(json.dumps(cfg.to_dict(), indent=2))
-        os.replace(tmp, out / "config.json")
+        atomic_write_json(out / "config.json", cfg.to_dict())
     batches = DataLoader(train_set, batch_sampler=BatchStream(train_set, t.batch_size // dist.world_size, dist.rank,
                                                               dist.world_size, t.seed, start_step=step),
                          num_workers=t.num_workers, pin_memory=dist.device.type == "cuda")
