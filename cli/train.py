@@ -32,7 +32,7 @@ def add_arguments(p):
     for kind, help_text in KINDS.items():
         s = sub.add_parser(kind, help=help_text, description=help_text)
         s.add_argument("--data", type=Path, required=True, help="dataset folder from `data build`")
-        s.add_argument("--config", default="small", help="small | paper | a JSON file (default: small)")
+        s.add_argument("--config", default="small", help="tiny | small | paper (core/config_presets.py) or a JSON file (default: small)")
         s.add_argument("--out", type=Path, required=True, help="run folder (checkpoints, log.jsonl)")
         s.add_argument("--steps", type=int, help="override the config's number of steps")
         s.add_argument("--resume", action="store_true", help="continue from RUN/last.pt if it exists")

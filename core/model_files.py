@@ -141,18 +141,24 @@ def _note(path: Path) -> None:
               "(re-export the model to add one)", file=sys.stderr)
 
 
+def _verify_covered(target: Path) -> bool:
+    """Check ``target`` (a file or a folder) against the manifest covering it: False with a note
+    when none does."""
+    root, entries = _covering(target)
+    if not entries:
+        _note(target)
+        return False
+    _check(root, entries, target)
+    return True
+
+
 def verify_file(path) -> bool:
     """Check one model file against the manifest that lists it. True when checked, False (with a
     note) when no manifest lists it; ShapeMoveError when it is missing or differs."""
     path = Path(path)
     if not path.is_file():
         raise ShapeMoveError(f"model file {path} not found")
-    folder, entries = _covering(path)
-    if not entries:
-        _note(path)
-        return False
-    _check(folder, entries, path)
-    return True
+    return _verify_covered(path)
 
 
 def verify_manifest(folder, required=()) -> bool:
@@ -165,12 +171,7 @@ def verify_manifest(folder, required=()) -> bool:
     if missing:
         raise ShapeMoveError(f"model folder {folder} is incomplete: {', '.join(missing)} missing; re-export or "
                              "re-train the model (a model without its files would silently produce garbage)")
-    root, entries = _covering(folder)
-    if not entries:
-        _note(folder)
-        return False
-    _check(root, entries, folder)
-    return True
+    return _verify_covered(folder)
 
 
 class damaged_model_errors:

@@ -7,6 +7,7 @@ reader's peak memory well under 1 GB (the readers hold ~6 float64 (T,J,3,3) arra
 """
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import numpy as np
@@ -38,6 +39,23 @@ def read_text(path, what: str, max_bytes: int | None = None) -> str:
     if b"\0" in raw[:4096]:
         raise ShapeMoveError(f"{path}: binary data, not an {what} text file")
     return raw.decode("utf-8", errors="replace")
+
+
+def read_json(path, what: str, max_bytes: int = 1 << 20):
+    """A user's JSON file (a preset, a config): 'WHAT not found: PATH'; the size is checked before
+    reading; unreadable or invalid JSON is one sentence 'cannot read WHAT PATH: ...'."""
+    path = Path(path)
+    if not path.is_file():
+        raise ShapeMoveError(f"{what} not found: {path}")
+    size = path.stat().st_size
+    if size > max_bytes:
+        raise ShapeMoveError(f"{path}: {size:,} bytes is too large for a {what} (at most {max_bytes:,})")
+    try:
+        return json.loads(path.read_text(encoding="utf-8"))
+    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+        raise ShapeMoveError(f"cannot read {what} {path}: not valid JSON ({exc})") from None
+    except OSError as exc:
+        raise ShapeMoveError(f"cannot read {what} {path}: {exc.strerror or exc}") from None
 
 
 def check_joint_frames(frames, joints, source, what: str = "clip") -> None:

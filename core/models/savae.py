@@ -11,11 +11,11 @@ from __future__ import annotations
 import dataclasses
 import json
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import torch
 from torch import nn
 
+from ..config_presets import PRESETS, load_config
 from ..constants import FSQ_LEVELS
 from ..errors import ShapeMoveError
 from .decoder import Decoder
@@ -76,6 +76,13 @@ class SAVAEConfig:
         return cls()
 
     @classmethod
+    def tiny(cls) -> "SAVAEConfig":
+        """A smoke run: width 16, one resblock, 32-frame crops, 40 steps."""
+        return cls(width=16, depth=1, shape_hidden=16,
+                   train=TrainSettings(steps=40, batch_size=4, window=32, lr=3e-3, warmup_steps=2, log_every=10,
+                                       val_every=10_000, val_batches=1, ckpt_every=10_000))
+
+    @classmethod
     def small(cls) -> "SAVAEConfig":
         """CPU-sized: width 128, same depth/dilations/downsampling as the paper."""
         return cls(width=128, shape_hidden=128,
@@ -96,9 +103,9 @@ class SAVAEConfig:
     @classmethod
     def from_dict(cls, d: dict) -> "SAVAEConfig":
         d = dict(d)
-        base = {"small": cls.small, "paper": cls.paper}.get(d.pop("base", "paper"))
+        base = cls._presets().get(d.pop("base", "paper"))
         if base is None:
-            raise ShapeMoveError("config 'base' must be 'small' or 'paper'")
+            raise ShapeMoveError(f"config 'base' must be one of {', '.join(PRESETS)}")
         cfg = base()
         sub = {"loss": LossWeights, "train": TrainSettings}
         for key, value in d.items():
@@ -116,17 +123,14 @@ class SAVAEConfig:
         return cfg
 
     @classmethod
-    def load(cls, name_or_path: str) -> "SAVAEConfig":
-        """'small', 'paper' or a JSON file (optionally with "base": "small"|"paper" + overrides)."""
-        if name_or_path in ("small", "paper"):
-            return getattr(cls, name_or_path)()
-        p = Path(name_or_path)
-        if not p.is_file():
-            raise ShapeMoveError(f"config must be 'small', 'paper' or a JSON file; not found: {p}")
-        try:
-            return cls.from_dict(json.loads(p.read_text()))
-        except json.JSONDecodeError as exc:
-            raise ShapeMoveError(f"{p}: not valid JSON ({exc})") from exc
+    def _presets(cls) -> dict:
+        return {"tiny": cls.tiny, "small": cls.small, "paper": cls.paper}
+
+    @classmethod
+    def load(cls, name_or_path: str | None) -> "SAVAEConfig":
+        """A preset (``config_presets.PRESETS``; None = small) or a JSON file (optionally with
+        "base": a preset name, default paper, + overrides)."""
+        return load_config("SA-VAE", name_or_path, cls._presets(), lambda d, p: cls.from_dict(d))
 
     def validate(self) -> None:
         if self.loss.dyn_stability < 0:

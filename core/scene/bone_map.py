@@ -11,15 +11,15 @@ case-insensitively without a namespace (``mixamorig1:Hips`` matches ``mixamorig:
 """
 from __future__ import annotations
 
-import json
-import os
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from ..atomic import atomic_write_json
 from ..body.skeleton import JOINT_NAMES, NUM_BODY_JOINTS
 from ..errors import ShapeMoveError
+from ..io.limits import read_json
 from ..io.rig_map import OPENBODY_LAYOUT, SPINE_JOINTS, normalize
 
 SMPL22 = tuple(JOINT_NAMES[:NUM_BODY_JOINTS])
@@ -166,16 +166,7 @@ def _check_preset(data, source) -> dict:
 
 def load_preset(path) -> dict:
     """A preset file -> {"name", "description", "bones": {joint: [candidates]}} (validated)."""
-    path = Path(path)
-    if not path.is_file():
-        raise ShapeMoveError(f"bone-map preset not found: {path}")
-    if path.stat().st_size > MAX_PRESET_BYTES:
-        raise ShapeMoveError(f"{path}: too large for a bone-map preset ({path.stat().st_size} bytes)")
-    try:
-        data = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
-        raise ShapeMoveError(f"cannot read bone-map preset {path}: {exc}") from None
-    return _check_preset(data, path)
+    return _check_preset(read_json(path, "bone-map preset", MAX_PRESET_BYTES), Path(path))
 
 
 def builtin_presets() -> dict:
@@ -201,11 +192,7 @@ def save_preset(path, mapping: dict, name: str, description: str = "") -> Path:
         raise ShapeMoveError(f"not SMPL body joints: {', '.join(bad)}")
     data = {"format": PRESET_FORMAT, "version": 1, "name": str(name), "description": str(description),
             "bones": {j: [mapping[j]] for j in SMPL22 if mapping.get(j)}}
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text(json.dumps(data, indent=1), encoding="utf-8")
-    os.replace(tmp, path)
+    path = atomic_write_json(path, data, indent=1)
     return path
 
 

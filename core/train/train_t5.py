@@ -18,8 +18,6 @@ and actions with their MiniLM vectors: ``known_texts.py``).
 """
 from __future__ import annotations
 
-import json
-import os
 import random
 import time
 from dataclasses import asdict, dataclass, field
@@ -29,6 +27,8 @@ import numpy as np
 import torch
 from torch.nn.parallel import DistributedDataParallel as DDP
 
+from ..atomic import atomic_path
+from ..config_presets import load_config
 from ..errors import ShapeMoveError
 from ..models.shapemove_t5 import ShapeMoveT5, T5Size, size_from_dict
 from ..models.tokenizer import add_motion_tokens, load_tokenizer, tokenizer_from_sentencepiece, train_sentencepiece
@@ -76,19 +76,23 @@ class T5TrainConfig:
             raise ShapeMoveError("T5 config: steps, batch_size and max_codes must be >= 1")
 
     @classmethod
+    def paper(cls) -> "T5TrainConfig":
+        """The paper's model: a whole T5 of T5-base's sizes (12+12 layers, 768 wide) trained from
+        scratch here (``--base-model`` loads pretrained weights instead); a GPU run."""
+        return cls(size=asdict(T5Size(d_model=768, d_ff=3072, num_layers=12, num_decoder_layers=12, num_heads=12)),
+                   encoder="t5", steps=20000, batch_size=32, lr=2e-4, warmup_steps=1000, log_every=100,
+                   ckpt_every=1000)
+
+    @classmethod
     def load(cls, name_or_path: str | None) -> "T5TrainConfig":
-        if name_or_path in (None, "small"):
-            return cls()
-        if name_or_path == "tiny":
-            return cls.tiny()
-        p = Path(name_or_path)
-        if not p.is_file():
-            raise ShapeMoveError(f"T5 config {name_or_path!r}: use 'small', 'tiny' or a JSON file")
-        data = json.loads(p.read_text())
-        unknown = set(data) - set(asdict(cls()))
-        if unknown:
-            raise ShapeMoveError(f"{p}: unknown T5 config keys {sorted(unknown)}")
-        return cls(**data)
+        """A preset (``config_presets.PRESETS``; None = small) or a JSON file of settings."""
+        def from_json(data, p):
+            unknown = set(data) - set(asdict(cls()))
+            if unknown:
+                raise ShapeMoveError(f"{p}: unknown T5 config keys {sorted(unknown)}")
+            return cls(**data)
+
+        return load_config("T5", name_or_path, {"tiny": cls.tiny, "small": cls, "paper": cls.paper}, from_json)
 
 
 def lr_at(step: int, c: T5TrainConfig) -> float:
@@ -139,9 +143,8 @@ def _train(data, vae_path, out, c, base_model, resume, dist, progress, cancel, v
     if tokens is None:
         tokens = tokenize_clips(vae, data, ids)
         if dist.is_main:
-            tmp = out / "tokens.tmp.npz"
-            np.savez(tmp, __vae__=np.array(vae_stamp), **tokens)
-            os.replace(tmp, cache)
+            with atomic_path(cache, suffix=".npz") as tmp:
+                np.savez(tmp, __vae__=np.array(vae_stamp), **tokens)
     num_codes = int(vae.quantizer.codebook_size)
     # -- 2. text reader: MiniLM states of every training text, or the T5's tokenizer ------------
     from ..models.text_encoder import StateCache, load_text_encoder
@@ -244,6 +247,6 @@ def _train(data, vae_path, out, c, base_model, resume, dist, progress, cancel, v
 
 
 def from_cli(args) -> dict:
-    c = T5TrainConfig.load(None if args.config == "small" else args.config)
+    c = T5TrainConfig.load(args.config)
     return train_t5(args.data, args.vae, args.out, c, base_model=args.base_model, resume=args.resume,
                     steps=args.steps, device=args.device, verbose=not args.quiet)

@@ -18,7 +18,6 @@ pure function of (seed, step), so an interrupted and resumed run equals an unint
 """
 from __future__ import annotations
 
-import json
 import math
 import os
 import time
@@ -30,6 +29,8 @@ import torch
 from torch import nn
 from torch.nn.parallel import DistributedDataParallel as DDP
 
+from ..atomic import atomic_write_json
+from ..config_presets import load_config
 from ..errors import ShapeMoveError
 from ..eval.tma_embed import KIND, eval_pairs, pad_batch, score_pairs, text_inputs
 from ..models.tma import TMA, TMAConfig
@@ -73,30 +74,24 @@ class TMATrainConfig:
 
     @classmethod
     def load(cls, config=None) -> "TMATrainConfig":
-        """None/"small", "tiny", "paper", a JSON file, a TMAConfig (small training settings) or an instance."""
+        """A preset (``config_presets.PRESETS``; None = small), a JSON file, a TMAConfig (small training
+        settings) or an instance."""
         if isinstance(config, cls):
             return cls(**asdict(config))
         if isinstance(config, TMAConfig):
             return cls(model=asdict(config))
-        if config in (None, "small"):
-            return cls()
-        if config in ("tiny", "paper"):
-            return getattr(cls, config)()
-        p = Path(config)
-        if not p.is_file():
-            raise ShapeMoveError(f"TMA config {config!r}: use 'small', 'paper', 'tiny' or a JSON file")
-        try:
-            data = json.loads(p.read_text())
-        except json.JSONDecodeError as exc:
-            raise ShapeMoveError(f"{p}: not valid JSON ({exc})") from exc
-        unknown = set(data) - set(asdict(cls()))
-        if unknown:
-            raise ShapeMoveError(f"{p}: unknown TMA config keys {sorted(unknown)}")
-        model = {**asdict(TMAConfig()), **data.pop("model", {})}
-        unknown = set(model) - set(asdict(TMAConfig()))
-        if unknown:
-            raise ShapeMoveError(f"{p}: unknown TMA model keys {sorted(unknown)}")
-        return cls(model=model, **data)
+
+        def from_json(data, p):
+            unknown = set(data) - set(asdict(cls()))
+            if unknown:
+                raise ShapeMoveError(f"{p}: unknown TMA config keys {sorted(unknown)}")
+            model = {**asdict(TMAConfig()), **data.pop("model", {})}
+            unknown = set(model) - set(asdict(TMAConfig()))
+            if unknown:
+                raise ShapeMoveError(f"{p}: unknown TMA model keys {sorted(unknown)}")
+            return cls(model=model, **data)
+
+        return load_config("TMA", config, {"tiny": cls.tiny, "small": cls, "paper": cls.paper}, from_json)
 
     def validate(self) -> None:
         if self.steps < 1 or self.batch_size < 2:
@@ -288,9 +283,7 @@ def _train(data, out, c, resume, body_name, dist, progress, cancel, verbose) -> 
         return {}
 
     if dist.is_main:
-        tmp = out / "config.json.tmp"
-        tmp.write_text(json.dumps(asdict(c), indent=2))
-        os.replace(tmp, out / "config.json")
+        atomic_write_json(out / "config.json", asdict(c))
     bar = tqdm(total=c.steps, initial=step, desc="train tma", unit="step", disable=not (dist.is_main and verbose))
     metrics: dict = {"step": step}
     t0, s0 = time.time(), step
