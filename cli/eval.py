@@ -88,7 +88,16 @@ def _exit_code(result) -> int:
     return result if isinstance(result, int) and not isinstance(result, bool) else 0
 
 
-KINDS = [add_recon, add_generate]
+def add_paraphrase(sub):
+    from ..core.eval import paraphrase_eval
+
+    p = sub.add_parser("paraphrase", help="held-out paraphrases: generated motion's action by the TMA, per action",
+                       description=paraphrase_eval.__doc__.splitlines()[0])
+    paraphrase_eval.add_arguments(p)
+    p.set_defaults(_run=paraphrase_eval.from_cli)
+
+
+KINDS = [add_recon, add_generate, add_paraphrase]
 
 
 def add_arguments(p):
