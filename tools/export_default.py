@@ -68,6 +68,7 @@ def main() -> int:
     licence = ROOT / "weights" / "default" / "LICENSE.txt"  # the weights' CC BY-NC licence + attributions
     if licence.is_file():
         shutil.copy2(licence, tmp / "LICENSE.txt")
+    write_manifest(tmp)  # one manifest for the exported (float16) files; the runs' own are dropped
     old = args.out.with_name(args.out.name + ".old")
     shutil.rmtree(old, ignore_errors=True)
     if args.out.exists():
