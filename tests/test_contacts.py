@@ -107,5 +107,5 @@ def test_soles_match_the_full_mesh(openbody):
     foot_r = np.isin(lab, [8, 11])
     np.testing.assert_allclose(per_foot[:, 0], mesh[:, foot_l].min(1), atol=2e-4)
     np.testing.assert_allclose(per_foot[:, 1], mesh[:, foot_r].min(1), atol=2e-4)
-    # the body sample is sparse: never below the true lowest point, and close to it
-    assert (low >= mesh.min(1) - 2e-4).all() and (low - mesh.min(1)).max() < 0.03
+    # the candidates hold every vertex that can be lowest: the whole mesh's lowest point
+    np.testing.assert_allclose(low, mesh.min(1), atol=5e-4)

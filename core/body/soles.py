@@ -7,10 +7,13 @@ above the floor), so putting a foot *joint* on y = 0 sinks the mesh. Two tools:
   ankle, left foot, right foot) above the lowest vertex of their own skin region (heel region for
   the ankles, forefoot for the foot joints). Linear-cost, batched, differentiable in nothing (it
   is a constant per body): the training losses use it to turn joint heights into sole heights.
-* ``GroundProbe(body, betas)``: the foot vertices (exact skinning, they have <= 2 weights) and a
-  sparse sample of the rest of the mesh (4 largest weights), posed for many frames at a fraction
-  of the cost of skinning the whole mesh. ``lowest(rotations, transl)`` gives per frame the lowest
-  foot vertex and the lowest point of the (sampled) body.
+* ``GroundProbe(body, betas)``: the vertices that can ever be the lowest point of the mesh
+  (``candidate_vertices``: the extreme points of every rigidly skinned part and all blended
+  vertices, ``scene.sole_height.sole_vertices`` over the whole body; about half the mesh, chosen
+  once per body model), posed with their full skin weights for many frames at once: only the
+  vertical row of each skinning transform is needed, one (T,96) x (96,n) product.
+  ``lowest(rotations, transl)`` gives per frame the lowest vertex of each foot, of the feet and of
+  the whole body (a kneeling shin, a hand on the floor, a lying back included).
 """
 from __future__ import annotations
 
@@ -22,14 +25,22 @@ from .kinematics import skinning_transforms
 from .skeleton import FOOT_JOINTS
 
 FOOT_IDS = FOOT_JOINTS   # left ankle, right ankle, left foot, right foot (SMPL order)
-BODY_STRIDE = 24            # every n-th non-foot vertex in the probe (catches knees, hands, seat)
-SOLE_HEIGHT = 0.03          # foot vertices up to this rest height are probed (sole, heel, toe tips)
-SOLE_STRIDE = 1             # every n-th of them (2 already misses the lowest point by up to 1.3 mm)
-TOP_WEIGHTS = 4
 
 
 def _labels(body) -> np.ndarray:
     return body.skin_weights.argmax(axis=1)
+
+
+def candidate_vertices(body) -> np.ndarray:
+    """Indices of the vertices that can be the lowest point of ``body``'s mesh in some pose:
+    ``scene.sole_height.sole_vertices`` with no height band, on the mean shape (a shape change
+    moves an extreme point by a vertex at most: sub-mm). Computed once per body instance."""
+    ids = getattr(body, "_ground_candidates", None)
+    if ids is None:
+        from ..scene.sole_height import sole_vertices
+
+        ids = body._ground_candidates = sole_vertices(body.v_template.numpy(), body.skin_weights, 1, band=np.inf)
+    return ids
 
 
 def sole_offsets(body, betas=None) -> torch.Tensor:
@@ -50,23 +61,19 @@ def sole_offsets(body, betas=None) -> torch.Tensor:
 
 
 class GroundProbe:
-    """Posed positions of the sole vertices (+ a sample of the body) for one body shape."""
+    """Heights of the mesh's candidate lowest vertices (feet first) for one body shape, any pose."""
 
-    def __init__(self, body, betas=None, body_stride: int = BODY_STRIDE):
+    def __init__(self, body, betas=None):
         b = body._betas(betas)[:1]
         lab = _labels(body)
-        low = (body.v_template[:, 1] + body.shapedirs[:, 1] @ b[0]).numpy() < SOLE_HEIGHT
-        feet = np.flatnonzero(np.isin(lab, FOOT_IDS) & low)[::SOLE_STRIDE]
-        others = np.flatnonzero(~np.isin(lab, FOOT_IDS))[::body_stride]
+        cand = candidate_vertices(body)
+        is_foot = np.isin(lab[cand], FOOT_IDS)
+        feet, others = cand[is_foot], cand[~is_foot]
         ids = np.concatenate([feet, others])
         self.num_feet = len(feet)
         self.foot_side = np.isin(lab[feet], [8, 11]).astype(np.int64)  # 0 left, 1 right
         w = torch.as_tensor(body.skin_weights[ids], dtype=torch.float64)
-        top = torch.topk(w, TOP_WEIGHTS, dim=1)
-        self.w_idx = top.indices                                          # (n,k)
-        self.w = top.values / top.values.sum(1, keepdim=True)
-        self.dense_w = torch.zeros(w.shape[1], len(ids), dtype=torch.float64)    # (24,n) of the top weights
-        self.dense_w.scatter_(0, self.w_idx.T, self.w.T)
+        self.dense_w = (w / w.sum(1, keepdim=True).clamp_min(1e-12)).T.contiguous()  # (24,n)
         with torch.no_grad():
             t = torch.as_tensor(ids)
             self.rest_v = (body.v_template[t] + torch.einsum("vcb,b->vc", body.shapedirs[t], b[0])).double()
@@ -75,18 +82,6 @@ class GroundProbe:
         v1 = torch.cat([self.rest_v, torch.ones(len(ids), 1, dtype=torch.float64)], 1)     # (n,4)
         self.y_map = (self.dense_w[:, None, :] * v1.T[None]).reshape(-1, len(ids)).float()  # (24*4,n)
         self.sole_offsets = sole_offsets(body, b)[0].double().numpy()
-
-    def vertices(self, rotations, transl) -> torch.Tensor:
-        """rotations (T,24,3,3) local, transl (T,3) -> (T,n,3) probe points (feet first)."""
-        rot = torch.as_tensor(np.asarray(rotations), dtype=torch.float64)
-        tr = torch.as_tensor(np.asarray(transl), dtype=torch.float64)
-        T = rot.shape[0]
-        rest = self.rest_j[None].expand(T, -1, -1)
-        posed, world = forward_kinematics(rot, rest, self.parents)
-        A = skinning_transforms(world, posed, rest)[..., :3, :]                 # (T,24,3,4)
-        M = (A[:, self.w_idx] * self.w[None, :, :, None, None]).sum(2)      # (T,n,3,4)
-        v = (M[..., :3] @ self.rest_v[None, :, :, None]).squeeze(-1) + M[..., 3]
-        return v + tr[:, None]
 
     def heights(self, rotations, transl) -> np.ndarray:
         """(T,n) heights (y, m) of the probe points (feet first): only the y row of each skinning
