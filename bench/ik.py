@@ -19,7 +19,15 @@ import time
 import numpy as np
 import torch
 
+from ..core.body.fit import bone_lengths, fit_betas_to_bone_lengths, fit_betas_to_clip, fit_betas_to_motion
 from ..core.body.ik import bone_turn_deg, ik_lbfgs_baseline, solve_ik
+from ..core.body.load import load_body_model
+from ..core.body.skeleton import JOINT_NAMES, PARENTS
+from ..core.geometry.torch_ops import axis_angle_to_matrix, forward_kinematics
+from ..core.io.archive import mocap_root
+from ..core.io.mocap import load_mocap, load_smpl22
+from ..core.io.resample import resample_positions
+from ..core.io.rig_map import DEFAULT_LAYOUT, OPENBODY_LAYOUT, SMPL_LAYOUT, detect_rig, mapping_matrix
 
 CLIPS = [  # (archive folder, glob) - the first match of each
     ("bandai", "dataset-1/data/dataset-1_walk-back_active_001.bvh"),
@@ -33,8 +41,6 @@ CLIPS = [  # (archive folder, glob) - the first match of each
 
 def _body_rest():
     """The default body model (OpenBody) and its mean rest joints (24,3)."""
-    from ..core.body.load import load_body_model
-
     body = load_body_model()
     return body, body.rest_joints()[0].double().numpy()
 
@@ -42,18 +48,12 @@ def _body_rest():
 def _fit_rest(body, joints):
     """Rest joints (24,3) of the body with betas fitted to the clip's bone lengths, and the fit's
     bone-length RMS (m)."""
-    from ..core.body.fit import fit_betas_to_bone_lengths
-    from ..core.body.skeleton import PARENTS
-
     lengths = np.median(np.linalg.norm(joints[:, 1:] - joints[:, PARENTS[1:22]], axis=-1), 0)
     fit = fit_betas_to_bone_lengths(body, lengths)
     return body.rest_joints(torch.tensor(fit.betas)[None])[0].double().numpy(), fit.residual
 
 
 def _real_clips(n: int, max_frames: int):
-    from ..core.io.archive import mocap_root
-    from ..core.io.mocap import load_smpl22
-
     root = mocap_root()
     out = []
     for folder, pattern in CLIPS:
@@ -79,13 +79,6 @@ ARCHIVE_CLIPS = {  # archive -> globs (the first match of each), 5 clips per arc
 
 def _archive_table(body, quick: bool) -> dict:
     """Mean joint error (cm) per archive and (layout, fit); per joint for the baseline and the best."""
-    from ..core.body.fit import bone_lengths, fit_betas_to_bone_lengths, fit_betas_to_clip, fit_betas_to_motion
-    from ..core.body.skeleton import JOINT_NAMES
-    from ..core.io.archive import mocap_root
-    from ..core.io.mocap import load_mocap
-    from ..core.io.resample import resample_positions
-    from ..core.io.rig_map import DEFAULT_LAYOUT, OPENBODY_LAYOUT, SMPL_LAYOUT, detect_rig, mapping_matrix
-
     layouts = {"smpl": SMPL_LAYOUT, "default": DEFAULT_LAYOUT, "openbody": OPENBODY_LAYOUT}
     fits = {"lengths": lambda j: fit_betas_to_bone_lengths(body, np.median(bone_lengths(j), 0)),
             "motion": lambda j: fit_betas_to_motion(body, j),
@@ -138,9 +131,6 @@ def _archive_table(body, quick: bool) -> dict:
 
 
 def _synthetic_clip(rest, frames: int, seed: int = 0):
-    from ..core.geometry.torch_ops import axis_angle_to_matrix, forward_kinematics
-    from ..core.body.skeleton import PARENTS
-
     g = torch.Generator().manual_seed(seed)
     t = torch.linspace(0, 2 * np.pi, frames, dtype=torch.float64)[:, None, None]
     amp = torch.rand(1, 24, 3, generator=g, dtype=torch.float64) * 0.6
@@ -162,9 +152,6 @@ def _best_time(fn, repeats: int):
 
 def _reachable(res, rest):
     """FK of an IK result: targets the body reaches exactly (a real motion on a body that fits)."""
-    from ..core.geometry.torch_ops import forward_kinematics
-    from ..core.body.skeleton import PARENTS
-
     rot = torch.tensor(res.rotations, dtype=torch.float64)
     pos, _ = forward_kinematics(rot, torch.tensor(rest).expand(len(rot), -1, -1), PARENTS)
     return pos[:, :22].numpy() + res.transl[:, None]
@@ -193,8 +180,6 @@ class _Tally:
 
 
 def run(quick: bool = False) -> dict:
-    from ..core.body.skeleton import JOINT_NAMES
-
     torch.set_num_threads(1)
     body, rest = _body_rest()
     max_frames = 120 if quick else 400

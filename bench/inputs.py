@@ -10,6 +10,10 @@ from __future__ import annotations
 import shutil
 from pathlib import Path
 
+from ..core.data.build import build_dataset
+from ..core.generation.model_bundle import DEFAULT_MODEL_DIR
+from ..core.io.archive import default_cache_dir, mocap_root
+
 CLIPS = [
     "dataset-1_walk_feminine_001", "dataset-1_run_happy_001", "dataset-2_wave-left-hand_elderly_001",
     "dataset-2_walk_masculine_003", "dataset-1_kick_normal_001", "dataset-2_run_elderly_001",
@@ -19,15 +23,10 @@ CLIPS = [
 
 
 def cache_dir() -> Path:
-    from ..core.io.archive import default_cache_dir
-
     return default_cache_dir() / "bench"
 
 
 def small_dataset() -> Path:
-    from ..core.data.build import build_dataset
-    from ..core.io.archive import mocap_root
-
     out = cache_dir() / "data"
     if not (out / "Mean.npy").is_file() or len((out / "train.txt").read_text().split()) < 4:
         report = build_dataset([mocap_root()], out, only=CLIPS, augment_share=0.5, verbose=False)
@@ -37,8 +36,6 @@ def small_dataset() -> Path:
 
 def model_dir() -> tuple[Path, str]:
     """(model folder, description)."""
-    from ..core.generation.model_bundle import DEFAULT_MODEL_DIR
-
     if (DEFAULT_MODEL_DIR / "savae.pt").is_file() and (DEFAULT_MODEL_DIR / "t5").is_dir():
         return DEFAULT_MODEL_DIR, "the default model"
     out = cache_dir() / "tiny_model"

@@ -11,10 +11,12 @@ import time
 
 import numpy as np
 
+from ..core.scene.motion_file import make_motion
+from ..core.scene.pose import pose_bone_quaternions, root_locations
+from ..core.scene.rig_data import motion_channels_z_up
+
 
 def _motion(body, frames: int):
-    from ..core.scene.motion_file import make_motion
-
     rng = np.random.default_rng(0)
     t = np.arange(frames)[:, None, None]
     poses = rng.normal(0, 0.4, (1, 24, 3)) * np.sin(0.15 * t + rng.uniform(0, 6, (1, 24, 3)))
@@ -37,8 +39,6 @@ def run(quick: bool = False) -> dict:
     import bpy
 
     from ..core.scene.capsule_body import capsule_body
-    from ..core.scene.pose import pose_bone_quaternions, root_locations
-    from ..core.scene.rig_data import motion_channels_z_up
     from ..shapemove_addon.bone_placement import rest_rotations
     from ..shapemove_addon.keyframes import FIRST_FRAME, write_pose_action
     from ..shapemove_addon.scene_build import build_rig

@@ -13,12 +13,13 @@ import time
 
 import numpy as np
 
+from ..core.scene.bodies import load_body
+from ..core.scene.motion_file import make_motion
+
 
 def run(quick: bool = False) -> dict:
     import bpy
 
-    from ..core.scene.bodies import load_body
-    from ..core.scene.motion_file import make_motion
     from ..shapemove_addon.scene_build import build_rig
     from ..shapemove_addon.shape_sync import set_betas
 

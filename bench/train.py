@@ -14,6 +14,8 @@ from pathlib import Path
 
 import numpy as np
 
+from .inputs import small_dataset
+
 
 def _rate(log: Path) -> float:
     times = [json.loads(line)["sec_per_step"] for line in log.read_text().splitlines()]
@@ -45,8 +47,6 @@ def _t5(data: Path, vae: Path, out: Path, small: bool, steps: int) -> float:
 
 def run(quick: bool = False) -> dict:
     import torch
-
-    from .inputs import small_dataset
 
     data = small_dataset()
     steps = 4 if quick else 12

@@ -8,6 +8,8 @@ from __future__ import annotations
 import importlib
 from pathlib import Path
 
+from ..core.atomic import atomic_write_json
+
 BENCHES = ["ik", "keys", "sliders", "generate", "train"]
 
 
@@ -31,8 +33,6 @@ def run(args) -> int:
         print(f"== bench {name}")
         results.update(mod.run(quick=args.quick))
     if args.json:
-        from ..core.atomic import atomic_write_json
-
         atomic_write_json(args.json, results)
         print(f"wrote {args.json}")
     return 0

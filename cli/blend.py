@@ -10,6 +10,8 @@ from pathlib import Path
 
 from ..core.atomic import atomic_path
 from ..core.errors import ShapeMoveError
+from ..core.scene.bodies import load_body
+from ..core.scene.motion_file import load_motion
 
 
 def add_arguments(p):
@@ -23,9 +25,6 @@ def add_arguments(p):
 
 
 def run(args) -> int:
-    from ..core.scene.bodies import load_body
-    from ..core.scene.motion_file import load_motion
-
     if args.out.suffix.lower() != ".blend":
         raise ShapeMoveError(f"--out must end in .blend, got {args.out}")
     motion = load_motion(args.motion)  # fail on bad input before paying for bpy

@@ -4,6 +4,10 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from ..core.data.build import AUGMENT_SHARE, build_dataset
+from ..core.data.compose import compose_dataset
+from ..core.errors import ShapeMoveError
+
 
 def add_arguments(p):
     sub = p.add_subparsers(dest="action", required=True)
@@ -30,15 +34,11 @@ def add_arguments(p):
 def run(args) -> int:
     if args.action == "compose":
         from ..core.body.load import load_body_model
-        from ..core.data.compose import compose_dataset
 
         ids = compose_dataset(args.data, args.count, seed=args.seed, body=load_body_model(args.body_model))
         print(f"composed clips written: {len(ids)} (training split); {args.data}/meta.jsonl, split lists and Mean/Std refreshed")
         return 0
     from ..core.body.load import load_body_model
-    from ..core.data.build import AUGMENT_SHARE, build_dataset
-
-    from ..core.errors import ShapeMoveError
 
     try:
         shard = tuple(int(v) for v in args.shard.split("/"))

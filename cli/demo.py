@@ -8,6 +8,10 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from ..core.data.shape_text import shape_adjectives
+from ..core.errors import ShapeMoveError
+from ..core.scene.motion_file import save_motion
+
 DEFAULT_PROMPT = "a person jogs forward and waves"
 DEFAULT_SHAPE = "a tall, heavy-set man"
 
@@ -26,10 +30,7 @@ def run(args) -> int:
     import time
 
     from ..core.body.measure import measure
-    from ..core.data.shape_text import shape_adjectives
-    from ..core.errors import ShapeMoveError
     from ..core.generation.generate import Generator
-    from ..core.scene.motion_file import save_motion
 
     t0 = time.time()
     gen = Generator(args.model)

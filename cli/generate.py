@@ -4,6 +4,11 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from ..core.atomic import ensure_parent
+from ..core.errors import ShapeMoveError
+from ..core.generation.sampling_params import check_sampling
+from ..core.scene.motion_file import save_motion
+
 
 def add_arguments(p):
     p.add_argument("--prompt", required=True, help='motion text, e.g. "a person jogs forward and waves"')
@@ -23,15 +28,10 @@ def add_arguments(p):
 
 def run(args) -> int:
     from ..core.body.measure import measure
-    from ..core.errors import ShapeMoveError
     from ..core.generation.generate import Generator, parse_betas
-    from ..core.scene.motion_file import save_motion
 
     if args.out.suffix.lower() != ".npz":
         raise ShapeMoveError(f"--out must end in .npz, got {args.out}")
-    from ..core.atomic import ensure_parent
-    from ..core.generation.sampling_params import check_sampling
-
     check_sampling(args.seed, args.temperature, args.top_k)  # before loading any model
     ensure_parent(args.out)  # a parent that is a file, or no permission: said now, not after generating
     betas = parse_betas(args.betas) if args.betas else None

@@ -11,6 +11,9 @@ import json
 import re
 from pathlib import Path
 
+from ..core.errors import ShapeMoveError
+from ..core.scene.motion_file import save_motion
+
 
 def add_arguments(p):
     p.add_argument("--prompts", type=Path, required=True)
@@ -22,8 +25,6 @@ def add_arguments(p):
 
 
 def read_prompts(path: Path) -> list[dict]:
-    from ..core.errors import ShapeMoveError
-
     if not path.is_file():
         raise ShapeMoveError(f"prompts file not found: {path}")
     lines = [ln for ln in path.read_text(encoding="utf-8", errors="replace").splitlines() if ln.strip()]
@@ -51,9 +52,7 @@ def slug(text: str) -> str:
 def run(args) -> int:
     from tqdm import tqdm
 
-    from ..core.errors import ShapeMoveError
     from ..core.generation.generate import Generator, parse_betas
-    from ..core.scene.motion_file import save_motion
 
     items = read_prompts(args.prompts)
     try:

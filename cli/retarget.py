@@ -11,6 +11,9 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from ..core.errors import ShapeMoveError
+from ..core.scene.motion_file import save_motion
+
 
 def add_arguments(p):
     p.add_argument("--motion", type=Path, required=True, help="input motion: .bvh, .amc (with its .asf) or AMASS .npz")
@@ -26,7 +29,6 @@ def add_arguments(p):
 def target_betas(body, betas_text: str | None, shape_text: str | None):
     """Exactly one of --betas / --shape-text -> (10,) betas."""
     from ..core.body.shape_from_measurements import betas_from_shape_text
-    from ..core.errors import ShapeMoveError
     from ..core.generation.generate import parse_betas
 
     if (betas_text is None) == (shape_text is None):
@@ -37,9 +39,7 @@ def target_betas(body, betas_text: str | None, shape_text: str | None):
 def run(args) -> int:
     from ..core.body.load import load_body_model
     from ..core.body.measure import measure
-    from ..core.errors import ShapeMoveError
     from ..core.generation.retarget import load_vae, naive_retarget, retarget
-    from ..core.scene.motion_file import save_motion
 
     if args.out.suffix.lower() != ".npz":
         raise ShapeMoveError(f"--out must end in .npz, got {args.out}")

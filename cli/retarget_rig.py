@@ -10,6 +10,10 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from ..core.errors import ShapeMoveError
+from ..core.scene.bone_map import find_preset
+from ..core.scene.motion_file import load_motion
+
 
 def add_arguments(p):
     p.add_argument("--motion", type=Path, required=True, help="ShapeMove motion file (.npz)")
@@ -21,14 +25,10 @@ def add_arguments(p):
 
 
 def run(args) -> int:
-    from ..core.errors import ShapeMoveError
-    from ..core.scene.motion_file import load_motion
-
     if args.out.suffix.lower() != ".blend":
         raise ShapeMoveError(f"--out must end in .blend, got {args.out}")
     load_motion(args.motion)  # fail on bad input before paying for bpy
     if args.preset is not None:
-        from ..core.scene.bone_map import find_preset
         find_preset(args.preset)
     try:
         import bpy  # noqa: F401

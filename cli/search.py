@@ -7,6 +7,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from ..core.search.motion_search import check_query, index_library, search
+
 
 def add_arguments(p):
     p.add_argument("--library", type=Path, required=True, help="dataset folder or folder of .npz/.bvh/.amc motions")
@@ -17,8 +19,6 @@ def add_arguments(p):
 
 
 def run(args) -> int:
-    from ..core.search.motion_search import check_query, index_library, search
-
     check_query(args.query, args.top)
     index = index_library(args.library, args.tma, use_cache=not args.no_cache)
     results = search(index, args.query, args.top)

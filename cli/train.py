@@ -12,13 +12,14 @@ import json
 import os
 from pathlib import Path
 
+from ..core.errors import ShapeMoveError
+from ..core.train.run_guard import check_run_folder
+
 KINDS = {"vae": "the shape-aware VAE (stage 1)", "t5": "text -> motion tokens + [BETA] head (stage 2)",
          "tma": "the text-motion retrieval model (TMA)"}
 
 
 def _module(kind: str):
-    from ..core.errors import ShapeMoveError
-
     try:
         return importlib.import_module(f"...core.train.train_{kind}", __name__)
     except ModuleNotFoundError as exc:
@@ -48,8 +49,6 @@ def add_arguments(p):
 
 
 def run(args) -> int:
-    from ..core.train.run_guard import check_run_folder
-
     check_run_folder(args.out, args.kind, resume=args.resume, force=args.force)
     metrics = _module(args.kind).from_cli(args)
     if int(os.environ.get("RANK", 0)) == 0 and metrics:

@@ -5,20 +5,19 @@ The protocol is described in core/worker/protocol.py; the ops in core/worker/ops
 """
 from __future__ import annotations
 
+from ..core.worker.ops import default_jobs
+from ..core.worker.protocol import CONTROL_OPS
+from ..core.worker.server import main
+
 
 def add_arguments(p):
     p.add_argument("--list", action="store_true", help="print the available ops and exit")
 
 
 def run(args) -> int:
-    from ..core.worker.protocol import CONTROL_OPS
-
     if args.list:
-        from ..core.worker.ops import default_jobs
-
         for name in [*CONTROL_OPS, *sorted(default_jobs())]:
             print(name)
         return 0
-    from ..core.worker.server import main
 
     return main()

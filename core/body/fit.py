@@ -31,8 +31,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ShapeMoveError
+from .ik import solve_ik
 from .model import NUM_BETAS, BodyModel
-from .skeleton import BODY_BONES, JOINT_INDEX, JOINT_NAMES, NUM_BODY_JOINTS
+from .skeleton import BODY_BONES, JOINT_INDEX, JOINT_NAMES, NUM_BODY_JOINTS, PARENTS
 
 NUM_BONES = len(BODY_BONES)  # 21
 DEFAULT_REG = 1e-6
@@ -249,8 +250,6 @@ CLIP_ROUNDS = 3      # IK <-> betas alternations
 
 def _world_rotations(rot: np.ndarray) -> np.ndarray:
     """(F,24,3,3) local rotations -> (F,22,3,3) world rotations of the body joints."""
-    from .skeleton import PARENTS
-
     G = np.empty((rot.shape[0], NUM_BODY_JOINTS, 3, 3))
     G[:, 0] = rot[:, 0]
     for j in range(1, NUM_BODY_JOINTS):
@@ -272,9 +271,6 @@ def fit_betas_to_clip(body: BodyModel, joints, reg: float = CLIP_REG, pose_reg: 
     what the joint error counts. The IK poses change with the betas, hence the rounds; the
     result with the lowest IK error (bone-length fit included) wins.
     """
-    from .ik import solve_ik
-    from .skeleton import PARENTS
-
     x = np.asarray(joints, dtype=np.float64)
     if pose_reg < 0 or frames < 1 or rounds < 0:
         raise ShapeMoveError("pose_reg must be >= 0, frames >= 1 and rounds >= 0")

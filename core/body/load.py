@@ -10,6 +10,8 @@ from pathlib import Path
 
 from ..errors import ShapeMoveError
 from .model import BodyModel
+from .openbody import OpenBody
+from .smpl_family import SMPLFamilyBody
 
 _CACHE: dict[tuple, BodyModel] = {}
 
@@ -30,12 +32,8 @@ def load_body_model(spec: str | Path | None = None) -> BodyModel:
     key = _cache_key(spec)
     if key not in _CACHE:
         if key[0] == "openbody":
-            from .openbody import OpenBody
-
             _CACHE[key] = OpenBody.load()
         else:
-            from .smpl_family import SMPLFamilyBody
-
             _CACHE[key] = SMPLFamilyBody.load(key[1])
     return _CACHE[key]
 

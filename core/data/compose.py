@@ -29,7 +29,10 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ShapeMoveError
+from ..geometry.rotations import (axis_angle_to_matrix, matrix_to_axis_angle, matrix_to_quaternion,
+                                  quaternion_to_matrix, slerp, yaw_matrix)
 from .actions import ACTIONS
+from .build import ClipProcessor, _write_clip, finalize
 from .captions import _pick, _tidy, progressive
 from .sources import ClipSource
 
@@ -98,8 +101,6 @@ def load_part(data: Path, cid: str, meta: dict, body, first: bool) -> Part:
     """A clip of the built dataset as rotations + root path; ``first``: keep its END (A), else its START (B)."""
     import torch
 
-    from ..geometry.rotations import axis_angle_to_matrix
-
     poses = np.load(data / "poses" / f"{cid}.npy")
     transl = np.load(data / "transl" / f"{cid}.npy")
     betas = np.load(data / "betas" / f"{cid}.npy").astype(np.float32)
@@ -122,8 +123,6 @@ def _yaw(root_rot: np.ndarray) -> float:
 
 def join(a: Part, b: Part, scale_b: float, blend: int = BLEND_FRAMES):
     """(rotations (T,24,3,3), root (T,3), contacts (T,4)) of A then B with a cross-faded transition."""
-    from ..geometry.rotations import matrix_to_quaternion, quaternion_to_matrix, slerp, yaw_matrix
-
     k = int(min(blend, len(a.rotations) - 1, len(b.rotations) - 1))
     start = len(a.rotations) - k                          # first frame of A that is blended
     turn = yaw_matrix(_yaw(a.rotations[start, 0]) - _yaw(b.rotations[0, 0]))
@@ -149,8 +148,6 @@ def join(a: Part, b: Part, scale_b: float, blend: int = BLEND_FRAMES):
 def compose_arrays(proc, a: Part, b: Part) -> dict:
     """The arrays ``build._write_clip`` writes, for A then B on A's body (ClipProcessor FK/grounding/features)."""
     import torch
-
-    from ..geometry.rotations import matrix_to_axis_angle
 
     rest_a = proc.body.rest_joints(torch.as_tensor(a.betas)[None])[0].numpy()
     rest_b = proc.body.rest_joints(torch.as_tensor(b.betas)[None])[0].numpy()
@@ -187,8 +184,6 @@ def compose_dataset(data, count: int, seed: int = 0, body=None, verbose: bool = 
     """Add ``count`` composed clips to the built dataset ``data`` (resumable: ids are
     ``comp{seed}_{i:05d}`` and a clip whose meta exists is skipped). Returns the ids written."""
     from tqdm import tqdm
-
-    from .build import ClipProcessor, _write_clip, finalize
 
     data = Path(data)
     if not (data / "meta").is_dir():

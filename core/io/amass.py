@@ -16,17 +16,18 @@ from pathlib import Path
 import numpy as np
 import torch
 
+from ..body.openbody import OpenBody
 from ..geometry.fk import bone_offsets, forward_kinematics
 from ..geometry.rotations import axis_angle_to_matrix
 from ..body.skeleton import JOINT_NAMES, NUM_BODY_JOINTS, PARENTS
 from ..errors import ShapeMoveError
+from .limits import check_joint_frames
 from .mocap_clip import Mocap, finish_mocap
+from .npz_read import read_npz
 from .units_axes import to_y_up
 
 
 def _default_model():
-    from ..body.openbody import OpenBody
-
     return OpenBody.load()
 
 
@@ -37,9 +38,6 @@ def is_smpl_family(model) -> bool:
 
 def read_amass_npz(path) -> dict:
     """The arrays of an AMASS file, checked: poses (T,66), trans (T,3), betas (10,), fps, gender."""
-    from .limits import check_joint_frames
-    from .npz_read import read_npz
-
     path = Path(path)
     data = read_npz(path, ("poses", "trans", "betas", "mocap_framerate", "mocap_frame_rate", "gender"),
                     max_bytes=256 * 2**20, skip_objects=("gender",), what="AMASS motion file")

@@ -24,6 +24,7 @@ from ..geometry.fk import forward_kinematics, joints_from_offsets
 from ..geometry.rotations import euler_matrix
 from .limits import MAX_HIERARCHY_BYTES, MAX_JOINT_FRAMES, check_joint_frames, parse_floats, read_text
 from .mocap_clip import Mocap, finish_mocap
+from .rig_map import find_rig
 
 INCH = 0.0254
 MAX_VALUE = 1e7
@@ -327,8 +328,6 @@ def amc_fps(amc_path, default: float = 120.0) -> float:
 def load_amc(path, asf=None, fps: float | None = None, up_axis: str | None = None) -> Mocap:
     """Read an AMC with its ASF into a Mocap (metres, Y up). The up axis is detected for a
     humanoid we can map (CMU/HDM05 are Y up) and taken as Acclaim's Y otherwise."""
-    from .rig_map import find_rig
-
     path = Path(path)
     asf_path = Path(asf) if asf else find_asf(path)
     skel = load_asf(asf_path)

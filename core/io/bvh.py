@@ -16,6 +16,7 @@ from ..geometry.fk import forward_kinematics, joints_from_offsets
 from ..geometry.rotations import axis_rotation
 from .limits import MAX_HIERARCHY_BYTES, check_joint_frames, parse_floats, read_text
 from .mocap_clip import Mocap, finish_mocap
+from .units_axes import UNITS
 
 CHANNELS = {"xposition": ("p", 0), "yposition": ("p", 1), "zposition": ("p", 2),
             "xrotation": ("r", "x"), "yrotation": ("r", "y"), "zrotation": ("r", "z")}
@@ -216,8 +217,6 @@ def bvh_local_transforms(offsets, channels, data):
 def load_bvh(path, unit: str | None = None, up_axis: str | None = None) -> Mocap:
     """Read a BVH file into a Mocap (metres, Y up). ``unit`` ('m', 'cm', 'mm', 'inch') and
     ``up_axis`` ('Y', 'Z') override the detection."""
-    from .units_axes import UNITS
-
     path = Path(path)
     text = read_text(path, "BVH")
     names, parents, offsets, channels, data, dt = parse_bvh(text, path)

@@ -198,8 +198,6 @@ def local_rotations(table: np.ndarray) -> np.ndarray:
 
 def load_deepmimic(path, loop_min_seconds: float = LOOP_MIN_SECONDS, subject: str = "deepmimic"):
     """Read a DeepMimic motion file into a ``mocap.Mocap`` (metres, Y up, facing +Z)."""
-    from .mocap_clip import finish_mocap
-
     path = Path(path)
     if not path.is_file():
         raise ShapeMoveError(f"motion file not found: {path}")

@@ -11,10 +11,17 @@ from pathlib import Path
 
 import numpy as np
 
+from ..body.skeleton import PARENTS
 from ..constants import FPS
 from ..errors import ShapeMoveError
 from ..geometry.fk import joints_from_offsets
+from .asf_amc import load_amc
+from .bvh import load_bvh
+from .deepmimic import load_deepmimic
 from .mocap_clip import Mocap
+from .resample import resample_positions
+from .rig_map import detect_rig, mapping_matrix, pose_candidates
+from .tpose import tpose_lead_in
 
 
 def load_mocap(path, body_model=None, **kwargs) -> Mocap:
@@ -24,16 +31,14 @@ def load_mocap(path, body_model=None, **kwargs) -> Mocap:
         raise ShapeMoveError(f"motion file not found: {path}")
     ext = path.suffix.lower()
     if ext == ".bvh":
-        from .bvh import load_bvh
         return load_bvh(path, **kwargs)
     if ext == ".amc":
-        from .asf_amc import load_amc
         return load_amc(path, **kwargs)
     if ext == ".npz":
         from .amass import load_amass
+
         return load_amass(path, body_model=body_model, **kwargs)
     if ext in (".txt", ".json"):
-        from .deepmimic import load_deepmimic
         return load_deepmimic(path, **kwargs)
     raise ShapeMoveError(f"{path}: unsupported motion file type {ext!r} (use .bvh, .amc, AMASS .npz or DeepMimic .txt)")
 
@@ -63,7 +68,6 @@ class Motion22:
 
     def bone_lengths(self) -> np.ndarray:
         """(22,) median over frames of |joint - SMPL parent| in metres (0 for the pelvis)."""
-        from ..body.skeleton import PARENTS
         par = PARENTS[:22]
         out = np.zeros(22)
         out[1:] = np.median(np.linalg.norm(self.joints[:, 1:] - self.joints[:, par[1:]], axis=-1), axis=0)
@@ -72,11 +76,6 @@ class Motion22:
 
 def mocap_to_smpl22(mocap: Mocap, fps: float = FPS, drop_tpose: bool = True) -> Motion22:
     """Map a Mocap to SMPL22 positions, cut a T-pose lead-in, resample to ``fps``."""
-    from ..body.skeleton import PARENTS
-    from .resample import resample_positions
-    from .rig_map import detect_rig, mapping_matrix, pose_candidates
-    from .tpose import tpose_lead_in
-
     rig = detect_rig(mocap.names, mocap.parents,
                      pose_candidates(joints_from_offsets(mocap.offsets, mocap.parents), mocap.positions))
     W = mapping_matrix(rig, mocap.names, mocap.positions)

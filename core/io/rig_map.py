@@ -34,6 +34,7 @@ import numpy as np
 from ..body.skeleton import JOINT_NAMES, NUM_BODY_JOINTS
 from ..errors import ShapeMoveError
 from .rig import SPINE_JOINTS, Rig, normalize
+from .skeleton_match import match_humanoid
 
 SMPL22 = JOINT_NAMES[:NUM_BODY_JOINTS]
 
@@ -184,7 +185,6 @@ def pose_candidates(rest, positions) -> np.ndarray:
 
 
 def _match(names, parents, rest) -> Rig:
-    from .skeleton_match import match_humanoid
     return match_humanoid(names, parents, rest)
 
 

@@ -21,6 +21,7 @@ from ..body.skeleton import JOINT_NAMES, NUM_BODY_JOINTS
 from ..errors import ShapeMoveError
 from ..io.limits import read_json
 from ..io.rig_map import OPENBODY_LAYOUT, SPINE_JOINTS, normalize
+from ..io.skeleton_match import match_humanoid
 
 SMPL22 = tuple(JOINT_NAMES[:NUM_BODY_JOINTS])
 PRESET_DIR = Path(__file__).with_name("rig_presets")
@@ -95,8 +96,6 @@ def _skeleton(arm: ArmatureRest):
 def auto_map(arm: ArmatureRest) -> dict:
     """Bone map by the skeleton's shape and name hints (``skeleton_match``); raises
     ShapeMoveError naming the body part it could not find."""
-    from ..io.skeleton_match import match_humanoid
-
     names, parents, pos = _skeleton(arm)
     rig = match_humanoid(names, parents, pos, rig_name="armature")
     bones = set(arm.names)

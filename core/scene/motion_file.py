@@ -17,8 +17,10 @@ from pathlib import Path
 
 import numpy as np
 
+from ..atomic import atomic_path
 from ..body.skeleton import NUM_BODY_JOINTS, NUM_JOINTS
 from ..errors import ShapeMoveError
+from ..io.npz_read import read_npz
 
 
 @dataclass
@@ -116,7 +118,6 @@ def save_motion(path, m: Motion) -> Path:
     for name in ("tokens", "features", "network_joints", "contacts"):
         if getattr(m, name) is not None:
             arrays[name] = np.asarray(getattr(m, name))
-    from ..atomic import atomic_path
 
     with atomic_path(path) as tmp:  # read-only folder, a parent that is a file, disk full: a sentence, no *.tmp
         with open(tmp, "wb") as f:
@@ -129,7 +130,6 @@ def load_motion(path) -> Motion:
     path = Path(path)
     if not path.is_file():
         raise ShapeMoveError(f"motion file not found: {path}")
-    from ..io.npz_read import read_npz
 
     try:  # headers checked and sizes capped before allocating; pickled arrays refused
         data = read_npz(path, max_bytes=512 * 2**20, what="motion file")

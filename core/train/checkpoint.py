@@ -14,6 +14,7 @@ from pathlib import Path
 import numpy as np
 import torch
 
+from ... import __version__
 from ..atomic import atomic_path
 from ..errors import ShapeMoveError
 from ..model_files import add_to_manifest, verify_file
@@ -22,8 +23,6 @@ FORMAT = 1
 
 
 def code_version() -> str:
-    from ... import __version__
-
     return __version__
 
 

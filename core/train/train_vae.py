@@ -23,7 +23,10 @@ from torch.nn.parallel import DistributedDataParallel as DDP
 from torch.utils.data import DataLoader
 
 from ..atomic import atomic_write_json
+from ..body.load import load_body_model
+from ..body.soles import sole_offsets
 from ..errors import ShapeMoveError
+from ..models.fsq import codebook_usage
 from ..models.savae import SAVAE, SAVAEConfig, TrainSettings
 from ..models.vae_losses import bone_lengths, vae_losses
 from . import distributed
@@ -51,7 +54,6 @@ def resolve_body(body):
     """A BodyModel instance, a body spec ("openbody", an SMPL-family file) or None (the default)."""
     if body is not None and not isinstance(body, str):
         return body
-    from ..body.load import load_body_model
 
     return load_body_model(body)
 
@@ -83,8 +85,6 @@ def target_bones(body, betas: torch.Tensor) -> torch.Tensor | None:
 def body_soles(body, betas: torch.Tensor) -> torch.Tensor:
     """(B, 4) sole offsets of joints 7, 8, 10, 11 of ``body`` with ``betas`` (B, 10): the ground
     losses act on the soles of the target body. On the CPU, as ``target_bones``."""
-    from ..body.soles import sole_offsets
-
     return sole_offsets(body, betas.detach().cpu()).to(betas.device)
 
 
@@ -102,8 +102,6 @@ def _to(batch: dict, device) -> dict:
 @torch.no_grad()
 def evaluate(model: SAVAE, dataset: MotionClips, cfg: SAVAEConfig, device, body=None) -> dict:
     """Mean losses and codebook usage over up to ``val_batches`` fixed crops of ``dataset``."""
-    from ..models.fsq import codebook_usage
-
     model.eval()
     bs = cfg.train.batch_size
     keys = [(i, 0) for i in range(len(dataset))][: bs * cfg.train.val_batches]

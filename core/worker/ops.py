@@ -15,8 +15,11 @@ from collections import deque
 from contextlib import redirect_stderr
 from pathlib import Path
 
+from ... import __version__
+from ...cli import COMMANDS, main
 from ..errors import ShapeMoveError
 from .op_support import param, str_list
+from .protocol import CONTROL_OPS
 
 # -- ops ---------------------------------------------------------------------------------------
 def env_info(params, progress, cancel) -> dict:
@@ -25,8 +28,6 @@ def env_info(params, progress, cancel) -> dict:
 
     import numpy
     import torch
-
-    from ... import __version__
 
     return {"executable": sys.executable, "python": platform.python_version(), "platform": platform.platform(),
             "shapemove": __version__, "numpy": numpy.__version__, "torch": torch.__version__,
@@ -121,8 +122,6 @@ def cli(params, progress, cancel) -> dict:
     """params {"argv": ["data", "build", ...]}: run a `python -m shapemove` command in this process.
     Its printed output arrives as log messages; a failure -> error with its last stderr lines.
     Commands have no cancel hook: a cancelled cli job still runs to its end."""
-    from ...cli import COMMANDS, main
-
     argv = str_list(params, "cli", "argv")
     if not argv or argv[0] not in COMMANDS or argv[0] == "worker":
         known = ", ".join(c for c in COMMANDS if c != "worker")
@@ -174,8 +173,6 @@ def panel_ops_problem() -> str:
 
 def register(name: str, func) -> None:
     """Add a job op (``func(params, progress, cancel) -> dict``); control op names are reserved."""
-    from .protocol import CONTROL_OPS
-
     if name in CONTROL_OPS:
         raise ShapeMoveError(f"{name!r} is a control op of the worker and cannot be a job")
     JOBS[name] = func
