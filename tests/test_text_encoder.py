@@ -82,6 +82,7 @@ def test_state_cache_matches_the_encoder(enc):
 def test_unknown_pieces(enc):
     assert enc.unknown_share("a person does a cartwheel") == 0.0
     assert enc.unknown_share("\u4f60\u597d \U0001f642") == 1.0
+    assert 0.3 < enc.unknown_share("a person \U0001f642\U0001f642\U0001f642\U0001f642") < 0.7
 
 
 def test_fingerprint_check():
@@ -89,3 +90,19 @@ def test_fingerprint_check():
     for bad in (None, {"name": te.NAME, "sha256": "0" * 64}, {"name": "bert-base", "sha256": te.MODEL_SHA256}):
         with pytest.raises(ShapeMoveError, match="trained with text encoder"):
             te.check_fingerprint(bad, "some model")
+
+
+def test_plain_torch_forward_equals_transformers_bert(enc):
+    """The encoder's own BERT forward + tokenizers give transformers.BertModel's states."""
+    from transformers import AutoTokenizer, BertModel
+
+    texts = ["A person walks forward.", "someone does a cartwheel, then waves with the LEFT hand!", "jump"]
+    ref_model = BertModel.from_pretrained(str(enc.folder), local_files_only=True).eval()
+    ref_tok = AutoTokenizer.from_pretrained(str(enc.folder), local_files_only=True)
+    e = ref_tok(texts, padding=True, return_tensors="pt")
+    with torch.no_grad():
+        ref = ref_model(**e).last_hidden_state
+    x, m = enc.states(texts)
+    assert torch.equal(m, e.attention_mask.bool())
+    torch.testing.assert_close(x[m], ref[m], atol=2e-4, rtol=1e-4)
+    assert enc.unknown_share("a person walks") == 0.0

