@@ -21,6 +21,7 @@ from ..core.scene.bone_map import (SMPL22, ArmatureRest, apply_preset, builtin_p
                                    map_armature, save_preset)
 from ..core.scene.motion_file import load_motion
 from ..core.scene.rig_retarget import retarget_to_armature
+from .headless import save_blend
 from .keyframes import write_pose_action
 from .operators import ReportingOperator
 from .panels import _SubPanel
@@ -115,8 +116,6 @@ def retarget_rig_file(motion_path, blend_in, armature: str, out_blend, preset=No
     """Headless: open ``blend_in``, bake the motion file onto its armature object ``armature``
     (bone map from ``preset``, else the one stored on the object, else automatic), save
     ``out_blend`` atomically. Returns facts about the bake."""
-    from .headless import save_blend
-
     ensure_registered()
     motion = load_motion(motion_path)
     blend_in = Path(blend_in)

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..core.body.body_arrays import load_body_arrays
 from ..core.constants import is_openbody
 from ..core.errors import ShapeMoveError
 from . import shape_sync
@@ -30,8 +31,6 @@ def semantic_body(rig):
     """The numpy body with the phenotype map for ``rig``'s body model, or None (not OpenBody)."""
     if rig is None or not is_openbody(rig.get("shapemove_body_model", "")):
         return None
-    from ..core.body.body_arrays import load_body_arrays
-
     body = load_body_arrays("openbody")
     return body if body.has_phenotypes else None
 

@@ -16,8 +16,10 @@ import numpy as np
 
 from ..constants import FPS
 from ..errors import ShapeMoveError
+from ..generation.model_bundle import resolve_model_dir
 from ..io.mocap import Motion22
 from ..scene.motion_file import load_motion, save_motion
+from ..search.motion_search import check_query, index_library, search as _search
 from .op_support import JobCancelled, param
 
 TRAIN_KINDS = ("vae", "t5", "tma")
@@ -48,7 +50,6 @@ def _betas(params: dict, op: str, name: str = "betas", default=None):
 def _generator(model, body):
     """A cached Generator for (model folder or None = default, body spec)."""
     from ..generation.generate import Generator
-    from ..generation.model_bundle import resolve_model_dir
 
     d = resolve_model_dir(model or None)
     stamp = max((p.stat().st_mtime_ns for p in d.rglob("*") if p.is_file()), default=0)
@@ -171,7 +172,6 @@ def retarget(params, progress, cancel) -> dict:
             if method == "savae":
                 raise
     if cancel():
-
         raise JobCancelled
     progress(0.3, "retargeting" + (" through the SA-VAE" if vae is not None else " (naive: no SA-VAE model)"))
     motion = savae_retarget(source, vae, body, betas) if vae is not None else naive_retarget(source, body, betas)
@@ -211,8 +211,6 @@ def _library_clip(path: Path):
 def search(params, progress, cancel) -> dict:
     """params {"folder", "query", "top_k", "tma" (tma.pt or a folder holding it, optional)} ->
     {"results": [{"id", "score", "path", "caption"}], "count", "skipped", "from_cache"}."""
-    from ..search.motion_search import check_query, index_library, search as _search
-
     op = "search"
     query = check_query(param(params, op, "query", str), int(param(params, op, "top_k", int, 10)))
     index = index_library(param(params, op, "folder", str), tma=param(params, op, "tma", str, None) or None,
@@ -279,10 +277,11 @@ def train(params, progress, cancel) -> dict:
         product, target = run, model_dir / "tma"
     published = False
     if not cancel() and product.exists():
-        if kind == "tma":  # tma.pt needs its tokenizer/ beside it
+        if kind == "tma":  # tma.pt, and the tokenizer/ of a sentencepiece TMA beside it (MiniLM TMAs have none)
             target.mkdir(parents=True, exist_ok=True)
             _publish(run / "tma.pt", target / "tma.pt")
-            _publish(run / "tokenizer", target / "tokenizer")
+            if (run / "tokenizer").is_dir():
+                _publish(run / "tokenizer", target / "tokenizer")
         else:
             _publish(product, target)
         published = True
