@@ -22,6 +22,9 @@ import numpy as np
 from ..atomic import atomic_path
 from ..constants import FPS
 from ..errors import ShapeMoveError
+from ..generation.model_bundle import DEFAULT_MODEL_DIR
+from ..io.mocap import load_smpl22
+from ..io.resample import resample_positions
 
 INDEX_NAME = ".shapemove_index.npz"
 MOCAP_EXTS = (".bvh", ".amc")
@@ -108,16 +111,10 @@ def load_motion_features(path: Path) -> tuple[np.ndarray, str]:
                 if joints.ndim != 3 or joints.shape[1] < 22 or joints.shape[2] != 3:
                     raise ShapeMoveError(f"joints must be (T,22,3), got {joints.shape}")
                 if abs(fps - FPS) > 1e-3:
-                    from ..io.resample import resample_positions
-
                     joints = resample_positions(joints[:, :22], fps, FPS)
                 return features_from_joints(joints[:, :22]), caption
-        from ..io.mocap import load_smpl22  # an AMASS file
-
-        return features_from_joints(np.asarray(load_smpl22(path).joints, np.float32)), caption
+        return features_from_joints(np.asarray(load_smpl22(path).joints, np.float32)), caption  # an AMASS file
     if ext in MOCAP_EXTS:
-        from ..io.mocap import load_smpl22
-
         return features_from_joints(np.asarray(load_smpl22(path).joints, np.float32)), caption
     raise ShapeMoveError(f"{path}: not a motion file (.npz, .bvh, .amc)")
 
@@ -129,8 +126,6 @@ def resolve_tma(tma):
     if isinstance(tma, tuple):
         return tma, None
     if tma is None:
-        from ..generation.model_bundle import DEFAULT_MODEL_DIR
-
         tma = DEFAULT_MODEL_DIR / "tma" / "tma.pt"
         if not tma.is_file():
             raise ShapeMoveError(f"no TMA given and the default model has none ({tma}); train one with "
