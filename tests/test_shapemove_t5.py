@@ -215,7 +215,7 @@ def test_minilm_decoder_learns_prompts_codes_and_betas(minilm, tmp_path):
         ids = m.vocab.target_ids(t)
         labels[i, : len(ids)] = torch.tensor(ids)
     opt = torch.optim.Adam(m.parameters(), lr=3e-3)
-    for _ in range(150):
+    for _ in range(300):
         out = m(x, mask, labels, betas, seg)
         opt.zero_grad()
         out["loss"].backward()

@@ -6,8 +6,10 @@ Two encoders (``encoder`` in the folder's ``shapemove.json``):
   (``text_encoder.py``). Shape text and motion text are encoded separately (segments 0 and 1),
   their token states projected 384 -> d_model and concatenated; a T5 *decoder* stack
   cross-attends to them and writes from its own motion-only vocabulary (pad, </s>, [BETA],
-  [SOM], [EOM], the N FSQ codes). Saved as ``model.safetensors`` + ``config.json`` (the
-  decoder's T5Config) + the encoder's fingerprint, which loading checks.
+  [SOM], [EOM], the N FSQ codes). The stack is ``t5_decoder.T5Decoder`` (T5Stack's maths and
+  parameter names in plain torch: loading never imports transformers). Saved as
+  ``model.safetensors`` + ``config.json`` (the decoder's sizes) + the encoder's fingerprint,
+  which loading checks.
 - ``"t5"``: a whole T5 encoder-decoder on a sentencepiece tokenizer trained on the captions (from
   scratch), or a local pretrained T5 folder (``--base-model``) with its own tokenizer; saved with
   ``save_pretrained`` + ``tokenizer.json`` (its sha256 recorded and checked on load).
@@ -63,41 +65,34 @@ def shapemove_prompt(motion_text: str, shape_text: str | None = None) -> str:
 
 
 class MiniLMDecoder(nn.Module):
-    """MiniLM token states -> (projection + segment embedding) -> T5 decoder stack -> motion logits."""
+    """MiniLM token states -> (projection + segment embedding) -> T5 decoder stack -> motion logits.
+    The stack is ``t5_decoder.T5Decoder`` (T5Stack's maths and parameter names, no transformers)."""
 
     def __init__(self, config, text_dim: int = 384):
         super().__init__()
-        from transformers.models.t5.modeling_t5 import T5Stack
+        from .t5_decoder import T5Decoder
 
         self.config = config
         d = config.d_model
         self.proj = nn.Sequential(nn.Linear(text_dim, d), nn.LayerNorm(d))
         self.segment = nn.Embedding(2, d)  # 0 shape text, 1 motion text
-        self.decoder = T5Stack(config)
+        self.decoder = T5Decoder(config)
         self.lm_head = nn.Linear(d, config.vocab_size, bias=False)
 
     @staticmethod
     def make_config(size: "T5Size", vocab_size: int):
-        from transformers import T5Config
+        from .t5_decoder import T5DecoderConfig
 
-        return T5Config(vocab_size=vocab_size, d_model=size.d_model, d_ff=size.d_ff, d_kv=size.d_kv,
-                        num_layers=size.num_decoder_layers, num_decoder_layers=size.num_decoder_layers,
-                        num_heads=size.num_heads, dropout_rate=size.dropout_rate, is_decoder=True,
-                        is_encoder_decoder=False, use_cache=True, pad_token_id=0, eos_token_id=1,
-                        decoder_start_token_id=0, tie_word_embeddings=False)
+        return T5DecoderConfig(vocab_size=vocab_size, d_model=size.d_model, d_ff=size.d_ff, d_kv=size.d_kv,
+                               num_heads=size.num_heads, num_layers=size.num_decoder_layers,
+                               dropout_rate=size.dropout_rate)
 
     def encode(self, states, mask, segments):
         return self.proj(states) + self.segment(segments), mask
 
     def step(self, enc, mask, decoder_ids, past=None, use_cache: bool = False):
-        if use_cache and past is None:  # self- and cross-attention caches (a bare stack would share one)
-            from transformers.cache_utils import DynamicCache, EncoderDecoderCache
-
-            past = EncoderDecoderCache(DynamicCache(config=self.config), DynamicCache(config=self.config))
-        out = self.decoder(input_ids=decoder_ids, encoder_hidden_states=enc, encoder_attention_mask=mask,
-                           past_key_values=past, use_cache=use_cache)
-        hidden = out.last_hidden_state
-        return self.lm_head(hidden), hidden, (out.past_key_values if use_cache else None)
+        hidden, cache = self.decoder(decoder_ids, enc, mask, cache=past, use_cache=use_cache)
+        return self.lm_head(hidden), hidden, cache
 
 
 class ShapeMoveT5(nn.Module):
@@ -271,14 +266,13 @@ class ShapeMoveT5(nn.Module):
         verify_manifest(directory, required=MINILM_FILES if encoder == "minilm" else T5_FILES)
         with damaged_model_errors(directory):
             if encoder == "minilm":
-                from transformers import T5Config
-
+                from .t5_decoder import T5DecoderConfig
                 from .text_encoder import HIDDEN, check_fingerprint, load_text_encoder
                 from .tokenizer import MotionVocab
 
                 check_fingerprint(info.get("text_encoder"), str(directory))
                 reader = load_text_encoder()
-                cfg = T5Config.from_json_file(str(directory / "config.json"))
+                cfg = T5DecoderConfig.from_dict(json.loads((directory / "config.json").read_text()))
                 vocab = MotionVocab.motion_only(int(info.get("num_codes", 0)))
                 if cfg.vocab_size != vocab.vocab_size:
                     raise ShapeMoveError(f"{directory}: config.json has {cfg.vocab_size} tokens, shapemove.json "
