@@ -64,6 +64,7 @@ def _train_tiny(data: Path, out: Path) -> None:
     shutil.copy2(runs / "vae" / "savae.pt", tmp / "savae.pt")
     shutil.copytree(runs / "t5" / "t5", tmp / "t5")
     shutil.copy2(runs / "tma" / "tma.pt", tmp / "tma" / "tma.pt")
-    shutil.copytree(runs / "tma" / "tokenizer", tmp / "tma" / "tokenizer")
+    if (runs / "tma" / "tokenizer").is_dir():  # sentencepiece TMAs only
+        shutil.copytree(runs / "tma" / "tokenizer", tmp / "tma" / "tokenizer")
     shutil.rmtree(out, ignore_errors=True)
     tmp.rename(out)
