@@ -97,7 +97,53 @@ def add_paraphrase(sub):
     p.set_defaults(_run=paraphrase_eval.from_cli)
 
 
-KINDS = [add_recon, add_generate, add_paraphrase]
+# -- eval retarget (HUMOS's application: SA-VAE retargeting against naive) ----------------------------
+RETARGET_BODIES = {"a very tall, heavy-set man": "height 195 cm, waist 110 cm", "a short, slim woman": "height 152 cm, waist 64 cm"}
+
+
+def add_retarget(sub):
+    p = sub.add_parser("retarget", help="SA-VAE retargeting against naive retargeting onto new bodies",
+                       description="Random test clips moved onto two bodies (a very tall heavy-set man, a short "
+                                   "slim woman) by the SA-VAE (encode -> decode with new betas) and naively "
+                                   "(copy rotations, scale the root path); physics on the new body's mesh")
+    p.add_argument("--data", type=Path, required=True, help="dataset folder from `data build`")
+    p.add_argument("--split", default="test", choices=["train", "val", "test"])
+    p.add_argument("--checkpoint", type=Path, required=True, help="SA-VAE run folder or .pt file")
+    p.add_argument("--json", type=Path, required=True, help="write the metrics here")
+    p.add_argument("--max-clips", type=int, default=10, help="a seeded random subset of N clips (default 10)")
+    p.add_argument("--seed", type=int, default=0)
+    p.set_defaults(_run=run_retarget)
+
+
+def run_retarget(args) -> int:
+    import numpy as np
+
+    from ..core.body.load import load_body_model
+    from ..core.body.shape_from_measurements import betas_from_shape_text
+    from ..core.errors import ShapeMoveError
+    from ..core.eval.retarget_compare import KEYS, compare_retargeting
+    from ..core.train.motion_dataset import read_split
+
+    clips = read_split(args.data, args.split)
+    if not clips:
+        raise ShapeMoveError(f"{args.data}: the {args.split} split is empty")
+    if args.max_clips < 1:
+        raise ShapeMoveError("--max-clips must be at least 1")
+    rng = np.random.default_rng(args.seed)
+    clips = [clips[i] for i in sorted(rng.choice(len(clips), min(args.max_clips, len(clips)), replace=False))]
+    body = load_body_model(None)
+    bodies = [betas_from_shape_text(body, text) for text in RETARGET_BODIES.values()]
+    result = compare_retargeting(args.data, args.checkpoint, clips, bodies, body=body)
+    result["bodies"] = list(RETARGET_BODIES)
+    atomic_write_json(args.json, result, nan_to_null=True)
+    print(f"{'metric':<20}{'SA-VAE':>10}{'naive':>10}")
+    for k in KEYS:
+        print(f"{k:<20}{result['savae'][k]:>10.2f}{result['naive'][k]:>10.2f}")
+    print(f"{len(clips)} clips x {len(bodies)} bodies; wrote {args.json}")
+    return 0
+
+
+KINDS = [add_recon, add_generate, add_paraphrase, add_retarget]
 
 
 def add_arguments(p):

@@ -22,10 +22,15 @@ RECON_ROWS = [
     ("mpjpe_mm", "MPJPE, global (mm)", 1, "—"),
     ("mpjpe_local_mm", "MPJPE, root-aligned (mm)", 1, "—"),
     ("bone_err_mm", "bone-length error (mm)", 1, "45.9"),
-    ("penetrate_cm", "penetrate (cm)", 2, "0.027"),
-    ("float_cm", "float (cm)", 2, "0.266"),
-    ("skate_pct", "skate (%)", 2, "6.1"),
-    ("dyn_stable_pct", "dynamic stability (% frames with ZMP in the base of support)", 1, "—"),
+    # the paper's figures stand only beside the paper's definitions (mean over ALL frames; GMD skate on
+    # the foot joints); ours (over the frames past 5 mm; skate on the foot vertices) have no paper figure
+    ("penetrate_all_cm", "penetrate, paper definition: mean over all frames (cm)", 3, "0.027"),
+    ("float_all_cm", "float, paper definition: mean over all frames (cm)", 3, "0.266"),
+    ("skate_joints_pct", "skate, GMD on the foot joints (%)", 2, "6.1"),
+    ("penetrate_cm", "penetrate, over frames > 5 mm under (cm)", 2, "—"),
+    ("float_cm", "float, over frames > 5 mm above (cm)", 2, "—"),
+    ("skate_pct", "skate, foot mesh vertices (%)", 2, "—"),
+    ("dyn_stable_pct", "dynamic stability (HUMOS: % frames with the ZMP in the base of support)", 1, "—"),
     ("code_usage_pct", "codebook usage (%)", 1, "—"),
 ]
 GENERATE_ROWS = [
@@ -33,10 +38,13 @@ GENERATE_ROWS = [
     ("r_precision_top3", "R-precision top 3", 3, "—"),
     ("matching_score", "matching score (lower is better)", 3, "—"),
     ("fid", "FID (TMA embeddings)", 3, "—"),
-    ("penetrate_cm", "penetrate (cm)", 2, "0.027"),
-    ("float_cm", "float (cm)", 2, "0.266"),
-    ("skate_pct", "skate (%)", 1, "6.1"),
-    ("dyn_stable_pct", "dynamic stability (%)", 1, "—"),
+    ("penetrate_all_cm", "penetrate, paper definition: mean over all frames (cm)", 3, "0.027"),
+    ("float_all_cm", "float, paper definition: mean over all frames (cm)", 3, "0.266"),
+    ("skate_joints_pct", "skate, GMD on the foot joints (%)", 1, "6.1"),
+    ("penetrate_cm", "penetrate, over frames > 5 mm under (cm)", 2, "—"),
+    ("float_cm", "float, over frames > 5 mm above (cm)", 2, "—"),
+    ("skate_pct", "skate, foot mesh vertices (%)", 1, "—"),
+    ("dyn_stable_pct", "dynamic stability (HUMOS, %)", 1, "—"),
     ("height_err_cm", "height error of the predicted body (cm)", 2, "0.58"),
     ("waist_err_cm", "waist error of the predicted body (cm)", 2, "—"),
 ]
