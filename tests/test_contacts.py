@@ -109,3 +109,21 @@ def test_soles_match_the_full_mesh(openbody):
     np.testing.assert_allclose(per_foot[:, 1], mesh[:, foot_r].min(1), atol=2e-4)
     # the candidates hold every vertex that can be lowest: the whole mesh's lowest point
     np.testing.assert_allclose(low, mesh.min(1), atol=5e-4)
+
+
+def test_ground_shift_caps_flight_of_predicted_contacts():
+    """A stretch without contact longer than ``max_flight`` is not a jump: its lowest point goes to
+    the floor; a short one keeps its interpolated flight; without the cap (mocap) both keep it."""
+    T = 30
+    low = np.zeros(T)
+    low[5:8] = 0.10            # a 3-frame hop: 10 cm of flight
+    low[12:28] = 0.40          # 16 frames "in the air": a decoder that missed the steps
+    per_foot = np.stack([low, low], 1)
+    c = np.zeros((T, 4), np.uint8)
+    c[:5, 0] = c[8:12, 0] = c[28:, 0] = 1
+    s = ground_shift(per_foot, low, c, max_flight=10)
+    h = low + s
+    np.testing.assert_allclose(h[5:8], 0.10)        # the hop stays a hop
+    np.testing.assert_allclose(h[12:28], 0.0)       # the long stretch stands on the floor
+    h_free = low + ground_shift(per_foot, low, c)
+    np.testing.assert_allclose(h_free[12:28], 0.40)  # measured contacts: heights kept (e.g. climbing)

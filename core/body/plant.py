@@ -58,14 +58,20 @@ def plant_targets(joints, contacts, sole_offsets, fade: int = FADE) -> tuple[np.
     return tgt, floor
 
 
-def ground_shift(per_foot, lowest_all, contacts) -> np.ndarray:
+MAX_FLIGHT = 10   # frames (0.5 s at 20 fps, a 30 cm jump): longer flights are missed steps
+
+
+def ground_shift(per_foot, lowest_all, contacts, max_flight: int | None = None) -> np.ndarray:
     """(T,) vertical shift that grounds a posed body on its mesh.
 
     per_foot (T,2) lowest vertex of the left/right foot, lowest_all (T,) lowest point of the body,
     contacts (T,4) of joints 7, 8, 10, 11. Frames where a foot is in contact: that foot's lowest
     vertex (the lower of two) goes to 0. Other frames: the shift is interpolated between contact
     frames (held at the ends). No contact at all: one shift for the clip, lowest point on 0.
-    Finally every frame is lifted where needed so that no point is below the floor."""
+    Finally every frame is lifted where needed so that no point is below the floor.
+    ``max_flight`` (frames): a stretch without contact longer than that cannot be a flight phase
+    (predicted contacts missed a step): its lowest point goes to the floor instead. None (measured
+    mocap contacts): every stretch keeps its interpolated height, e.g. climbing."""
     c = np.asarray(contacts).astype(bool)
     foot_on = np.stack([c[:, 0] | c[:, 2], c[:, 1] | c[:, 3]], axis=1)        # left, right
     support = foot_on.any(1)
@@ -76,6 +82,10 @@ def ground_shift(per_foot, lowest_all, contacts) -> np.ndarray:
         shift = np.interp(t, t[support], -lowest_contact[support])
     else:
         shift = np.full(len(c), -low_all.min())
+    if max_flight is not None:
+        for s, e in runs(~support):
+            if e - s > max_flight:
+                shift[s:e] = -low_all[s:e]
     return np.maximum(shift, -low_all)
 
 
@@ -127,7 +137,7 @@ def plant_motion(body, betas, joints, contacts, refine_iters: int = 10, gate: bo
     ik = solve_ik(targets, rest, refine_iters=refine_iters)
     transl = np.asarray(ik.transl, dtype=np.float64).copy()
     per_foot, _, low = probe.lowest(ik.rotations, transl)
-    shift = ground_shift(per_foot, low, c)
+    shift = ground_shift(per_foot, low, c, max_flight=MAX_FLIGHT)  # predicted contacts can miss steps
     transl[:, 1] += shift
     posed = _posed(ik, rest, body.parents)   # error against the input joints (floor removed)
     posed[..., 1] += shift[:, None]
