@@ -271,15 +271,11 @@ def test_model_folder_with_another_encoder_or_tokenizer_is_refused(minilm, model
         ShapeMoveT5.load(tmp_path / "b")
 
 
-def test_old_format_default_t5_still_loads():
-    import json
-
+def test_default_t5_reads_prompts_with_minilm():
+    """The embedded default: MiniLM encoder, FSQ-sized code vocabulary, a decode of bounded length."""
     from shapemove.core.generation.model_bundle import DEFAULT_MODEL_DIR
 
-    folder = DEFAULT_MODEL_DIR / "t5"
-    if json.loads((folder / "shapemove.json").read_text()).get("format") != "shapemove-t5/1":
-        pytest.skip("the default T5 has been retrained in the new format")
-    m, tok = ShapeMoveT5.load(folder)
-    assert m.encoder_kind == "t5" and m.vocab.num_codes == 1000
+    m, tok = ShapeMoveT5.load(DEFAULT_MODEL_DIR / "t5")
+    assert m.encoder_kind == "minilm" and m.vocab.num_codes == 1000
     d = decode(m, m.inputs_for(tok, ["a person walks forward"], [None]), 4, 8, temperature=0)
     assert 4 <= len(d.codes[0]) <= 8 and d.betas.shape == (1, 10)

@@ -222,15 +222,15 @@ def test_tma_records_its_text_encoder_and_refuses_another(trained, tmp_path):
         load_tma(tmp_path / "tma.pt")
 
 
-def test_sentencepiece_tma_of_the_old_default_still_loads():
+def test_default_tma_embeds_with_minilm():
+    """The embedded default TMA reads text through MiniLM: unit vectors, paraphrases closer than
+    unrelated actions."""
     from shapemove.core.generation.model_bundle import DEFAULT_MODEL_DIR
 
-    folder = DEFAULT_MODEL_DIR / "tma"
-    if not (folder / "tokenizer").is_dir():
-        pytest.skip("the default model's TMA is a MiniLM one now")
-    model, tok, mean, std = load_tma(folder)
-    assert model.cfg.text_encoder == "sentencepiece"
+    model, tok, mean, std = load_tma(DEFAULT_MODEL_DIR / "tma")
+    assert model.cfg.text_encoder == "minilm"
     from shapemove.core.eval.tma_embed import embed_texts
 
-    v = embed_texts(model, tok, ["a person walks forward", "a person kicks"])
+    v = embed_texts(model, tok, ["a person walks forward", "someone walks ahead", "a person does a backflip"])
     np.testing.assert_allclose(np.linalg.norm(v, axis=1), 1.0, atol=1e-5)
+    assert v[0] @ v[1] > v[0] @ v[2]
