@@ -27,7 +27,6 @@ Positions: metres, Y up. Local rotations as in ``kinematics.forward_kinematics``
 """
 from __future__ import annotations
 
-from contextlib import contextmanager
 from dataclasses import dataclass
 
 import numpy as np
@@ -36,6 +35,7 @@ import torch
 from ..errors import ShapeMoveError
 from ..geometry.torch_ops import (axis_angle_to_matrix, forward_kinematics, forward_kinematics_offsets, orthonormal_frame,
                                   rotation_between)
+from ..torch_threads import one_torch_thread
 from .skeleton import NUM_BODY_JOINTS, NUM_JOINTS, PARENTS
 
 # (limb root, hinge joint, end joint, hinge axis in the rest pose; positive angle = flexion)
@@ -91,16 +91,6 @@ def _smoothstep(x: torch.Tensor, lo: float, hi: float) -> torch.Tensor:
     return t * t * (3 - 2 * t)
 
 
-@contextmanager
-def _one_thread():
-    """Run torch on one thread: the tensors here are tiny (frames x 24 x 4 x 4), and intra-op
-    threads only add synchronisation (badly so on a busy machine)."""
-    n = torch.get_num_threads()
-    torch.set_num_threads(1)
-    try:
-        yield
-    finally:
-        torch.set_num_threads(n)
 
 
 # -- input checks --------------------------------------------------------------------------------
@@ -449,7 +439,7 @@ def solve_ik(joints, rest_joints, parents=PARENTS, refine_iters: int = 2, max_tu
     the body fits. Bad input raises ShapeMoveError.
     Returns local rotations (T,24,3,3) and transl (T,3) such that FK + transl ~ joints."""
     target, rest, parents = _prepare(joints, rest_joints, parents)
-    with _one_thread():
+    with one_torch_thread():
         rot, transl = analytic_ik(target, rest, parents, max_turn_deg)
         if refine_iters > 0:
             with torch.no_grad():
@@ -477,6 +467,6 @@ def ik_lbfgs_baseline(joints, rest_joints, iters: int = 100, parents=PARENTS) ->
         loss.backward()
         return loss
 
-    with _one_thread():
+    with one_torch_thread():
         opt.step(closure)
         return _result(axis_angle_to_matrix(aa.detach()), tr.detach(), target, rest, parents)

@@ -11,7 +11,6 @@ joints from the HumanML3D features -> IK onto the body with those betas -> ``Mot
 """
 from __future__ import annotations
 
-from contextlib import contextmanager
 from dataclasses import dataclass
 
 import numpy as np
@@ -20,9 +19,9 @@ import torch
 from ..constants import FPS
 from ..errors import ShapeMoveError
 from ..scene.motion_file import Motion
+from ..torch_threads import one_torch_thread
 from .decode import decode_tokens
 from .prompts import check_prompt
-
 
 
 @dataclass
@@ -50,17 +49,6 @@ def parse_betas(text: str) -> np.ndarray:
     return np.array(vals + [0.0] * (10 - len(vals)), dtype=np.float32)
 
 
-@contextmanager
-def one_thread():
-    """Torch on one thread for the prompt's small matrix products (reading the prompt, writing
-    ~50 tokens): threads only add waiting there, and on a busy 2-core machine waiting for a second
-    core made the T5 60x slower (6.8 s instead of 0.09 s for 50 tokens)."""
-    n = torch.get_num_threads()
-    torch.set_num_threads(1)
-    try:
-        yield
-    finally:
-        torch.set_num_threads(n)
 
 
 class Generator:
@@ -98,7 +86,7 @@ class Generator:
         if self.t5 is None:
             raise ShapeMoveError(f"{self.model_dir} has no t5/ model: text-to-motion needs one (train t5)")
         codes, betas = [], []
-        with one_thread():
+        with one_torch_thread():
             for r in reqs:  # one at a time: each has its own seed, length and temperature
                 g = torch.Generator().manual_seed(int(r.seed))
                 lo, hi = self._length(r.seconds)
@@ -157,7 +145,7 @@ class Generator:
             r.seed, r.temperature, r.top_k = check_sampling(r.seed, r.temperature, r.top_k)
         checks = []
         for r in reqs:  # every text checked before any generation
-            with one_thread():
+            with one_torch_thread():
                 checks.append(self.check_text(r.prompt))
                 if r.shape_text:
                     self.check_text(r.shape_text, "shape text")
