@@ -21,6 +21,7 @@ import pytest
 from shapemove.core.scene.motion_file import make_motion
 
 bpy = pytest.importorskip("bpy", reason="needs the bpy module (pip install bpy==5.0.1)")
+from bpy_readback import bone_heads_world, evaluated_vertices  # noqa: E402
 pytestmark = pytest.mark.blender
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -38,18 +39,6 @@ def _motion(body):
     return make_motion(body, poses, transl, rng.normal(0, 1, 10), fps=20, prompt="export test")
 
 
-def _heads(arm, names):
-    return np.array([list(arm.matrix_world @ arm.pose.bones[n].head) for n in names])
-
-
-def _vertices(obj):
-    ev = obj.evaluated_get(bpy.context.evaluated_depsgraph_get())
-    co = np.empty(len(ev.data.vertices) * 3, dtype=np.float32)
-    ev.data.vertices.foreach_get("co", co)
-    m = np.array(obj.matrix_world)
-    return co.reshape(-1, 3) @ m[:3, :3].T + m[:3, 3]
-
-
 @pytest.fixture(scope="module")
 def exported(tmp_path_factory, openbody):
     from shapemove.shapemove_addon import export
@@ -63,7 +52,7 @@ def exported(tmp_path_factory, openbody):
     ref = {}
     for f in range(1, FRAMES + 1):
         scene.frame_set(f)
-        ref[f] = (_heads(rig.armature, names), _vertices(rig.body))
+        ref[f] = (bone_heads_world(rig.armature, names), evaluated_vertices(rig.body))
     basis = np.array([list(v.co) for v in rig.body.data.shape_keys.key_blocks["Basis"].data])
     files = {fmt: export.export_rig(bpy.context, rig.armature, d / "rig", fmt) for fmt in export.FORMATS}
     yield dict(rig=rig, names=names, ref=ref, basis=basis, files=files, dir=d)
@@ -99,9 +88,9 @@ def _reimport(exported, fmt):
         for f in range(1, FRAMES + 1):  # the same scene frame == the same time (20 fps, frame 1 = 0 s)
             bpy.context.scene.frame_set(f)
             heads, verts = exported["ref"][f]
-            out["bone_err"].append(float(np.abs(_heads(arm, exported["names"]) * scale - heads).max()))
+            out["bone_err"].append(float(np.abs(bone_heads_world(arm, exported["names"]) * scale - heads).max()))
             if match is not None:
-                out["mesh_err"].append(float(np.abs(_vertices(body) - verts[match]).max()))
+                out["mesh_err"].append(float(np.abs(evaluated_vertices(body) - verts[match]).max()))
         rest = {b.name: b.head_local for b in arm.data.bones}
         out["upright"] = float((arm.matrix_world @ rest["head"]).z - (arm.matrix_world @ rest["pelvis"]).z) * scale
         return out

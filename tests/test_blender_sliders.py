@@ -11,6 +11,7 @@ from shapemove.core.scene.axes import points_to_z_up
 from shapemove.core.scene.motion_file import make_motion
 
 bpy = pytest.importorskip("bpy", reason="needs the bpy module (pip install bpy==5.0.1)")
+from bpy_readback import bone_heads_world, evaluated_vertices  # noqa: E402
 pytestmark = pytest.mark.blender
 
 FRAMES = 24
@@ -40,18 +41,6 @@ def _forward(body, betas, poses, transl):
         out = body.forward(torch.as_tensor(betas, dtype=torch.float32)[None].expand(len(poses), -1),
                            torch.as_tensor(poses, dtype=torch.float32), torch.as_tensor(transl, dtype=torch.float32))
     return out.joints.numpy().astype(np.float64), out.vertices.numpy().astype(np.float64)
-
-
-def _vertices(obj):
-    ev = obj.evaluated_get(bpy.context.evaluated_depsgraph_get())
-    co = np.empty(len(ev.data.vertices) * 3, dtype=np.float32)
-    ev.data.vertices.foreach_get("co", co)
-    m = np.array(obj.matrix_world)
-    return co.reshape(-1, 3) @ m[:3, :3].T + m[:3, 3]
-
-
-def _heads(arm, names):
-    return np.array([list(arm.matrix_world @ arm.pose.bones[n].head) for n in names])
 
 
 def _height_beta(body) -> int:
@@ -89,7 +78,7 @@ def _state(rig, frames):
     out = []
     for f in frames:
         bpy.context.scene.frame_set(f)
-        out.append((_heads(rig.armature, names), _vertices(rig.body)))
+        out.append((bone_heads_world(rig.armature, names), evaluated_vertices(rig.body)))
     return out
 
 
@@ -136,10 +125,10 @@ def test_shape_change_keeps_the_motion_and_the_feet_on_the_floor(scene, openbody
     rel_err, floor, ungrounded = [], [], []
     for k in range(FRAMES):
         bpy.context.scene.frame_set(1 + k)
-        heads = _heads(rig.armature, names[:22])
+        heads = bone_heads_world(rig.armature, names[:22])
         want = points_to_z_up(joints[k, :22])
         rel_err.append(np.abs((heads - heads[0]) - (want - want[0])).max())  # the pose is the motion's
-        floor.append(_vertices(rig.body)[:, 2].min())  # the body's lowest point: the soles
+        floor.append(evaluated_vertices(rig.body)[:, 2].min())  # the body's lowest point: the soles
         ungrounded.append(verts[k, :, 1].min())
     assert max(rel_err) <= MM
     assert np.abs(floor).max() <= MM, np.round(floor, 4)

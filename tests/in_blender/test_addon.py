@@ -23,6 +23,9 @@ os.environ["BLENDER_USER_RESOURCES"] = CONFIG["user_resources"]
 
 import bpy  # noqa: E402
 
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))  # tests/: bpy_readback
+from bpy_readback import bone_heads_world, evaluated_vertices  # noqa: E402
+
 ADDON = "bl_ext.user_default.shapemove"
 FRAMES = CONFIG["frames"]
 MM = 1e-3
@@ -35,18 +38,6 @@ def ext(name):
 
 def datablock_counts():
     return {k: len(getattr(bpy.data, k)) for k in ("objects", "meshes", "armatures", "actions", "shape_keys", "collections")}
-
-
-def bone_heads_world(arm, names):
-    return np.array([list(arm.matrix_world @ arm.pose.bones[n].head) for n in names])
-
-
-def evaluated_vertices(obj):
-    ev = obj.evaluated_get(bpy.context.evaluated_depsgraph_get())
-    co = np.empty(len(ev.data.vertices) * 3, dtype=np.float32)
-    ev.data.vertices.foreach_get("co", co)
-    m = np.array(obj.matrix_world)
-    return co.reshape(-1, 3) @ m[:3, :3].T + m[:3, 3]
 
 
 def build(motion_path, model_file=""):
