@@ -33,6 +33,7 @@ from ..errors import ShapeMoveError
 from ..models.shapemove_t5 import ShapeMoveT5, T5Size, size_from_dict
 from ..models.tokenizer import add_motion_tokens, load_tokenizer, tokenizer_from_sentencepiece, train_sentencepiece
 from . import distributed
+from .checkpoint_cadence import finish, save_if_due
 from .run_log import record
 from .checkpoint import config_differences, load_checkpoint, save_checkpoint
 from .t5_dataset import T2MExamples, all_texts, collate, collate_minilm, tokenize_clips
@@ -237,13 +238,8 @@ def _train(data, vae_path, out, c, base_model, resume, dist, progress, cancel, v
             if dist.is_main:
                 bar.set_postfix(ce=f"{m['ce']:.3f}", l1=f"{m['l1']:.3f}")
                 record(out, metrics, progress, step, c.steps, f"ce {m['ce']:.3f}")
-        if step % c.ckpt_every == 0 and step < c.steps:
-            save()
-    bar.close()
-    save(final=step >= c.steps)
-    distributed.barrier(dist)
-    metrics["step"] = step
-    return metrics
+        save_if_due(save, step, c.ckpt_every, c.steps, dist)
+    return finish(save, bar, step, c.steps, dist, metrics)
 
 
 def from_cli(args) -> dict:

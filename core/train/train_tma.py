@@ -35,6 +35,7 @@ from ..errors import ShapeMoveError
 from ..eval.tma_embed import KIND, eval_pairs, pad_batch, score_pairs, text_inputs
 from ..models.tma import TMA, TMAConfig
 from . import distributed
+from .checkpoint_cadence import finish, save_if_due
 from .run_log import record
 from .checkpoint import load_checkpoint, make_metadata, save_checkpoint, stats_hash
 from .motion_dataset import load_stats, read_split
@@ -319,14 +320,8 @@ def _train(data, out, c, resume, body_name, dist, progress, cancel, verbose) -> 
                 bar.set_postfix(loss=f"{train_metrics['loss']:.3f}",
                                 **({"r1": f"{metrics['val']['r_precision_top1']:.3f}"} if "val" in metrics else {}))
                 record(out, metrics, progress, step, c.steps, f"loss {train_metrics['loss']:.3f}")
-        if step % c.ckpt_every == 0 and step < c.steps:
-            save()
-            distributed.barrier(dist)
-    bar.close()
-    save(final=step >= c.steps)
-    distributed.barrier(dist)
-    metrics["step"] = step
-    return metrics
+        save_if_due(save, step, c.ckpt_every, c.steps, dist)
+    return finish(save, bar, step, c.steps, dist, metrics)
 
 
 def from_cli(args) -> dict:

@@ -30,6 +30,7 @@ from ..models.fsq import codebook_usage
 from ..models.savae import SAVAE, SAVAEConfig, TrainSettings
 from ..models.vae_losses import bone_lengths, vae_losses
 from . import distributed
+from .checkpoint_cadence import finish, save_if_due
 from .run_log import record
 from .checkpoint import load_checkpoint, make_metadata, save_checkpoint, stats_hash
 from .motion_dataset import BatchStream, MotionClips
@@ -220,14 +221,8 @@ def _train(data, out, cfg, t, resume, body, dist, progress, cancel, verbose) -> 
                 bar.set_postfix(loss=f"{train_metrics['total']:.4f}",
                                 **({"val": f"{metrics['val']['total']:.4f}"} if "val" in metrics else {}))
                 record(out, metrics, progress, step, t.steps, f"loss {train_metrics['total']:.4f}")
-        if step % t.ckpt_every == 0 and step < t.steps:
-            save()
-            distributed.barrier(dist)
-    bar.close()
-    save(final=step >= t.steps)
-    distributed.barrier(dist)
-    metrics["step"] = step
-    return metrics
+        save_if_due(save, step, t.ckpt_every, t.steps, dist)
+    return finish(save, bar, step, t.steps, dist, metrics)
 
 
 def from_cli(args) -> dict:
