@@ -33,10 +33,6 @@ from .splits import split_of
 MIN_FRAMES = 24          # 1.2 s; the SA-VAE trains on the clips of >= 64 frames, the T5 on all
 AUGMENT_SHARE = 0.5      # fraction of Bandai clips that get one copy on a sampled body
 AUGMENT_BETA_CLIP = 2.5  # sampled betas ~ N(0,1) clipped to +-2.5
-# Ridge prior of the betas fit, in m^2: ~2 cm of bone-length noise. A mapped mocap skeleton never
-# matches the body model's joint layout exactly (torso, hips); with a weak prior the fit explains
-# that mismatch with absurd bodies (|betas| ~ 25-40, waists of 3 m). 4e-4 keeps |betas| ~ 1-2.
-FIT_REG = 4e-4
 
 SUBDIRS = ["new_joints", "new_joint_vecs", "norm_joints", "norm_joint_vecs", "betas", "poses", "transl",
            "contacts", "texts", "shape_texts", "meta"]

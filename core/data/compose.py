@@ -151,10 +151,9 @@ def compose_arrays(proc, a: Part, b: Part) -> dict:
 
     rest_a = proc.body.rest_joints(torch.as_tensor(a.betas)[None])[0].numpy()
     rest_b = proc.body.rest_joints(torch.as_tensor(b.betas)[None])[0].numpy()
-    pelvis_h = lambda r: r[0, 1] - min(r[7, 1], r[8, 1], r[10, 1], r[11, 1])  # noqa: E731
-    rot, root, contacts = join(a, b, pelvis_h(rest_a) / pelvis_h(rest_b))
+    rot, root, contacts = join(a, b, proc.stride_scale(rest_b, a.betas))
     shaped = proc.pose_on(rot, root, a.betas, 1.0, contacts)
-    normal = proc.pose_on(rot, root, np.zeros(10, np.float32), pelvis_h(proc.rest0) / pelvis_h(rest_a), contacts)
+    normal = proc.pose_on(rot, root, np.zeros(10, np.float32), proc.stride_scale(rest_a, None), contacts)
     return {
         "new_joints": shaped, "new_joint_vecs": proc.features(shaped, rot, contacts),
         "norm_joints": normal, "norm_joint_vecs": proc.features(normal, rot, contacts),
