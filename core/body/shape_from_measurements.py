@@ -28,6 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..atomic import atomic_path
 from ..errors import ShapeMoveError
 from .measure import MEASUREMENTS, measure_mesh
 from .skeleton import JOINT_INDEX as JI
@@ -87,12 +88,8 @@ class GirthRegression:
         return out[:, [GIRTHS.index(k) for k in keys]]
 
     def save(self, path: Path) -> None:
-        import os
-
-        path = Path(path)
-        tmp = path.with_name(path.name + ".tmp.npz")
-        np.savez(tmp, coef=self.coef, key=np.array(self.key), rms_cm=self.rms_cm, girths=np.array(GIRTHS))
-        os.replace(tmp, path)
+        with atomic_path(path, suffix=".npz") as tmp:
+            np.savez(tmp, coef=self.coef, key=np.array(self.key), rms_cm=self.rms_cm, girths=np.array(GIRTHS))
 
     @classmethod
     def load(cls, path: Path) -> "GirthRegression":
