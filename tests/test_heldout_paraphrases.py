@@ -73,3 +73,17 @@ def test_no_held_out_prompt_is_a_generated_caption(mocap_root):
 @pytest.mark.parametrize("probe", ["A person walks forward.", "Someone is waving with the left hand."])
 def test_the_clash_check_would_catch_a_generated_sentence(probe):
     assert norm(probe) in _generator_space()
+
+
+def test_blind_set_loads_names_known_actions_and_shares_no_prompt_with_the_first_set():
+    """configs/heldout_paraphrases_blind.json: a second set written blind by another author."""
+    from shapemove.core.eval.paraphrase_eval import load_prompts
+
+    blind = load_prompts(PATH.with_name("heldout_paraphrases_blind.json"))
+    assert len(blind) >= 150
+    unknown = sorted({n for p in blind for n in [p["action"], *p["also"]] if n not in ACTIONS})
+    assert not unknown, f"unknown action names: {unknown}"
+    assert len({p["action"] for p in blind}) >= 45
+    first = {p["text"].strip().lower() for p in load_prompts(PATH)}
+    shared = sum(p["text"].strip().lower() in first for p in blind)
+    assert shared == 0, f"{shared} blind prompts repeat a prompt of the first held-out set"
