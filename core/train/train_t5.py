@@ -19,7 +19,6 @@ and actions with their MiniLM vectors: ``known_texts.py``).
 from __future__ import annotations
 
 import random
-import time
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
@@ -34,7 +33,7 @@ from ..models.shapemove_t5 import ShapeMoveT5, T5Size, size_from_dict
 from ..models.tokenizer import add_motion_tokens, load_tokenizer, tokenizer_from_sentencepiece, train_sentencepiece
 from . import distributed
 from .checkpoint_cadence import finish, save_if_due
-from .run_log import record
+from .run_log import StepLog
 from .checkpoint import config_differences, load_checkpoint, save_checkpoint
 from .t5_dataset import T2MExamples, all_texts, collate, collate_minilm, tokenize_clips
 from .train_vae import rng_state, set_rng_state
@@ -126,7 +125,6 @@ def train_t5(data, vae, out, config: T5TrainConfig | None = None, base_model=Non
 
 
 def _train(data, vae_path, out, c, base_model, resume, dist, progress, cancel, verbose) -> dict:
-    from tqdm import tqdm
 
     out.mkdir(parents=True, exist_ok=True)
     # -- 1. motion tokens from the frozen SA-VAE (cached per VAE file) -------------------------
@@ -208,9 +206,7 @@ def _train(data, vae_path, out, c, base_model, resume, dist, progress, cancel, v
             raw.save(out / "t5", None if c.encoder == "minilm" else tok, meta | {"step": step},
                      known=build_known(data, train_ids, states))
 
-    bar = tqdm(total=c.steps, initial=step, desc="train t5", unit="step", disable=not (dist.is_main and verbose))
-    metrics: dict = {"step": step}
-    t0, s0 = time.time(), step
+    log = StepLog(out, c.steps, step, dist, progress, "train t5", verbose)
     model.train()
     while step < c.steps:
         if distributed.broadcast_flag(bool(cancel and dist.is_main and cancel()), dist):
@@ -229,17 +225,13 @@ def _train(data, vae_path, out, c, base_model, resume, dist, progress, cancel, v
         optimizer.step()
         scheduler.step()
         step += 1
-        bar.update(1)
+        log.bar.update(1)
         if step % c.log_every == 0 or step == c.steps:
-            m = distributed.mean_over_ranks({"loss": float(res["loss"].detach()), "ce": float(res["ce"]), "l1": float(res["l1"])}, dist)
-            metrics = {"step": step, "lr": scheduler.get_last_lr()[0], "train": m,
-                       "sec_per_step": (time.time() - t0) / max(1, step - s0)}
-            t0, s0 = time.time(), step
-            if dist.is_main:
-                bar.set_postfix(ce=f"{m['ce']:.3f}", l1=f"{m['l1']:.3f}")
-                record(out, metrics, progress, step, c.steps, f"ce {m['ce']:.3f}")
+            log.log(step, scheduler.get_last_lr()[0],
+                    {"loss": float(res["loss"].detach()), "ce": float(res["ce"]), "l1": float(res["l1"])},
+                    {"ce": ("train", "ce"), "l1": ("train", "l1")})
         save_if_due(save, step, c.ckpt_every, c.steps, dist)
-    return finish(save, bar, step, c.steps, dist, metrics)
+    return finish(save, log.bar, step, c.steps, dist, log.metrics)
 
 
 def from_cli(args) -> dict:

@@ -20,7 +20,6 @@ from __future__ import annotations
 
 import math
 import os
-import time
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
@@ -36,7 +35,7 @@ from ..eval.tma_embed import KIND, eval_pairs, pad_batch, score_pairs, text_inpu
 from ..models.tma import TMA, TMAConfig
 from . import distributed
 from .checkpoint_cadence import finish, save_if_due
-from .run_log import record
+from .run_log import StepLog
 from .checkpoint import load_checkpoint, make_metadata, save_checkpoint, stats_hash
 from .motion_dataset import load_stats, read_split
 from .t5_dataset import read_lines
@@ -228,8 +227,6 @@ def _text_reader(data: Path, out: Path, c: TMATrainConfig, dist, texts: list[str
 
 
 def _train(data, out, c, resume, body_name, dist, progress, cancel, verbose) -> dict:
-    from tqdm import tqdm
-
     out.mkdir(parents=True, exist_ok=True)
     # -- data and tokenizer ------------------------------------------------------------------
     mean, std = load_stats(data)
@@ -279,15 +276,13 @@ def _train(data, out, c, resume, body_name, dist, progress, cancel, verbose) -> 
             save_checkpoint(out / "tma.pt", {"model": model.state_dict()}, meta)
 
     def validate() -> dict:
-        if len(val_feats) >= 2:
-            return score_pairs(model, tok, mean, std, val_feats, val_texts)
-        return {}
+        val = score_pairs(model, tok, mean, std, val_feats, val_texts) if len(val_feats) >= 2 else {}
+        model.train()
+        return val
 
     if dist.is_main:
         atomic_write_json(out / "config.json", asdict(c))
-    bar = tqdm(total=c.steps, initial=step, desc="train tma", unit="step", disable=not (dist.is_main and verbose))
-    metrics: dict = {"step": step}
-    t0, s0 = time.time(), step
+    log = StepLog(out, c.steps, step, dist, progress, "train tma", verbose)
     model.train()
     # -- loop ----------------------------------------------------------------------------------
     while step < c.steps:
@@ -304,24 +299,14 @@ def _train(data, out, c, resume, body_name, dist, progress, cancel, verbose) -> 
         optimizer.step()
         scheduler.step()
         step += 1
-        bar.update(1)
+        log.bar.update(1)
         done = step == c.steps
         if done or step % c.log_every == 0 or step % c.val_every == 0:
-            train_metrics = distributed.mean_over_ranks({"loss": loss.item()}, dist)
-            metrics = {"step": step, "lr": scheduler.get_last_lr()[0], "train": train_metrics,
-                       "sec_per_step": (time.time() - t0) / max(1, step - s0)}
-            if dist.is_main and (done or step % c.val_every == 0):
-                val = validate()
-                model.train()
-                if val:
-                    metrics["val"] = val
-            t0, s0 = time.time(), step
-            if dist.is_main:
-                bar.set_postfix(loss=f"{train_metrics['loss']:.3f}",
-                                **({"r1": f"{metrics['val']['r_precision_top1']:.3f}"} if "val" in metrics else {}))
-                record(out, metrics, progress, step, c.steps, f"loss {train_metrics['loss']:.3f}")
+            log.log(step, scheduler.get_last_lr()[0], {"loss": loss.item()},
+                    {"loss": ("train", "loss"), "r1": ("val", "r_precision_top1")},
+                    validate if done or step % c.val_every == 0 else None)
         save_if_due(save, step, c.ckpt_every, c.steps, dist)
-    return finish(save, bar, step, c.steps, dist, metrics)
+    return finish(save, log.bar, step, c.steps, dist, log.metrics)
 
 
 def from_cli(args) -> dict:

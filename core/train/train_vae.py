@@ -14,7 +14,6 @@ from __future__ import annotations
 import copy
 import math
 import random
-import time
 from pathlib import Path
 
 import numpy as np
@@ -31,7 +30,7 @@ from ..models.savae import SAVAE, SAVAEConfig, TrainSettings
 from ..models.vae_losses import bone_lengths, vae_losses
 from . import distributed
 from .checkpoint_cadence import finish, save_if_due
-from .run_log import record
+from .run_log import StepLog
 from .checkpoint import load_checkpoint, make_metadata, save_checkpoint, stats_hash
 from .motion_dataset import BatchStream, MotionClips
 
@@ -144,8 +143,6 @@ def train_vae(data, out, config: SAVAEConfig | None = None, steps: int | None = 
 
 
 def _train(data, out, cfg, t, resume, body, dist, progress, cancel, verbose) -> dict:
-    from tqdm import tqdm
-
     if t.batch_size % dist.world_size:
         raise ShapeMoveError(f"batch_size {t.batch_size} must be divisible by the number of processes ({dist.world_size})")
     # -- data ----------------------------------------------------------------------------------
@@ -190,9 +187,7 @@ def _train(data, out, cfg, t, resume, body, dist, progress, cancel, verbose) -> 
                                                               dist.world_size, t.seed, start_step=step),
                          num_workers=t.num_workers, pin_memory=dist.device.type == "cuda")
     batch_iter = iter(batches)
-    bar = tqdm(total=t.steps, initial=step, desc="train vae", unit="step", disable=not (dist.is_main and verbose))
-    metrics: dict = {"step": step}
-    t0, t0_step = time.time(), step
+    log = StepLog(out, t.steps, step, dist, progress, "train vae", verbose)
     model.train()
     # -- loop ----------------------------------------------------------------------------------
     while step < t.steps:
@@ -208,21 +203,15 @@ def _train(data, out, cfg, t, resume, body, dist, progress, cancel, verbose) -> 
         optimizer.step()
         scheduler.step()
         step += 1
-        bar.update(1)
+        log.bar.update(1)
         done = step == t.steps
         if done or step % t.log_every == 0 or step % t.val_every == 0:
-            train_metrics = distributed.mean_over_ranks({k: float(v.detach()) for k, v in losses.items()}, dist)
-            metrics = {"step": step, "lr": scheduler.get_last_lr()[0], "train": train_metrics,
-                       "sec_per_step": (time.time() - t0) / (step - t0_step)}
-            if dist.is_main and (done or step % t.val_every == 0) and len(val_set):
-                metrics["val"] = evaluate(raw, val_set, cfg, dist.device, body)
-            t0, t0_step = time.time(), step
-            if dist.is_main:
-                bar.set_postfix(loss=f"{train_metrics['total']:.4f}",
-                                **({"val": f"{metrics['val']['total']:.4f}"} if "val" in metrics else {}))
-                record(out, metrics, progress, step, t.steps, f"loss {train_metrics['total']:.4f}")
+            validate = (lambda: evaluate(raw, val_set, cfg, dist.device, body)) \
+                if (done or step % t.val_every == 0) and len(val_set) else None
+            log.log(step, scheduler.get_last_lr()[0], {k: float(v.detach()) for k, v in losses.items()},
+                    {"loss": ("train", "total"), "val": ("val", "total")}, validate, digits=4)
         save_if_due(save, step, t.ckpt_every, t.steps, dist)
-    return finish(save, bar, step, t.steps, dist, metrics)
+    return finish(save, log.bar, step, t.steps, dist, log.metrics)
 
 
 def from_cli(args) -> dict:
