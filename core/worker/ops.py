@@ -9,14 +9,10 @@ panel ops of ``jobs_shapemove`` join through ``default_jobs()``, which the runne
 """
 from __future__ import annotations
 
-import io
 import sys
-from collections import deque
-from contextlib import redirect_stderr
 from pathlib import Path
 
 from ... import __version__
-from ...cli import COMMANDS, main
 from ..errors import ShapeMoveError
 from .op_support import param, str_list
 from .protocol import CONTROL_OPS
@@ -103,48 +99,12 @@ def train_vae(params, progress, cancel) -> dict:
     return {"metrics": metrics, "out": param(params, op, "out", str)}
 
 
-class _Tail(io.TextIOBase):
-    """Forwards writes to ``target`` and keeps the last lines (for the error message)."""
-
-    def __init__(self, target, lines: int = 20):
-        self.target, self.lines = target, deque(maxlen=lines)
-
-    def write(self, s: str) -> int:
-        self.target.write(s)
-        self.lines.extend(line for line in s.replace("\r", "\n").split("\n") if line.strip())
-        return len(s)
-
-    def flush(self) -> None:
-        self.target.flush()
-
-
-def cli(params, progress, cancel) -> dict:
-    """params {"argv": ["data", "build", ...]}: run a `python -m shapemove` command in this process.
-    Its printed output arrives as log messages; a failure -> error with its last stderr lines.
-    Commands have no cancel hook: a cancelled cli job still runs to its end."""
-    argv = str_list(params, "cli", "argv")
-    if not argv or argv[0] not in COMMANDS or argv[0] == "worker":
-        known = ", ".join(c for c in COMMANDS if c != "worker")
-        raise ShapeMoveError(f"op 'cli': argv must start with a command ({known}), got {argv[:1]}")
-    tail = _Tail(sys.stderr)
-    with redirect_stderr(tail):
-        try:
-            code = main(argv)
-        except SystemExit as exc:  # argparse errors
-            code = exc.code if isinstance(exc.code, int) else 2
-    if code:
-        why = "; ".join(list(tail.lines)[-3:]) or "no message"
-        raise ShapeMoveError(f"`shapemove {' '.join(argv)}` failed (exit code {code}): {why}")
-    return {"exit_code": 0}
-
-
 JOBS: dict = {
     "env_info": env_info,
     "body_info": body_info,
     "measure": measure,
     "build_dataset": build_dataset,
     "train_vae": train_vae,
-    "cli": cli,
 }
 
 
