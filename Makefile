@@ -58,7 +58,8 @@ eval: setup
 	$(PY) -m shapemove eval recon --data $(BUILT) --split test --checkpoint runs/untrained/savae.pt --max-clips 40 --json out/eval_recon_untrained.json
 	$(PY) -m shapemove eval generate --data $(BUILT) --split test --model weights/default --max-clips 60 --json out/eval_generate.json
 	$(PY) -m shapemove eval retarget --data $(BUILT) --checkpoint weights/default/savae.pt --json out/eval_retarget.json
-	$(PY) -m shapemove eval paraphrase --model weights/default --json out/eval_paraphrase.json
+	$(PY) -m shapemove eval paraphrase --model weights/default --data $(BUILT) --json out/eval_paraphrase.json
+	$(PY) -m shapemove eval paraphrase --model weights/default --data $(BUILT) --prompts configs/heldout_paraphrases_blind.json --json out/eval_paraphrase_blind.json
 	$(PY) tools/eval_report.py
 
 extension: setup

@@ -91,7 +91,7 @@ def _exit_code(result) -> int:
 def add_paraphrase(sub):
     from ..core.eval import paraphrase_eval
 
-    p = sub.add_parser("paraphrase", help="held-out paraphrases: generated motion's action by the TMA, per action",
+    p = sub.add_parser("paraphrase", help="held-out paraphrases: generated motion's action (5 nearest training clips in TMA motion space), per action",
                        description=paraphrase_eval.__doc__.splitlines()[0])
     paraphrase_eval.add_arguments(p)
     p.set_defaults(_run=paraphrase_eval.from_cli)

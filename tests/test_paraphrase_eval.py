@@ -10,14 +10,14 @@ from tiny_models import tiny_bundle  # noqa: F401  (session fixture)
 def test_paraphrase_eval_on_a_tiny_model(tiny_bundle, tmp_path, capsys):  # noqa: F811
     from shapemove.cli import main
 
-    model, _ = tiny_bundle
+    model, data = tiny_bundle
     prompts = {"prompts": [{"text": "Someone strolls down the street.", "action": "walk"},
                            {"text": "A footballer boots the ball away.", "action": "kick", "also": ["kick ball"]},
                            {"text": "The kid dashes to the bus.", "action": "run", "also": ["sprint", "walk"]},
                            {"text": "A person does a handstand on the beach.", "action": "handstand"}]}
     (tmp_path / "p.json").write_text(json.dumps(prompts))
     assert main(["eval", "paraphrase", "--model", str(model), "--prompts", str(tmp_path / "p.json"), "--seconds", "1",
-                 "--json", str(tmp_path / "r.json"), "--quiet"]) == 0
+                 "--data", str(data), "--json", str(tmp_path / "r.json"), "--quiet"]) == 0
     out = capsys.readouterr().out
     res = json.loads((tmp_path / "r.json").read_text())
     known = res["actions"]
@@ -25,12 +25,22 @@ def test_paraphrase_eval_on_a_tiny_model(tiny_bundle, tmp_path, capsys):  # noqa
     assert "handstand" in res["unknown_action"] and res["unknown_prompts"] == len(prompts["prompts"]) - len(expected_known)
     rows = res["rows"]
     assert [r["text"] for r in rows] == [p["text"] for p in expected_known]
-    for kind in ("motion", "text"):
-        strict = sum(r[f"{kind}_pred"] == r["action"] for r in rows)
-        lenient = sum(r[f"{kind}_pred"] == r["action"] or r[f"{kind}_pred"] in r["also"] for r in rows)
+    # the kNN classifier read every training clip of the dataset whose main action the model knows
+    metas = [json.loads(ln) for ln in (data / "meta.jsonl").read_text().splitlines() if ln.strip()]
+    train = set((data / "train.txt").read_text().split())
+    labelled = [m["labels"]["actions"][0] for m in metas
+                if m["id"] in train and (m.get("labels") or {}).get("actions") and m["labels"]["actions"][0] in known]
+    clf = res["classifier"]
+    assert clf["clips"] == len(labelled) and clf["k"] == 5 and clf["split"] == "train"
+    assert clf["actions_without_clips"] == sorted(set(known) - set(labelled))
+    assert all(r["motion_pred"] in labelled for r in rows)  # kNN names only actions of training clips
+    assert clf["ceiling"]["split"] == "test" and "names real test clips' action" in out
+    for kind, pred in (("motion", "motion"), ("text", "text"), ("motion_vs_text_prototypes", "motion_proto")):
+        strict = sum(r[f"{pred}_pred"] == r["action"] for r in rows)
+        lenient = sum(r[f"{pred}_pred"] == r["action"] or r[f"{pred}_pred"] in r["also"] for r in rows)
         assert res[kind]["accuracy"] == pytest.approx(strict / len(rows))
         assert res[kind]["accuracy_lenient"] == pytest.approx(lenient / len(rows))
-        assert all(r[f"{kind}_pred"] in known for r in rows)
+        assert all(r[f"{pred}_pred"] in known for r in rows)
     assert "overall" in out and "Held-out paraphrases" in out
 
 
@@ -46,3 +56,44 @@ def test_bad_prompt_files(tmp_path):
         load_prompts(tmp_path / "b.json")
     with pytest.raises(ShapeMoveError, match="not found"):
         load_prompts(tmp_path / "missing.json")
+
+
+def _para_result(motion, ceiling, text, proto, prompts):
+    def col(v):
+        return {"accuracy": v, "accuracy_lenient": v + 0.05, "prompts": prompts, "per_action": {}}
+
+    return {"motion": col(motion), "text": col(text), "motion_vs_text_prototypes": col(proto),
+            "classifier": {"k": 5, "ceiling": {"accuracy": ceiling, "accuracy_lenient": ceiling, "clips": 467}}}
+
+
+def test_eval_report_writes_the_paraphrase_table(tmp_path):
+    import importlib.util
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    spec = importlib.util.spec_from_file_location("eval_report", root / "tools" / "eval_report.py")
+    rep = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(rep)
+    (tmp_path / "p.json").write_text(json.dumps(_para_result(0.612, 0.949, 0.362, 0.092, 141)))
+    (tmp_path / "b.json").write_text(json.dumps(_para_result(0.55, 0.949, 0.30, 0.08, 188)))
+    readme = tmp_path / "README.md"
+    readme.write_text("x\n<!-- eval:paraphrase -->\nstale table\n<!-- /eval:paraphrase -->\ny\n")
+    none = ["--recon", str(tmp_path / "no.json"), "--generate", str(tmp_path / "no.json")]
+    args = none + ["--paraphrase", str(tmp_path / "p.json"), "--readme", str(readme)]
+    assert rep.main(args + ["--paraphrase-blind", str(tmp_path / "missing.json")]) == 0
+    text = readme.read_text()
+    assert "stale table" not in text and "held-out paraphrases (141 prompts)" in text and "blind" not in text
+    rows = {ln.split(" | ")[0].strip("| "): ln.split(" | ")[1:] for ln in text.splitlines() if ln.startswith("| ")}
+    strict = "generated motion (5 nearest training clips in TMA motion space), strict"
+    assert rows[strict][0].strip(" |") == "61.2 %"
+    assert rows["the same classifier on real test clips (ceiling), strict"][0].strip(" |") == "94.9 %"
+    assert rows["prompt's TMA text vs action text prototypes, lenient"][0].strip(" |") == "41.2 %"
+    assert rows["generated motion vs action text prototypes (older classifier), strict"][0].strip(" |") == "9.2 %"
+    assert rep.main(args + ["--paraphrase-blind", str(tmp_path / "b.json")]) == 0
+    rows = {ln.split(" | ")[0].strip("| "): ln.split(" | ")[1:] for ln in readme.read_text().splitlines()
+            if ln.startswith("| ")}
+    assert [c.strip(" |") for c in rows[strict]] == ["61.2 %", "55.0 %"]
+    plain = tmp_path / "PLAIN.md"
+    plain.write_text("no paraphrase block\n")
+    assert rep.main(none + ["--paraphrase", str(tmp_path / "p.json"), "--readme", str(plain)]) == 0
+    assert plain.read_text() == "no paraphrase block\n"

@@ -1,10 +1,13 @@
-"""Write the evaluation tables into the README from the JSON of `eval recon` / `eval generate`.
+"""Write the evaluation tables into the README from the JSON of `eval recon` / `eval generate` / `eval paraphrase`.
 
     python tools/eval_report.py [--recon out/eval_recon.json] [--untrained out/eval_recon_untrained.json]
-                                [--generate out/eval_generate.json] [--readme README.md]
+                                [--generate out/eval_generate.json] [--paraphrase out/eval_paraphrase.json]
+                                [--paraphrase-blind out/eval_paraphrase_blind.json] [--readme README.md]
 
 Each table sits between ``<!-- eval:recon -->`` / ``<!-- /eval:recon -->`` (and ``eval:generate``)
-markers in the README and is replaced whole; the paper's figures stand beside for reference.
+markers in the README and is replaced whole; the paper's figures stand beside for reference. The
+paraphrase table (``eval:paraphrase``, with the blind set's column when its JSON exists) is written
+only where the README has that block.
 """
 from __future__ import annotations
 
@@ -75,6 +78,39 @@ def generate_table(gen: dict) -> str:
     return "\n".join(lines)
 
 
+PARAPHRASE_ROWS = [  # (label, result key, metric key): percentages of the held-out prompts
+    ("generated motion (5 nearest training clips in TMA motion space), strict", "motion", "accuracy"),
+    ("generated motion, lenient (an 'also' action counts)", "motion", "accuracy_lenient"),
+    ("the same classifier on real test clips (ceiling), strict", "ceiling", "accuracy"),
+    ("the same classifier on real test clips (ceiling), lenient (any of the clip's actions)", "ceiling", "accuracy_lenient"),
+    ("prompt's TMA text vs action text prototypes, strict", "text", "accuracy"),
+    ("prompt's TMA text vs action text prototypes, lenient", "text", "accuracy_lenient"),
+    ("generated motion vs action text prototypes (older classifier), strict", "motion_vs_text_prototypes", "accuracy"),
+    ("generated motion vs action text prototypes, lenient", "motion_vs_text_prototypes", "accuracy_lenient"),
+]
+
+
+def _paraphrase_cell(res: dict | None, key: str, metric: str) -> str:
+    if res is None:
+        return "—"
+    col = ((res.get("classifier") or {}).get("ceiling") or {}) if key == "ceiling" else (res.get(key) or {})
+    v = col.get(metric)
+    return "—" if v is None else f"{100 * float(v):.1f} %"
+
+
+def paraphrase_table(held: dict, blind: dict | None = None) -> str:
+    """Right-action rates of `eval paraphrase` (held-out set, and the blind set when given); target 80 %."""
+    def name(res, default):
+        return f"{default} ({res['motion']['prompts']} prompts)"
+
+    head = ["right action", name(held, "held-out paraphrases")] + ([name(blind, "blind held-out set")] if blind else [])
+    lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    for label, key, metric in PARAPHRASE_ROWS:
+        cells = [label, _paraphrase_cell(held, key, metric)] + ([_paraphrase_cell(blind, key, metric)] if blind else [])
+        lines.append("| " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
 def replace_block(text: str, name: str, body: str) -> str:
     pattern = re.compile(rf"(<!-- eval:{name} -->\n).*?(\n<!-- /eval:{name} -->)", re.S)
     if not pattern.search(text):
@@ -87,6 +123,8 @@ def main(argv=None) -> int:
     ap.add_argument("--recon", type=Path, default=ROOT / "out" / "eval_recon.json")
     ap.add_argument("--untrained", type=Path, default=ROOT / "out" / "eval_recon_untrained.json")
     ap.add_argument("--generate", type=Path, default=ROOT / "out" / "eval_generate.json")
+    ap.add_argument("--paraphrase", type=Path, default=ROOT / "out" / "eval_paraphrase.json")
+    ap.add_argument("--paraphrase-blind", type=Path, default=ROOT / "out" / "eval_paraphrase_blind.json")
     ap.add_argument("--readme", type=Path, default=ROOT / "README.md")
     args = ap.parse_args(argv)
     text = args.readme.read_text(encoding="utf-8")
@@ -95,6 +133,12 @@ def main(argv=None) -> int:
         text = replace_block(text, "recon", recon_table(json.loads(args.recon.read_text()), untrained))
     if args.generate.is_file():
         text = replace_block(text, "generate", generate_table(json.loads(args.generate.read_text())))
+    if args.paraphrase.is_file():
+        if "<!-- eval:paraphrase -->" in text:
+            blind = json.loads(args.paraphrase_blind.read_text()) if args.paraphrase_blind.is_file() else None
+            text = replace_block(text, "paraphrase", paraphrase_table(json.loads(args.paraphrase.read_text()), blind))
+        else:
+            print(f"{args.readme} has no <!-- eval:paraphrase --> block: paraphrase table not written")
     atomic_write_text(args.readme, text)
     print(f"updated the evaluation tables in {args.readme}")
     return 0

@@ -1,0 +1,252 @@
+"""Which action is a motion? Its k nearest training clips in TMA motion space vote.
+
+    clf = ActionClassifier.from_data(tma, "data/built", actions)   # embeds the train split once
+    clf.classify([features, ...])          # -> ["walk", ...]  (raw (T, 263) HumanML3D features)
+    clf.ceiling("data/built", "test")      # how often it names real held-out clips' action
+
+Each training clip whose main action (``labels.actions[0]`` of its meta) is one of ``actions`` is
+embedded once with the TMA's motion side (unit vectors); clips without one are skipped. A motion is
+embedded the same way and gets the majority action of its ``k`` most cosine-similar training clips;
+a tie between actions goes to the one whose tied neighbours have the larger summed similarity.
+This reads actions in motion space, where they separate well; the TMA's text prototypes of an
+action ("A person {phrase}.") lie far from most motions of that action, so nearest-prototype
+classification of motions is much weaker (``paraphrase_eval`` still reports it, by name).
+
+``ceiling`` is the classifier's own accuracy on the real clips of another split: strict (the clip's
+main action) and lenient (any of its ``labels.actions``), overall and per action. A generated
+motion can be judged right at most about that often.
+"""
+from __future__ import annotations
+
+import json
+import os
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import ShapeMoveError
+
+REPO_ROOT = Path(__file__).resolve().parents[2]
+FEATURES = "new_joint_vecs"
+MAX_META_BYTES = 256 << 20
+MAX_CLIP_FRAMES = 20 * 60 * 10  # 10 minutes at 20 fps: longer is not a clip of a built dataset
+CHUNK = 256  # clips loaded and embedded at a time (bounded memory)
+
+
+def default_built_dir() -> Path | None:
+    """``$SHAPEMOVE_BUILT``, else the repository's ``data/built`` (``make train-default``), if it exists."""
+    env = os.environ.get("SHAPEMOVE_BUILT")
+    p = Path(env) if env else REPO_ROOT / "data" / "built"
+    return p if p.is_dir() else None
+
+
+def check_built(data) -> Path:
+    data = Path(data)
+    if not data.is_dir():
+        raise ShapeMoveError(f"dataset folder not found: {data} (build one with `python -m shapemove data build`)")
+    if not (data / FEATURES).is_dir():
+        raise ShapeMoveError(f"{data}: not a built dataset (no {FEATURES}/ folder)")
+    return data
+
+
+def clip_actions(data, ids: list[str]) -> dict[str, list[str]]:
+    """{clip id: its labels.actions} for the clips ``ids`` (from ``meta.jsonl``, else ``meta/ID.json``);
+    clips without meta or actions get []."""
+    data = Path(data)
+    want, out = set(ids), {}
+    jl = data / "meta.jsonl"
+    if jl.is_file():
+        if jl.stat().st_size > MAX_META_BYTES:
+            raise ShapeMoveError(f"{jl}: larger than {MAX_META_BYTES >> 20} MB; not a dataset's meta")
+        with jl.open(encoding="utf-8") as fh:
+            for n, line in enumerate(fh, 1):
+                if not line.strip():
+                    continue
+                try:
+                    m = json.loads(line)
+                except json.JSONDecodeError as exc:
+                    raise ShapeMoveError(f"{jl}: line {n} is not valid JSON ({exc})") from None
+                if isinstance(m, dict) and m.get("id") in want:
+                    out[m["id"]] = _actions_of(m)
+    for cid in ids:
+        if cid not in out:
+            f = data / "meta" / f"{cid}.json"
+            try:
+                m = json.loads(f.read_text(encoding="utf-8")) if f.is_file() and f.stat().st_size < (1 << 20) else {}
+            except (UnicodeDecodeError, json.JSONDecodeError):
+                m = {}
+            out[cid] = _actions_of(m)
+    return out
+
+
+def _actions_of(meta) -> list[str]:
+    labels = meta.get("labels") if isinstance(meta, dict) else None
+    acts = labels.get("actions") if isinstance(labels, dict) else None
+    return [a for a in acts if isinstance(a, str)] if isinstance(acts, list) else []
+
+
+def labelled_clips(data, split: str, actions, max_clips: int | None = None, seed: int = 0):
+    """[(clip id, labels.actions)] of ``split`` whose main action is one of ``actions`` (all, or a
+    seeded random ``max_clips`` of them, in split order)."""
+    from ..train.motion_dataset import read_split
+
+    data = check_built(data)
+    ids = read_split(data, split)
+    known = set(actions)
+    acts = clip_actions(data, ids)
+    clips = [(cid, acts[cid]) for cid in ids if acts[cid] and acts[cid][0] in known]
+    if max_clips is not None and len(clips) > max_clips:
+        keep = np.sort(np.random.default_rng(seed).choice(len(clips), max_clips, replace=False))
+        clips = [clips[i] for i in keep]
+    return clips
+
+
+def load_features(data, cid: str) -> np.ndarray | None:
+    """The clip's raw (T, 263) features, or None when it has no usable features file."""
+    from .tma_embed import FEATURE_DIM
+
+    f = Path(data) / FEATURES / f"{cid}.npy"
+    if not f.is_file():
+        return None
+    try:
+        x = np.load(f, mmap_mode="r", allow_pickle=False)
+    except (ValueError, OSError):
+        return None
+    if x.ndim != 2 or x.shape[1] != FEATURE_DIM or not 4 <= x.shape[0] <= MAX_CLIP_FRAMES:
+        return None
+    x = np.asarray(x, dtype=np.float32)
+    return x if np.isfinite(x).all() else None
+
+
+def embed_clips(embed: Callable, data, clips, desc: str, progress: bool = True):
+    """(unit embeddings (N, E), [labels.actions] of the embedded clips, ids skipped for lack of
+    usable features), loading and embedding ``CHUNK`` clips at a time."""
+    from tqdm import tqdm
+
+    embs, labels, skipped = [], [], []
+    with tqdm(total=len(clips), desc=desc, unit="clip", disable=not progress) as bar:
+        for s in range(0, len(clips), CHUNK):
+            feats = []
+            for cid, acts in clips[s:s + CHUNK]:
+                f = load_features(data, cid)
+                if f is None:
+                    skipped.append(cid)
+                else:
+                    feats.append(f)
+                    labels.append(acts)
+            if feats:
+                embs.append(np.asarray(embed(feats), np.float32))
+            bar.update(len(clips[s:s + CHUNK]))
+    emb = np.concatenate(embs) if embs else np.zeros((0, 0), np.float32)
+    return emb, labels, skipped
+
+
+def knn_vote(sims: np.ndarray, labels: list[str], k: int = 5) -> list[str]:
+    """Per row of ``sims`` (N, M: similarity to each of M labelled examples), the majority label of
+    its ``k`` most similar examples; ties go to the label with the larger summed similarity."""
+    sims = np.asarray(sims, np.float64)
+    if sims.ndim != 2 or sims.shape[1] != len(labels) or not len(labels):
+        raise ShapeMoveError(f"knn_vote: similarities of shape {sims.shape} for {len(labels)} labelled examples")
+    k = max(1, min(int(k), len(labels)))
+    top = np.argpartition(-sims, k - 1, axis=1)[:, :k] if k < len(labels) else np.tile(np.arange(len(labels)), (len(sims), 1))
+    out = []
+    for row, idx in zip(sims, top):
+        votes: dict[str, list] = {}
+        for j in idx:
+            v = votes.setdefault(labels[j], [0, 0.0])
+            v[0] += 1
+            v[1] += float(row[j])
+        out.append(max(sorted(votes), key=lambda a: (votes[a][0], votes[a][1])))
+    return out
+
+
+def score(preds: list[str], label_lists: list[list[str]]) -> dict:
+    """Strict (== labels[0]) and lenient (in labels) accuracy, overall and per main action."""
+    per: dict = {}
+    for p, labels in zip(preds, label_lists):
+        d = per.setdefault(labels[0], {"n": 0, "strict": 0, "lenient": 0})
+        d["n"] += 1
+        d["strict"] += p == labels[0]
+        d["lenient"] += p in labels
+    n = sum(d["n"] for d in per.values())
+    return {"accuracy": sum(d["strict"] for d in per.values()) / n if n else None,
+            "accuracy_lenient": sum(d["lenient"] for d in per.values()) / n if n else None,
+            "clips": n,
+            "per_action": {a: {"n": d["n"], "accuracy": d["strict"] / d["n"], "accuracy_lenient": d["lenient"] / d["n"]}
+                           for a, d in sorted(per.items())}}
+
+
+def tma_embedder(tma) -> Callable:
+    """features list -> (N, E) unit TMA motion embeddings, for a ``load_tma`` tuple or a path."""
+    from .tma_embed import embed_motions, load_tma
+
+    model, _, mean, std = load_tma(tma) if isinstance(tma, (str, Path)) else tma
+    return lambda feats: embed_motions(model, feats, mean, std)
+
+
+class ActionClassifier:
+    """k-nearest-neighbour action of motions among labelled training clips (module docstring)."""
+
+    def __init__(self, embeddings: np.ndarray, labels: list[str], embed: Callable | None = None, k: int = 5,
+                 info: dict | None = None, actions=None):
+        emb = np.asarray(embeddings, np.float32)
+        if emb.ndim != 2 or len(emb) != len(labels) or not len(labels):
+            raise ShapeMoveError(f"ActionClassifier: {len(labels)} labels for embeddings of shape {emb.shape}; need >= 1 of each, equal")
+        self.embeddings = emb / np.linalg.norm(emb, axis=1, keepdims=True).clip(1e-8)
+        self.labels, self.embed, self.k = list(labels), embed, int(k)
+        self.info = dict(info or {})
+        self.actions = sorted(set(actions) if actions is not None else set(self.labels))
+
+    @classmethod
+    def from_data(cls, tma, data, actions, split: str = "train", k: int = 5, embed: Callable | None = None,
+                  progress: bool = True) -> "ActionClassifier":
+        """Embed the ``split`` clips of the built dataset ``data`` whose main action is in ``actions``.
+        ``embed`` (features list -> (N, E)) replaces the TMA's motion side when given (``tma`` unused)."""
+        embed = embed or tma_embedder(tma)
+        data = check_built(data)
+        clips = labelled_clips(data, split, actions)
+        if not clips:
+            raise ShapeMoveError(f"{data}: no clip of split '{split}' ({split}.txt) has a main action "
+                                 "(labels.actions[0] of its meta) among the model's known actions; "
+                                 "is this the built dataset the model was trained on?")
+        emb, labels, skipped = embed_clips(embed, data, clips, f"embed {split} clips", progress)
+        if not labels:
+            raise ShapeMoveError(f"{data}: none of the {len(clips)} labelled '{split}' clips has usable "
+                                 f"{FEATURES}/ features")
+        main = [a[0] for a in labels]
+        info = {"kind": f"{k}-nearest training clips in TMA motion space", "k": k, "data": str(data),
+                "split": split, "clips": len(main), "skipped_without_features": len(skipped),
+                "actions_without_clips": sorted(set(actions) - set(main))}
+        return cls(emb, main, embed, k, info, actions)
+
+    def classify_embeddings(self, emb: np.ndarray, chunk: int = 1024) -> list[str]:
+        emb = np.asarray(emb, np.float32)
+        if emb.ndim != 2 or emb.shape[1] != self.embeddings.shape[1]:
+            raise ShapeMoveError(f"ActionClassifier: embeddings of shape {emb.shape}, expected (N, {self.embeddings.shape[1]})")
+        emb = emb / np.linalg.norm(emb, axis=1, keepdims=True).clip(1e-8)
+        out: list[str] = []
+        for s in range(0, len(emb), chunk):  # (chunk, M) similarities at a time
+            out += knn_vote(emb[s:s + chunk] @ self.embeddings.T, self.labels, self.k)
+        return out
+
+    def classify(self, feats: list) -> list[str]:
+        """Action of each raw (T, 263) feature array."""
+        if self.embed is None:
+            raise ShapeMoveError("ActionClassifier: built from embeddings only; it cannot embed motions")
+        return self.classify_embeddings(self.embed(feats)) if len(feats) else []
+
+    def ceiling(self, data, split: str = "test", max_clips: int | None = None, seed: int = 0,
+                progress: bool = True) -> dict:
+        """``score`` of the classifier on the real clips of ``split`` whose main action
+        (``labels.actions[0]``) is one of ``self.actions`` (the model's known actions, also those
+        without training clips, which it can never name), plus "split" and "skipped_without_features"."""
+        if self.embed is None:
+            raise ShapeMoveError("ActionClassifier: built from embeddings only; it cannot embed real clips")
+        data = check_built(data)
+        clips = labelled_clips(data, split, self.actions, max_clips, seed)
+        if not clips:
+            return {**score([], []), "split": split, "skipped_without_features": 0}
+        emb, labels, skipped = embed_clips(self.embed, data, clips, f"classify {split} clips", progress)
+        preds = self.classify_embeddings(emb) if labels else []
+        return {**score(preds, labels), "split": split, "skipped_without_features": len(skipped)}
