@@ -38,8 +38,9 @@ from .checkpoint_cadence import finish, save_if_due
 from .run_log import StepLog
 from .checkpoint import load_checkpoint, make_metadata, save_checkpoint, stats_hash
 from .motion_dataset import load_stats, read_split
+from .optimizer_step import optimizer_step
 from .t5_dataset import read_lines
-from .train_vae import rng_state, set_rng_state
+from .resume import restore, rng_state
 
 RESUME_IGNORES = ("steps",)  # a resumed run may be extended; anything else must match
 FEATURE_KINDS = ("norm_joint_vecs", "new_joint_vecs")
@@ -250,11 +251,7 @@ def _train(data, out, c, resume, body_name, dist, progress, cancel, verbose) -> 
     if resume and last.is_file():
         ckpt = load_checkpoint(last, map_location=dist.device, kind=KIND, config=asdict(c), ignore=RESUME_IGNORES,
                                stats_hash_=stats_hash(mean, std))
-        model.load_state_dict(ckpt["model"])
-        optimizer.load_state_dict(ckpt["optimizer"])
-        scheduler.load_state_dict(ckpt["scheduler"])
-        step = int(ckpt["step"])
-        set_rng_state(ckpt["rng"])
+        step = restore(ckpt, model, optimizer, scheduler)
     elif resume and dist.is_main and verbose:
         print(f"no checkpoint in {out}: starting from scratch")
     pairs = _Pairs(model)
@@ -292,12 +289,7 @@ def _train(data, out, c, resume, body_name, dist, progress, cancel, verbose) -> 
         text_a, text_b = text_inputs(model, tok, texts)
         loss = pairs(text_a.to(dist.device), text_b.to(dist.device), feats.to(dist.device),
                      lengths.to(dist.device), [caption_key(t) for t in texts])
-        optimizer.zero_grad(set_to_none=True)
-        loss.backward()
-        if c.grad_clip:
-            torch.nn.utils.clip_grad_norm_(model.parameters(), c.grad_clip)
-        optimizer.step()
-        scheduler.step()
+        optimizer_step(loss, optimizer, scheduler, model.parameters(), c.grad_clip)
         step += 1
         log.bar.update(1)
         done = step == c.steps

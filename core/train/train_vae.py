@@ -13,10 +13,8 @@ from __future__ import annotations
 
 import copy
 import math
-import random
 from pathlib import Path
 
-import numpy as np
 import torch
 from torch.nn.parallel import DistributedDataParallel as DDP
 from torch.utils.data import DataLoader
@@ -33,6 +31,8 @@ from .checkpoint_cadence import finish, save_if_due
 from .run_log import StepLog
 from .checkpoint import load_checkpoint, make_metadata, save_checkpoint, stats_hash
 from .motion_dataset import BatchStream, MotionClips
+from .optimizer_step import optimizer_step
+from .resume import restore, rng_state, set_rng_state  # noqa: F401  (set_rng_state: used by train_t5)
 
 KIND = "savae"
 RESUME_IGNORES = ("train.steps",)  # a resumed run may be extended; anything else must match
@@ -56,23 +56,6 @@ def resolve_body(body):
         return body
 
     return load_body_model(body)
-
-
-def rng_state() -> dict:
-    np_state = np.random.get_state()
-    py = random.getstate()
-    return {"torch": torch.get_rng_state(), "python": list(py[1]), "python_gauss": py[2],
-            "numpy": torch.from_numpy(np_state[1].astype(np.int64)), "numpy_pos": int(np_state[2]),
-            "numpy_gauss": [int(np_state[3]), float(np_state[4])],
-            "cuda": torch.cuda.get_rng_state_all() if torch.cuda.is_available() else []}
-
-
-def set_rng_state(s: dict) -> None:
-    torch.set_rng_state(s["torch"])
-    random.setstate((3, tuple(s["python"]), s["python_gauss"]))
-    np.random.set_state(("MT19937", s["numpy"].numpy().astype(np.uint32), s["numpy_pos"], *s["numpy_gauss"]))
-    if s["cuda"] and torch.cuda.is_available():
-        torch.cuda.set_rng_state_all(s["cuda"])
 
 
 def target_bones(body, betas: torch.Tensor) -> torch.Tensor | None:
@@ -161,11 +144,7 @@ def _train(data, out, cfg, t, resume, body, dist, progress, cancel, verbose) -> 
     if resume and last.exists():
         ckpt = load_checkpoint(last, map_location="cpu", kind=KIND, body=body_name, config=cfg.to_dict(),
                                ignore=RESUME_IGNORES, stats_hash_=stats_hash(mean, std))
-        model.load_state_dict(ckpt["model"])
-        optimizer.load_state_dict(ckpt["optimizer"])
-        scheduler.load_state_dict(ckpt["scheduler"])
-        step = int(ckpt["step"])
-        set_rng_state(ckpt["rng"])
+        step = restore(ckpt, model, optimizer, scheduler)
     elif resume and dist.is_main and verbose:
         print(f"no checkpoint in {out}: starting from scratch")
     raw = model
@@ -196,12 +175,7 @@ def _train(data, out, cfg, t, resume, body, dist, progress, cancel, verbose) -> 
         b = _to(next(batch_iter), dist.device)
         result = model(b["x"], b["betas"])
         losses = batch_losses(result, b, raw, cfg, body)
-        optimizer.zero_grad(set_to_none=True)
-        losses["total"].backward()
-        if t.grad_clip:
-            torch.nn.utils.clip_grad_norm_(raw.parameters(), t.grad_clip)
-        optimizer.step()
-        scheduler.step()
+        optimizer_step(losses["total"], optimizer, scheduler, raw.parameters(), t.grad_clip)
         step += 1
         log.bar.update(1)
         done = step == t.steps
