@@ -5,8 +5,9 @@ pick a worker Python when Blender's has no torch, and remember which job each pa
 """
 from __future__ import annotations
 
-from ..core.errors import ShapeMoveError
 from . import jobs
+from ..core.errors import ShapeMoveError
+from ..core.worker import ops
 from .paths import detect_python
 from .preferences import preferences
 
@@ -15,7 +16,6 @@ RUNNING: dict[str, str] = {}  # panel kind ("generate", "train", ...) -> its run
 
 def _ensure_ops() -> None:
     """The in-process runner serves ``core.worker.ops.JOBS``: add the panel ops to it."""
-    from ..core.worker import ops
     from ..core.worker.jobs_shapemove import register
 
     register(ops.JOBS)

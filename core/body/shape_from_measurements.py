@@ -29,6 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from ..atomic import atomic_path
+from ..data.shape_text import parse_shape_sentence
 from ..errors import ShapeMoveError
 from .measure import MEASUREMENTS, measure_mesh
 from .skeleton import JOINT_INDEX as JI
@@ -264,8 +265,6 @@ def shape_targets(text: str, body=None) -> dict | None:
     """Shape text -> target measurements (cm), or None when it states neither numbers nor size
     words (free text: the [BETA] head reads it). Numbers it states must be plausible: "5000 cm
     tall", "waist 0 cm" or "-170 cm" are a ShapeMoveError naming the number, never ignored."""
-    from ..data.shape_text import parse_shape_sentence
-
     if not isinstance(text, str) or not text.strip():
         raise ShapeMoveError("the shape text is empty")
     neg = NEGATIVE.search(text)

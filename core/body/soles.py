@@ -21,6 +21,7 @@ import numpy as np
 import torch
 
 from ..geometry.torch_ops import forward_kinematics
+from ..scene.sole_height import sole_vertices
 from .kinematics import skinning_transforms
 from .skeleton import FOOT_JOINTS
 
@@ -37,8 +38,6 @@ def candidate_vertices(body) -> np.ndarray:
     moves an extreme point by a vertex at most: sub-mm). Computed once per body instance."""
     ids = getattr(body, "_ground_candidates", None)
     if ids is None:
-        from ..scene.sole_height import sole_vertices
-
         ids = body._ground_candidates = sole_vertices(body.v_template.numpy(), body.skin_weights, 1, band=np.inf)
     return ids
 

@@ -24,8 +24,12 @@ from pathlib import Path
 import numpy as np
 
 from ..atomic import atomic_save_npy, atomic_write_text
+from ..body.plant import ground_shift, plant_targets
 from ..constants import FPS
 from ..errors import ShapeMoveError
+from ..geometry.rotations import matrix_to_axis_angle
+from ..io.mocap import load_smpl22
+from ..motion.contacts import detect_contacts, to_feature_order
 from .shape_text import shape_texts
 from .sources import ClipSource, discover, open_source
 from .splits import split_of
@@ -77,8 +81,6 @@ class ClipProcessor:
         return self._measured[key]
 
     def load(self, clip: ClipSource):
-        from ..io.mocap import load_smpl22
-
         motion = load_smpl22(clip.path, fps=FPS)
         joints = np.asarray(motion.joints, dtype=np.float32)
         if joints.shape[0] < MIN_FRAMES:
@@ -107,8 +109,6 @@ class ClipProcessor:
 
     def contacts(self, joints: np.ndarray) -> np.ndarray:
         """(T,4) uint8 foot contacts of joints 7, 8, 10, 11 detected on the source mocap."""
-        from ..motion.contacts import detect_contacts
-
         return detect_contacts(joints, FPS)
 
     def pose_on(self, rotations: np.ndarray, root: np.ndarray, betas: np.ndarray, scale: float,
@@ -122,7 +122,6 @@ class ClipProcessor:
         reproduces the result."""
         import torch
 
-        from ..body.plant import ground_shift
         from ..geometry.torch_ops import forward_kinematics
 
         rest = self.body.rest_joints(torch.as_tensor(betas)[None])  # (1,24,3)
@@ -139,7 +138,6 @@ class ClipProcessor:
         """(T-1,263) HumanML3D features of (T,22,3) joints grounded on the mesh (``pose_on``: heights
         kept as they are) with local ``rotations`` (T,>=22,3,3); the 4 foot-contact channels hold
         ``contacts`` (T,4) of joints 7, 8, 10, 11."""
-        from ..motion.contacts import to_feature_order
         from ..motion.features import feature_slices, features_from_joints
 
         f = features_from_joints(joints, rotations[:, :22], keep_height=True)
@@ -155,7 +153,6 @@ class ClipProcessor:
         import torch
 
         from ..body.ik import solve_ik
-        from ..body.plant import plant_targets
         from ..geometry.torch_ops import forward_kinematics
 
         contacts = self.contacts(joints)
@@ -188,8 +185,6 @@ class ClipProcessor:
         ``solve`` (contacts, fit, planted IK), then the shape-aware copy on the target body and the
         normalized copy on the canonical body, each grounded on its own mesh (``pose_on``)."""
         import torch
-
-        from ..geometry.rotations import matrix_to_axis_angle
 
         sol = self.solve(joints)
         rot, root, contacts = sol["rotations"], sol["root"], sol["contacts"]

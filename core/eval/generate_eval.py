@@ -29,6 +29,14 @@ import numpy as np
 from ..atomic import atomic_write_json
 from ..constants import FPS
 from ..errors import ShapeMoveError
+from ..generation.generate import Generator, Request
+from ..generation.model_bundle import model_files
+from ..geometry.rotations import axis_angle_to_matrix
+from ..train.motion_dataset import read_split
+from ..train.t5_dataset import read_lines
+from .evaluate import evaluate_motion
+from .report import aggregate
+from .tma_embed import embed_motions, embed_texts, load_tma
 
 KEYS = ("r_precision_top1", "r_precision_top3", "matching_score", "fid", "penetrate_cm", "float_cm", "skate_pct",
         "dyn_stable_pct", "height_err_cm", "waist_err_cm", "clips", "penetrate_all_cm", "float_all_cm",
@@ -41,9 +49,6 @@ def load_clips(data, split: str = "test", max_clips: int | None = None, seed: in
     id, caption (one, chosen with ``seed``), shape_text (numeric sentence or None), features
     (T,263) shape-aware, betas (10,), poses (T,24,3) axis-angle, transl (T,3). ``max_clips``
     keeps a seeded random subset (in split order)."""
-    from ..train.motion_dataset import read_split
-    from ..train.t5_dataset import read_lines
-
     root = Path(data)
     if not root.is_dir():
         raise ShapeMoveError(f"dataset folder not found: {root}")
@@ -76,9 +81,6 @@ def load_clips(data, split: str = "test", max_clips: int | None = None, seed: in
 
 def physics(body, betas, poses, transl) -> dict:
     """``evaluate_motion`` of one clip: betas (10,), poses (T,24,3) axis-angle, transl (T,3)."""
-    from ..geometry.rotations import axis_angle_to_matrix
-    from .evaluate import evaluate_motion
-
     rot = axis_angle_to_matrix(poses)
     return evaluate_motion(body, betas, rot, transl)
 
@@ -96,9 +98,7 @@ def score(tma, texts: list[str], feats: list, reference=None, clips_physics: lis
           height_err: float = 0.0, waist_err: float = 0.0) -> tuple[dict, np.ndarray]:
     """(the ``KEYS`` of one column, its motion embeddings). ``reference``: (N,E) real motion
     embeddings for FID (None: the column's own embeddings, i.e. the real-data ceiling)."""
-    from .report import aggregate
     from .retrieval import fid, matching_score, r_precision
-    from .tma_embed import embed_motions, embed_texts
 
     model, tok, mean, std = tma
     t = embed_texts(model, tok, texts)
@@ -120,10 +120,6 @@ def eval_generate(data, split: str = "test", model_dir=None, tma=None, max_clips
     {KEYS}} (see the module docstring). ``tma``: a path (tma.pt or its folder), a
     ``load_tma`` tuple, or None for the model folder's ``tma/``. ``generator``: an already loaded
     ``Generator`` (then ``model_dir`` is ignored). progress(fraction, message) after each clip."""
-    from ..generation.generate import Generator, Request
-    from ..generation.model_bundle import model_files
-    from .tma_embed import load_tma
-
     clips = load_clips(data, split, max_clips, seed)
     gen = generator if generator is not None else Generator(model_dir)
     if tma is None:

@@ -26,7 +26,14 @@ from pathlib import Path
 import numpy as np
 import torch
 
+from ..body.ik import solve_ik
+from ..body.load import load_body_model
 from ..errors import ShapeMoveError
+from ..generation.retarget import load_vae
+from ..geometry.rotations import axis_angle_to_matrix
+from ..models.fsq import codebook_usage
+from ..motion.features import joints_from_features
+from ..train.motion_dataset import read_split
 from .bones import mpjpe_mm
 from .evaluate import evaluate_motion
 from .report import aggregate
@@ -38,7 +45,6 @@ KEYS = ("mpjpe_mm", "mpjpe_local_mm", "bone_err_mm", "penetrate_cm", "float_cm",
 def _body(body):
     if body is not None and not isinstance(body, str):
         return body
-    from ..body.load import load_body_model
 
     return load_body_model(body)
 
@@ -58,9 +64,6 @@ def _pick(agg: dict) -> dict:
 def recon_clip(vae, body, norm_feats: np.ndarray, betas: np.ndarray, ik_refine_iters: int = 10):
     """(T-1,263) canonical features + betas -> (joints (n,22,3), rotations (n,24,3,3), transl (n,3),
     token indices (n/4,)) of the reconstruction, n = (T-1) cut to a multiple of the downsampling."""
-    from ..body.ik import solve_ik
-    from ..motion.features import joints_from_features
-
     n = len(norm_feats) // vae.cfg.downsample * vae.cfg.downsample
     if n == 0:
         raise ShapeMoveError(f"clip too short for the SA-VAE ({len(norm_feats)} feature rows)")
@@ -79,12 +82,6 @@ def eval_recon(data, checkpoint, split: str = "test", body=None, max_clips: int 
     clips of the dataset folder ``data``, with the ground truth's beside (see the module doc).
     progress(fraction, clip id) after each clip; ``per_clip``: a list to receive one dict per clip
     ({"id", "frames", the KEYS, "ground_truth": {KEYS}})."""
-    from ..geometry.rotations import axis_angle_to_matrix
-    from ..generation.retarget import load_vae
-    from ..models.fsq import codebook_usage
-    from ..motion.features import joints_from_features
-    from ..train.motion_dataset import read_split
-
     root = Path(data)
     if not root.is_dir():
         raise ShapeMoveError(f"dataset folder not found: {root}")

@@ -16,12 +16,20 @@ from dataclasses import dataclass
 import numpy as np
 import torch
 
+from ..body.load import load_body_model
 from ..constants import FPS
 from ..errors import ShapeMoveError
+from ..models.constrained_decoding import decode
+from ..models.known_texts import read_known
+from ..models.savae import load_savae
+from ..models.shapemove_t5 import ShapeMoveT5
+from ..models.text_encoder import load_text_encoder
 from ..scene.motion_file import Motion
 from ..torch_threads import one_torch_thread
 from .decode import decode_tokens
+from .model_bundle import model_files, resolve_model_dir
 from .prompts import check_prompt
+from .sampling_params import check_sampling
 
 
 @dataclass
@@ -53,17 +61,11 @@ def parse_betas(text: str) -> np.ndarray:
 
 class Generator:
     def __init__(self, model_dir=None, body=None, ik_refine_iters: int = 10):
-        from ..body.load import load_body_model
-        from ..models.savae import load_savae
-        from ..models.shapemove_t5 import ShapeMoveT5
-        from .model_bundle import model_files, resolve_model_dir
-
         self.model_dir = resolve_model_dir(model_dir)
         files = model_files(self.model_dir)
         self.body = body if body is not None and not isinstance(body, str) else load_body_model(body)
         self.vae = load_savae(files["savae"], body=self.body)
         self.t5, self.tok = (ShapeMoveT5.load(files["t5"]) if files["t5"].is_dir() else (None, None))
-        from ..models.known_texts import read_known
 
         self.known = read_known(files["t5"]) if self.t5 is not None else None  # training captions + actions
         self.ik_refine_iters = ik_refine_iters
@@ -81,8 +83,6 @@ class Generator:
 
     @torch.no_grad()
     def tokens_for(self, reqs: list[Request]) -> tuple[list[list[int]], torch.Tensor]:
-        from ..models.constrained_decoding import decode
-
         if self.t5 is None:
             raise ShapeMoveError(f"{self.model_dir} has no t5/ model: text-to-motion needs one (train t5)")
         codes, betas = [], []
@@ -105,7 +105,6 @@ class Generator:
     def _text_encoder(self):
         if self.t5 is not None and self.t5.encoder_kind == "minilm":
             return self.tok
-        from ..models.text_encoder import load_text_encoder
 
         return load_text_encoder()
 
@@ -137,8 +136,6 @@ class Generator:
         return self.generate_batch([Request(prompt, shape_text, betas, seconds, seed, temperature, top_k)])[0]
 
     def generate_batch(self, reqs: list[Request], progress=None, cancel=None) -> list[Motion]:
-        from .sampling_params import check_sampling
-
         for r in reqs:
             r.prompt = check_prompt(r.prompt)
             r.shape_text = check_prompt(r.shape_text, "shape text", allow_empty=True) or None

@@ -18,6 +18,7 @@ from torch import nn
 from ..config_presets import PRESETS, load_config
 from ..constants import FSQ_LEVELS
 from ..errors import ShapeMoveError
+from ..train.checkpoint import load_checkpoint
 from .decoder import Decoder
 from .encoder import Encoder
 from .fsq import FSQ
@@ -217,8 +218,6 @@ class SAVAE(nn.Module):
 def load_savae(path, body=None, device="cpu") -> SAVAE:
     """A trained SA-VAE from ``savae.pt`` or ``last.pt`` (eval mode). ``body``: a BodyModel or its
     name; when given, a checkpoint trained for another body model is a ShapeMoveError."""
-    from ..train.checkpoint import load_checkpoint
-
     name = body if body is None or isinstance(body, str) else body.name
     ckpt = load_checkpoint(path, map_location=device, kind="savae", body=name)
     meta = ckpt["metadata"]

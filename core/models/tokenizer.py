@@ -16,6 +16,7 @@ from pathlib import Path
 
 from ..constants import NUM_CODES  # the default FSQ codebook; models record their own count
 from ..errors import ShapeMoveError
+from ..model_files import damaged_model_errors, verify_manifest
 
 SOM, EOM, BETA = "[SOM]", "[EOM]", "[BETA]"
 MOTION_TOKENS = [f"[MID_{i}]" for i in range(NUM_CODES)]
@@ -83,7 +84,6 @@ def load_tokenizer(directory: Path, require_json: bool = True, num_codes: int | 
     if require_json and not (directory / "tokenizer.json").is_file():
         raise ShapeMoveError(f"{directory}: the model's tokenizer (tokenizer.json) is missing; the folder is "
                              "incomplete: copy the whole model folder again or retrain")
-    from ..model_files import damaged_model_errors, verify_manifest
 
     verify_manifest(directory)  # sha256 of the files when a manifest lists them
     with damaged_model_errors(directory):

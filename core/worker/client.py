@@ -22,8 +22,9 @@ import time
 from collections import deque
 from pathlib import Path
 
-from ..errors import ShapeMoveError
 from . import protocol as P
+from ..errors import ShapeMoveError
+from .runner import JobRunner
 
 PACKAGE_ROOT = Path(__file__).resolve().parents[2]  # the folder holding shapemove's __init__.py
 # Imports this package's folder as `shapemove` (whatever the folder is called, e.g. inside
@@ -296,8 +297,6 @@ class InProcessRunner(_Jobs):
 
     def start(self) -> None:
         if not self.alive():
-            from .runner import JobRunner
-
             self._runner = JobRunner(self._emit, self.jobs)
 
     def _emit(self, msg: dict) -> None:
