@@ -4,7 +4,6 @@ import json
 import numpy as np
 import pytest
 
-from conftest import need_data
 from shapemove.core.errors import ShapeMoveError
 from shapemove.core.eval.action_classifier import ActionClassifier, knn_vote, score
 
@@ -120,7 +119,9 @@ def test_default_model_classifier_ceiling_on_real_test_clips():
 
     data = default_built_dir()
     if data is None or not (data / "train.txt").is_file():
-        need_data("no built dataset (set SHAPEMOVE_BUILT or run `make train-default` for data/built)")
+        # a built dataset is derived (`make train-default`, ~25 min), not one of the archives that CI
+        # must have: without one this check is skipped, also under SHAPEMOVE_REQUIRE_DATA=1
+        pytest.skip("no built dataset (set SHAPEMOVE_BUILT or run `make train-default` for data/built)")
     torch.set_num_threads(1)
     gen = Generator(None)
     clf = ActionClassifier.from_data(load_tma(model_files(gen.model_dir)["tma"]), data, gen.known_actions, progress=False)

@@ -279,3 +279,50 @@ def test_default_t5_reads_prompts_with_minilm():
     assert m.encoder_kind == "minilm" and m.vocab.num_codes == 1000
     d = decode(m, m.inputs_for(tok, ["a person walks forward"], [None]), 4, 8, temperature=0)
     assert 4 <= len(d.codes[0]) <= 8 and d.betas.shape == (1, 10)
+
+
+def test_sentence_token_reads_the_pooled_prompt_and_survives_save_load(tmp_path):
+    """With ``sentence_token`` the memory gains one slot (the motion text's pooled, normalised MiniLM
+    vector, projected); with ``text_dropout`` = 1 a training forward sees only that slot of the motion
+    text, so two token sequences with the same mean give the same loss, while in eval mode (all tokens
+    visible) they do not. The flag travels in config.json: a saved folder loads to the same logits."""
+    from dataclasses import replace
+
+    torch.manual_seed(0)
+    size = replace(T5Size.tiny(), sentence_token=True, text_dropout=1.0)
+    m = ShapeMoveT5.build_minilm(1000, size)
+    B, L = 2, 5
+    states = torch.randn(B, L, 384)
+    mask = torch.ones(B, L, dtype=torch.bool)
+    seg = torch.ones(B, L, dtype=torch.long)
+    seg[:, :2] = 0  # two shape-text tokens first
+    words = states[:, 2:]
+    other = words - words.mean(1, keepdim=True) + words.mean(1, keepdim=True)  # same mean...
+    other = other[:, [2, 0, 1]] * 1.0
+    other[:, 0] += 0.5
+    other[:, 1] -= 0.5  # ...different tokens
+    states_b = torch.cat([states[:, :2], other], 1)
+    assert torch.allclose(states_b[:, 2:].mean(1), words.mean(1), atol=1e-5)
+
+    enc, emask = m.lm.eval().encode(states, mask, seg)
+    assert enc.shape[1] == L + 1 and bool(emask[:, 0].all())
+    pooled = torch.nn.functional.normalize(words.mean(1), dim=-1)
+    expect = m.lm.sentence_proj(pooled) + m.lm.segment.weight[1]
+    assert torch.allclose(enc[:, 0], expect, atol=1e-5)
+
+    labels = torch.tensor([[m.vocab.beta_id, m.vocab.som_id, *m.vocab.codes_to_ids([3]), m.vocab.eom_id]] * B)
+    m.train()
+    loss_a = m(states, mask, labels, segments=seg)["ce"]
+    loss_b = m(states_b, mask, labels, segments=seg)["ce"]
+    assert torch.allclose(loss_a, loss_b, atol=1e-5)
+    m.eval()
+    with torch.no_grad():
+        ea = m(states, mask, labels, segments=seg)["ce"]
+        eb = m(states_b, mask, labels, segments=seg)["ce"]
+    assert abs(float(ea - eb)) > 1e-4
+
+    m.save(tmp_path / "t5")
+    back = ShapeMoveT5.load(tmp_path / "t5")[0].eval()
+    assert back.lm.config.sentence_token and back.lm.config.text_dropout == 1.0
+    with torch.no_grad():
+        assert torch.allclose(back(states, mask, labels, segments=seg)["ce"], ea, atol=1e-5)

@@ -261,3 +261,16 @@ def known_actions(data_dir, split: str | None = None) -> list[tuple[str, int]]:
         for a in set((m.get("labels") or {}).get("actions", [])):
             counts[a] += 1
     return sorted(counts.items(), key=lambda kv: (-kv[1], kv[0]))
+
+
+def stored_labels(data_dir, clip_id: str) -> dict:
+    """The ``labels`` of a built clip's ``meta/{clip_id}.json`` ({} when it has none or is unreadable):
+    ``actions`` (main first) and, for clips that hold several actions in turn, ``sequence``."""
+    f = Path(data_dir) / "meta" / f"{clip_id}.json"
+    if not f.is_file() or f.stat().st_size > (1 << 20):
+        return {}
+    try:
+        labels = json.loads(f.read_text(encoding="utf-8")).get("labels")
+    except (UnicodeDecodeError, json.JSONDecodeError, AttributeError):
+        return {}
+    return labels if isinstance(labels, dict) else {}

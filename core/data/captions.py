@@ -135,19 +135,30 @@ _IRREGULAR = {"lies": "lying", "does": "doing", "goes": "going", "is": "being", 
               "sidesteps": "sidestepping", "tiptoes": "tiptoeing"}
 
 
+_BASE_IRREGULAR = {"lies": "lie", "dies": "die", "ties": "tie", "is": "be", "has": "have", "tiptoes": "tiptoe",
+                   "does": "do", "goes": "go"}
+
+
+def base_form(verb: str) -> str:
+    """Third-person present verb -> base form ('walks' -> 'walk', 'dashes' -> 'dash', 'lies' -> 'lie')."""
+    v = verb.lower()
+    if v in _BASE_IRREGULAR:
+        return _BASE_IRREGULAR[v]
+    if v.endswith("sses") or re.search(r"(ss|sh|ch|x|z|o)es$", v):
+        return v[:-2]
+    if v.endswith("ies"):
+        return v[:-3] + "y"
+    if v.endswith("s") and not v.endswith("ss"):
+        return v[:-1]
+    return v
+
+
 def gerund(verb: str) -> str:
     """Third-person present verb -> -ing form ('walks' -> 'walking', 'runs' -> 'running')."""
     v = verb.lower()
     if v in _IRREGULAR:
         return _IRREGULAR[v]
-    if v.endswith("sses") or re.search(r"(ss|sh|ch|x|z|o)es$", v):
-        base = v[:-2]
-    elif v.endswith("ies"):
-        base = v[:-3] + "y"
-    elif v.endswith("s"):
-        base = v[:-1]
-    else:
-        base = v
+    base = base_form(v)
     if base in _DOUBLE:
         return base + base[-1] + "ing"
     if base.endswith("ie"):

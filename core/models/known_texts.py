@@ -24,6 +24,8 @@ from pathlib import Path
 
 import torch
 
+from ..data.actions import stored_labels
+from ..data.paraphrase_bank import known_sentences
 from ..errors import ShapeMoveError
 
 NEAR = 0.40           # below this cosine similarity to every training caption: warn
@@ -44,20 +46,13 @@ def _read_lines(path: Path) -> list[str]:
 
 
 def _clip_actions(root: Path, cid: str) -> list[str]:
-    f = root / "meta" / f"{cid}.json"
-    if not f.is_file():
-        return []
-    try:
-        labels = json.loads(f.read_text()).get("labels") or {}
-    except (json.JSONDecodeError, AttributeError):
-        return []
-    acts = labels.get("actions") or []
-    return [str(a) for a in acts if isinstance(a, str)]
+    return [str(a) for a in stored_labels(root, cid).get("actions") or [] if isinstance(a, str)]
 
 
 def build_known(root, ids: list[str], states) -> dict:
     """Distinct captions of the clips ``ids`` with their action (the clip's main action from the
-    dataset's meta, else the first action the caption names) and their unit MiniLM vectors (mean
+    dataset's meta, else the first action the caption names), plus a fixed sample of the paraphrase
+    bank's sentences for each of those actions (``data/paraphrase_bank.py``), and their unit MiniLM vectors (mean
     of the token states that ``states`` gives: a StateCache or the TextEncoder)."""
     from ..data.actions import find_actions
     from .text_encoder import mean_pool
@@ -75,6 +70,9 @@ def build_known(root, ids: list[str], states) -> dict:
                 captions[c] = a
         for a in set(acts) or {captions.get(c, "") for c in _read_lines(root / "texts" / f"{cid}.txt")} - {""}:
             counts[a] = counts.get(a, 0) + 1
+    for a in counts:  # the phrasings training draws from the paraphrase bank, too
+        for c in known_sentences(a):
+            captions.setdefault(c, a)
     texts = sorted(captions)
     vecs = []
     for s in range(0, len(texts), 256):

@@ -51,6 +51,8 @@ class T5Size:
     num_heads: int = 4
     d_kv: int = 64
     dropout_rate: float = 0.1
+    sentence_token: bool = False   # MiniLM reader: add the pooled sentence vector as a memory slot
+    text_dropout: float = 0.0      # MiniLM reader: share of training prompts read from that slot alone
 
     @classmethod
     def tiny(cls) -> "T5Size":
@@ -76,6 +78,8 @@ class MiniLMDecoder(nn.Module):
         d = config.d_model
         self.proj = nn.Sequential(nn.Linear(text_dim, d), nn.LayerNorm(d))
         self.segment = nn.Embedding(2, d)  # 0 shape text, 1 motion text
+        if getattr(config, "sentence_token", False):
+            self.sentence_proj = nn.Sequential(nn.Linear(text_dim, d), nn.LayerNorm(d))
         self.decoder = T5Decoder(config)
         self.lm_head = nn.Linear(d, config.vocab_size, bias=False)
 
@@ -85,10 +89,25 @@ class MiniLMDecoder(nn.Module):
 
         return T5DecoderConfig(vocab_size=vocab_size, d_model=size.d_model, d_ff=size.d_ff, d_kv=size.d_kv,
                                num_heads=size.num_heads, num_layers=size.num_decoder_layers,
-                               dropout_rate=size.dropout_rate)
+                               dropout_rate=size.dropout_rate, sentence_token=size.sentence_token,
+                               text_dropout=size.text_dropout)
 
     def encode(self, states, mask, segments):
-        return self.proj(states) + self.segment(segments), mask
+        """Memory (B, L', d) and its mask: the projected token states (+ segment embedding), led by
+        the motion text's pooled sentence vector when ``config.sentence_token``. MiniLM was trained
+        so that paraphrases have near sentence vectors; hiding the motion text's token states from a
+        share (``text_dropout``) of training prompts makes the decoder read that vector, which
+        carries over to wordings the captions never used."""
+        enc = self.proj(states) + self.segment(segments)
+        if not getattr(self.config, "sentence_token", False):
+            return enc, mask
+        words = mask & (segments == 1)
+        pooled = (states * words[..., None]).sum(1) / words.sum(1, keepdim=True).clamp(min=1)
+        slot = self.sentence_proj(F.normalize(pooled, dim=-1))[:, None] + self.segment.weight[1]
+        if self.training and self.config.text_dropout > 0:
+            hide = torch.rand(len(mask), device=mask.device) < self.config.text_dropout
+            mask = mask & ~(hide[:, None] & (segments == 1))
+        return torch.cat([slot, enc], 1), torch.cat([torch.ones_like(mask[:, :1]), mask], 1)
 
     def step(self, enc, mask, decoder_ids, past=None, use_cache: bool = False):
         hidden, cache = self.decoder(decoder_ids, enc, mask, cache=past, use_cache=use_cache)

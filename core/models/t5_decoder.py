@@ -32,6 +32,11 @@ class T5DecoderConfig:
     relative_attention_num_buckets: int = 32
     relative_attention_max_distance: int = 128
     layer_norm_epsilon: float = 1e-6
+    # ShapeMove's MiniLM reader (shapemove_t5.MiniLMDecoder), not the stack: a memory slot holding the
+    # prompt's pooled sentence vector, and the share of training examples whose motion-text token
+    # states are hidden so that the decoder learns to read that sentence vector
+    sentence_token: bool = False
+    text_dropout: float = 0.0
 
     def to_json_string(self) -> str:
         return json.dumps({"model_type": "t5-decoder", **asdict(self)}, indent=2)

@@ -16,6 +16,8 @@ from pathlib import Path
 import numpy as np
 import torch
 
+from ..data.actions import stored_labels
+from ..data.paraphrase_bank import BANK_SHARE, training_caption
 from ..errors import ShapeMoveError
 from ..models.shapemove_t5 import shapemove_prompt
 from ..models.tokenizer import EOM, SOM
@@ -56,16 +58,18 @@ def all_texts(root: Path, ids: list[str]) -> list[str]:
 
 class T2MExamples:
     def __init__(self, root: Path, split: str, tokens: dict[str, np.ndarray], max_codes: int = 50,
-                 m2t_share: float = 0.0, no_shape_share: float = 0.2):
+                 m2t_share: float = 0.0, no_shape_share: float = 0.2, bank_share: float = BANK_SHARE):
         root = Path(root)
         self.ids = [c for c in read_split(root, split) if c in tokens and len(tokens[c])]
         if not self.ids:
             raise ShapeMoveError(f"{root}: no tokenized clips in split '{split}'")
         self.tokens = tokens
         self.captions = {c: read_lines(root / "texts" / f"{c}.txt") or ["a person moves."] for c in self.ids}
+        self.labels = {c: stored_labels(root, c) for c in self.ids}
         self.shapes = {c: read_lines(root / "shape_texts" / f"{c}.txt") for c in self.ids}
         self.betas = {c: np.load(root / "betas" / f"{c}.npy").astype(np.float32) for c in self.ids}
         self.max_codes, self.m2t_share, self.no_shape_share = max_codes, m2t_share, no_shape_share
+        self.bank_share = bank_share
 
     def __len__(self) -> int:
         return len(self.ids)
@@ -76,7 +80,7 @@ class T2MExamples:
         if len(codes) > self.max_codes:
             s = rng.randrange(len(codes) - self.max_codes + 1)
             codes = codes[s: s + self.max_codes]
-        caption = rng.choice(self.captions[cid])
+        caption = training_caption(self.captions[cid], self.labels[cid], rng, self.bank_share)
         if self.m2t_share and rng.random() < self.m2t_share:
             motion = SOM + "".join(f"[MID_{int(c)}]" for c in codes) + EOM
             return {"input": f"Describe the motion: {motion}", "codes": None, "text": caption, "betas": None,

@@ -28,6 +28,7 @@ from torch.nn.parallel import DistributedDataParallel as DDP
 
 from ..atomic import atomic_path
 from ..config_presets import load_config
+from ..data.paraphrase_bank import BANK_SHARE
 from ..errors import ShapeMoveError
 from ..models.shapemove_t5 import ShapeMoveT5, T5Size, size_from_dict
 from ..models.tokenizer import add_motion_tokens, load_tokenizer, tokenizer_from_sentencepiece, train_sentencepiece
@@ -53,6 +54,7 @@ class T5TrainConfig:
     beta_weight: float = 1.0
     max_codes: int = 50            # 10 s at 20 fps, 4x downsampling
     m2t_share: float = 0.0         # share of motion-to-text examples (the paper's pre-training; T5 encoder)
+    bank_share: float = BANK_SHARE  # share of captions drawn from the paraphrase bank (data/paraphrase_bank.py)
     encoder: str = "minilm"        # "minilm" (frozen pretrained MiniLM + T5 decoder) or "t5" (whole T5)
     vocab_size: int = 2000
     seed: int = 0
@@ -74,6 +76,8 @@ class T5TrainConfig:
             raise ShapeMoveError("motion-to-text examples (m2t_share) need the T5 encoder; set m2t_share to 0")
         if self.steps < 1 or self.batch_size < 1 or self.max_codes < 1:
             raise ShapeMoveError("T5 config: steps, batch_size and max_codes must be >= 1")
+        if not 0 <= self.bank_share <= 1:
+            raise ShapeMoveError(f"T5 config: bank_share must be in [0, 1], got {self.bank_share}")
 
     @classmethod
     def paper(cls) -> "T5TrainConfig":
@@ -188,7 +192,7 @@ def _train(data, vae_path, out, c, base_model, resume, dist, progress, cancel, v
     raw = model
     if dist.enabled:
         model = DDP(model, find_unused_parameters=True)
-    train_set = T2MExamples(data, "train", tokens, c.max_codes, c.m2t_share)
+    train_set = T2MExamples(data, "train", tokens, c.max_codes, c.m2t_share, bank_share=c.bank_share)
     meta = {"vae": str(vae_path), "vae_body": vae.metadata.get("body"), "config": asdict(c),
             "downsample": vae.cfg.downsample, "max_codes": c.max_codes, "data": str(data),
             "base_model": str(base_model) if base_model is not None else None}

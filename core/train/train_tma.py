@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import math
 import os
+import random
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
@@ -30,6 +31,8 @@ from torch.nn.parallel import DistributedDataParallel as DDP
 
 from ..atomic import atomic_write_json
 from ..config_presets import load_config
+from ..data.actions import stored_labels
+from ..data.paraphrase_bank import BANK_SHARE, training_caption
 from ..errors import ShapeMoveError
 from ..eval.tma_embed import KIND, eval_pairs, pad_batch, score_pairs, text_inputs
 from ..models.tma import TMA, TMAConfig
@@ -57,6 +60,7 @@ class TMATrainConfig:
     grad_clip: float = 1.0
     vocab_size: int = 2000          # sentencepiece only: upper bound (a small corpus gets fewer pieces)
     shape_aware_share: float = 0.5  # share of crops from new_joint_vecs (else norm_joint_vecs)
+    bank_share: float = BANK_SHARE  # share of captions drawn from the paraphrase bank (data/paraphrase_bank.py)
     seed: int = 0
     log_every: int = 50
     val_every: int = 500
@@ -97,8 +101,8 @@ class TMATrainConfig:
     def validate(self) -> None:
         if self.steps < 1 or self.batch_size < 2:
             raise ShapeMoveError("TMA training needs steps >= 1 and batch_size >= 2 (contrastive loss)")
-        if not (self.lr > 0 and 0 <= self.shape_aware_share <= 1):
-            raise ShapeMoveError("TMA config: lr must be > 0 and shape_aware_share in [0, 1]")
+        if not (self.lr > 0 and 0 <= self.shape_aware_share <= 1 and 0 <= self.bank_share <= 1):
+            raise ShapeMoveError("TMA config: lr must be > 0, shape_aware_share and bank_share in [0, 1]")
         m = self.model
         if m["dim"] % m["heads"] or m["dim"] % 2 or m["max_frames"] < 4:
             raise ShapeMoveError("TMA model: dim must be even and divisible by heads; max_frames >= 4")
@@ -116,7 +120,7 @@ class TMAClips:
     """The training clips: ids, captions and both feature arrays (normalized with Mean/Std)."""
 
     def __init__(self, root: Path, split: str, mean: np.ndarray, std: np.ndarray):
-        self.ids, self.captions, self.feats = [], [], []
+        self.ids, self.captions, self.labels, self.feats = [], [], [], []
         for cid in read_split(root, split):
             caps = read_lines(root / "texts" / f"{cid}.txt")
             if not caps:
@@ -132,6 +136,7 @@ class TMAClips:
                 pair.append((a - mean) / std)
             self.ids.append(cid)
             self.captions.append(caps)
+            self.labels.append(stored_labels(root, cid))
             self.feats.append(pair)
 
     def __len__(self) -> int:
@@ -146,8 +151,8 @@ class TMAClips:
         max_frames = c.model["max_frames"]
         texts, crops = [], []
         for i in picks:
-            caps = self.captions[i]
-            texts.append(caps[int(rng.integers(len(caps)))])
+            texts.append(training_caption(self.captions[i], self.labels[i], random.Random(int(rng.integers(1 << 31))),
+                                          c.bank_share))
             f = self.feats[i][int(rng.random() < c.shape_aware_share)]
             start = int(rng.integers(0, len(f) - max_frames + 1)) if len(f) > max_frames else 0
             crops.append(f[start:start + max_frames])
