@@ -128,7 +128,7 @@ def test_oversized_pkl_refused_before_reading(tmp_path):
     path = tmp_path / "SMPL_NEUTRAL.pkl"
     with open(path, "wb") as fh:  # sparse file: 500 MB declared, nothing written
         fh.truncate(500 * 2**20)
-    with pytest.raises(ShapeMoveError, match="larger than any SMPL-family .pkl"):
+    with pytest.raises(ShapeMoveError, match="SMPL-family .pkl files larger than 400 MB are refused"):
         read_model_file(path)
 
 

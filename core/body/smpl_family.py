@@ -36,6 +36,7 @@ import numpy as np
 import torch
 
 from ..errors import ShapeMoveError
+from ..io.limits import check_file_size
 from .model import BodyModel
 from .skeleton import NUM_BODY_JOINTS, NUM_JOINTS, PARENTS
 
@@ -191,10 +192,7 @@ def read_model_file(path: str | Path) -> dict:
 
             raw = read_npz(path, wanted, MAX_ARRAY_BYTES, skip_objects=("gender",), what="SMPL-family model")
         else:
-            size = path.stat().st_size
-            if size > MAX_PICKLE_BYTES:
-                raise ValueError(f"the file is {size / 2**20:.0f} MB, larger than any SMPL-family .pkl "
-                                 f"({MAX_PICKLE_BYTES // 2**20} MB)")
+            check_file_size(path, MAX_PICKLE_BYTES, "SMPL-family .pkl")
             with open(path, "rb") as fh:
                 raw = _ModelUnpickler(fh, encoding="latin1").load()
             if not isinstance(raw, dict):

@@ -21,21 +21,41 @@ MAX_HIERARCHY_BYTES = 4 * 2**20  # a skeleton description (BVH HIERARCHY, ASF) l
 _CHUNK = 1 << 20
 
 
+def _amount(n: int) -> str:
+    return f"{n:,} bytes" if n < 2**20 else f"{n / 2**20:,.1f} MB".replace(".0 MB", " MB")
+
+
+def check_file_size(path, max_bytes: int, what: str, advice: str = "") -> int:
+    """The size of the user's file ``path`` in bytes, refused (ShapeMoveError) when it is larger than
+    ``max_bytes``: the one size check made BEFORE a user file is read. The message names the file,
+    both sizes and ``what`` it was meant to be ('PATH: the BVH file is 80 MB; BVH files larger than
+    64 MB are refused (ADVICE)'); a file that cannot be stat'ed is 'cannot read WHAT PATH: ...'."""
+    path = Path(path)
+    try:
+        size = path.stat().st_size
+    except OSError as exc:
+        raise ShapeMoveError(f"cannot read {what} {path}: {exc.strerror or exc}") from None
+    if size > max_bytes:
+        have, limit = _amount(size), _amount(max_bytes)
+        if have == limit:  # 64 MB + a few bytes: say it in bytes
+            have, limit = f"{size:,} bytes", f"{max_bytes:,} bytes"
+        raise ShapeMoveError(f"{path}: the {what} file is {have}; {what} files larger than {limit} are refused"
+                             + (f" ({advice})" if advice else ""))
+    return size
+
+
 def read_text(path, what: str, max_bytes: int | None = None) -> str:
     """The text of a motion file: size checked before reading, binary files refused."""
     path = Path(path)
     max_bytes = max_bytes or MAX_TEXT_BYTES
+    check_file_size(path, max_bytes, what, "split the clip")
     try:
-        size = path.stat().st_size
-        if size > max_bytes:
-            raise ShapeMoveError(f"{path}: the {what} file is {size / 2**20:.0f} MB; motion files larger than "
-                                 f"{max_bytes // 2**20} MB are refused (split the clip)")
         with open(path, "rb") as fh:
             raw = fh.read(max_bytes + 1)
     except OSError as exc:
         raise ShapeMoveError(f"cannot read {what} {path}: {exc.strerror or exc}") from None
-    if len(raw) > max_bytes:
-        raise ShapeMoveError(f"{path}: the {what} file is larger than {max_bytes // 2**20} MB")
+    if len(raw) > max_bytes:  # not a regular file (its size said 0), or it grew
+        raise ShapeMoveError(f"{path}: the {what} file is larger than {_amount(max_bytes)}")
     if b"\0" in raw[:4096]:
         raise ShapeMoveError(f"{path}: binary data, not an {what} text file")
     return raw.decode("utf-8", errors="replace")
@@ -47,9 +67,7 @@ def read_json(path, what: str, max_bytes: int = 1 << 20):
     path = Path(path)
     if not path.is_file():
         raise ShapeMoveError(f"{what} not found: {path}")
-    size = path.stat().st_size
-    if size > max_bytes:
-        raise ShapeMoveError(f"{path}: {size:,} bytes is too large for a {what} (at most {max_bytes:,})")
+    check_file_size(path, max_bytes, what)
     try:
         return json.loads(path.read_text(encoding="utf-8"))
     except (json.JSONDecodeError, UnicodeDecodeError) as exc:
