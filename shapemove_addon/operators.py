@@ -62,6 +62,22 @@ def build_rig_from_file(path: str, name: str = "ShapeMove", measurements: dict |
     return rig
 
 
+def existing_path(value: str, what: str, folder: bool = False) -> str:
+    """A file or folder setting of the panels as an absolute path that exists; else a ShapeMoveError
+    'WHAT not found: PATH'."""
+    path = bpy.path.abspath(value) if value else ""
+    if not path or not (os.path.isdir(path) if folder else os.path.isfile(path)):
+        raise ShapeMoveError(f"{what} not found: {path or '(none given)'}")
+    return path
+
+
+def set_whole_shape(rig, betas, context) -> None:
+    """Set all of the rig's betas at once (random, reset, from text); the phenotype sliders are
+    re-derived from them."""
+    semantic_shape.forget_phenotype(rig)
+    shape_sync.set_betas(rig, betas, context)
+
+
 def on_generated(name: str, msg: dict):
     """The generate job's answer: build the rig, with its measurements and physics figures."""
     if msg.get("cancelled"):
@@ -88,8 +104,19 @@ class ReportingOperator:
         return {"FINISHED"}
 
 
+class JobOperator(ReportingOperator):
+    """A ReportingOperator whose start submits the background job ``job`` (the kind that
+    ``job_submit`` and the panel's ``draw_job`` know it by): greyed out while that job runs."""
+
+    job = ""
+
+    @classmethod
+    def poll(cls, context):
+        return not job_submit.running(cls.job)
+
+
 # -- build ---------------------------------------------------------------------------------------
-class SHAPEMOVE_OT_build_from_motion(bpy.types.Operator, ImportHelper):
+class SHAPEMOVE_OT_build_from_motion(ReportingOperator, bpy.types.Operator, ImportHelper):
     """Build a shaped, rigged and keyframed body from a ShapeMove motion file (.npz)"""
 
     bl_idname = "shapemove.build_from_motion"
@@ -108,37 +135,29 @@ class SHAPEMOVE_OT_build_from_motion(bpy.types.Operator, ImportHelper):
     def poll(cls, context):
         return context.mode == "OBJECT"
 
-    def execute(self, context):
-        try:
-            motion = load_motion(self.filepath)
-            model_file = self.body_model_file or (body_spec(context) if not is_openbody(motion.body_model) else None)
-            if model_file == "openbody":
-                model_file = None
-            rig = build_rig(context, motion, load_body(motion.body_model, model_file), name=self.rig_name,
-                            collection=context.collection)
-        except ShapeMoveError as exc:
-            self.report({"ERROR"}, str(exc))
-            return {"CANCELLED"}
+    def start(self, context):
+        motion = load_motion(self.filepath)
+        model_file = self.body_model_file or (body_spec(context) if not is_openbody(motion.body_model) else None)
+        if model_file == "openbody":
+            model_file = None
+        rig = build_rig(context, motion, load_body(motion.body_model, model_file), name=self.rig_name,
+                        collection=context.collection)
         rig.armature[MOTION_FILE_KEY] = os.path.abspath(self.filepath)
         rig.armature[HAS_TOKENS_KEY] = motion.tokens is not None and len(motion.tokens) > 0
         for obj in context.view_layer.objects:
             obj.select_set(False)
         rig.armature.select_set(True)
         context.view_layer.objects.active = rig.armature
-        self.report({"INFO"}, f"built {rig.armature.name}: {motion.num_frames} frames at {motion.fps:g} fps")
-        return {"FINISHED"}
+        return f"built {rig.armature.name}: {motion.num_frames} frames at {motion.fps:g} fps"
 
 
 # -- generate ------------------------------------------------------------------------------------
-class SHAPEMOVE_OT_generate(ReportingOperator, bpy.types.Operator):
+class SHAPEMOVE_OT_generate(JobOperator, bpy.types.Operator):
     """Generate a body shape and a motion from the prompt (runs in the background)"""
 
     bl_idname = "shapemove.generate"
     bl_label = "Generate"
-
-    @classmethod
-    def poll(cls, context):
-        return not job_submit.running("generate")
+    job = "generate"
 
     def start(self, context):
         s = context.scene.shapemove
@@ -151,7 +170,7 @@ class SHAPEMOVE_OT_generate(ReportingOperator, bpy.types.Operator):
                   "out": str(paths.new_motion_path(prompt))}
         name = paths.slug(prompt, 24)
 
-        job_submit.submit_job("generate", params, kind="generate", label="generate",
+        job_submit.submit_job("generate", params, kind=self.job, label="generate",
                               on_result=lambda msg: on_generated(name, msg))
         return "generating..."
 
@@ -180,7 +199,7 @@ class _RigOperator:
         return context.mode in ("OBJECT", "POSE") and active_rig(context) is not None
 
 
-class SHAPEMOVE_OT_random_shape(_RigOperator, bpy.types.Operator):
+class SHAPEMOVE_OT_random_shape(ReportingOperator, _RigOperator, bpy.types.Operator):
     """Give the active rig a random body shape (betas ~ N(0, spread))"""
 
     bl_idname = "shapemove.random_shape"
@@ -188,35 +207,21 @@ class SHAPEMOVE_OT_random_shape(_RigOperator, bpy.types.Operator):
 
     seed: IntProperty(name="Seed", default=-1, min=-1, description="-1: a new random shape every time")
 
-    def execute(self, context):
-        rig = active_rig(context)
+    def start(self, context):
         rng = np.random.default_rng(None if self.seed < 0 else self.seed)
         betas = np.clip(rng.normal(0.0, context.scene.shapemove.random_scale, NUM_BETAS),
                         -SLIDER_RANGE, SLIDER_RANGE)
-        try:
-            semantic_shape.forget_phenotype(rig)
-            shape_sync.set_betas(rig, betas, context)
-        except ShapeMoveError as exc:
-            self.report({"ERROR"}, str(exc))
-            return {"CANCELLED"}
-        return {"FINISHED"}
+        set_whole_shape(active_rig(context), betas, context)
 
 
-class SHAPEMOVE_OT_reset_shape(_RigOperator, bpy.types.Operator):
+class SHAPEMOVE_OT_reset_shape(ReportingOperator, _RigOperator, bpy.types.Operator):
     """Reset the active rig to the average body (all betas 0)"""
 
     bl_idname = "shapemove.reset_shape"
     bl_label = "Reset Shape"
 
-    def execute(self, context):
-        rig = active_rig(context)
-        try:
-            semantic_shape.forget_phenotype(rig)
-            shape_sync.set_betas(rig, np.zeros(NUM_BETAS), context)
-        except ShapeMoveError as exc:
-            self.report({"ERROR"}, str(exc))
-            return {"CANCELLED"}
-        return {"FINISHED"}
+    def start(self, context):
+        set_whole_shape(active_rig(context), np.zeros(NUM_BETAS), context)
 
 
 class SHAPEMOVE_OT_shape_from_text(ReportingOperator, _RigOperator, bpy.types.Operator):
@@ -237,8 +242,7 @@ class SHAPEMOVE_OT_shape_from_text(ReportingOperator, _RigOperator, bpy.types.Op
             target = bpy.data.objects.get(name)
             if target is None or msg.get("cancelled"):
                 return
-            semantic_shape.forget_phenotype(target)
-            shape_sync.set_betas(target, msg["result"]["betas"], bpy.context)
+            set_whole_shape(target, msg["result"]["betas"], bpy.context)
             store_measurements(target, msg["result"].get("achieved", {}))
 
         job_submit.submit_job("betas_from_text", {"text": text, "body": rig_body_spec(rig)}, kind="shape",
@@ -298,23 +302,22 @@ def _retarget_job(context, source: str, target_rig, name: str) -> None:
     job_submit.submit_job("retarget", params, kind="retarget", label=f"retarget {Path(source).name}", on_result=done)
 
 
-class SHAPEMOVE_OT_retarget(ReportingOperator, bpy.types.Operator):
+class SHAPEMOVE_OT_retarget(JobOperator, bpy.types.Operator):
     """Put a mocap clip (BVH, ASF/AMC, AMASS) or the active armature's action on a ShapeMove body"""
 
     bl_idname = "shapemove.retarget"
     bl_label = "Retarget"
+    job = "retarget"
 
     @classmethod
     def poll(cls, context):
-        return context.mode == "OBJECT" and not job_submit.running("retarget")
+        return context.mode == "OBJECT" and super().poll(context)
 
     def start(self, context):
         s = context.scene.shapemove
         target = s.retarget_target or active_rig(context)
         if s.retarget_source == "FILE":
-            source = bpy.path.abspath(s.retarget_path)
-            if not s.retarget_path or not os.path.isfile(source):
-                raise ShapeMoveError(f"motion file not found: {source or '(none given)'}")
+            source = existing_path(s.retarget_path, "motion file")
             name = Path(source).stem
         else:
             arm = context.active_object
@@ -340,21 +343,16 @@ def _export_plain_bvh(context, arm, path: str) -> None:
 
 
 # -- library -------------------------------------------------------------------------------------
-class SHAPEMOVE_OT_library_search(ReportingOperator, bpy.types.Operator):
+class SHAPEMOVE_OT_library_search(JobOperator, bpy.types.Operator):
     """Rank the motions of the library folder by the query (text-motion alignment model)"""
 
     bl_idname = "shapemove.library_search"
     bl_label = "Search"
-
-    @classmethod
-    def poll(cls, context):
-        return not job_submit.running("search")
+    job = "search"
 
     def start(self, context):
         s = context.scene.shapemove
-        folder = bpy.path.abspath(s.library_folder)
-        if not s.library_folder or not os.path.isdir(folder):
-            raise ShapeMoveError(f"library folder not found: {folder or '(none given)'}")
+        folder = existing_path(s.library_folder, "library folder", folder=True)
         if not s.library_query.strip():
             raise ShapeMoveError("the query is empty: describe a motion, e.g. 'a person waves'")
         scene_name = context.scene.name
@@ -372,11 +370,11 @@ class SHAPEMOVE_OT_library_search(ReportingOperator, bpy.types.Operator):
 
         params = {"folder": folder, "query": s.library_query.strip(), "top_k": s.library_top_k,
                   "tma": setting("active_model") or None}
-        job_submit.submit_job("search", params, kind="search", label="search", on_result=done)
+        job_submit.submit_job("search", params, kind=self.job, label="search", on_result=done)
         return "searching..."
 
 
-class SHAPEMOVE_OT_library_import(bpy.types.Operator):
+class SHAPEMOVE_OT_library_import(ReportingOperator, bpy.types.Operator):
     """Build a rig from this library motion (mocap files are retargeted first)"""
 
     bl_idname = "shapemove.library_import"
@@ -389,51 +387,41 @@ class SHAPEMOVE_OT_library_import(bpy.types.Operator):
     def poll(cls, context):
         return context.mode == "OBJECT"
 
-    def execute(self, context):
+    def start(self, context):
         s = context.scene.shapemove
         i = s.library_index if self.index < 0 else self.index
         if not 0 <= i < len(s.library_results):
-            self.report({"ERROR"}, "no search result selected")
-            return {"CANCELLED"}
+            raise ShapeMoveError("no search result selected")
         item = s.library_results[i]
         path = Path(item.path)
-        try:
-            if path.suffix.lower() == ".npz":
+        if path.suffix.lower() == ".npz":
+            try:
+                load_motion(path)  # a ShapeMove motion file: build it directly
+            except ShapeMoveError:
+                pass
+            else:
                 try:
-                    load_motion(path)  # a ShapeMove motion file: build it directly
-                except ShapeMoveError:
-                    pass
-                else:
-                    try:
-                        return bpy.ops.shapemove.build_from_motion(filepath=str(path), rig_name=paths.slug(item.name, 24))
-                    except RuntimeError as exc:  # its ERROR report
-                        raise ShapeMoveError(str(exc).replace("Error: ", "").strip()) from None
-            _retarget_job(context, str(path), active_rig(context), paths.slug(item.name, 24))
-        except ShapeMoveError as exc:
-            self.report({"ERROR"}, str(exc))
-            return {"CANCELLED"}
-        self.report({"INFO"}, f"retargeting {path.name}...")
-        return {"FINISHED"}
+                    bpy.ops.shapemove.build_from_motion(filepath=str(path), rig_name=paths.slug(item.name, 24))
+                except RuntimeError as exc:  # its ERROR report
+                    raise ShapeMoveError(str(exc).replace("Error: ", "").strip()) from None
+                return None  # the build operator reported what it built
+        _retarget_job(context, str(path), active_rig(context), paths.slug(item.name, 24))
+        return f"retargeting {path.name}..."
 
 
 # -- train ---------------------------------------------------------------------------------------
-class SHAPEMOVE_OT_train(ReportingOperator, bpy.types.Operator):
+class SHAPEMOVE_OT_train(JobOperator, bpy.types.Operator):
     """Train a model part on a dataset folder (runs in the background; cancel keeps a checkpoint)"""
 
     bl_idname = "shapemove.train"
     bl_label = "Train"
+    job = "train"
 
     resume: BoolProperty(name="Resume", default=False, description="Continue the last (cancelled) run")
 
-    @classmethod
-    def poll(cls, context):
-        return not job_submit.running("train")
-
     def start(self, context):
         s = context.scene.shapemove
-        data = bpy.path.abspath(s.train_data)
-        if not s.train_data or not os.path.isdir(data):
-            raise ShapeMoveError(f"dataset folder not found: {data or '(none given)'}")
+        data = existing_path(s.train_data, "dataset folder", folder=True)
         model_dir = paths.models_dir(context) / paths.slug(s.train_model_name)
         params = {"kind": s.train_kind, "data": data, "model_dir": str(model_dir), "steps": s.train_steps,
                   "resume": self.resume, "device": setting("device", "cpu"), "config": s.train_config,
@@ -446,7 +434,7 @@ class SHAPEMOVE_OT_train(ReportingOperator, bpy.types.Operator):
             if scene is not None and r.get("published"):
                 scene.shapemove.train_result = r["model_dir"]
 
-        job_submit.submit_job("train", params, kind="train", label=f"train {s.train_kind}", on_result=done)
+        job_submit.submit_job("train", params, kind=self.job, label=f"train {s.train_kind}", on_result=done)
         return f"training {s.train_kind} into {model_dir}"
 
 
@@ -473,7 +461,7 @@ class SHAPEMOVE_OT_use_model(bpy.types.Operator):
 
 
 # -- export --------------------------------------------------------------------------------------
-class SHAPEMOVE_OT_export(bpy.types.Operator, ExportHelper):
+class SHAPEMOVE_OT_export(ReportingOperator, bpy.types.Operator, ExportHelper):
     """Export the active ShapeMove rig with its animation (FBX, glTF or BVH)"""
 
     bl_idname = "shapemove.export"
@@ -501,36 +489,26 @@ class SHAPEMOVE_OT_export(bpy.types.Operator, ExportHelper):
         self.filename_ext = FORMATS[self.format]
         return super().invoke(context, event)
 
-    def execute(self, context):
-        try:
-            path = export_rig(context, active_rig(context), self.filepath, self.format)
-        except ShapeMoveError as exc:
-            self.report({"ERROR"}, str(exc))
-            return {"CANCELLED"}
-        self.report({"INFO"}, f"wrote {path}")
-        return {"FINISHED"}
+    def start(self, context):
+        return f"wrote {export_rig(context, active_rig(context), self.filepath, self.format)}"
 
 
 # -- preferences ---------------------------------------------------------------------------------
-class SHAPEMOVE_OT_detect_python(bpy.types.Operator):
+class SHAPEMOVE_OT_detect_python(ReportingOperator, bpy.types.Operator):
     """Find a Python with PyTorch for the ShapeMove jobs"""
 
     bl_idname = "shapemove.detect_python"
     bl_label = "Detect Python"
 
-    def execute(self, context):
-        try:
-            found = paths.detect_python()
-        except ShapeMoveError as exc:
-            self.report({"ERROR"}, str(exc))
-            return {"CANCELLED"}
-        prefs = preferences(context)
+    def start(self, context):
+        found = paths.detect_python()
         if not found:
-            self.report({"INFO"}, "Blender's Python has PyTorch: jobs run inside Blender")
-        elif prefs is not None:
-            prefs.python_env = found
-            self.report({"INFO"}, f"using {found}")
-        return {"FINISHED"}
+            return "Blender's Python has PyTorch: jobs run inside Blender"
+        prefs = preferences(context)
+        if prefs is None:
+            return None
+        prefs.python_env = found
+        return f"using {found}"
 
 
 classes = (SHAPEMOVE_OT_build_from_motion, SHAPEMOVE_OT_generate, SHAPEMOVE_OT_cancel_job,

@@ -52,6 +52,14 @@ class _SubPanel(_Panel):
     bl_parent_id = "SHAPEMOVE_PT_main"
 
 
+class _RigPanel(_SubPanel):
+    """A sub-panel shown only while a ShapeMove rig (or one of its meshes) is active."""
+
+    @classmethod
+    def poll(cls, context):
+        return rig_of(context.active_object) is not None
+
+
 class SHAPEMOVE_PT_main(_Panel, bpy.types.Panel):
     bl_label = "ShapeMove"
     bl_idname = "SHAPEMOVE_PT_main"
@@ -122,13 +130,9 @@ def draw_result(layout, rig) -> None:
             grid.label(text=f"{label}: {getattr(m, prop):.1f} cm")
 
 
-class SHAPEMOVE_PT_shape(_SubPanel, bpy.types.Panel):
+class SHAPEMOVE_PT_shape(_RigPanel, bpy.types.Panel):
     bl_label = "Shape"
     bl_idname = "SHAPEMOVE_PT_shape"
-
-    @classmethod
-    def poll(cls, context):
-        return rig_of(context.active_object) is not None
 
     def draw(self, context):
         rig = rig_of(context.active_object)
@@ -158,15 +162,11 @@ class SHAPEMOVE_PT_shape(_SubPanel, bpy.types.Panel):
         draw_job(box, "measure", "shapemove.measure", "Measure", icon="DRIVER_DISTANCE")
 
 
-class SHAPEMOVE_PT_shape_betas(_Panel, bpy.types.Panel):
+class SHAPEMOVE_PT_shape_betas(_RigPanel, bpy.types.Panel):
     bl_label = "Betas"
     bl_idname = "SHAPEMOVE_PT_shape_betas"
     bl_parent_id = "SHAPEMOVE_PT_shape"
     bl_options = {"DEFAULT_CLOSED"}
-
-    @classmethod
-    def poll(cls, context):
-        return rig_of(context.active_object) is not None
 
     def draw(self, context):
         rig = rig_of(context.active_object)
@@ -246,14 +246,10 @@ class SHAPEMOVE_PT_train(_SubPanel, bpy.types.Panel):
         col.label(text=f"Active model: {setting('active_model') or 'default'}")
 
 
-class SHAPEMOVE_PT_export(_SubPanel, bpy.types.Panel):
+class SHAPEMOVE_PT_export(_RigPanel, bpy.types.Panel):
     bl_label = "Export"
     bl_idname = "SHAPEMOVE_PT_export"
     bl_options = {"DEFAULT_CLOSED"}
-
-    @classmethod
-    def poll(cls, context):
-        return rig_of(context.active_object) is not None
 
     def draw(self, context):
         s = context.scene.shapemove
