@@ -127,3 +127,36 @@ def test_ground_shift_caps_flight_of_predicted_contacts():
     np.testing.assert_allclose(h[12:28], 0.0)       # the long stretch stands on the floor
     h_free = low + ground_shift(per_foot, low, c)
     np.testing.assert_allclose(h_free[12:28], 0.40)  # measured contacts: heights kept (e.g. climbing)
+
+
+def test_known_contacts_planted_without_drift_and_body_smoothed(openbody):
+    """A decoded clip whose body slides 3 mm/frame and jitters 2 mm, with known contacts (as the
+    retargeting path plants the source's): the posed foot in contact stays within 1 mm."""
+    from shapemove.core.body.plant import BODY_SMOOTH, plant_motion, smooth_body
+
+    T = 30
+    rng = np.random.default_rng(0)
+    j = _standing(openbody, T) + [0.0, 0.2, 0.0]                   # source floor 20 cm up
+    j[:, :, 2] += np.arange(T)[:, None] * 0.003                     # the whole body skates forward
+    j += rng.normal(0, 0.002, j.shape)                              # decoder jitter
+    c = np.zeros((T, 4), np.uint8)
+    c[2:14, [0, 2]] = 1                                             # left heel + toe down
+    c[16:28, [1, 3]] = 1                                            # right heel + toe down
+    sm = smooth_body(j, BODY_SMOOTH)
+    np.testing.assert_array_equal(sm[:, [7, 8, 10, 11]], j[:, [7, 8, 10, 11]])  # planted joints untouched
+    acc = lambda x: np.abs(np.diff(x[:, 0], 2, axis=0)).mean()  # noqa: E731
+    assert acc(sm) < 0.4 * acc(j)                                   # pelvis jitter (2nd difference) cut
+    b = np.zeros(10, np.float32)
+    p = plant_motion(openbody, b, j, c, refine_iters=5, gate=False, max_flight=None, smooth=BODY_SMOOTH)
+    np.testing.assert_array_equal(p.contacts, c)                    # known contacts: no gating
+    with torch.no_grad():
+        out = openbody(torch.as_tensor(b)[None], torch.as_tensor(p.rotations), torch.as_tensor(p.transl))
+    posed = out.joints[:, :22].double().numpy()
+    for k, jid in enumerate((7, 8, 10, 11)):
+        for s, e in runs(c[:, k]):
+            xz = posed[s:e, jid][:, [0, 2]]
+            assert np.linalg.norm(xz - xz.mean(0), axis=1).max() < 1e-3, (jid, s, e)   # < 1 mm drift
+    src = j[:, 10, [0, 2]]
+    assert np.linalg.norm(src[2:14] - src[2:14].mean(0), axis=1).max() > 0.015     # the input did slide
+    # grounded on the mesh: the lowest vertex of the planted foot touches y = 0
+    assert float(out.vertices[2:14, ..., 1].min()) == pytest.approx(0.0, abs=2e-3)

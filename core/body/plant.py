@@ -90,6 +90,21 @@ def ground_shift(per_foot, lowest_all, contacts, max_flight: int | None = None) 
 
 
 GATE_HEIGHT = 0.08   # m: a predicted contact whose sole is higher than this is not planted
+BODY_SMOOTH = 1.5    # frames (Gaussian sigma) of ``smooth_body`` when the contacts are known
+
+
+def smooth_body(joints, sigma: float = BODY_SMOOTH) -> np.ndarray:
+    """(T,22,3) decoded joints -> the same with every joint but the ankles and feet (which
+    ``plant_targets`` pins) Gaussian-smoothed over time (``sigma`` frames). The zero-moment point
+    follows the CoM's second derivative: 1-2 mm of decoder jitter per frame at 20 fps moves it by
+    centimetres, out of the base of support (HUMOS's dynamic stability)."""
+    from ..motion.skeleton_ops import gaussian_smooth
+
+    j = np.array(joints, dtype=np.float64)
+    body = [i for i in range(j.shape[1]) if i not in CONTACT_IDS]
+    if sigma > 0 and len(j) > 1:
+        j[:, body] = gaussian_smooth(j[:, body], sigma)
+    return j
 
 
 @dataclass
@@ -117,11 +132,14 @@ def gate_contacts(joints, contacts, sole_offsets, max_height: float = GATE_HEIGH
     return c.astype(np.uint8)
 
 
-def plant_motion(body, betas, joints, contacts, refine_iters: int = 10, gate: bool = True) -> Planted:
+def plant_motion(body, betas, joints, contacts, refine_iters: int = 10, gate: bool = True,
+                 max_flight: int | None = MAX_FLIGHT, smooth: float = 0.0) -> Planted:
     """Joint positions (T,22,3) (e.g. decoded by the SA-VAE) -> rotations and translation of
     ``body`` with ``betas`` whose feet in ``contacts`` (T,4) are planted and whose mesh stands on
     the floor: ``plant_targets`` + ``ik.solve_ik`` + ``ground_shift`` on the body's sole probe.
-    ``gate``: drop contacts whose sole is far above the floor first (``gate_contacts``)."""
+    ``gate``: drop contacts whose sole is far above the floor first (``gate_contacts``).
+    ``max_flight``: see ``ground_shift`` (None for known contacts, e.g. a retargeted source's).
+    ``smooth`` > 0: ``smooth_body`` with that sigma (frames) first."""
     import torch
 
     from .ik import solve_ik
@@ -129,7 +147,7 @@ def plant_motion(body, betas, joints, contacts, refine_iters: int = 10, gate: bo
 
     b = np.asarray(betas, dtype=np.float32).reshape(-1)
     probe = GroundProbe(body, b)
-    j = np.asarray(joints, dtype=np.float64)
+    j = smooth_body(joints, smooth) if smooth > 0 else np.asarray(joints, dtype=np.float64)
     c = gate_contacts(j, contacts, probe.sole_offsets) if gate else np.asarray(contacts, np.uint8)
     targets, floor = plant_targets(j, c, probe.sole_offsets)
     with torch.no_grad():
@@ -137,7 +155,7 @@ def plant_motion(body, betas, joints, contacts, refine_iters: int = 10, gate: bo
     ik = solve_ik(targets, rest, refine_iters=refine_iters)
     transl = np.asarray(ik.transl, dtype=np.float64).copy()
     per_foot, _, low = probe.lowest(ik.rotations, transl)
-    shift = ground_shift(per_foot, low, c, max_flight=MAX_FLIGHT)  # predicted contacts can miss steps
+    shift = ground_shift(per_foot, low, c, max_flight=max_flight)  # predicted contacts can miss steps
     transl[:, 1] += shift
     posed = _posed(ik, rest, body.parents)   # error against the input joints (floor removed)
     posed[..., 1] += shift[:, None]

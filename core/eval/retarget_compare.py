@@ -49,11 +49,14 @@ def _score(body, motion, betas) -> dict:
 
 
 def compare_retargeting(data, checkpoint, clips, target_betas_list, body=None, ik_refine_iters: int = 10,
-                        progress=None) -> dict:
+                        progress=None, plant_source_contacts: bool = True) -> dict:
     """{"savae": metrics, "naive": metrics} (``KEYS`` + "clips", "bodies") over every clip of
     ``clips`` (dataset clip ids or mocap files) moved onto every body of ``target_betas_list``
-    ((10,) betas each). ``checkpoint``: SA-VAE run folder or .pt. progress(fraction, clip)."""
-    from ..generation.retarget import check_betas, decode_tokens, encode_source, load_vae, naive_retarget, source_joints
+    ((10,) betas each). ``checkpoint``: SA-VAE run folder or .pt. progress(fraction, clip).
+    The SA-VAE side is decoded as ``generation.retarget.retarget`` does (the source's contacts
+    planted unless ``plant_source_contacts`` is False: the decoder's own contacts)."""
+    from ..generation.retarget import (check_betas, decode_tokens, encode_source, load_vae, naive_retarget,
+                                       source_contacts, source_joints)
     from ..io.mocap import Motion22
     from .recon import _body
 
@@ -67,8 +70,10 @@ def compare_retargeting(data, checkpoint, clips, target_betas_list, body=None, i
         joints, name = source_joints(source_motion(data, clip), body)
         src = Motion22(joints=joints, fps=float(FPS), source=name, subject="", offsets=np.zeros((22, 3)))  # read once
         codes = encode_source(joints, vae, body, ik_refine_iters)
+        contacts = source_contacts(joints) if plant_source_contacts else None
         for betas in targets:
-            rows["savae"].append(_score(body, decode_tokens(codes, vae, body, betas, ik_refine_iters), betas))
+            rows["savae"].append(_score(body, decode_tokens(codes, vae, body, betas, ik_refine_iters, contacts=contacts),
+                                        betas))
             rows["naive"].append(_score(body, naive_retarget(src, body, betas, ik_refine_iters), betas))
         if progress is not None:
             progress((i + 1) / len(clips), str(clip))

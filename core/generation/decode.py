@@ -18,12 +18,15 @@ def check_betas(betas) -> np.ndarray:
     return b
 
 
-def decode_tokens(codes: list[int], vae, body, betas, ik_refine_iters: int = 10, prompt: str | None = None) -> Motion:
+def decode_tokens(codes: list[int], vae, body, betas, ik_refine_iters: int = 10, prompt: str | None = None,
+                  contacts=None) -> Motion:
     """Motion tokens + betas (10,) -> Motion on ``body``: SA-VAE ``decode_long`` with the body's
     shape, joints from the features, then ``plant.plant_motion``: the feet the decoder's contact
     channels mark are planted (one fixed point per contact run, soles on y = 0), IK onto the body,
     and the posed mesh grounded frame by frame on its soles. The Motion's ``joints`` are FK of its
-    pose (what the rig plays); the decoder's own joints are kept as ``network_joints``."""
+    pose (what the rig plays); the decoder's own joints are kept as ``network_joints``.
+    ``contacts`` (>= T,4) known foot contacts (retargeting: the source motion's) are planted
+    instead of the decoder's channels, as measured contacts (no gating, flights kept)."""
     from ..body.plant import contacts_from_features
     from ..motion.features import joints_from_features
 
@@ -34,20 +37,30 @@ def decode_tokens(codes: list[int], vae, body, betas, ik_refine_iters: int = 10,
         idx = torch.as_tensor(codes, dtype=torch.long)[None]
         feats = vae.denormalize(vae.decode_long(vae.quantizer.indices_to_codes(idx), b))[0]
         joints = joints_from_features(feats.double()).float().numpy()
-    return motion_from_joints(body, b[0].numpy(), joints, contacts_from_features(feats.numpy()), ik_refine_iters,
-                              prompt=prompt, tokens=np.asarray(codes, np.int16), features=feats.numpy().astype(np.float32))
+    known = contacts is not None
+    if known:
+        contacts = np.asarray(contacts)
+        if contacts.ndim != 2 or contacts.shape[1] != 4 or len(contacts) < len(joints):
+            raise ShapeMoveError(f"known contacts must be (>= {len(joints)}, 4), got shape {contacts.shape}")
+        contacts = contacts[:len(joints)]
+    else:
+        contacts = contacts_from_features(feats.numpy())
+    return motion_from_joints(body, b[0].numpy(), joints, contacts, ik_refine_iters, prompt=prompt, known_contacts=known,
+                              tokens=np.asarray(codes, np.int16), features=feats.numpy().astype(np.float32))
 
 
 def motion_from_joints(body, betas, joints, contacts, ik_refine_iters: int = 10, prompt: str | None = None,
-                       **extra) -> Motion:
+                       known_contacts: bool = False, **extra) -> Motion:
     """(T,22,3) joint positions + (T,4) foot contacts of joints 7, 8, 10, 11 -> self-consistent
     Motion on ``body`` with ``betas``: contacts planted, mesh grounded (``plant.plant_motion``);
-    ``extra``: tokens, features (stored as they are)."""
-    from ..body.plant import plant_motion
+    ``known_contacts``: ``contacts`` are measured (not predicted): planted without gating, long
+    flights kept, the decoded body smoothed (``plant.smooth_body``); ``extra``: tokens, features."""
+    from ..body.plant import BODY_SMOOTH, plant_motion
     from ..geometry.rotations import matrix_to_axis_angle
     from ..scene.motion_file import make_motion
 
-    planted = plant_motion(body, betas, joints, contacts, refine_iters=ik_refine_iters)
+    planted = plant_motion(body, betas, joints, contacts, refine_iters=ik_refine_iters, **(
+        {"gate": False, "max_flight": None, "smooth": BODY_SMOOTH} if known_contacts else {}))
     poses = matrix_to_axis_angle(planted.rotations).astype(np.float32)
     m = make_motion(body, poses, planted.transl, betas, fps=float(FPS), prompt=prompt,
                     network_joints=np.asarray(joints, np.float32), contacts=planted.contacts, **extra)

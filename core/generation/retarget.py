@@ -7,10 +7,12 @@
      to its bone lengths, IK onto that body, the same rotations on the canonical body (betas = 0,
      stride scaled by the pelvis height) -> canonical HumanML3D features;
   3. SA-VAE encode -> motion tokens; decode them with the NEW betas -> shape-aware features ->
-     joints -> the feet the decoder marks in contact planted, IK onto the new body, the mesh grounded
-     on its soles (``decode_tokens``, the generator's decoding), so feet stay planted and bones
-     take the new body's lengths. The Motion keeps its tokens: ``Generator.redecode`` moves it
-     to yet another body.
+     joints -> the feet in contact planted, IK onto the new body, the mesh grounded on its soles
+     (``decode_tokens``, the generator's decoding), so feet stay planted and bones take the new
+     body's lengths. The contacts planted are the SOURCE motion's (``source_contacts``: detected
+     on the captured joints, which are known here), not the ones the decoder predicts: a
+     retargeted foot stays put exactly where the captured one did. The Motion keeps its tokens:
+     ``Generator.redecode`` moves it to yet another body (with the decoder's contacts).
 ``naive_retarget(motion, body, betas)``: the subject's local rotations copied onto the new body,
 the root trajectory scaled by the leg-length (pelvis height) ratio, the clip's lowest mesh point put
 on the floor (one offset, no contacts). Bones are the new body's, but feet slide, sink and float
@@ -100,14 +102,24 @@ def encode_source(joints: np.ndarray, vae, body, ik_refine_iters: int = 10) -> l
     return [int(i) for i in indices[0]]
 
 
-def retarget(motion, vae, body, betas, ik_refine_iters: int = 10) -> Motion:
+def source_contacts(joints) -> np.ndarray:
+    """(T,22,3) source joints at 20 fps -> (T,4) uint8 foot contacts of joints 7, 8, 10, 11
+    (``motion.contacts.detect_contacts``, as the dataset builder labels its clips)."""
+    from ..motion.contacts import detect_contacts
+
+    return detect_contacts(joints, FPS)
+
+
+def retarget(motion, vae, body, betas, ik_refine_iters: int = 10, plant_source_contacts: bool = True) -> Motion:
     """``motion`` (mocap file path or Motion22) performed by the body ``betas`` (10,), through the
     SA-VAE ``vae`` (trained for ``body``). Returns a validated Motion with tokens: 4*((T-1)//4)
-    frames at 20 fps."""
+    frames at 20 fps. ``plant_source_contacts``: plant the source's contacts (default) rather
+    than the decoder's predicted ones."""
     betas = check_betas(betas)
     joints, _ = source_joints(motion, body)
     codes = encode_source(joints, vae, body, ik_refine_iters)
-    out = decode_tokens(codes, vae, body, betas, ik_refine_iters)
+    out = decode_tokens(codes, vae, body, betas, ik_refine_iters,
+                        contacts=source_contacts(joints) if plant_source_contacts else None)
     validate(out)
     return out
 
