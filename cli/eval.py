@@ -136,9 +136,10 @@ def run_retarget(args) -> int:
     result = compare_retargeting(args.data, args.checkpoint, clips, bodies, body=body)
     result["bodies"] = list(RETARGET_BODIES)
     atomic_write_json(args.json, result, nan_to_null=True)
-    print(f"{'metric':<20}{'SA-VAE':>10}{'naive':>10}")
+    src = result.get("source")  # the capture on its own fitted body, for reference
+    print(f"{'metric':<20}{'SA-VAE':>10}{'naive':>10}" + (f"{'source':>10}" if src else ""))
     for k in KEYS:
-        print(f"{k:<20}{result['savae'][k]:>10.2f}{result['naive'][k]:>10.2f}")
+        print(f"{k:<20}{result['savae'][k]:>10.2f}{result['naive'][k]:>10.2f}" + (f"{src[k]:>10.2f}" if src else ""))
     print(f"{len(clips)} clips x {len(bodies)} bodies; wrote {args.json}")
     return 0
 

@@ -166,6 +166,31 @@ def test_retarget_through_savae(run_bvh, tiny_dataset, vae, body):
     assert np.allclose(again.features, tall.features, atol=1e-5)
 
 
+def test_retarget_plants_the_source_contacts(run_bvh, vae, body):
+    """The retargeted feet stay where the SOURCE's feet were in contact (known contacts, not the
+    decoder's): the motion's contacts are the source's, and a planted foot joint barely moves."""
+    from shapemove.core.body.shape_from_measurements import betas_from_shape_text
+    from shapemove.core.generation.retarget import retarget, source_contacts, source_joints
+    from shapemove.core.motion.contacts import runs
+
+    b = betas_from_shape_text(body, "A person standing 190 cm tall")
+    m = retarget(run_bvh, vae, body, b)
+    src = source_contacts(source_joints(run_bvh, body)[0])
+    assert src[:, 2:].sum() > 20                                   # a run: the toes touch down many times
+    np.testing.assert_array_equal(m.contacts, src[:m.num_frames])
+    with torch.no_grad():
+        fk = body.forward(torch.as_tensor(b)[None], torch.as_tensor(m.poses), torch.as_tensor(m.transl)).joints
+    fk = fk[:, :22].double().numpy()
+    steps = lambda j: np.concatenate([np.linalg.norm(np.diff(j[s:e, jid][:, [0, 2]], axis=0), axis=1)  # noqa: E731
+                                      for k, jid in enumerate((7, 8, 10, 11)) for s, e in runs(m.contacts[:, k])])
+    # planted: the median step of a foot joint in contact is < 1 mm/frame, where the decoded joints
+    # (20 training steps: a poor decoder) slide > 5 mm/frame; the largest steps come from frames
+    # where the decoded pelvis runs further than the leg reaches (IK compromise)
+    assert np.median(steps(fk)) < 1e-3 < 5e-3 < np.median(steps(m.network_joints.astype(np.float64)))
+    free = retarget(run_bvh, vae, body, b, plant_source_contacts=False)    # the decoder's own contacts
+    assert not np.array_equal(free.contacts, m.contacts)
+
+
 def test_naive_retarget_keeps_the_rotations_on_the_new_bones(run_bvh, tiny_dataset, body):
     from shapemove.core.body.skeleton import PARENTS
     from shapemove.core.eval.bones import bone_lengths, target_bone_lengths
@@ -205,11 +230,12 @@ def test_compare_retargeting(tiny_dataset, vae_run, body):
 
     targets = [betas_for_measurements(body, {"height_cm": h}) for h in (190.0, 155.0)]
     r = compare_retargeting(tiny_dataset, vae_run, ["cmu_09_01"], targets, body=body)
-    assert set(r) == {"savae", "naive"}
+    assert set(r) == {"savae", "naive", "source"}
     for name in r:
-        assert set(r[name]) == set(KEYS) | {"clips", "bodies"} and r[name]["bodies"] == 2
+        assert set(r[name]) == set(KEYS) | {"clips", "bodies"} and r[name]["bodies"] == (1 if name == "source" else 2)
         assert all(np.isfinite(r[name][k]) for k in KEYS)
     assert r["naive"]["bone_err_mm"] < 0.01 < r["savae"]["bone_err_mm"]
+    assert r["source"]["bone_err_mm"] < 0.01      # the capture's own FK on its own fitted body
     with pytest.raises(ShapeMoveError, match="no clip"):
         compare_retargeting(tiny_dataset, vae_run, ["no_such_clip"], targets, body=body)
 

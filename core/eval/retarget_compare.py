@@ -48,9 +48,23 @@ def _score(body, motion, betas) -> dict:
     return evaluate_motion(body, betas, rot, motion.transl, joints=joints, target_betas=betas)
 
 
+def source_score(body, data, clip):
+    """The captured motion on its own fitted body (the dataset's ``poses``/``transl``/``betas``),
+    scored as the retargeted ones: the level of penetrate/float/skate/stability the capture itself
+    reaches. None for a mocap file (no fitted body stored)."""
+    from ..geometry.rotations import axis_angle_to_matrix
+
+    if data is None or not (Path(data) / "poses" / f"{clip}.npy").is_file():
+        return None
+    load = lambda sub: np.load(Path(data) / sub / f"{clip}.npy").astype(np.float32)  # noqa: E731
+    betas = load("betas")
+    return evaluate_motion(body, betas, axis_angle_to_matrix(load("poses")), load("transl"), target_betas=betas)
+
+
 def compare_retargeting(data, checkpoint, clips, target_betas_list, body=None, ik_refine_iters: int = 10,
                         progress=None, plant_source_contacts: bool = True) -> dict:
-    """{"savae": metrics, "naive": metrics} (``KEYS`` + "clips", "bodies") over every clip of
+    """{"savae": metrics, "naive": metrics, "source": metrics} (``KEYS`` + "clips", "bodies";
+    "source": ``source_score`` of the dataset clips, absent if there are none) over every clip of
     ``clips`` (dataset clip ids or mocap files) moved onto every body of ``target_betas_list``
     ((10,) betas each). ``checkpoint``: SA-VAE run folder or .pt. progress(fraction, clip).
     The SA-VAE side is decoded as ``generation.retarget.retarget`` does (the source's contacts
@@ -65,7 +79,7 @@ def compare_retargeting(data, checkpoint, clips, target_betas_list, body=None, i
         raise ShapeMoveError("compare_retargeting needs at least one clip and one target body")
     body = _body(body)
     vae = load_vae(checkpoint, body)
-    rows = {"savae": [], "naive": []}
+    rows = {"savae": [], "naive": [], "source": []}
     for i, clip in enumerate(clips):
         joints, name = source_joints(source_motion(data, clip), body)
         src = Motion22(joints=joints, fps=float(FPS), source=name, subject="", offsets=np.zeros((22, 3)))  # read once
@@ -75,10 +89,15 @@ def compare_retargeting(data, checkpoint, clips, target_betas_list, body=None, i
             rows["savae"].append(_score(body, decode_tokens(codes, vae, body, betas, ik_refine_iters, contacts=contacts),
                                         betas))
             rows["naive"].append(_score(body, naive_retarget(src, body, betas, ik_refine_iters), betas))
+        if isinstance(clip, str) and (src_row := source_score(body, data, clip)) is not None:
+            rows["source"].append(src_row)
         if progress is not None:
             progress((i + 1) / len(clips), str(clip))
     out = {}
     for name, r in rows.items():
+        if not r:
+            continue
         agg = aggregate(r)
-        out[name] = {**{k: float(agg[k]) for k in KEYS}, "clips": len(clips), "bodies": len(targets)}
+        out[name] = {**{k: float(agg[k]) for k in KEYS}, "clips": len(r) if name == "source" else len(clips),
+                     "bodies": 1 if name == "source" else len(targets)}
     return out
