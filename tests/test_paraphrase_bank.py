@@ -48,3 +48,17 @@ def test_sentences_are_varied_capitalised_and_deterministic():
     assert known_sentences("punch") == known_sentences("punch") and len(known_sentences("punch")) == 40
     seq = sequence_sentence(["walk", "sit"], random.Random(3))
     assert seq[0].isupper() and seq.endswith(".")
+
+
+def test_action_balanced_clip_sampling():
+    """action_balance 1 draws each main action equally often, 0 each clip."""
+    import numpy as np
+
+    from shapemove.core.train.t5_dataset import clip_weights
+
+    ids = [f"w{i}" for i in range(90)] + ["c0", "c1"] + [f"r{i}" for i in range(8)]
+    labels = {c: {"actions": [{"w": "walk", "c": "cartwheel", "r": "run"}[c[0]]]} for c in ids}
+    for balance, expect in ((1.0, [1 / 3, 1 / 3, 1 / 3]), (0.0, [0.90, 0.02, 0.08])):
+        w = clip_weights(ids, labels, balance)
+        share = [w[:90].sum() / w.sum(), w[90:92].sum() / w.sum(), w[92:].sum() / w.sum()]
+        assert np.allclose(share, expect), (balance, share)
