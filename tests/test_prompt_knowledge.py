@@ -22,7 +22,12 @@ def test_model_folder_lists_its_captions_and_actions(tiny_bundle, gen):  # noqa:
     model, data = tiny_bundle
     doc = json.loads((model / "t5" / "known_texts.json").read_text())
     captions = {c for cid in read_split(data, "train") for c in (data / "texts" / f"{cid}.txt").read_text().splitlines() if c}
-    assert set(doc["captions"]) == captions
+    from shapemove.core.data.paraphrase_bank import known_sentences
+
+    bank = {s for a, _ in doc["actions"] for s in known_sentences(a)}
+    assert set(doc["captions"]) == captions | bank  # the training captions + 40 bank sentences per action
+    acts = dict(zip(doc["captions"], doc["caption_actions"]))
+    assert all(acts[s] for s in bank - captions)  # a bank sentence is listed under an action
     assert gen.known_actions and gen.known_actions == known_actions(model)
     assert "walk" in gen.known_actions and "kick" in gen.known_actions
 
