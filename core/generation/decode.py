@@ -5,9 +5,12 @@ from __future__ import annotations
 import numpy as np
 import torch
 
+from ..body.plant import BODY_SMOOTH, contacts_from_features, plant_motion
 from ..constants import FPS
 from ..errors import ShapeMoveError
-from ..scene.motion_file import Motion
+from ..geometry.rotations import matrix_to_axis_angle
+from ..motion.features import joints_from_features
+from ..scene.motion_file import Motion, make_motion
 
 
 
@@ -27,9 +30,6 @@ def decode_tokens(codes: list[int], vae, body, betas, ik_refine_iters: int = 10,
     pose (what the rig plays); the decoder's own joints are kept as ``network_joints``.
     ``contacts`` (>= T,4) known foot contacts (retargeting: the source motion's) are planted
     instead of the decoder's channels, as measured contacts (no gating, flights kept)."""
-    from ..body.plant import contacts_from_features
-    from ..motion.features import joints_from_features
-
     if not codes:
         raise ShapeMoveError("no motion tokens to decode")
     b = torch.as_tensor(check_betas(betas))[None]
@@ -55,10 +55,6 @@ def motion_from_joints(body, betas, joints, contacts, ik_refine_iters: int = 10,
     Motion on ``body`` with ``betas``: contacts planted, mesh grounded (``plant.plant_motion``);
     ``known_contacts``: ``contacts`` are measured (not predicted): planted without gating, long
     flights kept, the decoded body smoothed (``plant.smooth_body``); ``extra``: tokens, features."""
-    from ..body.plant import BODY_SMOOTH, plant_motion
-    from ..geometry.rotations import matrix_to_axis_angle
-    from ..scene.motion_file import make_motion
-
     planted = plant_motion(body, betas, joints, contacts, refine_iters=ik_refine_iters, **(
         {"gate": False, "max_flight": None, "smooth": BODY_SMOOTH} if known_contacts else {}))
     poses = matrix_to_axis_angle(planted.rotations).astype(np.float32)

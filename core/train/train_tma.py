@@ -35,7 +35,9 @@ from ..data.actions import stored_labels
 from ..data.paraphrase_bank import BANK_SHARE, training_caption
 from ..errors import ShapeMoveError
 from ..eval.tma_embed import KIND, eval_pairs, pad_batch, score_pairs, text_inputs
+from ..models.text_encoder import StateCache, fingerprint, load_text_encoder
 from ..models.tma import TMA, TMAConfig
+from ..models.tokenizer import load_tokenizer, tokenizer_from_sentencepiece, train_sentencepiece
 from . import distributed
 from .checkpoint_cadence import finish, save_if_due
 from .run_log import StepLog
@@ -205,12 +207,9 @@ def train_tma(data, out, config=None, steps: int | None = None, batch_size: int 
 def _text_reader(data: Path, out: Path, c: TMATrainConfig, dist, texts: list[str], verbose: bool):
     """MiniLM with every caption's token states cached, or (old TMAs) the sentencepiece tokenizer."""
     if c.model.get("text_encoder", "minilm") == "minilm":
-        from ..models.text_encoder import StateCache, load_text_encoder
-
         cache = StateCache(load_text_encoder())
         cache.add(texts, progress=dist.is_main and verbose)
         return cache
-    from ..models.tokenizer import load_tokenizer, tokenizer_from_sentencepiece, train_sentencepiece
 
     tok_dir = out / "tokenizer"
     if not (tok_dir / "tokenizer.json").is_file():
@@ -268,8 +267,6 @@ def _train(data, out, c, resume, body_name, dist, progress, cancel, verbose) -> 
             return
         extra = {}
         if cfg.text_encoder == "minilm":
-            from ..models.text_encoder import fingerprint
-
             extra["text_encoder"] = fingerprint()
         meta = make_metadata(KIND, asdict(c), body_name, mean, std, step, data=str(data), **extra)
         save_checkpoint(last, {"model": model.state_dict(), "optimizer": optimizer.state_dict(),
