@@ -21,7 +21,7 @@ from __future__ import annotations
 import random
 
 from .actions import ACTIONS
-from .captions import base_form, progressive
+from .captions import _tidy, base_form, progressive
 
 BANK_SHARE = 0.5
 
@@ -282,11 +282,6 @@ def _subject(rng: random.Random, entry: dict) -> str:
     return rng.choice(SUBJECTS)
 
 
-def _tidy(s: str) -> str:
-    s = " ".join(s.split())
-    return (s[0].upper() + s[1:]) if s else s
-
-
 def sentence(action: str, rng: random.Random) -> str:
     """One sentence naming ``action`` in a random phrasing and sentence shape."""
     e = BANK.get(action)
@@ -299,8 +294,7 @@ def sentence(action: str, rng: random.Random) -> str:
     if shape == "decl":
         s = f"{subj} {vp}."
     elif shape == "prog":
-        aux = "are" if subj in ("they",) else "is"
-        s = f"{subj} {aux} {progressive(vp)}."
+        s = f"{subj} is {progressive(vp)}."
     elif shape == "imp":
         s = f"{_base_vp(vp)}."
     elif shape == "make":

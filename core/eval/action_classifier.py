@@ -25,6 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..data.actions import stored_labels
 from ..errors import ShapeMoveError
 
 REPO_ROOT = Path(__file__).resolve().parents[2]
@@ -71,12 +72,7 @@ def clip_actions(data, ids: list[str]) -> dict[str, list[str]]:
                     out[m["id"]] = _actions_of(m)
     for cid in ids:
         if cid not in out:
-            f = data / "meta" / f"{cid}.json"
-            try:
-                m = json.loads(f.read_text(encoding="utf-8")) if f.is_file() and f.stat().st_size < (1 << 20) else {}
-            except (UnicodeDecodeError, json.JSONDecodeError):
-                m = {}
-            out[cid] = _actions_of(m)
+            out[cid] = _actions_of({"labels": stored_labels(data, cid)})
     return out
 
 

@@ -24,7 +24,7 @@ from pathlib import Path
 
 import torch
 
-from ..data.actions import stored_labels
+from ..data.actions import find_actions, stored_labels
 from ..data.paraphrase_bank import known_sentences
 from ..errors import ShapeMoveError
 
@@ -54,7 +54,6 @@ def build_known(root, ids: list[str], states) -> dict:
     dataset's meta, else the first action the caption names), plus a fixed sample of the paraphrase
     bank's sentences for each of those actions (``data/paraphrase_bank.py``), and their unit MiniLM vectors (mean
     of the token states that ``states`` gives: a StateCache or the TextEncoder)."""
-    from ..data.actions import find_actions
     from .text_encoder import mean_pool
 
     root = Path(root)

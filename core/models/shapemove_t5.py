@@ -78,7 +78,7 @@ class MiniLMDecoder(nn.Module):
         d = config.d_model
         self.proj = nn.Sequential(nn.Linear(text_dim, d), nn.LayerNorm(d))
         self.segment = nn.Embedding(2, d)  # 0 shape text, 1 motion text
-        if getattr(config, "sentence_token", False):
+        if config.sentence_token:
             self.sentence_proj = nn.Sequential(nn.Linear(text_dim, d), nn.LayerNorm(d))
         self.decoder = T5Decoder(config)
         self.lm_head = nn.Linear(d, config.vocab_size, bias=False)
@@ -99,7 +99,7 @@ class MiniLMDecoder(nn.Module):
         share (``text_dropout``) of training prompts makes the decoder read that vector, which
         carries over to wordings the captions never used."""
         enc = self.proj(states) + self.segment(segments)
-        if not getattr(self.config, "sentence_token", False):
+        if not self.config.sentence_token:
             return enc, mask
         words = mask & (segments == 1)
         pooled = (states * words[..., None]).sum(1) / words.sum(1, keepdim=True).clamp(min=1)
