@@ -147,19 +147,23 @@ class ClipProcessor:
     def solve(self, joints: np.ndarray) -> dict:
         """The subject's side of a clip (22 joints at 20 fps): contacts detected on the mocap, betas
         fitted, contact joints' IK targets planted on that body's soles (``plant.plant_targets``),
-        IK solved. Returns {"contacts" (T,4) uint8, "betas" (10,) fitted, "rotations" (T,24,3,3),
+        IK solved with the clip's torso/girdle joints calibrated (``joint_offsets``: constant offsets
+        of the rig's pelvis, hips, spine, neck, collars, head and shoulders from the body's joint
+        centres). Returns {"contacts" (T,4) uint8, "betas" (10,) fitted, "rotations" (T,24,3,3),
         "root" (T,3) world root trajectory, "rest" (24,3) rest joints of the fitted body,
-        "ik_error_cm" (vs the mocap), "ik_target_error_cm" (vs the planted targets)}."""
+        "ik_error_cm" (joint centres vs the mocap), "ik_marker_error_cm" (calibrated points vs the
+        mocap), "ik_target_error_cm" (calibrated points vs the planted targets), "ik_offset_max_cm"}."""
         import torch
 
-        from ..body.ik import solve_ik
+        from ..body.joint_offsets import marker_points, solve_ik_calibrated
         from ..geometry.torch_ops import forward_kinematics
 
         contacts = self.contacts(joints)
         fitted = self.fit(joints)
         rest = self.body.rest_joints(torch.as_tensor(fitted)[None])[0].numpy()
         targets, floor = plant_targets(joints, contacts, self.probe(fitted).sole_offsets)
-        ik = solve_ik(targets, rest, refine_iters=self.ik_refine_iters)
+        cal = solve_ik_calibrated(targets, rest, refine_iters=self.ik_refine_iters)
+        ik = cal.ik
         rot = np.asarray(ik.rotations, dtype=np.float32)
         fk, _ = forward_kinematics(torch.as_tensor(rot), torch.as_tensor(rest)[None].expand(len(rot), -1, -1),
                                    self.body.parents)
@@ -168,7 +172,9 @@ class ClipProcessor:
         return {"contacts": contacts, "betas": fitted, "rotations": rot, "rest": rest,
                 "root": np.asarray(ik.transl, dtype=np.float32) + rest[0],
                 "ik_error_cm": float(np.linalg.norm(fk - mocap, axis=-1).mean()) * 100,
-                "ik_target_error_cm": float(ik.mean_error_cm)}
+                "ik_marker_error_cm": float(np.linalg.norm(
+                    marker_points(rot, ik.transl, rest, cal.offsets) - mocap, axis=-1).mean()) * 100,
+                "ik_target_error_cm": cal.marker_error_cm, "ik_offset_max_cm": float(cal.offset_cm.max())}
 
     def stride_scale(self, rest_from: np.ndarray, betas_to: np.ndarray | None) -> float:
         """Root-trajectory scale moving a motion from the body with rest joints ``rest_from`` (24,3)
@@ -201,6 +207,7 @@ class ClipProcessor:
             "poses": matrix_to_axis_angle(rot).astype(np.float32),
             "transl": shaped[:, 0] - rest_t[0],  # BodyModel.forward(target, poses, transl) -> shaped
             "ik_error_cm": sol["ik_error_cm"], "ik_target_error_cm": sol["ik_target_error_cm"],
+            "ik_marker_error_cm": sol["ik_marker_error_cm"], "ik_offset_max_cm": sol["ik_offset_max_cm"],
             "measure": m,
         }
 
@@ -215,6 +222,7 @@ def _write_clip(out: Path, cid: str, arrays: dict, clip: ClipSource, split: str,
     meta = {"id": cid, "source": str(clip.path), "dataset": clip.dataset, "subject": clip.subject,
             "licence": clip.licence, "fps": FPS, "frames": int(arrays["new_joints"].shape[0]),
             "labels": clip.labels, "split": split, "ik_error_cm": round(arrays["ik_error_cm"], 3),
+            **{k: round(arrays[k], 3) for k in ("ik_marker_error_cm", "ik_offset_max_cm") if k in arrays},
             "measure": {k: round(v, 1) for k, v in m.items()}, **extra}
     atomic_write_text(out / "meta" / f"{cid}.json", json.dumps(meta))  # written last: marks the clip done
 
