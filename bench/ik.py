@@ -9,7 +9,8 @@ Then, per archive (5 clips each), the joint error of the real pipeline (rig map 
 OpenBody) for each rig-map layout and body fit: the legacy SMPL spine fractions with the
 exact-skeleton bone-length fit (the baseline), OpenBody's layout (``core.io.rig_map``), and the
 plausible-body fits ``fit_betas_to_motion`` and ``fit_betas_to_clip`` (the data builder's; also
-with its 10 IK steps) (largest |beta| printed: the exact-skeleton fit reaches its cm by betas of
+with its 10 IK steps, with and without the calibrated torso/girdle offsets of ``joint_offsets``:
+the builder's marker error, its joint-centre error and the offsets' sizes) (largest |beta| printed: the exact-skeleton fit reaches its cm by betas of
 +-20..60, i.e. deformed bodies).
 """
 from __future__ import annotations
@@ -21,6 +22,7 @@ import torch
 
 from ..core.body.fit import bone_lengths, fit_betas_to_bone_lengths, fit_betas_to_clip, fit_betas_to_motion
 from ..core.body.ik import bone_turn_deg, ik_lbfgs_baseline, solve_ik
+from ..core.body.joint_offsets import CALIBRATED_JOINTS, solve_ik_calibrated
 from ..core.body.load import load_body_model
 from ..core.body.skeleton import JOINT_NAMES, PARENTS
 from ..core.geometry.torch_ops import axis_angle_to_matrix, forward_kinematics
@@ -85,7 +87,7 @@ def _archive_table(body, quick: bool) -> dict:
             "clip": lambda j: fit_betas_to_clip(body, j)}
     root, frames, out = mocap_root(), 60 if quick else 200, {}
     for archive, patterns in ARCHIVE_CLIPS.items():
-        err, per, beta = {}, {}, {}
+        err, per, beta, calib = {}, {}, {}, {}
         for pattern in patterns[:1 if quick else None]:
             paths = sorted((root / archive).glob(pattern))
             if not paths:
@@ -103,6 +105,10 @@ def _archive_table(body, quick: bool) -> dict:
                     if lname == "openbody" and fname == "clip":  # the data builder's settings
                         err.setdefault(("openbody", "clip+10"), []).append(
                             solve_ik(joints, rest, refine_iters=10).mean_error_cm)
+                        cal = solve_ik_calibrated(joints, rest, refine_iters=10)  # what the builder runs
+                        err.setdefault(("openbody", "clip+10+cal"), []).append(cal.marker_error_cm)
+                        calib.setdefault("raw", []).append(cal.raw_error_cm)
+                        calib.setdefault("offsets", []).append(cal.offset_cm[list(CALIBRATED_JOINTS)])
                     per.setdefault((lname, fname), []).append(res.per_joint_error_cm())
                     beta[(lname, fname)] = max(beta.get((lname, fname), 0.0), float(np.abs(fit.betas).max()))
         if not err:
@@ -111,7 +117,9 @@ def _archive_table(body, quick: bool) -> dict:
         print(f"  {archive} ({n} clips, <= {frames} frames): mean joint error cm (max |beta|)")
         for (lname, fname), e in err.items():
             b = beta[(lname, fname.split("+")[0])]
-            note = " (10 IK steps: the data builder's)" if fname == "clip+10" else ""
+            note = {"clip+10": " (10 IK steps, joint centres)",
+                    "clip+10+cal": " (the data builder's: 10 IK steps, calibrated torso/girdle joints; marker error)"
+                    }.get(fname, "")
             print(f"    layout {lname:8s} fit {fname:7s}: {np.mean(e):5.2f} cm  ({b:.1f}){note}")
         for key in (("smpl", "lengths"), ("openbody", "clip")):
             pj = np.mean(per[key], 0)
@@ -122,7 +130,15 @@ def _archive_table(body, quick: bool) -> dict:
         out[f"ik_{archive}_legacy_err_cm"] = float(before)
         out[f"ik_{archive}_err_cm"] = float(after)
         out[f"ik_{archive}_motion_fit_err_cm"] = float(np.mean(err[("openbody", "motion")]))
-        out[f"ik_{archive}_builder_err_cm"] = float(np.mean(err[("openbody", "clip+10")]))
+        out[f"ik_{archive}_builder_uncalibrated_err_cm"] = float(np.mean(err[("openbody", "clip+10")]))
+        offs = np.concatenate(calib["offsets"])
+        out[f"ik_{archive}_builder_err_cm"] = float(np.mean(err[("openbody", "clip+10+cal")]))
+        out[f"ik_{archive}_builder_raw_err_cm"] = float(np.mean(calib["raw"]))
+        out[f"ik_{archive}_offset_mean_cm"], out[f"ik_{archive}_offset_max_cm"] = float(offs.mean()), float(offs.max())
+        print(f"    builder (calibrated): marker error {out[f'ik_{archive}_builder_err_cm']:.2f} cm, joint-centre error "
+              f"{out[f'ik_{archive}_builder_raw_err_cm']:.2f} cm (uncalibrated "
+              f"{out[f'ik_{archive}_builder_uncalibrated_err_cm']:.2f}); offsets of the {len(CALIBRATED_JOINTS)} "
+              f"calibrated joints mean {offs.mean():.1f} cm, max {offs.max():.1f} cm")
         out[f"ik_{archive}_default_layout_err_cm"] = float(np.mean(err[("default", "motion")]))
         out[f"ik_{archive}_openbody_lengths_fit_err_cm"] = float(np.mean(err[("openbody", "lengths")]))
         out[f"ik_{archive}_max_abs_beta"] = beta[("openbody", "clip")]
