@@ -34,10 +34,12 @@ def source_floor(joints, contacts, sole_offsets) -> float:
     return float(np.median(j[c])) if c.any() else float(j.min())
 
 
-def plant_targets(joints, contacts, sole_offsets, fade: int = FADE) -> tuple[np.ndarray, float]:
+def plant_targets(joints, contacts, sole_offsets, fade: int = FADE, fade_down: bool = True) -> tuple[np.ndarray, float]:
     """joints (T,22,3) mocap targets, contacts (T,4) of joints 7, 8, 10, 11, sole_offsets (4,) of
     the body the IK will fit -> (targets (T,22,3) with the floor at y = 0 and planted contact
-    joints, source floor height that was subtracted)."""
+    joints, source floor height that was subtracted). ``fade_down`` False: the fade around a run
+    moves the joint horizontally and up, never down (a foot still descending to, or rising from,
+    its plant keeps its own height: lowering it would drag the swing foot toward the floor)."""
     tgt = np.array(joints, dtype=np.float64)
     T = len(tgt)
     floor = source_floor(tgt, contacts, sole_offsets)
@@ -53,9 +55,103 @@ def plant_targets(joints, contacts, sole_offsets, fade: int = FADE) -> tuple[np.
                 w = 1.0 - d / (fade + 1)
                 for t, edge in ((s - d, s), (e - 1 + d, e - 1)):
                     if 0 <= t < T and weight[t] < w:
-                        corr[t], weight[t] = (anchor - tgt[edge, j]) * w, w
+                        step = anchor - tgt[edge, j]
+                        if not fade_down:
+                            step[1] = max(step[1], 0.0)
+                        corr[t], weight[t] = step * w, w
         tgt[:, j] += corr
     return tgt, floor
+
+
+def _turn(u: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """(N,3), (N,3) -> (N,3,3) the smallest rotation taking the direction of u to that of v."""
+    u = u / np.linalg.norm(u, axis=-1, keepdims=True).clip(1e-12)
+    v = v / np.linalg.norm(v, axis=-1, keepdims=True).clip(1e-12)
+    axis = np.cross(u, v)
+    s, c = np.linalg.norm(axis, axis=-1), np.clip((u * v).sum(-1), -1.0, 1.0)
+    k = axis / s[:, None].clip(1e-12)
+    K = np.zeros((len(u), 3, 3))
+    K[:, 0, 1], K[:, 0, 2], K[:, 1, 0], K[:, 1, 2], K[:, 2, 0], K[:, 2, 1] = -k[:, 2], k[:, 1], k[:, 2], -k[:, 0], -k[:, 1], k[:, 0]
+    return np.eye(3)[None] + s[:, None, None] * K + (1 - c)[:, None, None] * (K @ K)
+
+
+SOFT_REACH = 0.97  # of the leg's length: beyond it ``pin_feet`` approaches full stretch asymptotically
+LEGS = ((1, 4, 7, 10, 0, 2), (2, 5, 8, 11, 1, 3))   # hip, knee, ankle, foot joints; heel, toe contact column
+
+
+def contact_weights(contacts, fade: int = FADE) -> np.ndarray:
+    """(T,4) contacts -> (T,4) weights: 1 in contact, fading linearly to 0 over ``fade`` frames
+    on either side of each run (as ``plant_targets`` fades its targets)."""
+    c = np.asarray(contacts).astype(bool)
+    w = c.astype(np.float64)
+    T = len(c)
+    for k in range(c.shape[1]):
+        for s, e in runs(c[:, k]):
+            for d in range(1, fade + 1):
+                for t in (s - d, e - 1 + d):
+                    if 0 <= t < T:
+                        w[t, k] = max(w[t, k], 1.0 - d / (fade + 1))
+    return w
+
+
+def pin_feet(rotations, transl, rest, parents, targets, weights) -> np.ndarray:
+    """The contact-aware IK pass: after the whole-body IK, each leg's hip and knee are turned
+    (two-bone IK in the knee's own bending plane) so that a planted heel (ankle joint) lands on its
+    target, and the ankle turned so that a planted ball joint does too; where the ball is planted
+    more firmly than the heel (toe-off) the foot moves without turning so that the ball lands. ``weights`` (T,4) from ``contact_weights``: the
+    leg moves that fraction of its miss (1 in contact: exactly on target where the leg reaches).
+    rotations (T,24,3,3) local, transl (T,3), rest (24,3), targets (T,22,3) ->
+    new local rotations (T,24,3,3); frames without weight are unchanged."""
+    import torch
+
+    from ..geometry.torch_ops import forward_kinematics
+
+    rot = np.array(rotations, dtype=np.float64)
+    w = np.asarray(weights, dtype=np.float64)
+    with torch.no_grad():
+        pos, G = forward_kinematics(torch.as_tensor(rot), torch.as_tensor(rest, dtype=torch.float64)[None]
+                                    .expand(len(rot), -1, -1), parents)
+    pos, G = pos.numpy() + np.asarray(transl, dtype=np.float64)[:, None], G.numpy()
+    tgt = np.asarray(targets, dtype=np.float64)
+    rest = np.asarray(rest, dtype=np.float64)
+    for hip, knee, ankle, foot, kh, kt in LEGS:
+        t = np.flatnonzero((w[:, kh] > 0) | (w[:, kt] > 0))
+        if not len(t):
+            continue
+        h, k, a, b = pos[t, hip], pos[t, knee], pos[t, ankle], pos[t, foot]
+        wh, wt = w[t, kh, None], w[t, kt, None]
+        heel = (wh >= wt) & (wh > 0)                            # heel-led (else the ball leads: toe-off)
+        want = np.where(heel, a + wh * (tgt[t, ankle] - a), a + wt * (tgt[t, foot] - b))
+        l1, l2 = np.linalg.norm(rest[knee] - rest[hip]), np.linalg.norm(rest[ankle] - rest[knee])
+        v = want - h
+        d = np.linalg.norm(v, axis=-1, keepdims=True).clip(1e-9)
+        reach, soft = l1 + l2, SOFT_REACH * (l1 + l2)         # soft IK: no knee snap near full stretch
+        dc = np.where(d > soft, soft + (reach - soft) * (1 - np.exp(-(d - soft) / (reach - soft))), d)
+        dc = dc.clip(abs(l1 - l2) + 1e-4, reach - 1e-4)
+        vh = v / d
+        a2 = h + vh * dc                                        # where the ankle goes (reachable)
+        side = (k - h) - ((k - h) * vh).sum(-1, keepdims=True) * vh   # the knee's bend direction
+        lateral = G[t, hip][:, :, 0]                            # straight leg: bend about the hip's x axis
+        fallback = np.cross(lateral, vh)
+        fallback *= np.sign((fallback * (k - h)).sum(-1, keepdims=True) + 1e-12)
+        side = np.where(np.linalg.norm(side, axis=-1, keepdims=True) > 1e-4, side, fallback)
+        side /= np.linalg.norm(side, axis=-1, keepdims=True).clip(1e-12)
+        cos = ((l1 ** 2 + dc ** 2 - l2 ** 2) / (2 * l1 * dc)).clip(-1, 1)
+        k2 = h + l1 * (cos * vh + np.sqrt(1 - cos ** 2) * side)
+        R1 = _turn(k - h, k2 - h)
+        R2 = _turn(np.einsum("nij,nj->ni", R1, a - k), a2 - k2)
+        g_hip, g_knee = R1 @ G[t, hip], R2 @ R1 @ G[t, knee]
+        g_ankle = G[t, ankle]                                   # the foot keeps its world orientation...
+        both = (heel & (wt > 0))[:, 0]
+        if both.any():                                          # ...unless heel and ball are planted
+            b_want = b[both] + wt[both] * (tgt[t[both], foot] - b[both])
+            g_ankle = g_ankle.copy()
+            g_ankle[both] = _turn(b[both] - a[both], b_want - a2[both]) @ G[t[both], ankle]
+        parent = G[t, parents[hip]]
+        rot[t, hip] = parent.transpose(0, 2, 1) @ g_hip
+        rot[t, knee] = g_hip.transpose(0, 2, 1) @ g_knee
+        rot[t, ankle] = g_knee.transpose(0, 2, 1) @ g_ankle
+    return rot
 
 
 MAX_FLIGHT = 10   # frames (0.5 s at 20 fps, a 30 cm jump): longer flights are missed steps
@@ -133,13 +229,16 @@ def gate_contacts(joints, contacts, sole_offsets, max_height: float = GATE_HEIGH
 
 
 def plant_motion(body, betas, joints, contacts, refine_iters: int = 10, gate: bool = True,
-                 max_flight: int | None = MAX_FLIGHT, smooth: float = 0.0) -> Planted:
+                 max_flight: int | None = MAX_FLIGHT, smooth: float = 0.0, pin: bool = True) -> Planted:
     """Joint positions (T,22,3) (e.g. decoded by the SA-VAE) -> rotations and translation of
     ``body`` with ``betas`` whose feet in ``contacts`` (T,4) are planted and whose mesh stands on
     the floor: ``plant_targets`` + ``ik.solve_ik`` + ``ground_shift`` on the body's sole probe.
     ``gate``: drop contacts whose sole is far above the floor first (``gate_contacts``).
     ``max_flight``: see ``ground_shift`` (None for known contacts, e.g. a retargeted source's).
-    ``smooth`` > 0: ``smooth_body`` with that sigma (frames) first."""
+    ``smooth`` > 0: ``smooth_body`` with that sigma (frames) first. ``pin``: after the IK, the
+    contact-aware leg pass ``pin_feet`` puts the planted joints on their targets (the whole-body
+    IK spreads its misses over all joints, so a planted foot would otherwise slide by millimetres to
+    centimetres where the decoded body drifts away from it)."""
     import torch
 
     from .ik import solve_ik
@@ -149,13 +248,19 @@ def plant_motion(body, betas, joints, contacts, refine_iters: int = 10, gate: bo
     probe = GroundProbe(body, b)
     j = smooth_body(joints, smooth) if smooth > 0 else np.asarray(joints, dtype=np.float64)
     c = gate_contacts(j, contacts, probe.sole_offsets) if gate else np.asarray(contacts, np.uint8)
-    targets, floor = plant_targets(j, c, probe.sole_offsets)
+    targets, floor = plant_targets(j, c, probe.sole_offsets, fade_down=False)
     with torch.no_grad():
         rest = body.rest_joints(torch.as_tensor(b)[None])[0].numpy()
     ik = solve_ik(targets, rest, refine_iters=refine_iters)
+    if pin:
+        ik.rotations = pin_feet(ik.rotations, ik.transl, rest, body.parents, targets, contact_weights(c))
     transl = np.asarray(ik.transl, dtype=np.float64).copy()
     per_foot, _, low = probe.lowest(ik.rotations, transl)
     shift = ground_shift(per_foot, low, c, max_flight=max_flight)  # predicted contacts can miss steps
+    if smooth > 0:   # the body was smoothed: so is its vertical shift (still never under the floor)
+        from ..motion.skeleton_ops import gaussian_smooth
+
+        shift = np.maximum(gaussian_smooth(shift, smooth), -low)
     transl[:, 1] += shift
     posed = _posed(ik, rest, body.parents)   # error against the input joints (floor removed)
     posed[..., 1] += shift[:, None]

@@ -164,6 +164,29 @@ def foot_vertex_ids(skin_weights) -> dict[str, np.ndarray]:
     return out
 
 
+STANCE_SLIDE_STEP = 0.0025   # m per frame (5 cm/s): a planted joint moving more than this slides
+
+
+def stance_slide(joints, contacts, max_step: float = STANCE_SLIDE_STEP) -> tuple[Stat, Stat]:
+    """Slide of the feet that are KNOWN to be planted (not a paper metric; ``skate`` decides contact
+    from the height under a 5 cm line, so a body that floats above it never skates).
+
+    joints (T,>=22,3), contacts (T,4) of joints 7, 8, 10, 11 (heels, balls; ``motion.contacts``,
+    e.g. the source capture's). Over the frame pairs in which a joint is in contact in both frames:
+    (mean XZ step of that joint in mm, number of joint-pairs) and (% of those joint-pairs that step
+    more than ``max_step``, number of joint-pairs). No contact at all: (0, 0) twice."""
+    j = _np(joints, "joints", 3)
+    c = np.asarray(contacts).astype(bool)
+    if j.shape[1] < 22 or c.ndim != 2 or c.shape[1] != 4 or len(c) != len(j):
+        raise ShapeMoveError(f"stance_slide needs (T,>=22,3) joints and (T,4) contacts, got {j.shape} and {c.shape}")
+    both = c[:-1] & c[1:]                                                   # (T-1,4)
+    step = np.linalg.norm(np.diff(j[:, FOOT_JOINT_IDS][..., [0, 2]], axis=0), axis=-1)
+    n = int(both.sum())
+    if n == 0:
+        return Stat(0.0, 0), Stat(0.0, 0)
+    return Stat(float(step[both].mean() * 1000), n), Stat(float((step[both] > max_step).mean() * 100), n)
+
+
 def skate_from_joints(joints, height: float = CONTACT_HEIGHT, max_step: float = SKATE_STEP,
                       window: int = SKATE_WINDOW) -> Stat:
     """Joint-only fallback (GMD): the feet are the foot joints 10 and 11 of (T,>=22,3) joints."""

@@ -3,8 +3,11 @@
 Every clip is moved onto every target body both ways (``generation.retarget``) and scored with
 ``evaluate_motion`` on the target body: bone-length error against the TARGET body's bones (the
 SA-VAE's decoded joints; for naive retargeting the joints are the target body's FK, so ~0 by
-construction), penetrate, float, skate and dynamic stability of the posed mesh. Metrics are
-pooled over all (clip, body) motions, frame-weighted (``report.aggregate``).
+construction), penetrate, float, skate and dynamic stability of the posed mesh, and the slide of
+the feet the SOURCE plants (``physics.stance_slide`` on the posed joints, with the contacts detected
+on the captured joints: the same frames for both sides; floating does not hide it). Metrics are
+pooled over all (clip, body) motions, frame-weighted (``report.aggregate``; the stance slide over
+the planted joint-pairs).
 
     compare_retargeting("DATA", "runs/vae", ["cmu_09_01", "walk.bvh"], [np.zeros(10), tall_betas])
     -> {"savae": {KEYS...}, "naive": {KEYS...}}
@@ -21,7 +24,8 @@ from .evaluate import evaluate_motion
 from .report import aggregate
 
 KEYS = ("bone_err_mm", "penetrate_cm", "float_cm", "skate_pct", "dyn_stable_pct", "penetrate_all_cm", "float_all_cm",
-        "skate_joints_pct")
+        "skate_joints_pct", "stance_slide_mm", "stance_slide_pct")
+STANCE_KEYS = ("stance_slide_mm", "stance_slide_pct")   # weighted by the contact joint-pairs, n_stance
 
 
 def source_motion(data, clip):
@@ -40,12 +44,25 @@ def source_motion(data, clip):
     return Motion22(joints=joints, fps=float(FPS), source=str(clip), subject="", offsets=np.zeros((22, 3)))
 
 
-def _score(body, motion, betas) -> dict:
+def _score(body, motion, betas, contacts=None) -> dict:
+    """``evaluate_motion`` of a Motion on ``body`` + ``stance``: the slide of its posed joints
+    (FK, what the rig plays) where ``contacts`` (>= T,4; the source's) plant a foot."""
     from ..geometry.rotations import axis_angle_to_matrix
 
     rot = axis_angle_to_matrix(motion.poses)
     joints = motion.network_joints if motion.network_joints is not None else motion.joints  # decoded, if any
-    return evaluate_motion(body, betas, rot, motion.transl, joints=joints, target_betas=betas)
+    row = evaluate_motion(body, betas, rot, motion.transl, joints=joints, target_betas=betas)
+    return row if contacts is None else {**row, **stance(motion.joints, contacts)}
+
+
+def stance(joints, contacts) -> dict:
+    """(T,22,3) posed joints + (>= T,4) known contacts -> {stance_slide_mm, stance_slide_pct,
+    n_stance} (``physics.stance_slide``)."""
+    from .physics import stance_slide
+
+    j = np.asarray(joints)
+    mm, pct = stance_slide(j, np.asarray(contacts)[:len(j)])
+    return {"stance_slide_mm": mm.value, "stance_slide_pct": pct.value, "n_stance": mm.count}
 
 
 def source_score(body, data, clip):
@@ -58,7 +75,11 @@ def source_score(body, data, clip):
         return None
     load = lambda sub: np.load(Path(data) / sub / f"{clip}.npy").astype(np.float32)  # noqa: E731
     betas = load("betas")
-    return evaluate_motion(body, betas, axis_angle_to_matrix(load("poses")), load("transl"), target_betas=betas)
+    from ..generation.retarget import source_contacts
+
+    row = evaluate_motion(body, betas, axis_angle_to_matrix(load("poses")), load("transl"), target_betas=betas)
+    joints = load("new_joints")
+    return {**row, **stance(joints, source_contacts(joints))}
 
 
 def compare_retargeting(data, checkpoint, clips, target_betas_list, body=None, ik_refine_iters: int = 10,
@@ -84,11 +105,12 @@ def compare_retargeting(data, checkpoint, clips, target_betas_list, body=None, i
         joints, name = source_joints(source_motion(data, clip), body)
         src = Motion22(joints=joints, fps=float(FPS), source=name, subject="", offsets=np.zeros((22, 3)))  # read once
         codes = encode_source(joints, vae, body, ik_refine_iters)
-        contacts = source_contacts(joints) if plant_source_contacts else None
+        known = source_contacts(joints)        # also where the slide of planted feet is measured
+        contacts = known if plant_source_contacts else None
         for betas in targets:
             rows["savae"].append(_score(body, decode_tokens(codes, vae, body, betas, ik_refine_iters, contacts=contacts),
-                                        betas))
-            rows["naive"].append(_score(body, naive_retarget(src, body, betas, ik_refine_iters), betas))
+                                        betas, known))
+            rows["naive"].append(_score(body, naive_retarget(src, body, betas, ik_refine_iters), betas, known))
         if isinstance(clip, str) and (src_row := source_score(body, data, clip)) is not None:
             rows["source"].append(src_row)
         if progress is not None:
@@ -98,6 +120,9 @@ def compare_retargeting(data, checkpoint, clips, target_betas_list, body=None, i
         if not r:
             continue
         agg = aggregate(r)
+        n = sum(row["n_stance"] for row in r)
+        for k in STANCE_KEYS:   # pooled over the planted joint-pairs, not the frames
+            agg[k] = sum(row[k] * row["n_stance"] for row in r) / n if n else 0.0
         out[name] = {**{k: float(agg[k]) for k in KEYS}, "clips": len(r) if name == "source" else len(clips),
                      "bodies": 1 if name == "source" else len(targets)}
     return out
