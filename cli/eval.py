@@ -137,9 +137,10 @@ def run_retarget(args) -> int:
     result["bodies"] = list(RETARGET_BODIES)
     atomic_write_json(args.json, result, nan_to_null=True)
     src = result.get("source")  # the capture on its own fitted body, for reference
-    print(f"{'metric':<20}{'SA-VAE':>10}{'naive':>10}" + (f"{'source':>10}" if src else ""))
+    cols = [("SA-VAE", "savae"), ("naive", "naive"), ("swap", "swap")] + ([("source", "source")] if src else [])
+    print(f"{'metric':<20}" + "".join(f"{label:>10}" for label, _ in cols))
     for k in KEYS:
-        print(f"{k:<20}{result['savae'][k]:>10.2f}{result['naive'][k]:>10.2f}" + (f"{src[k]:>10.2f}" if src else ""))
+        print(f"{k:<20}" + "".join(f"{result[name][k]:>10.2f}" for _, name in cols))
     print(f"{len(clips)} clips x {len(bodies)} bodies; wrote {args.json}")
     return 0
 

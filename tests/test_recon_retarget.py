@@ -230,7 +230,7 @@ def test_compare_retargeting(tiny_dataset, vae_run, body):
 
     targets = [betas_for_measurements(body, {"height_cm": h}) for h in (190.0, 155.0)]
     r = compare_retargeting(tiny_dataset, vae_run, ["cmu_09_01"], targets, body=body)
-    assert set(r) == {"savae", "naive", "source"}
+    assert set(r) == {"savae", "naive", "swap", "source"}
     for name in r:
         assert set(r[name]) == set(KEYS) | {"clips", "bodies"} and r[name]["bodies"] == (1 if name == "source" else 2)
         assert all(np.isfinite(r[name][k]) for k in KEYS)

@@ -125,3 +125,20 @@ def test_retargeted_walk_keeps_planted_feet_still(mocap_root, body):
     extent = [np.linalg.norm(m.joints[s:e, j][:, [0, 2]] - m.joints[s, j, [0, 2]], axis=1).max()
               for k, j in enumerate(CONTACT_IDS) for s, e in runs(m.contacts[:, k])]
     assert len(extent) > 20 and np.median(extent) < 5e-3 and max(extent) < 2e-2
+
+
+def test_swap_betas_baseline_copies_pose_and_translation(mocap_root, body):
+    """The plainest baseline: the subject's rotations and translation verbatim, new betas; its
+    pelvis is the new body's rest pelvis + the subject's translation (not scaled, not grounded)."""
+    from shapemove.core.body.shape_from_measurements import betas_from_shape_text
+    from shapemove.core.generation.retarget import naive_retarget, swap_betas_retarget
+
+    bvh = mocap_root / "bandai" / "dataset-2" / "data" / f"{WALK}.bvh"
+    b = betas_from_shape_text(body, "height 195 cm, waist 110 cm")
+    swap, naive = swap_betas_retarget(bvh, body, b), naive_retarget(bvh, body, b)
+    assert np.allclose(swap.poses, naive.poses, atol=1e-6)                 # the same copied rotations
+    with torch.no_grad():
+        rest = body.rest_joints(torch.as_tensor(b)[None])[0].numpy()
+    assert np.allclose(swap.joints[:, 0], rest[0] + swap.transl, atol=1e-5)
+    travel = lambda m: np.linalg.norm(m.joints[-1, 0, [0, 2]] - m.joints[0, 0, [0, 2]])  # noqa: E731
+    assert travel(naive) > 1.05 * travel(swap) > 0.5            # naive scales the stride to the longer legs

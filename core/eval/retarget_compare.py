@@ -84,14 +84,15 @@ def source_score(body, data, clip):
 
 def compare_retargeting(data, checkpoint, clips, target_betas_list, body=None, ik_refine_iters: int = 10,
                         progress=None, plant_source_contacts: bool = True) -> dict:
-    """{"savae": metrics, "naive": metrics, "source": metrics} (``KEYS`` + "clips", "bodies";
+    """{"savae": metrics, "naive": metrics, "swap": metrics, "source": metrics} (``KEYS`` + "clips",
+    "bodies"; "swap": ``swap_betas_retarget``, rotations and translation copied, betas swapped;
     "source": ``source_score`` of the dataset clips, absent if there are none) over every clip of
     ``clips`` (dataset clip ids or mocap files) moved onto every body of ``target_betas_list``
     ((10,) betas each). ``checkpoint``: SA-VAE run folder or .pt. progress(fraction, clip).
     The SA-VAE side is decoded as ``generation.retarget.retarget`` does (the source's contacts
     planted unless ``plant_source_contacts`` is False: the decoder's own contacts)."""
     from ..generation.retarget import (check_betas, decode_tokens, encode_source, load_vae, naive_retarget,
-                                       source_contacts, source_joints)
+                                       source_contacts, source_joints, swap_betas_retarget)
     from ..io.mocap import Motion22
     from .recon import _body
 
@@ -100,7 +101,7 @@ def compare_retargeting(data, checkpoint, clips, target_betas_list, body=None, i
         raise ShapeMoveError("compare_retargeting needs at least one clip and one target body")
     body = _body(body)
     vae = load_vae(checkpoint, body)
-    rows = {"savae": [], "naive": [], "source": []}
+    rows = {"savae": [], "naive": [], "swap": [], "source": []}
     for i, clip in enumerate(clips):
         joints, name = source_joints(source_motion(data, clip), body)
         src = Motion22(joints=joints, fps=float(FPS), source=name, subject="", offsets=np.zeros((22, 3)))  # read once
@@ -111,6 +112,7 @@ def compare_retargeting(data, checkpoint, clips, target_betas_list, body=None, i
             rows["savae"].append(_score(body, decode_tokens(codes, vae, body, betas, ik_refine_iters, contacts=contacts),
                                         betas, known))
             rows["naive"].append(_score(body, naive_retarget(src, body, betas, ik_refine_iters), betas, known))
+            rows["swap"].append(_score(body, swap_betas_retarget(src, body, betas, ik_refine_iters), betas, known))
         if isinstance(clip, str) and (src_row := source_score(body, data, clip)) is not None:
             rows["source"].append(src_row)
         if progress is not None:

@@ -17,6 +17,8 @@
 the root trajectory scaled by the leg-length (pelvis height) ratio, the clip's lowest mesh point put
 on the floor (one offset, no contacts). Bones are the new body's, but feet slide, sink and float
 wherever the proportions differ.
+``swap_betas_retarget(motion, body, betas)``: the plainest baseline, the subject's rotations and
+translation copied verbatim with the new betas (no scaling, no grounding).
 """
 from __future__ import annotations
 
@@ -122,6 +124,20 @@ def retarget(motion, vae, body, betas, ik_refine_iters: int = 10, plant_source_c
                         contacts=source_contacts(joints) if plant_source_contacts else None)
     validate(out)
     return out
+
+
+def swap_betas_retarget(motion, body, betas, ik_refine_iters: int = 10) -> Motion:
+    """The plainest retargeting of SMPL-style parameters: the subject's local rotations AND its
+    translation (``transl``: FK + transl poses the subject) copied verbatim, only the betas
+    swapped (no stride scaling, no grounding: the pelvis keeps the subject's offset from the new
+    body's rest pelvis, so a longer-legged body sinks and a shorter one floats). T frames."""
+    betas = check_betas(betas)
+    joints, _ = source_joints(motion, body)
+    sol = processor(body, ik_refine_iters).solve(joints)
+    from ..geometry.rotations import matrix_to_axis_angle
+
+    return make_motion(body, matrix_to_axis_angle(sol["rotations"]).astype(np.float32),
+                       (sol["root"] - sol["rest"][0]).astype(np.float32), betas, fps=float(FPS))
 
 
 def naive_retarget(motion, body, betas, ik_refine_iters: int = 10) -> Motion:
