@@ -257,10 +257,11 @@ def plant_motion(body, betas, joints, contacts, refine_iters: int = 10, gate: bo
     transl = np.asarray(ik.transl, dtype=np.float64).copy()
     per_foot, _, low = probe.lowest(ik.rotations, transl)
     shift = ground_shift(per_foot, low, c, max_flight=max_flight)  # predicted contacts can miss steps
-    if smooth > 0:   # the body was smoothed: so is its vertical shift (still never under the floor)
+    if smooth > 0:   # the body was smoothed: so is its vertical shift, downward only (no added float,
+        # the peaks a per-frame shift puts into the pelvis height shaken off; never under the floor)
         from ..motion.skeleton_ops import gaussian_smooth
 
-        shift = np.maximum(gaussian_smooth(shift, smooth), -low)
+        shift = np.maximum(np.minimum(gaussian_smooth(shift, smooth), shift), -low)
     transl[:, 1] += shift
     posed = _posed(ik, rest, body.parents)   # error against the input joints (floor removed)
     posed[..., 1] += shift[:, None]
