@@ -2,7 +2,7 @@
 
 Mocap retargeted by IK onto another body keeps a few cm of joint error, so feet that stood still
 in the capture slide and hover on the body, and a body grounded by its lowest foot *joint* sinks
-(the soles are below the joints). Two steps fix that:
+(the soles are below the joints). These steps fix that:
 
 1. ``plant_targets``: before IK, move the targets of the joints in contact (heels = ankles,
    toes = ball joints, ``core.motion.contacts``) onto one fixed point per contact run: its XZ is
@@ -10,7 +10,11 @@ in the capture slide and hover on the body, and a body grounded by its lowest fo
    the sole touches y = 0. The source floor is estimated from the contacts themselves. The
    change fades out over ``FADE`` frames around each run so the targets stay continuous. IK
    (``ik.solve_ik``, which weights the ankles and feet most) then lands the feet there.
-2. ``ground_shift``: after posing, a per-frame vertical shift of the whole body computed on the
+   ``fade_down=False`` (decoding): the fade moves a foot sideways or up, never down.
+2. ``pin_feet`` (decoding): the whole-body IK spreads its misses over all joints, so a contact
+   leg is then turned (soft two-bone IK) to land its planted heel and ball exactly where the
+   leg reaches (a planted joint still steps ~0.4 mm per frame on average on real clips).
+3. ``ground_shift``: after posing, a per-frame vertical shift of the whole body computed on the
    mesh (``soles.GroundProbe``): on frames with a contact, the lowest vertex of the foot in
    contact goes to y = 0; between contact frames the shift is interpolated (a jump keeps its
    flight); no frame leaves any probe point under the floor.
