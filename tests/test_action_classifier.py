@@ -129,3 +129,46 @@ def test_default_model_classifier_ceiling_on_real_test_clips():
     c = clf.ceiling(data, "test", max_clips=60, progress=False)
     assert c["clips"] == 60
     assert c["accuracy"] >= 0.8, c
+
+
+def test_composed_clips_are_left_out_and_reachable_skips_the_same_source(tmp_path):
+    from shapemove.core.eval.action_classifier import source_of
+
+    data = _synthetic_built(tmp_path / "built")
+    # a composed "walk, then run" clip right among the walks, and an augmented copy of r1 at r1's angle
+    np.save(data / "new_joint_vecs" / "comp0_00000.npy", _angle_features(1))
+    np.save(data / "new_joint_vecs" / "r1_aug.npy", _angle_features(90))
+    with open(data / "meta.jsonl", "a") as fh:
+        fh.write(json.dumps({"id": "comp0_00000", "split": "train",
+                             "labels": {"actions": ["walk", "run"], "sequence": ["walk", "run"]}}) + "\n")
+        fh.write(json.dumps({"id": "r1_aug", "split": "train", "labels": {"actions": ["run"]}}) + "\n")
+    (data / "train.txt").write_text((data / "train.txt").read_text() + "comp0_00000\nr1_aug\n")
+    clf = ActionClassifier.from_data(None, data, ["walk", "run"], k=3, embed=_embed_first_two, progress=False)
+    assert clf.info["clips"] == 7  # w1-3, r1-3, r1_aug; not the composed clip
+    assert source_of("r1_aug") == "r1" and source_of("r1") == "r1"
+    assert sorted(clf.sources).count("r1") == 2
+    reach = clf.reachable()
+    # every clip is classified among the others: walks among walks (3 of 3 right); r1 and r1_aug may not
+    # see each other, so each sees r2, r3 + the nearest walk -> run; all right
+    assert reach["walk"] == {"n": 3, "accuracy": 1.0} and reach["run"] == {"n": 4, "accuracy": 1.0}
+    # k=5: r2 and r3 see r1, r1_aug and the other run (3 runs beat 2 walks); r1 and r1_aug, without
+    # each other, see only r2 and r3 against 3 walks: a new performance of a 2-source action is missed
+    clf5 = ActionClassifier.from_data(None, data, ["walk", "run"], k=5, embed=_embed_first_two, progress=False)
+    r5 = clf5.reachable()
+    assert r5["run"]["accuracy"] == pytest.approx(2 / 4)
+
+
+def test_feature_embedder_normalizes_pools_and_separates():
+    from shapemove.core.eval.action_classifier import FeatureEmbedder
+
+    rng = np.random.default_rng(0)
+    mean, std = rng.normal(size=263).astype(np.float32), rng.uniform(0.5, 2, 263).astype(np.float32)
+    emb = FeatureEmbedder(mean, std)
+    a = mean + std * rng.normal(size=(40, 263)).astype(np.float32)
+    e = emb([a, a[::-1]])
+    assert e.shape == (2, 6 * 263) and np.allclose(np.linalg.norm(e, axis=1), 1, atol=1e-5)
+    # mean and std over time do not depend on the order of frames; the quarters do
+    x = (a - mean) / std
+    manual = np.concatenate([x.mean(0), x.std(0)] + [x[10 * i:10 * (i + 1)].mean(0) for i in range(4)])
+    assert np.allclose(e[0], manual / np.linalg.norm(manual), atol=1e-5)
+    assert not np.allclose(e[0], e[1])

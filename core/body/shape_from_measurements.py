@@ -199,6 +199,39 @@ def fast_measure(body, betas: np.ndarray, keys, girths: GirthRegression | None =
     return np.stack(cols, 1)
 
 
+def torch_measure(body, keys=("height_cm", "waist_cm")):
+    """A differentiable ``fast_measure``: a function (B,10) float tensor -> (B, len(keys)) cm, for
+    height (top minus bottom of the rest mesh, linear in the betas) and the regression girths
+    (chest, waist, hip; needs the body's ``GirthRegression``). Used as a training loss."""
+    import torch
+
+    bad = [k for k in keys if k != "height_cm" and k not in GIRTHS]
+    if bad:
+        raise ShapeMoveError(f"torch_measure: no differentiable measure for {bad} (height_cm and {', '.join(GIRTHS)})")
+    girths = girth_regression(body) if any(k in GIRTHS for k in keys) else None
+    if any(k in GIRTHS for k in keys) and girths is None:
+        raise ShapeMoveError("torch_measure: this body has no girth regression (assets/girth_regression.npz is OpenBody's)")
+    y0, yd, _, _ = _linear_arrays(body)
+    Y0, YD = torch.as_tensor(y0, dtype=torch.float32), torch.as_tensor(yd, dtype=torch.float32)
+    coef = torch.as_tensor(girths.coef, dtype=torch.float32) if girths is not None else None
+    n = body.num_betas
+    iu = torch.triu_indices(n, n)
+
+    def measure(b):
+        cols = []
+        if "height_cm" in keys:
+            ys = Y0.to(b.device)[None] + b @ YD.to(b.device).T
+            height = 100.0 * (ys.max(1).values - ys.min(1).values)
+        if coef is not None:
+            q = torch.cat([torch.ones_like(b[:, :1]), b, b[:, iu[0]] * b[:, iu[1]]], 1)
+            g = q @ coef.to(b.device)
+        for k in keys:
+            cols.append(height if k == "height_cm" else g[:, GIRTHS.index(k)])
+        return torch.stack(cols, 1)
+
+    return measure
+
+
 def _check_targets(targets: dict) -> dict:
     if not isinstance(targets, dict) or not targets:
         raise ShapeMoveError("no target measurements given (e.g. {'height_cm': 190})")

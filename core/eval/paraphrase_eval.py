@@ -15,7 +15,14 @@ the model generates a motion, and its action is read three ways:
   phrases, ``core/data/actions.py``), nearest wins: how well the text side reads the paraphrase,
   independent of the generator;
 - ``motion_vs_text_prototypes``: the generated motion's embedding against those same text
-  prototypes (the classifier used before; weak even on real clips, reported so nothing is hidden).
+  prototypes (the classifier used before; weak even on real clips, reported so nothing is hidden);
+- ``motion_features``: the same 5-NN vote on an embedding without the TMA
+  (``action_classifier.FeatureEmbedder``): generation keeps the best of several samples by TMA
+  similarity (``generation/rerank.py``), and this judge cannot be flattered by that choice.
+
+``reachable`` is what a perfect generator could score on these prompts under each classifier: the
+mean over the prompts of their action's leave-one-source-out accuracy on the training clips
+(``ActionClassifier.reachable``; 0 for an action that is no clip's main action).
 
 Each strict (the expected action) and lenient (also one of "also"), per action and overall, over
 the prompts whose action the model was trained on; prompts of actions it does not know are
@@ -97,14 +104,16 @@ def _tally(rows: list[dict], key: str) -> dict:
 
 def eval_paraphrase(model_dir=None, prompts=None, tma=None, seed: int = 0, seconds: float | None = 4.0,
                     progress=None, generator=None, data=None, classifier=None, ceiling_clips: int | None = None,
-                    show_progress: bool = True) -> dict:
+                    show_progress: bool = True, candidates: int | None = None, feature_classifier=None) -> dict:
     """Generate a motion per held-out prompt and classify it (module docstring). ``data``: the built
     dataset whose training clips the kNN classifier reads (default ``default_built_dir()``);
-    ``classifier``: an ``ActionClassifier`` to use instead. Returns {"motion", "text",
+    ``classifier``: an ``ActionClassifier`` to use instead (``feature_classifier`` likewise for the
+    TMA-free one); ``candidates``: best-of-N samples per prompt (default: the product's). Returns {"motion", "text",
     "motion_vs_text_prototypes", "classifier", "unknown_action", "actions", "rows", ...}."""
     from ..generation.generate import Generator, Request
     from ..generation.model_bundle import model_files
-    from .action_classifier import ActionClassifier, default_built_dir
+    from ..generation.sampling_params import DEFAULT_CANDIDATES
+    from .action_classifier import ActionClassifier, FeatureEmbedder, default_built_dir
     from .tma_embed import embed_motions, embed_texts, load_tma
 
     items = load_prompts(prompts)
@@ -130,29 +139,52 @@ def eval_paraphrase(model_dir=None, prompts=None, tma=None, seed: int = 0, secon
         ceiling = classifier.ceiling(data, "test", max_clips=ceiling_clips, progress=show_progress)
     else:
         ceiling = classifier.ceiling(data, "test", max_clips=ceiling_clips, progress=show_progress) if data else None
+    if feature_classifier is None and data is not None:
+        feature_classifier = ActionClassifier.from_data(None, data, actions, embed=FeatureEmbedder.from_data(data),
+                                                        progress=show_progress)
+        feature_classifier.info["kind"] = "5-nearest training clips in pooled raw-feature space (no TMA)"
     A = action_embeddings(tma, actions)
     known = [it for it in items if it["action"] in actions]
-    rows, embs = [], []
+    rows, embs, feats = [], [], []
     for i, it in enumerate(known):
-        m = gen.generate_batch([Request(it["text"], seconds=seconds, seed=seed + i)])[0]
+        m = gen.generate_batch([Request(it["text"], seconds=seconds, seed=seed + i,
+                                        candidates=DEFAULT_CANDIDATES if candidates is None else candidates)])[0]
         motion_emb = embed_motions(model, [m.features], mean, std)[0]
         embs.append(motion_emb)
+        feats.append(m.features)
         rows.append({**it, "motion_proto_pred": actions[int(np.argmax(A @ motion_emb))],
                      "warned": bool(m.warnings)})
         if progress is not None:
             progress((i + 1) / len(known), it["text"])
     for r, p in zip(rows, classifier.classify_embeddings(np.stack(embs)) if embs else []):
         r["motion_pred"] = p
+    if feature_classifier is not None:
+        for r, p in zip(rows, feature_classifier.classify(feats)):
+            r["motion_features_pred"] = p
     text_emb = embed_texts(model, tok, [r["text"] for r in rows]) if rows else np.zeros((0, A.shape[1]))
     for r, t in zip(rows, text_emb):
         r["text_pred"] = actions[int(np.argmax(A @ t))]
+    clfs = {"motion": classifier, "motion_features": feature_classifier}
+    reach = {k: _reachable(c, rows) for k, c in clfs.items() if c is not None}
     return {"motion": _tally(rows, "motion_pred"), "text": _tally(rows, "text_pred"),
             "motion_vs_text_prototypes": _tally(rows, "motion_proto_pred"),
+            **({"motion_features": _tally(rows, "motion_features_pred")} if feature_classifier is not None else {}),
+            "reachable": reach,
+            "candidates": DEFAULT_CANDIDATES if candidates is None else candidates,
             "classifier": {**classifier.info, "ceiling": ceiling},
+            "feature_classifier": dict(feature_classifier.info) if feature_classifier is not None else None,
             "unknown_action": sorted({it["action"] for it in items if it["action"] not in actions}),
             "unknown_prompts": len(items) - len(known), "warned": sum(r["warned"] for r in rows),
             "prompts_file": str(Path(prompts) if prompts else DEFAULT_PROMPTS),
             "actions": actions, "rows": rows}
+
+
+def _reachable(classifier, rows: list[dict]) -> float | None:
+    """Mean over the prompts of their action's leave-one-source-out accuracy (0 without clips)."""
+    if not rows:
+        return None
+    per = classifier.reachable()
+    return float(np.mean([per.get(r["action"], {}).get("accuracy", 0.0) for r in rows]))
 
 
 def _pct(v, digits: int = 1) -> str:
@@ -181,6 +213,14 @@ def format_results(res: dict) -> str:
     lines.append(f"lenient (an 'also' action counts): motion {_pct(m['accuracy_lenient'])}, text "
                  f"{_pct(t['accuracy_lenient'])}, motion vs text prototypes {_pct(pr['accuracy_lenient'])}; "
                  f"prompts warned as far from the training data: {res['warned']}")
+    if res.get("motion_features"):
+        lines.append(f"without the TMA (5-NN on pooled raw features): motion {_pct(res['motion_features']['accuracy'])} "
+                     f"({_pct(res['motion_features']['accuracy_lenient'])} lenient)")
+    reach = res.get("reachable") or {}
+    if reach:
+        lines.append("reachable (a perfect generator, each prompt's action judged by leave-one-source-out on the "
+                     "training clips): " + ", ".join(f"{k} {_pct(v)}" for k, v in reach.items()))
+    lines.append(f"best of {res.get('candidates', 1)} samples per prompt (TMA choice)")
     if ceil:
         info = res["classifier"]
         lines.append(f"the classifier ({info.get('k')}-NN over {info.get('clips')} {info.get('split')} clips) names real "
@@ -199,6 +239,8 @@ def add_arguments(p) -> None:
     p.add_argument("--tma", type=Path, default=None, help="TMA whose embeddings are compared (default: the model's tma/)")
     p.add_argument("--seconds", type=float, default=4.0, help="length of each generated motion")
     p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--candidates", type=int, default=None,
+                   help="token samples per prompt, the TMA keeps the closest (default: the product's, 8; 1 = none)")
     p.add_argument("--json", type=Path, default=None, help="write the results here")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
 
@@ -216,7 +258,7 @@ def from_cli(args) -> int:
 
     try:
         res = eval_paraphrase(args.model, args.prompts, args.tma, args.seed, args.seconds, progress, data=args.data,
-                              show_progress=not args.quiet)
+                              show_progress=not args.quiet, candidates=args.candidates)
     finally:
         if bar is not None:
             bar.close()

@@ -29,7 +29,8 @@ from ..torch_threads import one_torch_thread
 from .decode import decode_tokens
 from .model_bundle import model_files, resolve_model_dir
 from .prompts import check_prompt
-from .sampling_params import check_sampling
+from .rerank import CandidatePicker, candidate_features
+from .sampling_params import DEFAULT_CANDIDATES, check_candidates, check_sampling
 
 
 @dataclass
@@ -42,6 +43,7 @@ class Request:
     temperature: float = 1.0
     top_k: int | None = 50
     shape_from: str = "auto"  # "auto": measurements stated in the shape text win; "head": the [BETA] head only
+    candidates: int = DEFAULT_CANDIDATES  # token samples drawn; the TMA keeps the one closest to the prompt
 
 
 def parse_betas(text: str) -> np.ndarray:
@@ -70,6 +72,17 @@ class Generator:
         self.known = read_known(files["t5"]) if self.t5 is not None else None  # training captions + actions
         self.ik_refine_iters = ik_refine_iters
         self.max_codes = int(getattr(self.t5, "info", {}).get("max_codes", 50)) if self.t5 else 50
+        self._tma_file = files.get("tma")
+        self._picker = None
+
+    @property
+    def picker(self) -> CandidatePicker | None:
+        """The best-of-N chooser on the model folder's TMA (loaded on first use), or None without one."""
+        if self._picker is None and self._tma_file is not None and self._tma_file.is_file():
+            from ..eval.tma_embed import load_tma
+
+            self._picker = CandidatePicker(load_tma(self._tma_file))
+        return self._picker
 
     # -- tokens ------------------------------------------------------------------------------
     def _length(self, seconds: float | None) -> tuple[int, int]:
@@ -90,10 +103,14 @@ class Generator:
             for r in reqs:  # one at a time: each has its own seed, length and temperature
                 g = torch.Generator().manual_seed(int(r.seed))
                 lo, hi = self._length(r.seconds)
-                inputs = self.t5.inputs_for(self.tok, [r.prompt], [r.shape_text])
+                n = r.candidates if r.temperature > 0 and self.picker is not None else 1
+                inputs = self.t5.inputs_for(self.tok, [r.prompt] * n, [r.shape_text] * n)
                 out = decode(self.t5, inputs, lo, hi, temperature=r.temperature, top_k=r.top_k, generator=g)
-                codes.append(out.codes[0])
-                betas.append(out.betas[0])
+                best = 0
+                if n > 1:  # the [BETA] state does not depend on the sampled tokens: one body for all
+                    best = self.picker.pick(r.prompt, candidate_features(self.vae, out.codes, out.betas[0].numpy()))
+                codes.append(out.codes[best])
+                betas.append(out.betas[best])
         return codes, torch.stack(betas)
 
     # -- what the model knows ----------------------------------------------------------------
@@ -140,6 +157,7 @@ class Generator:
             r.prompt = check_prompt(r.prompt)
             r.shape_text = check_prompt(r.shape_text, "shape text", allow_empty=True) or None
             r.seed, r.temperature, r.top_k = check_sampling(r.seed, r.temperature, r.top_k)
+            r.candidates = check_candidates(r.candidates)
         checks = []
         for r in reqs:  # every text checked before any generation
             with one_torch_thread():

@@ -9,6 +9,8 @@ from ..errors import ShapeMoveError
 
 MAX_TEMPERATURE = 100.0
 MAX_SEED = 2**63 - 1
+DEFAULT_CANDIDATES = 8   # best-of-N token samples (generation/rerank.py)
+MAX_CANDIDATES = 64
 
 
 def _integer(value, name: str) -> int:
@@ -45,3 +47,12 @@ def check_sampling(seed, temperature, top_k) -> tuple[int, float, int | None]:
         if top_k < 0:
             raise ShapeMoveError(f"top-k must be 0 (no limit) or a positive whole number, got {top_k}")
     return seed, temperature, top_k
+
+
+def check_candidates(n) -> int:
+    """Number of token samples for best-of-N (``rerank.py``): a whole number from 1 (no choice) to
+    ``MAX_CANDIDATES``."""
+    n = _integer(n, "candidates")
+    if not 1 <= n <= MAX_CANDIDATES:
+        raise ShapeMoveError(f"candidates must be between 1 and {MAX_CANDIDATES}, got {n if abs(n) < 10**9 else 'a huge number'}")
+    return n

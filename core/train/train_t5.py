@@ -11,13 +11,16 @@
    T5 learns from scratch (or the tokenizer of a pretrained T5 folder given as ``base_model`` is
    extended and that T5 is fine-tuned);
 3. model + [BETA] head learn text -> [BETA] [SOM] codes [EOM] (+ optional motion-to-text examples,
-   T5 encoder only).
+   T5 encoder only);
+4. ``head_steps`` more steps train the [BETA] head alone on heights and waists in cm, the T5 frozen
+   (``beta_head_refit.py``). Steps count on from ``steps``: a run resumes in either phase.
 Writes ``out/last.pt`` (full training state, atomic; ``resume=True`` continues from it) and, at
 the end, ``out/t5/`` (weights + beta head + metadata, the T5's tokenizer, and the training captions
 and actions with their MiniLM vectors: ``known_texts.py``).
 """
 from __future__ import annotations
 
+import math
 import random
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
@@ -40,6 +43,7 @@ from .t5_dataset import T2MExamples, all_texts, collate, collate_minilm, tokeniz
 from .train_vae import rng_state, set_rng_state
 
 KIND = "shapemove-t5"
+HEAD_KEYS = ("head_steps", "head_batch_size", "head_lr", "head_measure_weight")  # may change on resume
 
 
 @dataclass
@@ -61,6 +65,10 @@ class T5TrainConfig:
     seed: int = 0
     log_every: int = 50
     ckpt_every: int = 250
+    head_steps: int = 0            # [BETA] head alone after the main steps (beta_head_refit.py)
+    head_batch_size: int = 256
+    head_lr: float = 3e-4
+    head_measure_weight: float = 0.3  # per cm of height + waist error, beside the betas' L1
 
     @classmethod
     def tiny(cls) -> "T5TrainConfig":
@@ -81,6 +89,9 @@ class T5TrainConfig:
             raise ShapeMoveError(f"T5 config: bank_share must be in [0, 1], got {self.bank_share}")
         if not 0 <= self.action_balance <= 1:
             raise ShapeMoveError(f"T5 config: action_balance must be in [0, 1], got {self.action_balance}")
+        if self.head_steps < 0 or self.head_batch_size < 1 or self.head_lr <= 0 or self.head_measure_weight < 0:
+            raise ShapeMoveError("T5 config: head_steps >= 0, head_batch_size >= 1, head_lr > 0 and "
+                                 "head_measure_weight >= 0 are required")
 
     @classmethod
     def paper(cls) -> "T5TrainConfig":
@@ -106,7 +117,7 @@ def lr_at(step: int, c: T5TrainConfig) -> float:
     if step < c.warmup_steps:
         return (step + 1) / c.warmup_steps
     p = (step - c.warmup_steps) / max(1, c.steps - c.warmup_steps)
-    return 0.1 + 0.9 * 0.5 * (1 + np.cos(np.pi * min(1.0, p)))
+    return 0.1 + 0.9 * 0.5 * (1 + math.cos(math.pi * min(1.0, p)))  # a float: numpy scalars would make last.pt unloadable
 
 
 def load_vae(path):
@@ -180,16 +191,20 @@ def _train(data, vae_path, out, c, base_model, resume, dist, progress, cancel, v
     optimizer = torch.optim.AdamW(model.parameters(), lr=c.lr, weight_decay=c.weight_decay)
     scheduler = torch.optim.lr_scheduler.LambdaLR(optimizer, lambda s: lr_at(s, c))
     step, rng = 0, random.Random(c.seed + 1000 * dist.rank)
+    head_state = None
     last = out / "last.pt"
     if resume and last.is_file():
         ckpt = load_checkpoint(last, map_location=dist.device, kind=KIND)  # weights_only=True: never unpickles code
-        diff = config_differences(ckpt["config"], asdict(c), ignore=("steps",))
+        diff = config_differences(ckpt["config"], asdict(c), ignore=("steps",) + HEAD_KEYS)
         if ckpt.get("kind") != KIND or diff:
             raise ShapeMoveError(f"{last}: cannot resume, the configuration differs ({', '.join(diff) or 'kind'})")
         model.load_state_dict(ckpt["model"])
         optimizer.load_state_dict(ckpt["optimizer"])
         scheduler.load_state_dict(ckpt["scheduler"])
         step = int(ckpt["step"])
+        if step > c.steps and ckpt.get("head_optimizer") is None:
+            raise ShapeMoveError(f"{last}: saved at step {step}, beyond the {c.steps} main steps, without a head phase")
+        head_state = ckpt.get("head_optimizer")
         set_rng_state(ckpt["rng"])
         rng.setstate(ckpt["py_rng_examples"])
     raw = model
@@ -201,12 +216,18 @@ def _train(data, vae_path, out, c, base_model, resume, dist, progress, cancel, v
             "downsample": vae.cfg.downsample, "max_codes": c.max_codes, "data": str(data),
             "base_model": str(base_model) if base_model is not None else None}
 
+    total = c.steps + c.head_steps
+    head_opt = torch.optim.AdamW(raw.beta_head.parameters(), lr=c.head_lr, weight_decay=c.weight_decay)
+    if head_state is not None:
+        head_opt.load_state_dict(head_state)
+
     def save(final: bool = False):
         if not dist.is_main:
             return
         save_checkpoint(last, {"kind": KIND, "config": asdict(c), "model": raw.state_dict(),
                                "optimizer": optimizer.state_dict(), "scheduler": scheduler.state_dict(),
-                               "step": step, "rng": rng_state(), "py_rng_examples": rng.getstate()},
+                               "step": step, "rng": rng_state(), "py_rng_examples": rng.getstate(),
+                               "head_optimizer": head_opt.state_dict() if step > c.steps else None},
                         {"format": 1, "kind": KIND})
         if final:
             from ..models.known_texts import build_known
@@ -214,7 +235,7 @@ def _train(data, vae_path, out, c, base_model, resume, dist, progress, cancel, v
             raw.save(out / "t5", None if c.encoder == "minilm" else tok, meta | {"step": step},
                      known=build_known(data, train_ids, states))
 
-    log = StepLog(out, c.steps, step, dist, progress, "train t5", verbose)
+    log = StepLog(out, total, step, dist, progress, "train t5", verbose)
     model.train()
     while step < c.steps:
         if distributed.broadcast_flag(bool(cancel and dist.is_main and cancel()), dist):
@@ -238,8 +259,47 @@ def _train(data, vae_path, out, c, base_model, resume, dist, progress, cancel, v
             log.log(step, scheduler.get_last_lr()[0],
                     {"loss": float(res["loss"].detach()), "ce": float(res["ce"]), "l1": float(res["l1"])},
                     {"ce": ("train", "ce"), "l1": ("train", "l1")})
-        save_if_due(save, step, c.ckpt_every, c.steps, dist)
-    return finish(save, log.bar, step, c.steps, dist, log.metrics)
+        save_if_due(save, step, c.ckpt_every, total, dist)
+    # -- 4. the [BETA] head alone on heights and waists (beta_head_refit.py) -------------------
+    if step >= c.steps and step < total:
+        from ..body.load import load_body_model
+        from ..body.shape_from_measurements import torch_measure
+        from .beta_head_refit import MEASURES, beta_states, head_loss
+
+        body = load_body_model(None)  # OpenBody: the body whose betas -> girth regression ships
+        if vae.metadata.get("body") not in (None, body.name):
+            raise ShapeMoveError(f"head_steps measure bodies of {body.name}; this SA-VAE was trained for "
+                                 f"{vae.metadata.get('body')!r} (set head_steps to 0)")
+        measure = torch_measure(body, MEASURES)
+        raw.eval()
+        raw.beta_head.train()
+    while c.steps <= step < total:
+        if distributed.broadcast_flag(bool(cancel and dist.is_main and cancel()), dist):
+            break
+        batch = [train_set.sample(rng) for _ in range(max(1, c.head_batch_size // dist.world_size))]
+        if c.encoder == "minilm":
+            inputs, _, betas = collate_minilm(batch, states, raw.vocab)
+        else:
+            input_ids, attn, _, betas = collate(batch, tok, raw.vocab)
+            inputs = (input_ids, attn)
+        keep = torch.tensor([e["betas"] is not None for e in batch])
+        h = beta_states(raw, tuple(x.to(dist.device) for x in inputs))
+        loss, l1, cm = head_loss(raw.beta_head, h[keep.to(h.device)], betas[keep].to(dist.device), measure,
+                                 c.head_measure_weight)
+        for g in head_opt.param_groups:  # linear decay to 0 over the head phase
+            g["lr"] = c.head_lr * (total - step) / c.head_steps
+        head_opt.zero_grad(set_to_none=True)
+        loss.backward()
+        distributed.mean_gradients(raw.beta_head.parameters(), dist)
+        head_opt.step()
+        step += 1
+        log.bar.update(1)
+        if step % c.log_every == 0 or step == total:
+            log.log(step, head_opt.param_groups[0]["lr"], {"head_loss": float(loss.detach()), "l1": float(l1),
+                                                            "height_waist_cm": float(cm)},
+                    {"l1": ("train", "l1"), "cm": ("train", "height_waist_cm")})
+        save_if_due(save, step, c.ckpt_every, total, dist)
+    return finish(save, log.bar, step, total, dist, log.metrics)
 
 
 def from_cli(args) -> dict:

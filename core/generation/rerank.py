@@ -1,0 +1,46 @@
+"""Best of N: several motion-token samples for one prompt, the one the text-motion model (TMA,
+Human TOMATO's alignment model) finds closest to the prompt is kept.
+
+The T5 samples its tokens; for prompts far from the common training actions a single sample often
+drifts to a frequent motion (a walk, a raised hand). ``pick`` decodes every candidate's features
+with the SA-VAE and compares their TMA motion embeddings with the prompt's TMA text embedding
+(cosine); the highest wins. The TMA is the model's own (``tma/`` of the model folder), so choosing
+costs one batched SA-VAE decode and one TMA pass (tens of milliseconds), not a second generator.
+
+Bias to keep in mind: R-precision and the paraphrase classifier also read TMA embeddings, so
+``eval generate`` scores the generator with one candidate, and ``eval paraphrase`` also reports a
+classifier that does not use the TMA (``action_classifier.FeatureEmbedder``).
+"""
+from __future__ import annotations
+
+import numpy as np
+import torch
+
+
+
+class CandidatePicker:
+    def __init__(self, tma):
+        """``tma``: a ``tma_embed.load_tma`` tuple (model, text reader, mean, std)."""
+        self.model, self.tok, self.mean, self.std = tma
+
+    def scores(self, prompt: str, feats: list) -> np.ndarray:
+        """(N,) cosine similarity of each candidate's (T, 263) features to the prompt."""
+        from ..eval.tma_embed import embed_motions, embed_texts
+
+        text = embed_texts(self.model, self.tok, [prompt])[0]
+        return embed_motions(self.model, feats, self.mean, self.std) @ text
+
+    def pick(self, prompt: str, feats: list) -> int:
+        """Index of the candidate closest to ``prompt`` (the first on a tie)."""
+        return int(np.argmax(self.scores(prompt, feats)))
+
+
+@torch.no_grad()
+def candidate_features(vae, codes: list[list[int]], betas) -> list[np.ndarray]:
+    """Raw (T, 263) SA-VAE features of each candidate's codes for the body ``betas`` (10,)."""
+    b = torch.as_tensor(np.asarray(betas, np.float32))[None]
+    out = []
+    for c in codes:
+        idx = torch.as_tensor(c, dtype=torch.long)[None]
+        out.append(vae.denormalize(vae.decode_long(vae.quantizer.indices_to_codes(idx), b))[0].numpy())
+    return out

@@ -1,0 +1,69 @@
+"""The [BETA] head's measurement phase (core/train/beta_head_refit.py, T5 training step 4) and the
+differentiable measurements it trains on."""
+import shutil
+
+import numpy as np
+import pytest
+import torch
+
+from shapemove.core.body.load import load_body_model
+from shapemove.core.body.shape_from_measurements import fast_measure, girth_regression, torch_measure
+from shapemove.core.errors import ShapeMoveError
+
+
+def test_torch_measure_matches_fast_measure_and_has_gradients():
+    body = load_body_model(None)
+    b = np.random.default_rng(0).normal(size=(16, 10)).clip(-3, 3)
+    want = fast_measure(body, b, ("height_cm", "waist_cm", "hip_cm"), girth_regression(body))
+    measure = torch_measure(body, ("height_cm", "waist_cm", "hip_cm"))
+    bt = torch.tensor(b, dtype=torch.float32, requires_grad=True)
+    got = measure(bt)
+    assert np.allclose(got.detach().numpy(), want, atol=0.02)  # cm, float32 vs float64
+    got[:, 0].sum().backward()
+    assert bt.grad.abs().sum() > 0
+    with pytest.raises(ShapeMoveError, match="no differentiable measure"):
+        torch_measure(body, ("arm_length_cm",))
+
+
+def test_lr_schedule_is_a_plain_float():
+    from shapemove.core.train.train_t5 import T5TrainConfig, lr_at
+
+    c = T5TrainConfig(steps=100, warmup_steps=10)
+    assert all(type(lr_at(s, c)) is float for s in (0, 9, 10, 50, 100, 150))  # numpy scalars break last.pt loading
+
+
+def test_head_phase_trains_only_the_head_and_resumes(tiny_dataset, tmp_path):
+    from tiny_models import build_tiny_bundle
+
+    from shapemove.core.models.shapemove_t5 import ShapeMoveT5
+    from shapemove.core.train.train_t5 import T5TrainConfig, train_t5
+
+    bundle = build_tiny_bundle(tiny_dataset, tmp_path / "bundle")
+    vae = bundle.parent / "runs" / "vae" / "savae.pt"
+    c = T5TrainConfig.tiny()
+    c.steps, c.warmup_steps, c.ckpt_every = 8, 2, 4  # past the warm-up: last.pt must still load
+    main = tmp_path / "main"
+    train_t5(tiny_dataset, vae, main, c, device="cpu", verbose=False)
+    before, _ = ShapeMoveT5.load(main / "t5")
+
+    c.head_steps, c.head_batch_size, c.head_lr = 12, 16, 3e-3
+    whole = tmp_path / "whole"
+    shutil.copytree(main, whole)
+    train_t5(tiny_dataset, vae, whole, c, resume=True, device="cpu", verbose=False)
+    after, _ = ShapeMoveT5.load(whole / "t5")
+    assert after.info["step"] == 20
+    for k, v in before.lm.state_dict().items():  # the T5 is frozen in the head phase
+        assert torch.equal(v, after.lm.state_dict()[k]), k
+    moved = [k for k, v in before.beta_head.state_dict().items() if not torch.equal(v, after.beta_head.state_dict()[k])]
+    assert moved
+
+    # killed in the middle of the head phase (cancel after 5 head steps), then resumed: same head
+    cut = tmp_path / "cut"
+    shutil.copytree(main, cut)
+    calls = iter(range(100))
+    train_t5(tiny_dataset, vae, cut, c, resume=True, device="cpu", verbose=False, cancel=lambda: next(calls) >= 5)
+    assert not (cut / "t5" / "beta_head.safetensors").exists() or ShapeMoveT5.load(cut / "t5")[0].info["step"] == 8
+    train_t5(tiny_dataset, vae, cut, c, resume=True, device="cpu", verbose=False)
+    resumed, _ = ShapeMoveT5.load(cut / "t5")
+    for k, v in after.beta_head.state_dict().items():
+        assert torch.allclose(v, resumed.beta_head.state_dict()[k], atol=1e-6), k

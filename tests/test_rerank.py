@@ -1,0 +1,48 @@
+"""Best of N (core/generation/rerank.py): the generator keeps the sample the TMA finds closest to the prompt."""
+import numpy as np
+import pytest
+import torch
+
+from tiny_models import tiny_bundle  # noqa: F401  (session fixture)
+
+from shapemove.core.errors import ShapeMoveError
+from shapemove.core.generation.sampling_params import check_candidates
+
+
+@pytest.mark.parametrize("bad,match", [(0, "between 1 and 64"), (65, "between 1 and 64"), (2.5, "whole number"),
+                                       ("8", "whole number"), (True, "whole number")])
+def test_candidates_are_checked(bad, match):
+    with pytest.raises(ShapeMoveError, match=match):
+        check_candidates(bad)
+    assert check_candidates(8.0) == 8
+
+
+def test_generator_keeps_the_candidate_closest_to_the_prompt(tiny_bundle):  # noqa: F811
+    from shapemove.core.eval.tma_embed import embed_motions, embed_texts, load_tma
+    from shapemove.core.generation.generate import Generator, Request
+    from shapemove.core.models.constrained_decoding import decode
+
+    model_dir, _ = tiny_bundle
+    gen = Generator(model_dir)
+    prompt, n, seed = "a person walks forward", 6, 11
+    motion = gen.generate_batch([Request(prompt, seconds=2.0, seed=seed, candidates=n)])[0]
+    # the same samples drawn by hand, scored by hand (features, TMA embeddings, cosine)
+    g = torch.Generator().manual_seed(seed)
+    lo, hi = gen._length(2.0)
+    out = decode(gen.t5, gen.t5.inputs_for(gen.tok, [prompt] * n, [None] * n), lo, hi, temperature=1.0, top_k=50,
+                 generator=g)
+    assert len({tuple(c) for c in out.codes}) > 1, "the candidates should differ"
+    model, tok, mean, std = load_tma(model_dir / "tma" / "tma.pt")
+    feats = []
+    with torch.no_grad():
+        for c in out.codes:
+            idx = torch.as_tensor(c)[None]
+            feats.append(gen.vae.denormalize(gen.vae.decode_long(gen.vae.quantizer.indices_to_codes(idx),
+                                                                 out.betas[:1]))[0].numpy())
+    sims = embed_motions(model, feats, mean, std) @ embed_texts(model, tok, [prompt])[0]
+    assert list(motion.tokens) == out.codes[int(np.argmax(sims))]
+    # one candidate: the first sample of a batch of one, no choice
+    single = gen.generate_batch([Request(prompt, seconds=2.0, seed=seed, candidates=1)])[0]
+    g = torch.Generator().manual_seed(seed)
+    first = decode(gen.t5, gen.t5.inputs_for(gen.tok, [prompt], [None]), lo, hi, temperature=1.0, top_k=50, generator=g)
+    assert list(single.tokens) == first.codes[0]
