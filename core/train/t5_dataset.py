@@ -67,10 +67,13 @@ def clip_weights(ids: list[str], labels: dict, balance: float) -> np.ndarray:
     return np.array([count[a] ** -float(balance) for a in main], dtype=np.float64)
 
 
+NULL_PROMPT = ""  # the motion text of the unconditional examples (classifier-free guidance)
+
+
 class T2MExamples:
     def __init__(self, root: Path, split: str, tokens: dict[str, np.ndarray], max_codes: int = 50,
                  m2t_share: float = 0.0, no_shape_share: float = 0.2, bank_share: float = BANK_SHARE,
-                 action_balance: float = 0.0):
+                 action_balance: float = 0.0, null_share: float = 0.0):
         root = Path(root)
         self.ids = [c for c in read_split(root, split) if c in tokens and len(tokens[c])]
         if not self.ids:
@@ -82,6 +85,7 @@ class T2MExamples:
         self.betas = {c: np.load(root / "betas" / f"{c}.npy").astype(np.float32) for c in self.ids}
         self.max_codes, self.m2t_share, self.no_shape_share = max_codes, m2t_share, no_shape_share
         self.bank_share = bank_share
+        self.null_share = null_share  # share of examples whose motion text is NULL_PROMPT (guidance)
         self.cumulative = clip_weights(self.ids, self.labels, action_balance).cumsum()
 
     def __len__(self) -> int:
@@ -95,6 +99,8 @@ class T2MExamples:
             s = rng.randrange(len(codes) - self.max_codes + 1)
             codes = codes[s: s + self.max_codes]
         caption = training_caption(self.captions[cid], self.labels[cid], rng, self.bank_share)
+        if self.null_share and rng.random() < self.null_share:  # no draw at 0: the same examples as before
+            caption = NULL_PROMPT
         if self.m2t_share and rng.random() < self.m2t_share:
             motion = SOM + "".join(f"[MID_{int(c)}]" for c in codes) + EOM
             return {"input": f"Describe the motion: {motion}", "codes": None, "text": caption, "betas": None,

@@ -60,6 +60,7 @@ class T5TrainConfig:
     m2t_share: float = 0.0         # share of motion-to-text examples (the paper's pre-training; T5 encoder)
     bank_share: float = BANK_SHARE  # share of captions drawn from the paraphrase bank (data/paraphrase_bank.py)
     action_balance: float = 0.0    # clip sampling weight 1 / (clips of its main action) ** this (1 = actions equally)
+    null_share: float = 0.0        # share of prompts trained without motion text (classifier-free guidance)
     encoder: str = "minilm"        # "minilm" (frozen pretrained MiniLM + T5 decoder) or "t5" (whole T5)
     vocab_size: int = 2000
     seed: int = 0
@@ -89,6 +90,8 @@ class T5TrainConfig:
             raise ShapeMoveError(f"T5 config: bank_share must be in [0, 1], got {self.bank_share}")
         if not 0 <= self.action_balance <= 1:
             raise ShapeMoveError(f"T5 config: action_balance must be in [0, 1], got {self.action_balance}")
+        if not 0 <= self.null_share < 1:
+            raise ShapeMoveError(f"T5 config: null_share must be in [0, 1), got {self.null_share}")
         if self.head_steps < 0 or self.head_batch_size < 1 or self.head_lr <= 0 or self.head_measure_weight < 0:
             raise ShapeMoveError("T5 config: head_steps >= 0, head_batch_size >= 1, head_lr > 0 and "
                                  "head_measure_weight >= 0 are required")
@@ -211,7 +214,7 @@ def _train(data, vae_path, out, c, base_model, resume, dist, progress, cancel, v
     if dist.enabled:
         model = DDP(model, find_unused_parameters=True)
     train_set = T2MExamples(data, "train", tokens, c.max_codes, c.m2t_share, bank_share=c.bank_share,
-                            action_balance=c.action_balance)
+                            action_balance=c.action_balance, null_share=c.null_share)
     meta = {"vae": str(vae_path), "vae_body": vae.metadata.get("body"), "config": asdict(c),
             "downsample": vae.cfg.downsample, "max_codes": c.max_codes, "data": str(data),
             "base_model": str(base_model) if base_model is not None else None}
