@@ -23,6 +23,7 @@ from pathlib import Path
 
 from .atomic import atomic_write_json
 from .errors import ShapeMoveError
+from .io.limits import read_bounded
 
 MANIFEST = "manifest.json"
 FORMAT = "shapemove-manifest/1"
@@ -71,10 +72,9 @@ def write_manifest(folder) -> Path:
 
 
 def _read(manifest: Path) -> dict:
+    raw = read_bounded(manifest, MAX_MANIFEST_BYTES, "model manifest", "re-export or re-train the model")
     try:
-        if manifest.stat().st_size > MAX_MANIFEST_BYTES:
-            raise ValueError("too large")
-        data = json.loads(manifest.read_text(encoding="utf-8"))
+        data = json.loads(raw.decode("utf-8"))
         if not isinstance(data, dict) or data.get("format") != FORMAT or not isinstance(data.get("files"), dict):
             raise ValueError(f"not a {FORMAT} manifest")
         for name, e in data["files"].items():

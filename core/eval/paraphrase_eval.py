@@ -45,15 +45,10 @@ MAX_PROMPTS_BYTES = 4 << 20
 
 def load_prompts(path=None) -> list[dict]:
     """The held-out prompts [{text, action, also: [..]}] of a JSON file ({"prompts": [...]} or a list)."""
+    from ..io.limits import read_json
+
     path = Path(path) if path else DEFAULT_PROMPTS
-    if not path.is_file():
-        raise ShapeMoveError(f"paraphrase file not found: {path}")
-    if path.stat().st_size > MAX_PROMPTS_BYTES:
-        raise ShapeMoveError(f"{path}: larger than {MAX_PROMPTS_BYTES >> 20} MB; not a prompt list")
-    try:
-        doc = json.loads(path.read_text(encoding="utf-8"))
-    except (UnicodeDecodeError, json.JSONDecodeError) as exc:
-        raise ShapeMoveError(f"{path}: not valid JSON ({exc})") from None
+    doc = read_json(path, "paraphrase prompt list", MAX_PROMPTS_BYTES)
     items = doc.get("prompts") if isinstance(doc, dict) else doc
     out = []
     for i, it in enumerate(items if isinstance(items, list) else []):

@@ -7,9 +7,11 @@ A model folder holds ``savae.pt`` (SA-VAE), ``t5/`` (ShapeMove T5: save_pretrain
 """
 from __future__ import annotations
 
+import sys
 from pathlib import Path
 
 from ..errors import ShapeMoveError
+from ..io.limits import read_json
 
 PACKAGE_ROOT = Path(__file__).resolve().parents[2]
 DEFAULT_MODEL_DIR = PACKAGE_ROOT / "weights" / "default"
@@ -32,27 +34,33 @@ def model_files(d: Path) -> dict:
     return files
 
 
-MAX_KNOWN_BYTES = 64 << 20
+MAX_KNOWN_BYTES = 64 << 20  # t5/known_texts.json (50,000 captions at most: a few MB)
 
 
 def known_actions(model_dir=None, limit: int | None = None) -> list[str]:
     """The actions a model folder's T5 was trained on, most frequent first (``t5/known_texts.json``,
     written at training time); [] for folders without it. Plain JSON, no torch: the Blender panel
-    reads it to suggest prompts."""
-    import json
-
+    reads it to suggest prompts. A file that is too large or damaged gives [] and a one-line note
+    on stderr (once per file version: panels redraw often, each file is read once)."""
     try:
         f = resolve_model_dir(model_dir) / "t5" / "known_texts.json"
-        if not f.is_file() or f.stat().st_size > MAX_KNOWN_BYTES:
+        if not f.is_file():
             return []
         key = (str(f), f.stat().st_mtime_ns)
-        if key not in _known_cache:  # panels redraw often: read each file once
-            actions = json.loads(f.read_text(encoding="utf-8")).get("actions", [])
-            _known_cache.clear()
-            _known_cache[key] = [str(a[0]) for a in actions if isinstance(a, list) and a and isinstance(a[0], str)]
-        names = _known_cache[key]
-    except (OSError, ValueError, AttributeError, ShapeMoveError):
+    except (OSError, ShapeMoveError):
         return []
+    if key not in _known_cache:
+        _known_cache.clear()
+        try:
+            doc = read_json(f, "known-texts", MAX_KNOWN_BYTES, "copy the model folder again")
+            actions = doc.get("actions") if isinstance(doc, dict) else None
+            if not isinstance(actions, list):
+                raise ShapeMoveError(f"{f}: no list of actions; copy the model folder again")
+            _known_cache[key] = [str(a[0]) for a in actions if isinstance(a, list) and a and isinstance(a[0], str)]
+        except ShapeMoveError as exc:
+            print(f"note: no prompt suggestions: {exc}", file=sys.stderr)
+            _known_cache[key] = []
+    names = _known_cache[key]
     return names[:limit] if limit else list(names)
 
 

@@ -44,36 +44,57 @@ def check_file_size(path, max_bytes: int, what: str, advice: str = "") -> int:
     return size
 
 
-def read_text(path, what: str, max_bytes: int | None = None) -> str:
-    """The text of a motion file: size checked before reading, binary files refused."""
+def read_bounded(path, max_bytes: int, what: str, advice: str = "") -> bytes:
+    """The bytes of the user's file ``path``, at most ``max_bytes``: the size is checked before
+    reading (``check_file_size``) and at most ``max_bytes + 1`` bytes are read, so a file whose
+    size says less than it holds (a FIFO, a /proc file, a file that grows while read) is refused
+    too ('PATH: the WHAT file is more than LIMIT ...; WHAT files larger than LIMIT are refused')."""
     path = Path(path)
-    max_bytes = max_bytes or MAX_TEXT_BYTES
-    check_file_size(path, max_bytes, what, "split the clip")
+    check_file_size(path, max_bytes, what, advice)
     try:
         with open(path, "rb") as fh:
             raw = fh.read(max_bytes + 1)
     except OSError as exc:
         raise ShapeMoveError(f"cannot read {what} {path}: {exc.strerror or exc}") from None
-    if len(raw) > max_bytes:  # not a regular file (its size said 0), or it grew
-        raise ShapeMoveError(f"{path}: the {what} file is larger than {_amount(max_bytes)}")
+    if len(raw) > max_bytes:
+        refuse_larger(path, max_bytes, what, advice)
+    return raw
+
+
+def refuse_larger(path, max_bytes: int, what: str, advice: str = ""):
+    """Raise the refusal of a file found holding more than ``max_bytes`` while it was read (its size
+    said less: a FIFO, a /proc file, a file that grows), worded as ``check_file_size``'s."""
+    limit = _amount(max_bytes)
+    raise ShapeMoveError(f"{path}: the {what} file is more than {limit} (it grew while being read, or is not a "
+                         f"regular file); {what} files larger than {limit} are refused"
+                         + (f" ({advice})" if advice else ""))
+
+
+def read_text(path, what: str, max_bytes: int | None = None) -> str:
+    """The text of a motion file: size bounded (``read_bounded``), binary files refused."""
+    path = Path(path)
+    raw = read_bounded(path, max_bytes or MAX_TEXT_BYTES, what, "split the clip")
     if b"\0" in raw[:4096]:
         raise ShapeMoveError(f"{path}: binary data, not an {what} text file")
     return raw.decode("utf-8", errors="replace")
 
 
-def read_json(path, what: str, max_bytes: int = 1 << 20):
-    """A user's JSON file (a preset, a config): 'WHAT not found: PATH'; the size is checked before
-    reading; unreadable or invalid JSON is one sentence 'cannot read WHAT PATH: ...'."""
+def read_json(path, what: str, max_bytes: int = 1 << 20, advice: str = ""):
+    """A user's JSON file (a preset, a config): 'WHAT not found: PATH'; at most ``max_bytes`` are
+    read (``read_bounded``, the refusal ends with ``advice``); unreadable or invalid JSON is one
+    sentence 'cannot read WHAT PATH: ...'."""
     path = Path(path)
-    if not path.is_file():
+    if not path.exists():
         raise ShapeMoveError(f"{what} not found: {path}")
-    check_file_size(path, max_bytes, what)
+    if path.is_dir():
+        raise ShapeMoveError(f"cannot read {what} {path}: it is a folder")
+    raw = read_bounded(path, max_bytes, what, advice)
     try:
-        return json.loads(path.read_text(encoding="utf-8"))
+        return json.loads(raw.decode("utf-8"))
     except (json.JSONDecodeError, UnicodeDecodeError) as exc:
         raise ShapeMoveError(f"cannot read {what} {path}: not valid JSON ({exc})") from None
-    except OSError as exc:
-        raise ShapeMoveError(f"cannot read {what} {path}: {exc.strerror or exc}") from None
+    except RecursionError:
+        raise ShapeMoveError(f"cannot read {what} {path}: not valid JSON (nested too deeply)") from None
 
 
 def check_joint_frames(frames, joints, source, what: str = "clip") -> None:

@@ -27,6 +27,8 @@ import torch
 from ..data.actions import find_actions, stored_labels
 from ..data.paraphrase_bank import known_sentences
 from ..errors import ShapeMoveError
+from ..generation.model_bundle import MAX_KNOWN_BYTES
+from ..io.limits import read_json
 
 NEAR = 0.50           # below this cosine similarity to every known caption: warn
 MAX_KNOWN = 50_000    # captions kept (bounded file size)
@@ -61,13 +63,14 @@ def build_known(root, ids: list[str], states) -> dict:
     counts: dict[str, int] = {}
     for cid in ids:
         acts = _clip_actions(root, cid)
-        for c in _read_lines(root / "texts" / f"{cid}.txt"):
+        lines = _read_lines(root / "texts" / f"{cid}.txt")
+        for c in lines:
             if len(captions) >= MAX_KNOWN:
                 break
             a = acts[0] if acts else next(iter(find_actions(c)), "")
             if c not in captions or (not captions[c] and a):
                 captions[c] = a
-        for a in set(acts) or {captions.get(c, "") for c in _read_lines(root / "texts" / f"{cid}.txt")} - {""}:
+        for a in set(acts) or {captions.get(c, "") for c in lines} - {""}:
             counts[a] = counts.get(a, 0) + 1
     for a in counts:  # the phrasings training draws from the paraphrase bank, too
         for c in known_sentences(a):
@@ -139,8 +142,8 @@ def read_known(folder) -> Known | None:
     j, v = folder / JSON_NAME, folder / VECTORS_NAME
     if not j.is_file() or not v.is_file():
         return None
+    doc = read_json(j, JSON_NAME, MAX_KNOWN_BYTES, "copy the model folder again")
     try:
-        doc = json.loads(j.read_text())
         vectors = load_file(str(v))["vectors"]
         captions, acts = list(doc["captions"]), list(doc["caption_actions"])
         actions = [(a, n) for a, n in doc["actions"]]
