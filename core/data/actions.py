@@ -12,13 +12,12 @@ patterns overlap, the longer match wins ("jumping jacks" over "jump", "spin kick
 """
 from __future__ import annotations
 
-import json
 import re
 from collections import Counter
 from dataclasses import dataclass
-from pathlib import Path
 
 from ..errors import ShapeMoveError
+from .built_meta import clip_meta, iter_meta
 
 
 @dataclass(frozen=True)
@@ -242,35 +241,23 @@ def _from_text(labels: dict, captions: list[str]) -> list[str]:
 
 
 def known_actions(data_dir, split: str | None = None) -> list[tuple[str, int]]:
-    """(action, number of clips) over a built dataset's ``meta.jsonl`` (or ``meta/*.json``), most
-    frequent first; ``split`` restricts to one split. Composed and augmented clips count too."""
-    data_dir = Path(data_dir)
-    metas = []
-    if (data_dir / "meta.jsonl").is_file():
-        for line in (data_dir / "meta.jsonl").read_text(encoding="utf-8").splitlines():
-            if line.strip():
-                metas.append(json.loads(line))
-    elif (data_dir / "meta").is_dir():
-        metas = [json.loads(p.read_text(encoding="utf-8")) for p in sorted((data_dir / "meta").glob("*.json"))]
-    else:
-        raise ShapeMoveError(f"{data_dir}: not a built dataset (no meta.jsonl or meta/ folder)")
+    """(action, number of clips) over a built dataset's ``meta.jsonl`` (or ``meta/*.json``, read by
+    ``built_meta.iter_meta``), most frequent first; ``split`` restricts to one split. Composed and
+    augmented clips count too."""
     counts: Counter = Counter()
-    for m in metas:
+    for m in iter_meta(data_dir):
         if split is not None and m.get("split") != split:
             continue
-        for a in set((m.get("labels") or {}).get("actions", [])):
-            counts[a] += 1
+        labels = m.get("labels")
+        acts = labels.get("actions") if isinstance(labels, dict) else None
+        if isinstance(acts, list):
+            counts.update({a for a in acts if isinstance(a, str)})  # one count per clip
     return sorted(counts.items(), key=lambda kv: (-kv[1], kv[0]))
 
 
 def stored_labels(data_dir, clip_id: str) -> dict:
-    """The ``labels`` of a built clip's ``meta/{clip_id}.json`` ({} when it has none or is unreadable):
+    """The ``labels`` of a built clip's ``meta/{clip_id}.json`` ({} when it has none; a note when it is
+    too large or unreadable, ``built_meta.clip_meta``):
     ``actions`` (main first) and, for clips that hold several actions in turn, ``sequence``."""
-    f = Path(data_dir) / "meta" / f"{clip_id}.json"
-    if not f.is_file() or f.stat().st_size > (1 << 20):
-        return {}
-    try:
-        labels = json.loads(f.read_text(encoding="utf-8")).get("labels")
-    except (UnicodeDecodeError, json.JSONDecodeError, AttributeError):
-        return {}
+    labels = clip_meta(data_dir, clip_id).get("labels")
     return labels if isinstance(labels, dict) else {}

@@ -62,28 +62,12 @@ def check_built(data) -> Path:
 
 
 def clip_actions(data, ids: list[str]) -> dict[str, list[str]]:
-    """{clip id: its labels.actions} for the clips ``ids`` (from ``meta.jsonl``, else ``meta/ID.json``);
-    clips without meta or actions get []."""
-    data = Path(data)
-    want, out = set(ids), {}
-    jl = data / "meta.jsonl"
-    if jl.is_file():
-        if jl.stat().st_size > MAX_META_BYTES:
-            raise ShapeMoveError(f"{jl}: larger than {MAX_META_BYTES >> 20} MB; not a dataset's meta")
-        with jl.open(encoding="utf-8") as fh:
-            for n, line in enumerate(fh, 1):
-                if not line.strip():
-                    continue
-                try:
-                    m = json.loads(line)
-                except json.JSONDecodeError as exc:
-                    raise ShapeMoveError(f"{jl}: line {n} is not valid JSON ({exc})") from None
-                if isinstance(m, dict) and m.get("id") in want:
-                    out[m["id"]] = _actions_of(m)
-    for cid in ids:
-        if cid not in out:
-            out[cid] = _actions_of({"labels": stored_labels(data, cid)})
-    return out
+    """{clip id: its labels.actions} for the clips ``ids`` (``built_meta.read_meta``: ``meta.jsonl``,
+    else ``meta/ID.json``); clips without meta or actions get []."""
+    from ..data.built_meta import read_meta
+
+    metas = read_meta(data, ids)
+    return {cid: _actions_of(metas[cid]) for cid in ids}
 
 
 def _actions_of(meta) -> list[str]:
