@@ -21,6 +21,10 @@ def add_arguments(p):
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--temperature", type=float, default=1.0, help="sampling temperature; 0 = greedy")
     p.add_argument("--top-k", type=int, default=50)
+    p.add_argument("--candidates", type=int, default=None,
+                   help="token samples drawn; the text-motion model keeps the one closest to the prompt (default 8; 1 = none)")
+    p.add_argument("--guidance", type=float, default=None,
+                   help="classifier-free guidance scale (default: the model's, 2 for models trained with null prompts; 0 = none)")
     p.add_argument("--model", type=Path, default=None, help="model folder (default: the embedded default model)")
     p.add_argument("--body-model", default=None, help="openbody (default) or a path to SMPL-family model files")
     p.add_argument("--out", type=Path, required=True)
@@ -33,13 +37,17 @@ def run(args) -> int:
     if args.out.suffix.lower() != ".npz":
         raise ShapeMoveError(f"--out must end in .npz, got {args.out}")
     check_sampling(args.seed, args.temperature, args.top_k)  # before loading any model
+    from ..core.generation.sampling_params import DEFAULT_CANDIDATES, check_candidates, check_guidance
+
+    candidates = check_candidates(DEFAULT_CANDIDATES if args.candidates is None else args.candidates)
+    guidance = check_guidance(args.guidance)
     ensure_parent(args.out)  # a parent that is a file, or no permission: said now, not after generating
     betas = parse_betas(args.betas) if args.betas else None
     gen = Generator(args.model, body=args.body_model)
     from ..core.generation.generate import Request
 
     motion = gen.generate_batch([Request(args.prompt, args.shape_text, betas, args.seconds, args.seed, args.temperature,
-                                         args.top_k, args.shape_from)])[0]
+                                         args.top_k, args.shape_from, candidates, guidance)])[0]
     save_motion(args.out, motion)
     import sys
 

@@ -22,7 +22,7 @@ from ..errors import ShapeMoveError
 from ..models.constrained_decoding import decode
 from ..models.known_texts import read_known
 from ..models.savae import load_savae
-from ..models.shapemove_t5 import ShapeMoveT5
+from ..models.shapemove_t5 import NULL_PROMPT, ShapeMoveT5
 from ..models.text_encoder import load_text_encoder
 from ..scene.motion_file import Motion
 from ..torch_threads import one_torch_thread
@@ -30,7 +30,7 @@ from .decode import decode_tokens
 from .model_bundle import model_files, resolve_model_dir
 from .prompts import check_prompt
 from .rerank import CandidatePicker, candidate_features
-from .sampling_params import DEFAULT_CANDIDATES, check_candidates, check_sampling
+from .sampling_params import DEFAULT_CANDIDATES, DEFAULT_GUIDANCE, check_candidates, check_guidance, check_sampling
 
 
 @dataclass
@@ -44,6 +44,7 @@ class Request:
     top_k: int | None = 50
     shape_from: str = "auto"  # "auto": measurements stated in the shape text win; "head": the [BETA] head only
     candidates: int = DEFAULT_CANDIDATES  # token samples drawn; the TMA keeps the one closest to the prompt
+    guidance: float | None = None  # classifier-free guidance scale; None: the model's default (0 without a null prompt)
 
 
 def parse_betas(text: str) -> np.ndarray:
@@ -72,6 +73,8 @@ class Generator:
         self.known = read_known(files["t5"]) if self.t5 is not None else None  # training captions + actions
         self.ik_refine_iters = ik_refine_iters
         self.max_codes = int(getattr(self.t5, "info", {}).get("max_codes", 50)) if self.t5 else 50
+        trained_null = float(((self.t5.info if self.t5 else {}).get("config") or {}).get("null_share", 0) or 0)
+        self.default_guidance = DEFAULT_GUIDANCE if trained_null > 0 else 0.0  # a model without a null prompt: none
         self._tma_file = files.get("tma")
         self._picker = None
 
@@ -105,7 +108,10 @@ class Generator:
                 lo, hi = self._length(r.seconds)
                 n = r.candidates if r.temperature > 0 and self.picker is not None else 1
                 inputs = self.t5.inputs_for(self.tok, [r.prompt] * n, [r.shape_text] * n)
-                out = decode(self.t5, inputs, lo, hi, temperature=r.temperature, top_k=r.top_k, generator=g)
+                s = self.default_guidance if r.guidance is None else r.guidance
+                null = self.t5.inputs_for(self.tok, [NULL_PROMPT] * n, [r.shape_text] * n) if s > 0 else None
+                out = decode(self.t5, inputs, lo, hi, temperature=r.temperature, top_k=r.top_k, generator=g,
+                             guidance=s, null_inputs=null)
                 best = 0
                 if n > 1:  # the [BETA] state does not depend on the sampled tokens: one body for all
                     best = self.picker.pick(r.prompt, candidate_features(self.vae, out.codes, out.betas[0].numpy()))
@@ -158,6 +164,7 @@ class Generator:
             r.shape_text = check_prompt(r.shape_text, "shape text", allow_empty=True) or None
             r.seed, r.temperature, r.top_k = check_sampling(r.seed, r.temperature, r.top_k)
             r.candidates = check_candidates(r.candidates)
+            r.guidance = check_guidance(r.guidance)
         checks = []
         for r in reqs:  # every text checked before any generation
             with one_torch_thread():

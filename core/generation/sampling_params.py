@@ -11,6 +11,8 @@ MAX_TEMPERATURE = 100.0
 MAX_SEED = 2**63 - 1
 DEFAULT_CANDIDATES = 8   # best-of-N token samples (generation/rerank.py)
 MAX_CANDIDATES = 64
+DEFAULT_GUIDANCE = 2.0    # classifier-free guidance of models trained with null_share (constrained_decoding.py)
+MAX_GUIDANCE = 20.0
 
 
 def _integer(value, name: str) -> int:
@@ -56,3 +58,12 @@ def check_candidates(n) -> int:
     if not 1 <= n <= MAX_CANDIDATES:
         raise ShapeMoveError(f"candidates must be between 1 and {MAX_CANDIDATES}, got {n if abs(n) < 10**9 else 'a huge number'}")
     return n
+
+
+def check_guidance(s) -> float | None:
+    """Classifier-free guidance scale: None (the model's default) or a finite number in [0, MAX_GUIDANCE]."""
+    if s is None:
+        return None
+    if isinstance(s, bool) or not isinstance(s, (int, float)) or not math.isfinite(float(s)) or not 0 <= s <= MAX_GUIDANCE:
+        raise ShapeMoveError(f"guidance must be a number from 0 (none) to {MAX_GUIDANCE:g}, got {str(s)[:40]!r}")
+    return float(s)

@@ -5,6 +5,11 @@ reached) can appear in the motion span; `[EOM]` is forced at the maximum length.
 from the decoder state whose input is `[BETA]`. Batched; sampling with temperature/top-k, or
 greedy at temperature 0. The decoder keeps its key/value cache between steps (one new token per
 step), for either encoder (``ShapeMoveT5.encode``/``step``).
+
+Classifier-free guidance (``guidance`` s > 0, ``null_inputs``: the same requests with an empty
+motion text, which a model trained with ``null_share`` knows): every step also runs the decoder on
+the null inputs and samples from ``cond + s * (cond - uncond)`` logits, so tokens that the prompt
+makes likelier than no prompt at all are favoured. The betas come from the conditional rows.
 """
 from __future__ import annotations
 
@@ -31,9 +36,10 @@ def motion_mask(vocab, vocab_size: int, allow_end: bool) -> torch.Tensor:
 
 @torch.no_grad()
 def decode(model, inputs: tuple, min_codes: int, max_codes: int, temperature: float = 1.0,
-           top_k: int | None = None, generator: torch.Generator | None = None) -> Decoded:
+           top_k: int | None = None, generator: torch.Generator | None = None, guidance: float = 0.0,
+           null_inputs: tuple | None = None) -> Decoded:
     """``inputs``: ``model.inputs_for(...)`` (token ids + mask for a T5, states + mask + segments
-    for MiniLM)."""
+    for MiniLM); ``null_inputs`` the same for the empty motion text, needed when ``guidance`` > 0."""
     vocab = model.vocab
     enc, enc_mask = model.encode(*inputs)
     B = enc.shape[0]
@@ -42,12 +48,21 @@ def decode(model, inputs: tuple, min_codes: int, max_codes: int, temperature: fl
     # the state whose input is [BETA] (position 1) gives the betas
     logits, hidden, past = model.step(enc, enc_mask, seq, use_cache=True)
     betas = model.beta_head(hidden[:, 1])
+    guided = guidance > 0
+    if guided:
+        if null_inputs is None:
+            raise ValueError("guidance needs null_inputs")
+        enc0, mask0 = model.encode(*null_inputs)
+        logits0, _, past0 = model.step(enc0, mask0, seq, use_cache=True)
     V = logits.shape[-1]
     mask_open, mask_closed = motion_mask(vocab, V, True), motion_mask(vocab, V, False)
     done = torch.zeros(B, dtype=torch.bool)
     codes: list[list[int]] = [[] for _ in range(B)]
     for step in range(max_codes + 1):
         logits = logits[:, -1].float()
+        if guided:
+            cond = logits
+            logits = cond + guidance * (cond - logits0[:, -1].float())
         if step >= max_codes:  # forced end
             nxt = torch.full((B,), vocab.eom_id, dtype=torch.long)
         else:
@@ -69,4 +84,6 @@ def decode(model, inputs: tuple, min_codes: int, max_codes: int, temperature: fl
         if done.all():
             break
         logits, _, past = model.step(enc, enc_mask, nxt[:, None], past=past, use_cache=True)
+        if guided:
+            logits0, _, past0 = model.step(enc0, mask0, nxt[:, None], past=past0, use_cache=True)
     return Decoded(codes=codes, betas=betas, token_ids=seq[:, 1:].tolist())

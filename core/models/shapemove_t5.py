@@ -39,6 +39,7 @@ ENCODERS = ("minilm", "t5")
 T5_FILES = ("shapemove.json", "config.json", "model.safetensors", "beta_head.safetensors", "tokenizer.json")
 MINILM_FILES = ("shapemove.json", "config.json", "model.safetensors", "beta_head.safetensors")
 KNOWN_JSON, KNOWN_VECTORS = "known_texts.json", "known_texts.safetensors"
+NULL_PROMPT = ""  # the motion text of unconditional examples (null_share) and of guidance's second pass
 
 
 @dataclass

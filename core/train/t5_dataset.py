@@ -19,7 +19,7 @@ import torch
 from ..data.actions import stored_labels
 from ..data.paraphrase_bank import BANK_SHARE, training_caption
 from ..errors import ShapeMoveError
-from ..models.shapemove_t5 import shapemove_prompt
+from ..models.shapemove_t5 import NULL_PROMPT, shapemove_prompt
 from ..models.tokenizer import EOM, SOM
 from .motion_dataset import read_split
 
@@ -65,9 +65,6 @@ def clip_weights(ids: list[str], labels: dict, balance: float) -> np.ndarray:
     for a in main:
         count[a] = count.get(a, 0) + 1
     return np.array([count[a] ** -float(balance) for a in main], dtype=np.float64)
-
-
-NULL_PROMPT = ""  # the motion text of the unconditional examples (classifier-free guidance)
 
 
 class T2MExamples:

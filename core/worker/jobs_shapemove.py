@@ -104,6 +104,10 @@ def generate(params, progress, cancel) -> dict:
                   seed=int(param(params, op, "seed", int, 0)),
                   temperature=float(param(params, op, "temperature", (int, float), 1.0)),
                   top_k=param(params, op, "top_k", int, 50))
+    if params.get("candidates") is not None:
+        req.candidates = param(params, op, "candidates", int)
+    if params.get("guidance") is not None:
+        req.guidance = float(param(params, op, "guidance", (int, float)))
     progress(0.05, "loading models")
     gen = _generator(param(params, op, "model", str, None), param(params, op, "body", str, None))
     if cancel():
