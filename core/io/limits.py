@@ -4,6 +4,10 @@ anything is allocated, so a small hostile file cannot ask for gigabytes or hours
 The limits sit far above any real capture: the longest clip of CMU/HDM05/Bandai is ~36,000 frames
 (5 min at 120 fps) on ~40 joints (1.4 M joint-frames); a limit of 2 M joint-frames keeps every
 reader's peak memory well under 1 GB (the readers hold ~6 float64 (T,J,3,3) arrays at most).
+
+Every user file (motion text, JSON preset or config, model manifest, dataset meta) is bounded the
+same way: ``check_file_size`` before reading, then ``read_bounded`` reads at most ``max_bytes + 1``
+bytes, so a FIFO, a /proc file or a file that grows after the check is refused too, in the same words.
 """
 from __future__ import annotations
 
