@@ -28,19 +28,16 @@ samples with the TMA (``generation/rerank.py``), so a TMA-only judge could flatt
 """
 from __future__ import annotations
 
-import json
 import os
 from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
 
-from ..data.actions import stored_labels
 from ..errors import ShapeMoveError
 
 REPO_ROOT = Path(__file__).resolve().parents[2]
 FEATURES = "new_joint_vecs"
-MAX_META_BYTES = 256 << 20
 MAX_CLIP_FRAMES = 20 * 60 * 10  # 10 minutes at 20 fps: longer is not a clip of a built dataset
 CHUNK = 256  # clips loaded and embedded at a time (bounded memory)
 

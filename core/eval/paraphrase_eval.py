@@ -31,7 +31,6 @@ was not tuned on these prompts either.
 """
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import numpy as np
