@@ -88,6 +88,15 @@ def _exit_code(result) -> int:
     return result if isinstance(result, int) and not isinstance(result, bool) else 0
 
 
+def add_shape(sub):
+    from ..core.eval import shape_eval
+
+    p = sub.add_parser("shape", help="the [BETA] head on numeric shape texts and size words of new bodies",
+                       description=shape_eval.__doc__.splitlines()[0])
+    shape_eval.add_arguments(p)
+    p.set_defaults(_run=shape_eval.from_cli)
+
+
 def add_paraphrase(sub):
     from ..core.eval import paraphrase_eval
 
@@ -145,7 +154,7 @@ def run_retarget(args) -> int:
     return 0
 
 
-KINDS = [add_recon, add_generate, add_paraphrase, add_retarget]
+KINDS = [add_recon, add_generate, add_paraphrase, add_shape, add_retarget]
 
 
 def add_arguments(p):

@@ -46,7 +46,7 @@ def test_head_phase_trains_only_the_head_and_resumes(tiny_dataset, tmp_path):
     train_t5(tiny_dataset, vae, main, c, device="cpu", verbose=False)
     before, _ = ShapeMoveT5.load(main / "t5")
 
-    c.head_steps, c.head_batch_size, c.head_lr = 12, 16, 3e-3
+    c.head_steps, c.head_batch_size, c.head_lr, c.head_synthetic_share = 12, 16, 3e-3, 0.5
     whole = tmp_path / "whole"
     shutil.copytree(main, whole)
     train_t5(tiny_dataset, vae, whole, c, resume=True, device="cpu", verbose=False)
@@ -67,3 +67,24 @@ def test_head_phase_trains_only_the_head_and_resumes(tiny_dataset, tmp_path):
     resumed, _ = ShapeMoveT5.load(cut / "t5")
     for k, v in after.beta_head.state_dict().items():
         assert torch.allclose(v, resumed.beta_head.state_dict()[k], atol=1e-6), k
+
+
+def test_synthetic_bodies_are_new_measured_and_described():
+    import random
+
+    from shapemove.core.body.measure import measure
+    from shapemove.core.data.shape_text import parse_shape_text
+    from shapemove.core.train.beta_head_refit import synthetic_examples
+
+    body = load_body_model(None)
+    motions, shapes, betas = synthetic_examples(body, girth_regression(body), ["a person walks."], random.Random(3), 12)
+    assert motions == ["a person walks."] * 12 and len(shapes) == 12 and betas.shape == (12, 10)
+    assert betas.abs().max() <= 2.5 and len({tuple(b.tolist()) for b in betas}) == 12
+    m = measure(body, betas.numpy())
+    stated = [(i, parse_shape_text(t)) for i, t in enumerate(shapes)]
+    numeric = [(i, p) for i, p in stated if "height_cm" in p]
+    assert numeric, shapes
+    for i, p in numeric:  # each text states its own body's height (feet/inches: within half an inch)
+        assert abs(p["height_cm"] - float(m["height_cm"][i])) <= 1.3, (shapes[i], float(m["height_cm"][i]))
+    again = synthetic_examples(body, girth_regression(body), ["a person walks."], random.Random(3), 12)
+    assert again[1] == shapes and torch.equal(again[2], betas)  # the run's rng decides: resumable

@@ -196,6 +196,19 @@ class ShapeMoveT5(nn.Module):
                       output_hidden_states=True)
         return out.logits, out.decoder_hidden_states[-1], (out.past_key_values if use_cache else None)
 
+    def beta_state(self, inputs) -> torch.Tensor:
+        """(B, d_model) decoder states whose input is `[BETA]`, for ``inputs_for`` inputs (two decoder
+        positions, no motion tokens; ``constrained_decoding.decode`` reads the same state)."""
+        v = self.vocab
+        enc, mask = self.encode(*inputs)
+        seq = torch.tensor([[v.pad_id, v.beta_id]] * enc.shape[0], device=enc.device)
+        _, hidden, _ = self.step(enc, mask, seq)
+        return hidden[:, 1]
+
+    def predict_betas(self, inputs) -> torch.Tensor:
+        """(B, 10) betas of the `[BETA]` head for ``inputs_for`` inputs."""
+        return self.beta_head(self.beta_state(inputs))
+
     # -- training -----------------------------------------------------------------------------
     def forward(self, inputs_a, inputs_b, labels, betas=None, segments=None):
         """``inputs_a``, ``inputs_b``: input ids + attention mask (T5), or MiniLM states + mask with

@@ -43,7 +43,7 @@ from .t5_dataset import T2MExamples, all_texts, collate, collate_minilm, tokeniz
 from .train_vae import rng_state, set_rng_state
 
 KIND = "shapemove-t5"
-HEAD_KEYS = ("head_steps", "head_batch_size", "head_lr", "head_measure_weight")  # may change on resume
+HEAD_KEYS = ("head_steps", "head_batch_size", "head_lr", "head_measure_weight", "head_synthetic_share")  # may change on resume
 
 
 @dataclass
@@ -70,6 +70,7 @@ class T5TrainConfig:
     head_batch_size: int = 256
     head_lr: float = 3e-4
     head_measure_weight: float = 0.3  # per cm of height + waist error, beside the betas' L1
+    head_synthetic_share: float = 0.0  # share of head-phase examples describing new random bodies
 
     @classmethod
     def tiny(cls) -> "T5TrainConfig":
@@ -92,9 +93,10 @@ class T5TrainConfig:
             raise ShapeMoveError(f"T5 config: action_balance must be in [0, 1], got {self.action_balance}")
         if not 0 <= self.null_share < 1:
             raise ShapeMoveError(f"T5 config: null_share must be in [0, 1), got {self.null_share}")
-        if self.head_steps < 0 or self.head_batch_size < 1 or self.head_lr <= 0 or self.head_measure_weight < 0:
-            raise ShapeMoveError("T5 config: head_steps >= 0, head_batch_size >= 1, head_lr > 0 and "
-                                 "head_measure_weight >= 0 are required")
+        if (self.head_steps < 0 or self.head_batch_size < 1 or self.head_lr <= 0 or self.head_measure_weight < 0
+                or not 0 <= self.head_synthetic_share <= 1):
+            raise ShapeMoveError("T5 config: head_steps >= 0, head_batch_size >= 1, head_lr > 0, "
+                                 "head_measure_weight >= 0 and head_synthetic_share in [0, 1] are required")
 
     @classmethod
     def paper(cls) -> "T5TrainConfig":
@@ -267,26 +269,37 @@ def _train(data, vae_path, out, c, base_model, resume, dist, progress, cancel, v
     if step >= c.steps and step < total:
         from ..body.load import load_body_model
         from ..body.shape_from_measurements import torch_measure
-        from .beta_head_refit import MEASURES, beta_states, head_loss
+        from ..body.shape_from_measurements import girth_regression
+        from .beta_head_refit import MEASURES, FreshShapes, head_loss, synthetic_examples
 
         body = load_body_model(None)  # OpenBody: the body whose betas -> girth regression ships
         if vae.metadata.get("body") not in (None, body.name):
             raise ShapeMoveError(f"head_steps measure bodies of {body.name}; this SA-VAE was trained for "
                                  f"{vae.metadata.get('body')!r} (set head_steps to 0)")
         measure = torch_measure(body, MEASURES)
+        girths, captions = girth_regression(body), sorted({t for c in train_set.captions.values() for t in c})
         raw.eval()
         raw.beta_head.train()
     while c.steps <= step < total:
         if distributed.broadcast_flag(bool(cancel and dist.is_main and cancel()), dist):
             break
-        batch = [train_set.sample(rng) for _ in range(max(1, c.head_batch_size // dist.world_size))]
+        n = max(1, c.head_batch_size // dist.world_size)
+        n_new = int(round(n * c.head_synthetic_share))
+        batch = [e for e in (train_set.sample(rng) for _ in range(n - n_new)) if e.get("motion_text") is not None]
+        motions, shapes = [e.get("motion_text") for e in batch], [e.get("shape_text") for e in batch]
+        betas = torch.stack([torch.as_tensor(e["betas"]) if e["betas"] is not None else torch.zeros(10) for e in batch]
+                            ) if batch else torch.zeros(0, 10)
+        keep = [e["betas"] is not None for e in batch]
+        if n_new:
+            new_m, new_s, new_b = synthetic_examples(body, girths, captions, rng, n_new)
+            motions, shapes, betas, keep = motions + new_m, shapes + new_s, torch.cat([betas, new_b]), keep + [True] * n_new
         if c.encoder == "minilm":
-            inputs, _, betas = collate_minilm(batch, states, raw.vocab)
+            inputs = raw.inputs_for(FreshShapes(states), motions, shapes)
         else:
-            input_ids, attn, _, betas = collate(batch, tok, raw.vocab)
-            inputs = (input_ids, attn)
-        keep = torch.tensor([e["betas"] is not None for e in batch])
-        h = beta_states(raw, tuple(x.to(dist.device) for x in inputs))
+            inputs = raw.inputs_for(tok, motions, shapes)
+        keep = torch.tensor(keep)
+        with torch.no_grad():
+            h = raw.beta_state(tuple(x.to(dist.device) for x in inputs))
         loss, l1, cm = head_loss(raw.beta_head, h[keep.to(h.device)], betas[keep].to(dist.device), measure,
                                  c.head_measure_weight)
         for g in head_opt.param_groups:  # linear decay to 0 over the head phase
