@@ -60,6 +60,7 @@ eval: setup
 	$(PY) -m shapemove eval retarget --data $(BUILT) --checkpoint weights/default/savae.pt --json out/eval_retarget.json
 	$(PY) -m shapemove eval paraphrase --model weights/default --data $(BUILT) --json out/eval_paraphrase.json
 	$(PY) -m shapemove eval paraphrase --model weights/default --data $(BUILT) --prompts configs/heldout_paraphrases_blind.json --json out/eval_paraphrase_blind.json
+	$(PY) -m shapemove eval shape --model weights/default --bodies 200 --json out/eval_shape.json
 	$(PY) tools/eval_report.py
 
 extension: setup
