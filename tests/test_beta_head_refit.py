@@ -88,3 +88,25 @@ def test_synthetic_bodies_are_new_measured_and_described():
         assert abs(p["height_cm"] - float(m["height_cm"][i])) <= 1.3, (shapes[i], float(m["height_cm"][i]))
     again = synthetic_examples(body, girth_regression(body), ["a person walks."], random.Random(3), 12)
     assert again[1] == shapes and torch.equal(again[2], betas)  # the run's rng decides: resumable
+
+
+def test_a_run_saved_before_new_options_resumes_with_their_defaults(tiny_dataset, tmp_path):
+    from tiny_models import build_tiny_bundle
+
+    from shapemove.core.errors import ShapeMoveError
+    from shapemove.core.train.checkpoint import load_checkpoint, save_checkpoint
+    from shapemove.core.train.train_t5 import T5TrainConfig, train_t5
+
+    bundle = build_tiny_bundle(tiny_dataset, tmp_path / "bundle")
+    vae = bundle.parent / "runs" / "vae" / "savae.pt"
+    c = T5TrainConfig.tiny()
+    c.steps, c.ckpt_every = 6, 3
+    run = tmp_path / "run"
+    train_t5(tiny_dataset, vae, run, c, steps=3, device="cpu", verbose=False)
+    ck = load_checkpoint(run / "last.pt", kind="shapemove-t5")
+    del ck["config"]["null_share"]  # as written before that option existed
+    save_checkpoint(run / "last.pt", ck, ck["metadata"])
+    assert train_t5(tiny_dataset, vae, run, c, resume=True, steps=6, device="cpu", verbose=False)["step"] == 6
+    c.null_share = 0.2  # a real change is still refused
+    with pytest.raises(ShapeMoveError, match="null_share"):
+        train_t5(tiny_dataset, vae, run, c, resume=True, steps=8, device="cpu", verbose=False)

@@ -200,7 +200,8 @@ def _train(data, vae_path, out, c, base_model, resume, dist, progress, cancel, v
     last = out / "last.pt"
     if resume and last.is_file():
         ckpt = load_checkpoint(last, map_location=dist.device, kind=KIND)  # weights_only=True: never unpickles code
-        diff = config_differences(ckpt["config"], asdict(c), ignore=("steps",) + HEAD_KEYS)
+        saved = {**asdict(T5TrainConfig()), **ckpt["config"]}  # options added since: the run had their defaults
+        diff = config_differences(saved, asdict(c), ignore=("steps",) + HEAD_KEYS)
         if ckpt.get("kind") != KIND or diff:
             raise ShapeMoveError(f"{last}: cannot resume, the configuration differs ({', '.join(diff) or 'kind'})")
         model.load_state_dict(ckpt["model"])
