@@ -70,15 +70,13 @@ def test_head_phase_trains_only_the_head_and_resumes(tiny_dataset, tmp_path):
 
 
 def test_synthetic_bodies_are_new_measured_and_described():
-    import random
-
     from shapemove.core.body.measure import measure
     from shapemove.core.data.shape_text import parse_shape_text
-    from shapemove.core.train.beta_head_refit import synthetic_examples
+    from shapemove.core.train.beta_head_refit import synthetic_bodies
 
     body = load_body_model(None)
-    motions, shapes, betas = synthetic_examples(body, girth_regression(body), ["a person walks."], random.Random(3), 12)
-    assert motions == ["a person walks."] * 12 and len(shapes) == 12 and betas.shape == (12, 10)
+    shapes, betas = synthetic_bodies(body, girth_regression(body), 3, 12)
+    assert len(shapes) == 12 and betas.shape == (12, 10)
     assert betas.abs().max() <= 2.5 and len({tuple(b.tolist()) for b in betas}) == 12
     m = measure(body, betas.numpy())
     stated = [(i, parse_shape_text(t)) for i, t in enumerate(shapes)]
@@ -86,8 +84,8 @@ def test_synthetic_bodies_are_new_measured_and_described():
     assert numeric, shapes
     for i, p in numeric:  # each text states its own body's height (feet/inches: within half an inch)
         assert abs(p["height_cm"] - float(m["height_cm"][i])) <= 1.3, (shapes[i], float(m["height_cm"][i]))
-    again = synthetic_examples(body, girth_regression(body), ["a person walks."], random.Random(3), 12)
-    assert again[1] == shapes and torch.equal(again[2], betas)  # the run's rng decides: resumable
+    again = synthetic_bodies(body, girth_regression(body), 3, 12)
+    assert again[0] == shapes and torch.equal(again[1], betas)  # the seed decides: a resumed run has the same pool
 
 
 def test_a_run_saved_before_new_options_resumes_with_their_defaults(tiny_dataset, tmp_path):

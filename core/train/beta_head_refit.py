@@ -11,7 +11,7 @@ of the rest mesh, waist from the body's betas -> girth regression), so the loss 
 numbers the evaluation does. The decoder runs in eval mode without gradients (as at generation
 time) and only for the two positions up to `[BETA]`, so a step costs a few milliseconds; examples
 are drawn as in the main phase (captions, shape texts, none for a share of them), and a share
-``head_synthetic_share`` describes NEW random bodies (``synthetic_examples``): the dataset has a
+``head_synthetic_share`` describes NEW random bodies (``synthetic_bodies``, a pool of ``head_synthetic_bodies``): the dataset has a
 few real skeletons and ~1,400 augmented bodies, and a head trained on those alone reads the numbers
 of bodies it has seen far better than of new ones (``eval shape`` measures new ones).
 """
@@ -32,40 +32,27 @@ def head_loss(head, states: torch.Tensor, betas: torch.Tensor, measure, weight: 
     return l1 + weight * cm, l1.detach(), cm.detach()
 
 
-def synthetic_examples(body, girths, captions: list[str], rng, n: int) -> tuple[list[str], list[str], torch.Tensor]:
-    """``n`` examples of NEW bodies (the shape augmentation without a clip): betas ~ N(0,1) clipped
-    to +-2.5, measured (``fast_measure``: exact height and lengths, girths from ``girths``), described
-    by one of the dataset's shape texts (the long sentence, a short numeric text or size words, chosen
-    at random), beside a random training caption. (motion texts, shape texts, (n, 10) betas);
-    ``rng``: a ``random.Random`` (its state is the training run's, so a resumed run draws the same)."""
+def synthetic_bodies(body, girths, seed: int, n: int) -> tuple[list[str], torch.Tensor]:
+    """A pool of ``n`` NEW bodies (the shape augmentation without a clip), the same for a seed:
+    betas ~ N(0,1) clipped to +-2.5, measured (``fast_measure``: exact height and lengths, girths
+    from ``girths``), each described by one of the dataset's shape texts (the long sentence, a
+    short numeric text or size words). (shape texts, (n, 10) betas). The head phase encodes the
+    pool once and draws from it, so each step costs no text encoding."""
+    import random
+
     import numpy as np
 
     from ..body.measure import MEASUREMENTS
     from ..body.shape_from_measurements import fast_measure
     from ..data.shape_text import adjective_shape_text, numeric_shape_text, shape_sentence
 
-    np_rng = np.random.default_rng(rng.getrandbits(63))
-    b = np.clip(np_rng.standard_normal((n, body.num_betas)), -2.5, 2.5)
+    rng = random.Random(seed)
+    b = np.clip(np.random.default_rng(seed).standard_normal((n, body.num_betas)), -2.5, 2.5)
     m = fast_measure(body, b, MEASUREMENTS, girths)
     shapes = []
     for i in range(n):
         mi = {k: float(m[i, j]) for j, k in enumerate(MEASUREMENTS)}
-        key = f"{rng.getrandbits(32)}"
-        kind = rng.randrange(3)
+        key, kind = f"synthetic/{seed}/{i}", rng.randrange(3)
         shapes.append(shape_sentence(mi) if kind == 0 else numeric_shape_text(mi, key) if kind == 1
                       else adjective_shape_text(mi, key))
-    return [rng.choice(captions) for _ in range(n)], shapes, torch.as_tensor(b, dtype=torch.float32)
-
-
-class FreshShapes:
-    """A text reader for the head phase: texts the run's ``StateCache`` holds (training captions and
-    shape texts) come from it; others (the synthetic bodies' shape texts, each seen once) are encoded
-    without being kept, so memory stays flat."""
-
-    def __init__(self, cache):
-        self.cache = cache
-
-    def states(self, texts: list[str]):
-        if all(str(t) in self.cache.states_of for t in texts):
-            return self.cache.states(texts)
-        return self.cache.encoder.states([str(t) for t in texts])
+    return shapes, torch.as_tensor(b, dtype=torch.float32)

@@ -43,7 +43,8 @@ from .t5_dataset import T2MExamples, all_texts, collate, collate_minilm, tokeniz
 from .train_vae import rng_state, set_rng_state
 
 KIND = "shapemove-t5"
-HEAD_KEYS = ("head_steps", "head_batch_size", "head_lr", "head_measure_weight", "head_synthetic_share")  # may change on resume
+HEAD_KEYS = ("head_steps", "head_batch_size", "head_lr", "head_measure_weight", "head_synthetic_share",
+             "head_synthetic_bodies")  # may change on resume
 
 
 @dataclass
@@ -71,6 +72,7 @@ class T5TrainConfig:
     head_lr: float = 3e-4
     head_measure_weight: float = 0.3  # per cm of height + waist error, beside the betas' L1
     head_synthetic_share: float = 0.0  # share of head-phase examples describing new random bodies
+    head_synthetic_bodies: int = 4000  # size of that pool of bodies (their texts encoded once)
 
     @classmethod
     def tiny(cls) -> "T5TrainConfig":
@@ -94,9 +96,9 @@ class T5TrainConfig:
         if not 0 <= self.null_share < 1:
             raise ShapeMoveError(f"T5 config: null_share must be in [0, 1), got {self.null_share}")
         if (self.head_steps < 0 or self.head_batch_size < 1 or self.head_lr <= 0 or self.head_measure_weight < 0
-                or not 0 <= self.head_synthetic_share <= 1):
+                or not 0 <= self.head_synthetic_share <= 1 or self.head_synthetic_bodies < 1):
             raise ShapeMoveError("T5 config: head_steps >= 0, head_batch_size >= 1, head_lr > 0, "
-                                 "head_measure_weight >= 0 and head_synthetic_share in [0, 1] are required")
+                                 "head_measure_weight >= 0, head_synthetic_share in [0, 1] and head_synthetic_bodies >= 1 are required")
 
     @classmethod
     def paper(cls) -> "T5TrainConfig":
@@ -271,14 +273,18 @@ def _train(data, vae_path, out, c, base_model, resume, dist, progress, cancel, v
         from ..body.load import load_body_model
         from ..body.shape_from_measurements import torch_measure
         from ..body.shape_from_measurements import girth_regression
-        from .beta_head_refit import MEASURES, FreshShapes, head_loss, synthetic_examples
+        from .beta_head_refit import MEASURES, head_loss, synthetic_bodies
 
         body = load_body_model(None)  # OpenBody: the body whose betas -> girth regression ships
         if vae.metadata.get("body") not in (None, body.name):
             raise ShapeMoveError(f"head_steps measure bodies of {body.name}; this SA-VAE was trained for "
                                  f"{vae.metadata.get('body')!r} (set head_steps to 0)")
         measure = torch_measure(body, MEASURES)
-        girths, captions = girth_regression(body), sorted({t for c in train_set.captions.values() for t in c})
+        captions = sorted({t for c in train_set.captions.values() for t in c})
+        pool_texts, pool_betas = synthetic_bodies(body, girth_regression(body), c.seed, c.head_synthetic_bodies) \
+            if c.head_synthetic_share > 0 else ([], None)
+        if pool_texts and c.encoder == "minilm":
+            states.add(pool_texts, progress=dist.is_main and verbose)
         raw.eval()
         raw.beta_head.train()
     while c.steps <= step < total:
@@ -292,10 +298,12 @@ def _train(data, vae_path, out, c, base_model, resume, dist, progress, cancel, v
                             ) if batch else torch.zeros(0, 10)
         keep = [e["betas"] is not None for e in batch]
         if n_new:
-            new_m, new_s, new_b = synthetic_examples(body, girths, captions, rng, n_new)
-            motions, shapes, betas, keep = motions + new_m, shapes + new_s, torch.cat([betas, new_b]), keep + [True] * n_new
+            pick = [rng.randrange(len(pool_texts)) for _ in range(n_new)]
+            motions += [rng.choice(captions) for _ in pick]
+            shapes += [pool_texts[i] for i in pick]
+            betas, keep = torch.cat([betas, pool_betas[pick]]), keep + [True] * n_new
         if c.encoder == "minilm":
-            inputs = raw.inputs_for(FreshShapes(states), motions, shapes)
+            inputs = raw.inputs_for(states, motions, shapes)
         else:
             inputs = raw.inputs_for(tok, motions, shapes)
         keep = torch.tensor(keep)
