@@ -115,6 +115,23 @@ def paraphrase_table(held: dict, blind: dict | None = None) -> str:
     return "\n".join(lines)
 
 
+def shape_table(res: dict) -> str:
+    """`eval shape`: the head's height/waist errors per numeric form, and size words inside their ranges."""
+    n = res["numeric"]
+    lines = [f"| numeric shape text ({res['bodies']} new bodies) | texts | height error (cm) | waist error (cm) |",
+             "|---|---|---|---|"]
+    for form, d in n["per_form"].items():
+        if d["texts"]:
+            lines.append(f"| {form} | {d['texts']} | {d['height_err_cm']:.2f} | {d['waist_err_cm']:.2f} |")
+    lines.append(f"| **all numeric** | {n['texts']} | **{n['height_err_cm']:.2f}** | **{n['waist_err_cm']:.2f}** |")
+    words = res["adjectives"]["per_word"]
+    lines += ["", "| size word | bodies in the word's ranges | mean height (cm) | mean waist / height |", "|---|---|---|---|"]
+    for w, d in words.items():
+        lines.append(f"| {w} | {100 * d['in_range']:.0f} % | {d['height_cm']:.1f} | {d['waist_to_height']:.3f} |")
+    lines.append(f"| **all words** | **{100 * res['adjectives']['in_range']:.1f} %** | | |")
+    return "\n".join(lines)
+
+
 def replace_block(text: str, name: str, body: str) -> str:
     pattern = re.compile(rf"(<!-- eval:{name} -->\n).*?(\n<!-- /eval:{name} -->)", re.S)
     if not pattern.search(text):
@@ -129,6 +146,7 @@ def main(argv=None) -> int:
     ap.add_argument("--generate", type=Path, default=ROOT / "out" / "eval_generate.json")
     ap.add_argument("--paraphrase", type=Path, default=ROOT / "out" / "eval_paraphrase.json")
     ap.add_argument("--paraphrase-blind", type=Path, default=ROOT / "out" / "eval_paraphrase_blind.json")
+    ap.add_argument("--shape", type=Path, default=ROOT / "out" / "eval_shape.json")
     ap.add_argument("--readme", type=Path, default=ROOT / "README.md")
     args = ap.parse_args(argv)
     text = args.readme.read_text(encoding="utf-8")
@@ -137,6 +155,8 @@ def main(argv=None) -> int:
         text = replace_block(text, "recon", recon_table(json.loads(args.recon.read_text()), untrained))
     if args.generate.is_file():
         text = replace_block(text, "generate", generate_table(json.loads(args.generate.read_text())))
+    if args.shape.is_file() and "<!-- eval:shape -->" in text:
+        text = replace_block(text, "shape", shape_table(json.loads(args.shape.read_text())))
     if args.paraphrase.is_file():
         if "<!-- eval:paraphrase -->" in text:
             blind = json.loads(args.paraphrase_blind.read_text()) if args.paraphrase_blind.is_file() else None
