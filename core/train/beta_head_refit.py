@@ -56,3 +56,36 @@ def synthetic_bodies(body, girths, seed: int, n: int) -> tuple[list[str], torch.
         shapes.append(shape_sentence(mi) if kind == 0 else numeric_shape_text(mi, key) if kind == 1
                       else adjective_shape_text(mi, key))
     return shapes, torch.as_tensor(b, dtype=torch.float32)
+
+
+class HeadExamples:
+    """What the head phase reads: the main phase's examples (``T2MExamples``: captions, the clips'
+    shape texts or none, their betas) and, for a share of each batch, a body of the new-body pool
+    (``synthetic_bodies``) described beside a random training caption. ``measure``: the
+    differentiable height/waist of OpenBody, whose betas -> girth regression ships."""
+
+    def __init__(self, examples, vae_body: str | None, seed: int, pool_size: int):
+        from ..body.load import load_body_model
+        from ..body.shape_from_measurements import girth_regression, torch_measure
+        from ..errors import ShapeMoveError
+
+        body = load_body_model(None)
+        if vae_body not in (None, body.name):
+            raise ShapeMoveError(f"head_steps measure bodies of {body.name}; this SA-VAE was trained for "
+                                 f"{vae_body!r} (set head_steps to 0)")
+        self.examples, self.measure = examples, torch_measure(body, MEASURES)
+        self.captions = sorted({t for caps in examples.captions.values() for t in caps})
+        self.pool_texts, self.pool_betas = (synthetic_bodies(body, girth_regression(body), seed, pool_size)
+                                            if pool_size else ([], torch.zeros(0, body.num_betas)))
+
+    def batch(self, rng, n: int, share: float) -> tuple[list[str], list, torch.Tensor]:
+        """(motion texts, shape texts (None: no shape text), (B, 10) betas) of about ``n`` examples."""
+        n_new = int(round(n * share)) if self.pool_texts else 0
+        drawn = (self.examples.sample(rng) for _ in range(n - n_new))
+        batch = [e for e in drawn if e.get("motion_text") is not None]  # no motion-to-text examples
+        pick = [rng.randrange(len(self.pool_texts)) for _ in range(n_new)]
+        motions = [e["motion_text"] for e in batch] + [rng.choice(self.captions) for _ in pick]
+        shapes = [e["shape_text"] for e in batch] + [self.pool_texts[i] for i in pick]
+        betas = torch.cat([torch.stack([torch.as_tensor(e["betas"]) for e in batch]) if batch else
+                           torch.zeros(0, self.pool_betas.shape[1]), self.pool_betas[pick]])
+        return motions, shapes, betas

@@ -269,48 +269,24 @@ def _train(data, vae_path, out, c, base_model, resume, dist, progress, cancel, v
                     {"ce": ("train", "ce"), "l1": ("train", "l1")})
         save_if_due(save, step, c.ckpt_every, total, dist)
     # -- 4. the [BETA] head alone on heights and waists (beta_head_refit.py) -------------------
-    if step >= c.steps and step < total:
-        from ..body.load import load_body_model
-        from ..body.shape_from_measurements import torch_measure
-        from ..body.shape_from_measurements import girth_regression
-        from .beta_head_refit import MEASURES, head_loss, synthetic_bodies
+    if c.steps <= step < total:
+        from .beta_head_refit import HeadExamples, head_loss
 
-        body = load_body_model(None)  # OpenBody: the body whose betas -> girth regression ships
-        if vae.metadata.get("body") not in (None, body.name):
-            raise ShapeMoveError(f"head_steps measure bodies of {body.name}; this SA-VAE was trained for "
-                                 f"{vae.metadata.get('body')!r} (set head_steps to 0)")
-        measure = torch_measure(body, MEASURES)
-        captions = sorted({t for c in train_set.captions.values() for t in c})
-        pool_texts, pool_betas = synthetic_bodies(body, girth_regression(body), c.seed, c.head_synthetic_bodies) \
-            if c.head_synthetic_share > 0 else ([], None)
-        if pool_texts and c.encoder == "minilm":
-            states.add(pool_texts, progress=dist.is_main and verbose)
-        raw.eval()
+        head_set = HeadExamples(train_set, vae.metadata.get("body"), c.seed, c.head_synthetic_bodies
+                                if c.head_synthetic_share > 0 else 0)
+        if head_set.pool_texts and c.encoder == "minilm":
+            states.add(head_set.pool_texts, progress=dist.is_main and verbose)  # encoded once
+        raw.eval()  # the T5 as at generation time (no dropout); only the head learns
         raw.beta_head.train()
     while c.steps <= step < total:
         if distributed.broadcast_flag(bool(cancel and dist.is_main and cancel()), dist):
             break
-        n = max(1, c.head_batch_size // dist.world_size)
-        n_new = int(round(n * c.head_synthetic_share))
-        batch = [e for e in (train_set.sample(rng) for _ in range(n - n_new)) if e.get("motion_text") is not None]
-        motions, shapes = [e.get("motion_text") for e in batch], [e.get("shape_text") for e in batch]
-        betas = torch.stack([torch.as_tensor(e["betas"]) if e["betas"] is not None else torch.zeros(10) for e in batch]
-                            ) if batch else torch.zeros(0, 10)
-        keep = [e["betas"] is not None for e in batch]
-        if n_new:
-            pick = [rng.randrange(len(pool_texts)) for _ in range(n_new)]
-            motions += [rng.choice(captions) for _ in pick]
-            shapes += [pool_texts[i] for i in pick]
-            betas, keep = torch.cat([betas, pool_betas[pick]]), keep + [True] * n_new
-        if c.encoder == "minilm":
-            inputs = raw.inputs_for(states, motions, shapes)
-        else:
-            inputs = raw.inputs_for(tok, motions, shapes)
-        keep = torch.tensor(keep)
+        motions, shapes, betas = head_set.batch(rng, max(1, c.head_batch_size // dist.world_size),
+                                                c.head_synthetic_share)
         with torch.no_grad():
-            h = raw.beta_state(tuple(x.to(dist.device) for x in inputs))
-        loss, l1, cm = head_loss(raw.beta_head, h[keep.to(h.device)], betas[keep].to(dist.device), measure,
-                                 c.head_measure_weight)
+            h = raw.beta_state(tuple(x.to(dist.device) for x in raw.inputs_for(states if c.encoder == "minilm" else tok,
+                                                                               motions, shapes)))
+        loss, l1, cm = head_loss(raw.beta_head, h, betas.to(dist.device), head_set.measure, c.head_measure_weight)
         for g in head_opt.param_groups:  # linear decay to 0 over the head phase
             g["lr"] = c.head_lr * (total - step) / c.head_steps
         head_opt.zero_grad(set_to_none=True)
