@@ -21,6 +21,16 @@ def check_betas(betas) -> np.ndarray:
     return b
 
 
+@torch.no_grad()
+def decode_features(codes: list[int], vae, betas) -> torch.Tensor:
+    """Motion tokens + betas (10,) -> the SA-VAE's (T, 263) shape-aware features (denormalized)."""
+    if not codes:
+        raise ShapeMoveError("no motion tokens to decode")
+    b = torch.as_tensor(check_betas(betas))[None]
+    idx = torch.as_tensor(codes, dtype=torch.long)[None]
+    return vae.denormalize(vae.decode_long(vae.quantizer.indices_to_codes(idx), b))[0]
+
+
 def decode_tokens(codes: list[int], vae, body, betas, ik_refine_iters: int = 10, prompt: str | None = None,
                   contacts=None) -> Motion:
     """Motion tokens + betas (10,) -> Motion on ``body``: SA-VAE ``decode_long`` with the body's
@@ -30,12 +40,8 @@ def decode_tokens(codes: list[int], vae, body, betas, ik_refine_iters: int = 10,
     pose (what the rig plays); the decoder's own joints are kept as ``network_joints``.
     ``contacts`` (>= T,4) known foot contacts (retargeting: the source motion's) are planted
     instead of the decoder's channels, as measured contacts (no gating, flights kept)."""
-    if not codes:
-        raise ShapeMoveError("no motion tokens to decode")
-    b = torch.as_tensor(check_betas(betas))[None]
+    feats = decode_features(codes, vae, betas)
     with torch.no_grad():
-        idx = torch.as_tensor(codes, dtype=torch.long)[None]
-        feats = vae.denormalize(vae.decode_long(vae.quantizer.indices_to_codes(idx), b))[0]
         joints = joints_from_features(feats.double()).float().numpy()
     known = contacts is not None
     if known:
@@ -45,7 +51,7 @@ def decode_tokens(codes: list[int], vae, body, betas, ik_refine_iters: int = 10,
         contacts = contacts[:len(joints)]
     else:
         contacts = contacts_from_features(feats.numpy())
-    return motion_from_joints(body, b[0].numpy(), joints, contacts, ik_refine_iters, prompt=prompt, known_contacts=known,
+    return motion_from_joints(body, check_betas(betas), joints, contacts, ik_refine_iters, prompt=prompt, known_contacts=known,
                               tokens=np.asarray(codes, np.int16), features=feats.numpy().astype(np.float32))
 
 

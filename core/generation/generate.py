@@ -26,10 +26,10 @@ from ..models.shapemove_t5 import NULL_PROMPT, ShapeMoveT5
 from ..models.text_encoder import load_text_encoder
 from ..scene.motion_file import Motion
 from ..torch_threads import one_torch_thread
-from .decode import decode_tokens
+from .decode import decode_features, decode_tokens
 from .model_bundle import model_files, resolve_model_dir
 from .prompts import check_prompt
-from .rerank import CandidatePicker, candidate_features
+from .rerank import CandidatePicker
 from .sampling_params import DEFAULT_CANDIDATES, DEFAULT_GUIDANCE, check_candidates, check_guidance, check_sampling
 
 
@@ -114,7 +114,8 @@ class Generator:
                              guidance=s, null_inputs=null)
                 best = 0
                 if n > 1:  # the [BETA] state does not depend on the sampled tokens: one body for all
-                    best = self.picker.pick(r.prompt, candidate_features(self.vae, out.codes, out.betas[0].numpy()))
+                    feats = [decode_features(c, self.vae, out.betas[0].numpy()).numpy() for c in out.codes]
+                    best = self.picker.pick(r.prompt, feats)
                 codes.append(out.codes[best])
                 betas.append(out.betas[best])
         return codes, torch.stack(betas)

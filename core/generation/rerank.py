@@ -14,7 +14,6 @@ classifier that does not use the TMA (``action_classifier.FeatureEmbedder``).
 from __future__ import annotations
 
 import numpy as np
-import torch
 
 
 
@@ -33,14 +32,3 @@ class CandidatePicker:
     def pick(self, prompt: str, feats: list) -> int:
         """Index of the candidate closest to ``prompt`` (the first on a tie)."""
         return int(np.argmax(self.scores(prompt, feats)))
-
-
-@torch.no_grad()
-def candidate_features(vae, codes: list[list[int]], betas) -> list[np.ndarray]:
-    """Raw (T, 263) SA-VAE features of each candidate's codes for the body ``betas`` (10,)."""
-    b = torch.as_tensor(np.asarray(betas, np.float32))[None]
-    out = []
-    for c in codes:
-        idx = torch.as_tensor(c, dtype=torch.long)[None]
-        out.append(vae.denormalize(vae.decode_long(vae.quantizer.indices_to_codes(idx), b))[0].numpy())
-    return out
