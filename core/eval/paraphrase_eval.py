@@ -102,8 +102,9 @@ def eval_paraphrase(model_dir=None, prompts=None, tma=None, seed: int = 0, secon
     """Generate a motion per held-out prompt and classify it (module docstring). ``data``: the built
     dataset whose training clips the kNN classifier reads (default ``default_built_dir()``);
     ``classifier``: an ``ActionClassifier`` to use instead (``feature_classifier`` likewise for the
-    TMA-free one); ``candidates``: best-of-N samples per prompt (default: the product's). Returns {"motion", "text",
-    "motion_vs_text_prototypes", "classifier", "unknown_action", "actions", "rows", ...}."""
+    TMA-free one); ``candidates``: best-of-N samples per prompt (default: the product's). Returns
+    {"motion", "text", "motion_vs_text_prototypes", "motion_features", "reachable", "classifier",
+    "unknown_action", "actions", "rows", ...}."""
     from ..generation.generate import Generator, Request
     from ..generation.model_bundle import model_files
     from ..generation.sampling_params import DEFAULT_CANDIDATES
@@ -111,6 +112,7 @@ def eval_paraphrase(model_dir=None, prompts=None, tma=None, seed: int = 0, secon
     from .tma_embed import embed_motions, embed_texts, load_tma
 
     items = load_prompts(prompts)
+    candidates = DEFAULT_CANDIDATES if candidates is None else candidates
     if classifier is None:
         data = data if data is not None else default_built_dir()
         if data is None:
@@ -141,8 +143,7 @@ def eval_paraphrase(model_dir=None, prompts=None, tma=None, seed: int = 0, secon
     known = [it for it in items if it["action"] in actions]
     rows, embs, feats = [], [], []
     for i, it in enumerate(known):
-        m = gen.generate_batch([Request(it["text"], seconds=seconds, seed=seed + i,
-                                        candidates=DEFAULT_CANDIDATES if candidates is None else candidates)])[0]
+        m = gen.generate_batch([Request(it["text"], seconds=seconds, seed=seed + i, candidates=candidates)])[0]
         motion_emb = embed_motions(model, [m.features], mean, std)[0]
         embs.append(motion_emb)
         feats.append(m.features)
@@ -164,7 +165,7 @@ def eval_paraphrase(model_dir=None, prompts=None, tma=None, seed: int = 0, secon
             "motion_vs_text_prototypes": _tally(rows, "motion_proto_pred"),
             **({"motion_features": _tally(rows, "motion_features_pred")} if feature_classifier is not None else {}),
             "reachable": reach,
-            "candidates": DEFAULT_CANDIDATES if candidates is None else candidates,
+            "candidates": candidates,
             "classifier": {**classifier.info, "ceiling": ceiling},
             "feature_classifier": dict(feature_classifier.info) if feature_classifier is not None else None,
             "unknown_action": sorted({it["action"] for it in items if it["action"] not in actions}),
