@@ -146,13 +146,20 @@ def _archive_table(body, quick: bool) -> dict:
     return out
 
 
-def _synthetic_clip(rest, frames: int, seed: int = 0):
+def smooth_rotations(frames: int, seed: int = 0, amplitude: float = 0.6) -> torch.Tensor:
+    """(frames, 24, 3) float64 axis-angles: every joint swings sinusoidally (random amplitude up to
+    ``amplitude`` rad and phase, seeded) while the root turns once on the spot; a synthetic clip."""
     g = torch.Generator().manual_seed(seed)
     t = torch.linspace(0, 2 * np.pi, frames, dtype=torch.float64)[:, None, None]
-    amp = torch.rand(1, 24, 3, generator=g, dtype=torch.float64) * 0.6
+    amp = torch.rand(1, 24, 3, generator=g, dtype=torch.float64) * amplitude
     phase = torch.rand(1, 24, 3, generator=g, dtype=torch.float64) * 6.3
     aa = amp * torch.sin(t + phase)
     aa[:, 0, 1] += t[:, 0, 0]  # turning on the spot
+    return aa
+
+
+def _synthetic_clip(rest, frames: int, seed: int = 0):
+    aa = smooth_rotations(frames, seed)
     pos, _ = forward_kinematics(axis_angle_to_matrix(aa), torch.tensor(rest).expand(frames, -1, -1), PARENTS)
     return [("synthetic", pos[:, :22].numpy())]
 

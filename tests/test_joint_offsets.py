@@ -24,12 +24,9 @@ def rest(openbody):
 
 def motion(frames=60, seed=0):
     """Smooth random local rotations (frames,24,3,3) and translations (frames,3)."""
-    g = torch.Generator().manual_seed(seed)
-    t = torch.linspace(0, 2 * np.pi, frames, dtype=torch.float64)[:, None, None]
-    amp = torch.rand(1, 24, 3, generator=g, dtype=torch.float64) * 0.5
-    phase = torch.rand(1, 24, 3, generator=g, dtype=torch.float64) * 6.3
-    aa = amp * torch.sin(t + phase)
-    aa[:, 0, 1] += t[:, 0, 0]  # turning on the spot
+    from shapemove.bench.ik import smooth_rotations
+
+    aa = smooth_rotations(frames, seed, amplitude=0.5)
     transl = np.stack([np.linspace(0, 1, frames), np.zeros(frames), np.linspace(0, 0.5, frames)], -1)
     return axis_angle_to_matrix(aa).numpy(), transl
 
