@@ -189,6 +189,31 @@ def test_retarget_plants_the_source_contacts(run_bvh, vae, body):
     assert np.median(steps(fk)) < 1e-3 < 5e-3 < np.median(steps(m.network_joints.astype(np.float64)))
     free = retarget(run_bvh, vae, body, b, plant_source_contacts=False)    # the decoder's own contacts
     assert not np.array_equal(free.contacts, m.contacts)
+    assert m.contacts_measured and not free.contacts_measured
+
+
+def test_redecoding_a_retargeted_motion_plants_the_source_contacts(run_bvh, vae, body, tmp_path):
+    """A slider change re-decodes a retargeted motion: the source's contacts survive the motion file
+    and are planted on the new body, not the decoder's guesses; a generated motion (decoder
+    contacts) re-decodes with the decoder's contacts for the new body."""
+    from shapemove.core.generation.decode import redecode
+    from shapemove.core.generation.retarget import retarget
+    from shapemove.core.scene.motion_file import load_motion, save_motion
+
+    m = retarget(run_bvh, vae, body, np.zeros(10, np.float32))
+    back = load_motion(save_motion(tmp_path / "r.npz", m))
+    assert back.contacts_measured
+    tall = np.zeros(10, np.float32)
+    tall[0] = 2.0
+    r = redecode(back, vae, body, tall)
+    assert r.contacts_measured
+    np.testing.assert_array_equal(r.contacts, m.contacts)
+    np.testing.assert_array_equal(r.tokens, m.tokens)
+    free = retarget(run_bvh, vae, body, np.zeros(10, np.float32), plant_source_contacts=False)
+    back = load_motion(save_motion(tmp_path / "f.npz", free))
+    assert not back.contacts_measured
+    r = redecode(back, vae, body, tall)
+    assert not r.contacts_measured and not np.array_equal(r.contacts, m.contacts)
 
 
 def test_naive_retarget_keeps_the_rotations_on_the_new_bones(run_bvh, tiny_dataset, body):

@@ -55,6 +55,17 @@ def decode_tokens(codes: list[int], vae, body, betas, ik_refine_iters: int = 10,
                               tokens=np.asarray(codes, np.int16), features=feats.numpy().astype(np.float32))
 
 
+def redecode(motion: Motion, vae, body, betas, ik_refine_iters: int = 10) -> Motion:
+    """A motion's tokens decoded for another body (``betas``): feet stay planted and bones take the
+    new lengths. A retargeted motion plants its source's measured contacts again
+    (``contacts_measured``); a generated one plants what the decoder predicts for the new body."""
+    if motion.tokens is None or len(motion.tokens) == 0:
+        raise ShapeMoveError("this motion has no tokens to re-decode (it was not generated or retargeted)")
+    known = motion.contacts if motion.contacts_measured else None
+    return decode_tokens([int(t) for t in motion.tokens], vae, body, betas, ik_refine_iters, prompt=motion.prompt,
+                         contacts=known)
+
+
 def motion_from_joints(body, betas, joints, contacts, ik_refine_iters: int = 10, prompt: str | None = None,
                        known_contacts: bool = False, **extra) -> Motion:
     """(T,22,3) joint positions + (T,4) foot contacts of joints 7, 8, 10, 11 -> self-consistent
@@ -65,6 +76,7 @@ def motion_from_joints(body, betas, joints, contacts, ik_refine_iters: int = 10,
         {"gate": False, "max_flight": None, "smooth": BODY_SMOOTH} if known_contacts else {}))
     poses = matrix_to_axis_angle(planted.rotations).astype(np.float32)
     m = make_motion(body, poses, planted.transl, betas, fps=float(FPS), prompt=prompt,
-                    network_joints=np.asarray(joints, np.float32), contacts=planted.contacts, **extra)
+                    network_joints=np.asarray(joints, np.float32), contacts=planted.contacts,
+                    contacts_measured=bool(known_contacts), **extra)
     m.ik_error_cm = planted.ik_error_cm
     return m

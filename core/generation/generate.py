@@ -26,7 +26,7 @@ from ..models.shapemove_t5 import NULL_PROMPT, ShapeMoveT5
 from ..models.text_encoder import load_text_encoder
 from ..scene.motion_file import Motion
 from ..torch_threads import one_torch_thread
-from .decode import decode_features, decode_tokens
+from .decode import decode_features, decode_tokens, redecode
 from .model_bundle import model_files, resolve_model_dir
 from .prompts import check_prompt
 from .rerank import CandidatePicker
@@ -208,7 +208,5 @@ class Generator:
         return np.asarray(predicted, np.float32), "[BETA] head"
 
     def redecode(self, motion: Motion, betas) -> Motion:
-        """The same tokens on another body: feet stay planted and bones keep the new lengths."""
-        if motion.tokens is None or len(motion.tokens) == 0:
-            raise ShapeMoveError("this motion has no tokens to re-decode (it was not generated or retargeted)")
-        return self.decode_motion([int(t) for t in motion.tokens], betas, motion.prompt)
+        """The same tokens on another body (``decode.redecode``)."""
+        return redecode(motion, self.vae, self.body, betas, self.ik_refine_iters)

@@ -5,7 +5,8 @@ rotations (SMPL convention, relative to the body's rest pose), ``transl`` (T,3) 
 ``BodyModel.forward`` (posed joints = FK(rest joints) + transl), ``fps``, ``body_model`` (id such as
 "openbody-v1"); optional ``prompt`` (str), ``tokens`` and ``features`` (arrays), ``network_joints``
 (T,22,3: the joints the SA-VAE decoded, before IK and grounding) and ``contacts`` (T,4 uint8: foot
-contacts of joints 7, 8, 10, 11 that were planted).
+contacts of joints 7, 8, 10, 11 that were planted), with ``contacts_measured`` (uint8 1) when those
+came from the source mocap (retargeting) rather than the decoder: re-decoding plants them again.
 
 A motion file is self-consistent: ``joints`` are the body's joints posed by (betas, poses, transl)
 (``make_motion`` computes them; ``check_consistent`` verifies it), which is what the rig plays.
@@ -36,6 +37,7 @@ class Motion:
     features: np.ndarray | None = None
     network_joints: np.ndarray | None = None
     contacts: np.ndarray | None = None
+    contacts_measured: bool = False         # contacts came from the source mocap (retargeting), not the decoder
     # run-time facts of a generated motion, not stored in the file
     ik_error_cm: float | None = None        # decode: mean IK error of the planted joints
     shape_source: str | None = None         # generate: "[BETA] head", "measurements" or "given"
@@ -118,6 +120,8 @@ def save_motion(path, m: Motion) -> Path:
     for name in ("tokens", "features", "network_joints", "contacts"):
         if getattr(m, name) is not None:
             arrays[name] = np.asarray(getattr(m, name))
+    if m.contacts is not None and m.contacts_measured:
+        arrays["contacts_measured"] = np.uint8(1)
 
     with atomic_path(path) as tmp:  # read-only folder, a parent that is a file, disk full: a sentence, no *.tmp
         with open(tmp, "wb") as f:
@@ -144,6 +148,8 @@ def load_motion(path) -> Motion:
                prompt=str(data["prompt"]) if "prompt" in data else None,
                tokens=data.get("tokens"), features=data.get("features"),
                network_joints=data["network_joints"].astype(np.float32) if "network_joints" in data else None,
-               contacts=data["contacts"].astype(np.uint8) if "contacts" in data else None)
+               contacts=data["contacts"].astype(np.uint8) if "contacts" in data else None,
+               contacts_measured="contacts" in data and "contacts_measured" in data
+               and data["contacts_measured"].shape == () and bool(data["contacts_measured"]))
     validate(m)
     return m
