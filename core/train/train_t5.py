@@ -40,7 +40,8 @@ from .checkpoint_cadence import finish, save_if_due
 from .run_log import StepLog
 from .checkpoint import config_differences, load_checkpoint, save_checkpoint
 from .t5_dataset import T2MExamples, all_texts, collate, collate_minilm, tokenize_clips
-from .train_vae import rng_state, set_rng_state
+from .optimizer_step import optimizer_step
+from .resume import restore, rng_state
 
 KIND = "shapemove-t5"
 HEAD_KEYS = ("head_steps", "head_batch_size", "head_lr", "head_measure_weight", "head_synthetic_share",
@@ -206,14 +207,10 @@ def _train(data, vae_path, out, c, base_model, resume, dist, progress, cancel, v
         diff = config_differences(saved, asdict(c), ignore=("steps",) + HEAD_KEYS)
         if ckpt.get("kind") != KIND or diff:
             raise ShapeMoveError(f"{last}: cannot resume, the configuration differs ({', '.join(diff) or 'kind'})")
-        model.load_state_dict(ckpt["model"])
-        optimizer.load_state_dict(ckpt["optimizer"])
-        scheduler.load_state_dict(ckpt["scheduler"])
-        step = int(ckpt["step"])
+        step = restore(ckpt, model, optimizer, scheduler)
         if step > c.steps and ckpt.get("head_optimizer") is None:
             raise ShapeMoveError(f"{last}: saved at step {step}, beyond the {c.steps} main steps, without a head phase")
         head_state = ckpt.get("head_optimizer")
-        set_rng_state(ckpt["rng"])
         rng.setstate(ckpt["py_rng_examples"])
     raw = model
     if dist.enabled:
@@ -256,11 +253,7 @@ def _train(data, vae_path, out, c, base_model, resume, dist, progress, cancel, v
         else:
             input_ids, attn, labels, betas = (t.to(dist.device) for t in collate(batch, tok, raw.vocab))
             res = model(input_ids, attn, labels, betas)
-        optimizer.zero_grad(set_to_none=True)
-        res["loss"].backward()
-        torch.nn.utils.clip_grad_norm_(raw.parameters(), c.grad_clip)
-        optimizer.step()
-        scheduler.step()
+        optimizer_step(res["loss"], optimizer, scheduler, raw.parameters(), c.grad_clip)
         step += 1
         log.bar.update(1)
         if step % c.log_every == 0 or step == c.steps:

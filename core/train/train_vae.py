@@ -32,7 +32,7 @@ from .run_log import StepLog
 from .checkpoint import load_checkpoint, make_metadata, save_checkpoint, stats_hash
 from .motion_dataset import BatchStream, MotionClips
 from .optimizer_step import optimizer_step
-from .resume import restore, rng_state, set_rng_state  # noqa: F401  (set_rng_state: used by train_t5)
+from .resume import restore, rng_state
 
 KIND = "savae"
 RESUME_IGNORES = ("train.steps",)  # a resumed run may be extended; anything else must match
