@@ -34,6 +34,16 @@ def need_module(name: str, reason: str | None = None):
         need_data(reason or f"needs the Python module {name!r} ({exc})")
 
 
+@pytest.fixture(scope="module")
+def one_thread():
+    """Tiny models on a shared 2-core machine: intra-op threads only add contention (up to 10x slower).
+    A module opts in with ``pytestmark = pytest.mark.usefixtures("one_thread")``."""
+    from shapemove.core.torch_threads import one_torch_thread
+
+    with one_torch_thread():
+        yield
+
+
 @pytest.fixture(scope="session")
 def mocap_root():
     """Path with bandai/, hdm05/, cmu/ unpacked from ../shared/data (once, into .cache/mocap)."""

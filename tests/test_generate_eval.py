@@ -17,12 +17,8 @@ from tiny_models import tiny_bundle  # noqa: F401  (session fixture)
 PROMPT = "a person walks forward"
 
 
-@pytest.fixture(scope="module", autouse=True)
-def one_thread():
-    n = torch.get_num_threads()
-    torch.set_num_threads(1)
-    yield
-    torch.set_num_threads(n)
+
+pytestmark = pytest.mark.usefixtures("one_thread")
 
 
 @pytest.fixture(scope="module")

@@ -21,13 +21,8 @@ LIBRARY = ["HDM_bd_kickLFront1Reps_001_120", "HDM_bk_jogLeftCircle4StepsRstart_0
            "dataset-2_wave-left-hand_elderly_001", "dataset-1_run_happy_001", "cmu_02_01"]
 
 
-@pytest.fixture(scope="module", autouse=True)
-def one_thread():
-    """Tiny models on a shared 2-core machine: intra-op threads only add contention (10x slower)."""
-    n = torch.get_num_threads()
-    torch.set_num_threads(1)
-    yield
-    torch.set_num_threads(n)
+
+pytestmark = pytest.mark.usefixtures("one_thread")
 
 
 @pytest.fixture(scope="module")
