@@ -69,6 +69,7 @@ def _real_clips(n: int, max_frames: int):
     return out
 
 
+SHOULDERS = [JOINT_NAMES.index("left_shoulder"), JOINT_NAMES.index("right_shoulder")]
 ARCHIVE_CLIPS = {  # archive -> globs (the first match of each), 5 clips per archive
     "bandai": ["dataset-1/data/dataset-1_walk-back_active_001.bvh", "dataset-1/data/dataset-1_dash_active_001.bvh",
                "dataset-1/data/dataset-1_bow_active_001.bvh", "dataset-2/data/*_raise-up-both-hands_*.bvh",
@@ -109,6 +110,7 @@ def _archive_table(body, quick: bool) -> dict:
                         err.setdefault(("openbody", "clip+10+cal"), []).append(cal.marker_error_cm)
                         calib.setdefault("raw", []).append(cal.raw_error_cm)
                         calib.setdefault("offsets", []).append(cal.offset_cm[list(CALIBRATED_JOINTS)])
+                        calib.setdefault("shoulder_x", []).append(cal.offsets[SHOULDERS, 0] * 100.0)
                     per.setdefault((lname, fname), []).append(res.per_joint_error_cm())
                     beta[(lname, fname)] = max(beta.get((lname, fname), 0.0), float(np.abs(fit.betas).max()))
         if not err:
@@ -139,6 +141,12 @@ def _archive_table(body, quick: bool) -> dict:
               f"{out[f'ik_{archive}_builder_raw_err_cm']:.2f} cm (uncalibrated "
               f"{out[f'ik_{archive}_builder_uncalibrated_err_cm']:.2f}); offsets of the {len(CALIBRATED_JOINTS)} "
               f"calibrated joints mean {offs.mean():.1f} cm, max {offs.max():.1f} cm")
+        # where the rig puts a shoulder, sideways along the collar bone from OpenBody's (+: further out on
+        # the left, in on the right): archives that disagree in sign cannot share one body placement
+        sx = np.mean(calib["shoulder_x"], 0)
+        out[f"ik_{archive}_left_shoulder_offset_x_cm"] = float(sx[0])
+        out[f"ik_{archive}_right_shoulder_offset_x_cm"] = float(sx[1])
+        print(f"    mean shoulder offset along the collar (x, left/right): {sx[0]:+.1f} / {sx[1]:+.1f} cm")
         out[f"ik_{archive}_default_layout_err_cm"] = float(np.mean(err[("default", "motion")]))
         out[f"ik_{archive}_openbody_lengths_fit_err_cm"] = float(np.mean(err[("openbody", "lengths")]))
         out[f"ik_{archive}_max_abs_beta"] = beta[("openbody", "clip")]
