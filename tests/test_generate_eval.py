@@ -17,7 +17,6 @@ from tiny_models import tiny_bundle  # noqa: F401  (session fixture)
 PROMPT = "a person walks forward"
 
 
-
 pytestmark = pytest.mark.usefixtures("one_thread")
 
 

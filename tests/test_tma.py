@@ -21,7 +21,6 @@ LIBRARY = ["HDM_bd_kickLFront1Reps_001_120", "HDM_bk_jogLeftCircle4StepsRstart_0
            "dataset-2_wave-left-hand_elderly_001", "dataset-1_run_happy_001", "cmu_02_01"]
 
 
-
 pytestmark = pytest.mark.usefixtures("one_thread")
 
 

@@ -56,7 +56,6 @@ def build_tiny_dataset(mocap_root: Path, out: Path) -> Path:
     return out
 
 
-
 pytestmark = pytest.mark.usefixtures("one_thread")
 
 
