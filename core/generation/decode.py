@@ -40,6 +40,7 @@ def decode_tokens(codes: list[int], vae, body, betas, ik_refine_iters: int = 10,
     pose (what the rig plays); the decoder's own joints are kept as ``network_joints``.
     ``contacts`` (>= T,4) known foot contacts (retargeting: the source motion's) are planted
     instead of the decoder's channels, as measured contacts (no gating, flights kept)."""
+    betas = check_betas(betas)
     feats = decode_features(codes, vae, betas)
     with torch.no_grad():
         joints = joints_from_features(feats.double()).float().numpy()
@@ -51,7 +52,7 @@ def decode_tokens(codes: list[int], vae, body, betas, ik_refine_iters: int = 10,
         contacts = contacts[:len(joints)]
     else:
         contacts = contacts_from_features(feats.numpy())
-    return motion_from_joints(body, check_betas(betas), joints, contacts, ik_refine_iters, prompt=prompt, known_contacts=known,
+    return motion_from_joints(body, betas, joints, contacts, ik_refine_iters, prompt=prompt, known_contacts=known,
                               tokens=np.asarray(codes, np.int16), features=feats.numpy().astype(np.float32))
 
 
