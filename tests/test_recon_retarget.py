@@ -249,13 +249,34 @@ def test_naive_retarget_keeps_the_rotations_on_the_new_bones(run_bvh, tiny_datas
     assert np.allclose(step(m.joints), s * step(sub), atol=1e-4) and abs(s - 1) > 0.01
 
 
+def test_naive_retarget_grounded_per_frame_stands_on_the_floor_in_every_frame(run_bvh, tiny_dataset, body):
+    from shapemove.core.generation.retarget import naive_retarget
+
+    betas = np.load(tiny_dataset / "betas" / f"{RUN_CLIP}_aug.npy")
+    clip, frame = naive_retarget(run_bvh, body, betas), naive_retarget(run_bvh, body, betas, ground="frame")
+
+    def lowest(m):  # the full mesh (not the ground probe the grounding uses), per frame
+        with torch.no_grad():
+            v = body(torch.as_tensor(betas)[None].expand(m.num_frames, -1), torch.as_tensor(m.poses),
+                     torch.as_tensor(m.transl)).vertices
+        return v[..., 1].min(1).values.numpy()
+
+    low_clip, low_frame = lowest(clip), lowest(frame)
+    assert np.abs(low_frame).max() < 2e-3                       # every frame on the floor
+    assert low_clip.min() == pytest.approx(0, abs=2e-3) and low_clip.max() > 0.01   # one offset: hovers
+    assert np.array_equal(clip.poses, frame.poses)              # only the height changed
+    assert np.allclose(clip.transl[:, [0, 2]], frame.transl[:, [0, 2]])
+    with pytest.raises(ShapeMoveError, match="ground"):
+        naive_retarget(run_bvh, body, betas, ground="floor")
+
+
 def test_compare_retargeting(tiny_dataset, vae_run, body):
     from shapemove.core.body.shape_from_measurements import betas_for_measurements
     from shapemove.core.eval.retarget_compare import KEYS, compare_retargeting
 
     targets = [betas_for_measurements(body, {"height_cm": h}) for h in (190.0, 155.0)]
     r = compare_retargeting(tiny_dataset, vae_run, ["cmu_09_01"], targets, body=body)
-    assert set(r) == {"savae", "naive", "swap", "source"}
+    assert set(r) == {"savae", "naive", "naive_frame", "swap", "source"}
     for name in r:
         assert set(r[name]) == set(KEYS) | {"clips", "bodies"} and r[name]["bodies"] == (1 if name == "source" else 2)
         assert all(np.isfinite(r[name][k]) for k in KEYS)

@@ -84,8 +84,10 @@ def source_score(body, data, clip):
 
 def compare_retargeting(data, checkpoint, clips, target_betas_list, body=None, ik_refine_iters: int = 10,
                         progress=None, plant_source_contacts: bool = True) -> dict:
-    """{"savae": metrics, "naive": metrics, "swap": metrics, "source": metrics} (``KEYS`` + "clips",
-    "bodies"; "swap": ``swap_betas_retarget``, rotations and translation copied, betas swapped;
+    """{"savae": metrics, "naive": metrics, "naive_frame": metrics, "swap": metrics, "source": metrics}
+    (``KEYS`` + "clips", "bodies"; "naive_frame": ``naive_retarget(..., ground="frame")``, each frame's
+    lowest point on the floor: naive without its hovering, which hides slides from the 5 cm contact
+    line of ``skate``; "swap": ``swap_betas_retarget``, rotations and translation copied, betas swapped;
     "source": ``source_score`` of the dataset clips, absent if there are none) over every clip of
     ``clips`` (dataset clip ids or mocap files) moved onto every body of ``target_betas_list``
     ((10,) betas each). ``checkpoint``: SA-VAE run folder or .pt. progress(fraction, clip).
@@ -101,7 +103,7 @@ def compare_retargeting(data, checkpoint, clips, target_betas_list, body=None, i
         raise ShapeMoveError("compare_retargeting needs at least one clip and one target body")
     body = _body(body)
     vae = load_vae(checkpoint, body)
-    rows = {"savae": [], "naive": [], "swap": [], "source": []}
+    rows = {"savae": [], "naive": [], "naive_frame": [], "swap": [], "source": []}
     for i, clip in enumerate(clips):
         joints, name = source_joints(source_motion(data, clip), body)
         src = Motion22(joints=joints, fps=float(FPS), source=name, subject="", offsets=np.zeros((22, 3)))  # read once
@@ -112,6 +114,8 @@ def compare_retargeting(data, checkpoint, clips, target_betas_list, body=None, i
             rows["savae"].append(_score(body, decode_tokens(codes, vae, body, betas, ik_refine_iters, contacts=contacts),
                                         betas, known))
             rows["naive"].append(_score(body, naive_retarget(src, body, betas, ik_refine_iters), betas, known))
+            rows["naive_frame"].append(_score(body, naive_retarget(src, body, betas, ik_refine_iters, ground="frame"),
+                                              betas, known))
             rows["swap"].append(_score(body, swap_betas_retarget(src, body, betas, ik_refine_iters), betas, known))
         if isinstance(clip, str) and (src_row := source_score(body, data, clip)) is not None:
             rows["source"].append(src_row)

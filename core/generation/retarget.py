@@ -16,7 +16,8 @@
 ``naive_retarget(motion, body, betas)``: the subject's local rotations copied onto the new body,
 the root trajectory scaled by the leg-length (pelvis height) ratio, the clip's lowest mesh point put
 on the floor (one offset, no contacts). Bones are the new body's, but feet slide, sink and float
-wherever the proportions differ.
+wherever the proportions differ. ``ground="frame"`` puts each frame's lowest point on the floor
+instead: no hovering, but nothing keeps a foot planted.
 ``swap_betas_retarget(motion, body, betas)``: the plainest baseline, the subject's rotations and
 translation copied verbatim with the new betas (no scaling, no grounding).
 """
@@ -140,10 +141,14 @@ def swap_betas_retarget(motion, body, betas, ik_refine_iters: int = 10) -> Motio
                        (sol["root"] - sol["rest"][0]).astype(np.float32), betas, fps=float(FPS))
 
 
-def naive_retarget(motion, body, betas, ik_refine_iters: int = 10) -> Motion:
+def naive_retarget(motion, body, betas, ik_refine_iters: int = 10, ground: str = "clip") -> Motion:
     """Local rotations copied from the subject's IK onto the body ``betas``; root trajectory
-    scaled by the pelvis-height (leg length) ratio; the clip's lowest mesh point put on the floor
-    (one offset for the whole clip: no contact handling). T frames."""
+    scaled by the pelvis-height (leg length) ratio; ``ground`` "clip": the clip's lowest mesh
+    point put on the floor (one offset for the whole clip: no contact handling), "frame": each
+    frame's lowest mesh point (the body's ground probe) on the floor (never hovering, still no
+    contacts: feet slide and heels pop). T frames."""
+    if ground not in ("clip", "frame"):
+        raise ShapeMoveError(f"ground must be 'clip' or 'frame', got {ground!r}")
     betas = check_betas(betas)
     joints, _ = source_joints(motion, body)
     proc = processor(body, ik_refine_iters)
@@ -153,5 +158,9 @@ def naive_retarget(motion, body, betas, ik_refine_iters: int = 10) -> Motion:
         rest = body.rest_joints(torch.as_tensor(betas)[None])[0].numpy()
     from ..geometry.rotations import matrix_to_axis_angle
 
-    return make_motion(body, matrix_to_axis_angle(sol["rotations"]).astype(np.float32), shaped[:, 0] - rest[0],
-                       betas, fps=float(FPS))
+    transl = shaped[:, 0] - rest[0]
+    if ground == "frame":
+        from ..body.soles import GroundProbe
+
+        transl[:, 1] -= GroundProbe(body, betas).lowest(sol["rotations"], transl)[2]
+    return make_motion(body, matrix_to_axis_angle(sol["rotations"]).astype(np.float32), transl, betas, fps=float(FPS))
