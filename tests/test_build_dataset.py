@@ -122,7 +122,12 @@ def test_rerun_skips_finished_clips_and_reports_failures(mocap_root, tmp_path):
     again = build_dataset([src], out, verbose=False, ik_refine_iters=0)
     assert again.built == 0 and again.skipped_done == 1
     assert (out / "new_joints" / "walk.npy").stat().st_mtime_ns == stamp
-    assert "failed: 1" in (out / "build_report.txt").read_text()
+    report = (out / "build_report.txt").read_text()   # both runs' reports, the first run's first
+    assert report.startswith("clips built: 1 (") and "clips built: 0 (+0 augmented), already done: 1" in report
+    assert report.count("failed: 1") == 2
+    sharded = build_dataset([src], tmp_path / "sharded", verbose=False, ik_refine_iters=0, shard=(1, 2))
+    assert (tmp_path / "sharded" / "build_report.shard-1-of-2.txt").read_text() == sharded.summary() + "\n"
+    assert not (tmp_path / "sharded" / "build_report.txt").exists()   # a later run cannot overwrite a shard's
 
 
 def test_no_clips_is_a_clear_error(tmp_path):

@@ -299,7 +299,9 @@ def build_dataset(sources: list[Path], out: Path, body=None, augment_share: floa
     finalize(out)
     report.seconds = time.time() - t0
     report.splits = {s: len((out / f"{s}.txt").read_text().split()) for s in ("train", "val", "test")}
-    atomic_write_text(out / "build_report.txt", report.summary() + "\n")
+    path = out / ("build_report.txt" if count == 1 else f"build_report.shard-{index}-of-{count}.txt")
+    earlier = path.read_text() if path.is_file() else ""   # every run's report is kept, newest last
+    atomic_write_text(path, earlier + report.summary() + "\n")
     return report
 
 
