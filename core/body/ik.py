@@ -337,16 +337,12 @@ def _place_mid(root, mid, end, off_mid, off_end):
 
 # -- refinement ----------------------------------------------------------------------------------
 @functools.lru_cache(maxsize=4)
-def _gn_structure_cached(parents: tuple):
-    return _gn_structure(np.asarray(parents))
-
-
-def _gn_structure(parents):
+def _gn_structure(parents: tuple):
     """Sparsity of the refinement's Jacobian. Rows: the 22 joints, then the 22 bones (by child
     joint). Blocks (row, column): a joint k and each strict ancestor j of it that has a child in the
     22-joint body (the leaves' rotations move no body joint), the same for the bone ending at k,
     and joint k with the root translation (last column). Returns (rows, columns, kinds, ancestors,
-    movers), kind 0 joint/ancestor, 1 bone/ancestor, 2 translation."""
+    movers), kind 0 joint/ancestor, 1 bone/ancestor, 2 translation; cached per tree, so read only."""
     n = NUM_BODY_JOINTS
     movers = [j for j in range(n) if any(parents[c] == j for c in range(1, n))]
     col = {j: i for i, j in enumerate(movers)}
@@ -386,7 +382,7 @@ def refine(rot0, transl0, target, rest, parents, iters: int = 2, end_weight: flo
     offs = rest.clone()
     offs[1:] = rest[1:] - rest[parents[1:]]
     par = torch.as_tensor(parents[:n])
-    rows, cols, kinds, anc, movers = _gn_structure_cached(tuple(int(p) for p in parents))
+    rows, cols, kinds, anc, movers = _gn_structure(tuple(int(p) for p in parents))
     m = len(movers)
     nb = m + 1  # column blocks: the movers' turns, then the translation
     jrow = torch.where(kinds == 1, par[rows % n].clamp_min(0), anc)  # bone rows turn about the bone's parent...
