@@ -85,7 +85,7 @@ def source_score(body, data, clip):
 def compare_retargeting(data, checkpoint, clips, target_betas_list, body=None, ik_refine_iters: int = 10,
                         progress=None, plant_source_contacts: bool = True) -> dict:
     """{"savae": metrics, "naive": metrics, "naive_frame": metrics, "swap": metrics, "source": metrics}
-    (``KEYS`` + "clips", "bodies"; "naive_frame": ``naive_retarget(..., ground="frame")``, each frame's
+    (``KEYS`` + "clips", "bodies"; "naive_frame": ``ground_each_frame`` of naive, each frame's
     lowest point on the floor: naive without its hovering, which hides slides from the 5 cm contact
     line of ``skate``; "swap": ``swap_betas_retarget``, rotations and translation copied, betas swapped;
     "source": ``source_score`` of the dataset clips, absent if there are none) over every clip of
@@ -93,8 +93,8 @@ def compare_retargeting(data, checkpoint, clips, target_betas_list, body=None, i
     ((10,) betas each). ``checkpoint``: SA-VAE run folder or .pt. progress(fraction, clip).
     The SA-VAE side is decoded as ``generation.retarget.retarget`` does (the source's contacts
     planted unless ``plant_source_contacts`` is False: the decoder's own contacts)."""
-    from ..generation.retarget import (check_betas, decode_tokens, encode_source, load_vae, naive_retarget,
-                                       source_contacts, source_joints, swap_betas_retarget)
+    from ..generation.retarget import (check_betas, decode_tokens, encode_source, ground_each_frame, load_vae,
+                                       naive_retarget, source_contacts, source_joints, swap_betas_retarget)
     from ..io.mocap import Motion22
     from .recon import _body
 
@@ -113,9 +113,9 @@ def compare_retargeting(data, checkpoint, clips, target_betas_list, body=None, i
         for betas in targets:
             rows["savae"].append(_score(body, decode_tokens(codes, vae, body, betas, ik_refine_iters, contacts=contacts),
                                         betas, known))
-            rows["naive"].append(_score(body, naive_retarget(src, body, betas, ik_refine_iters), betas, known))
-            rows["naive_frame"].append(_score(body, naive_retarget(src, body, betas, ik_refine_iters, ground="frame"),
-                                              betas, known))
+            naive = naive_retarget(src, body, betas, ik_refine_iters)
+            rows["naive"].append(_score(body, naive, betas, known))
+            rows["naive_frame"].append(_score(body, ground_each_frame(naive, body), betas, known))
             rows["swap"].append(_score(body, swap_betas_retarget(src, body, betas, ik_refine_iters), betas, known))
         if isinstance(clip, str) and (src_row := source_score(body, data, clip)) is not None:
             rows["source"].append(src_row)

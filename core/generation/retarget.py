@@ -17,7 +17,7 @@
 the root trajectory scaled by the leg-length (pelvis height) ratio, the clip's lowest mesh point put
 on the floor (one offset, no contacts). Bones are the new body's, but feet slide, sink and float
 wherever the proportions differ. ``ground="frame"`` puts each frame's lowest point on the floor
-instead: no hovering, but nothing keeps a foot planted.
+instead (``ground_each_frame``): no hovering, but nothing keeps a foot planted.
 ``swap_betas_retarget(motion, body, betas)``: the plainest baseline, the subject's rotations and
 translation copied verbatim with the new betas (no scaling, no grounding).
 """
@@ -144,9 +144,8 @@ def swap_betas_retarget(motion, body, betas, ik_refine_iters: int = 10) -> Motio
 def naive_retarget(motion, body, betas, ik_refine_iters: int = 10, ground: str = "clip") -> Motion:
     """Local rotations copied from the subject's IK onto the body ``betas``; root trajectory
     scaled by the pelvis-height (leg length) ratio; ``ground`` "clip": the clip's lowest mesh
-    point put on the floor (one offset for the whole clip: no contact handling), "frame": each
-    frame's lowest mesh point (the body's ground probe) on the floor (never hovering, still no
-    contacts: feet slide and heels pop). T frames."""
+    point put on the floor (one offset for the whole clip: no contact handling), "frame":
+    ``ground_each_frame`` of that. T frames."""
     if ground not in ("clip", "frame"):
         raise ShapeMoveError(f"ground must be 'clip' or 'frame', got {ground!r}")
     betas = check_betas(betas)
@@ -158,9 +157,18 @@ def naive_retarget(motion, body, betas, ik_refine_iters: int = 10, ground: str =
         rest = body.rest_joints(torch.as_tensor(betas)[None])[0].numpy()
     from ..geometry.rotations import matrix_to_axis_angle
 
-    transl = shaped[:, 0] - rest[0]
-    if ground == "frame":
-        from ..body.soles import GroundProbe
+    out = make_motion(body, matrix_to_axis_angle(sol["rotations"]).astype(np.float32), shaped[:, 0] - rest[0], betas,
+                      fps=float(FPS))
+    return ground_each_frame(out, body) if ground == "frame" else out
 
-        transl[:, 1] -= GroundProbe(body, betas).lowest(sol["rotations"], transl)[2]
-    return make_motion(body, matrix_to_axis_angle(sol["rotations"]).astype(np.float32), transl, betas, fps=float(FPS))
+
+def ground_each_frame(motion: Motion, body) -> Motion:
+    """``motion`` moved up or down frame by frame so that each frame's lowest mesh point (the body's
+    ground probe) is on the floor: it never hovers or sinks, but nothing keeps a foot planted (feet
+    slide, heels pop, flights are pressed onto the floor). Poses and XZ path unchanged."""
+    from ..body.soles import GroundProbe
+    from ..geometry.rotations import axis_angle_to_matrix
+
+    transl = np.asarray(motion.transl, np.float64).copy()
+    transl[:, 1] -= GroundProbe(body, motion.betas).lowest(axis_angle_to_matrix(motion.poses), transl)[2]
+    return make_motion(body, motion.poses, transl.astype(np.float32), motion.betas, fps=motion.fps)
