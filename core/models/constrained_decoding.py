@@ -37,14 +37,20 @@ def motion_mask(vocab, vocab_size: int, allow_end: bool) -> torch.Tensor:
 @torch.no_grad()
 def decode(model, inputs: tuple, min_codes: int, max_codes: int, temperature: float = 1.0,
            top_k: int | None = None, generator: torch.Generator | None = None, guidance: float = 0.0,
-           null_inputs: tuple | None = None) -> Decoded:
+           null_inputs: tuple | None = None, prefix_codes: list[int] | None = None) -> Decoded:
     """``inputs``: ``model.inputs_for(...)`` (token ids + mask for a T5, states + mask + segments
-    for MiniLM); ``null_inputs`` the same for the empty motion text, needed when ``guidance`` > 0."""
+    for MiniLM); ``null_inputs`` the same for the empty motion text, needed when ``guidance`` > 0.
+    ``prefix_codes``: motion codes (0..NUM_CODES-1) already written after ``[SOM]`` for every row
+    (e.g. the last tokens of the previous segment of a timeline): the decoder continues from them;
+    ``codes`` holds only the new ones and ``min_codes``/``max_codes`` count only those."""
     vocab = model.vocab
     enc, enc_mask = model.encode(*inputs)
     B = enc.shape[0]
     start = vocab.pad_id  # decoder_start_token_id of every ShapeMove decoder
-    seq = torch.tensor([[start, vocab.beta_id, vocab.som_id]] * B, dtype=torch.long)
+    prefix = [vocab.first_code_id + int(c) for c in (prefix_codes or [])]
+    if any(not 0 <= int(c) < vocab.num_codes for c in (prefix_codes or [])):
+        raise ValueError(f"prefix codes must lie in 0..{vocab.num_codes - 1}")
+    seq = torch.tensor([[start, vocab.beta_id, vocab.som_id] + prefix] * B, dtype=torch.long)
     # the state whose input is [BETA] (position 1) gives the betas
     logits, hidden, past = model.step(enc, enc_mask, seq, use_cache=True)
     betas = model.beta_head(hidden[:, 1])
