@@ -56,7 +56,7 @@ LOAD_SCRIPT = """
 import sys, time
 import torch
 w, c = time.perf_counter(), time.process_time()
-from shapemove.core.eval.tma_embed import load_tma
+from shapemove.core.models.tma_embed import load_tma
 from shapemove.core.generation.generate import Generator
 g = Generator(sys.argv[1])
 tma = load_tma(sys.argv[1]) if (g.model_dir / "tma" / "tma.pt").is_file() else None

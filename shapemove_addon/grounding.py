@@ -9,7 +9,7 @@ not the rig's motion has tokens, this runs at once; a motion with tokens is re-d
 
 - Contacts: detected once from the keyed motion on the body it was keyed for
   (``core.motion.contacts.detect_contacts``), cached on the rig for that action and length.
-- Probe: each foot's sole vertices (``core.scene.sole_height.sole_vertices``) and every
+- Probe: each foot's sole vertices (``core.body.sole_height.sole_vertices``) and every
   ``BODY_STRIDE``-th other vertex, with their shape-key rows and skin weights, cached on the rig,
   so an update skins a few hundred vertices (``sole_height.lowest_heights``), not the mesh.
 Armature space (Z up) throughout; the rig object is assumed unrotated, as ShapeMove builds it.
@@ -18,12 +18,12 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..core.body import sole_height
 from ..core.body.plant import ground_shift
 from ..core.constants import FPS, NUM_BETAS
 from ..core.geometry.fk import forward_kinematics
 from ..core.geometry.rotations import quaternion_to_matrix
 from ..core.motion.contacts import detect_contacts
-from ..core.scene import sole_height
 from ..core.scene.axes import points_to_y_up
 from .rig_state import body_of
 

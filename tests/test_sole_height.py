@@ -1,4 +1,4 @@
-"""Lowest heights from a few skinned vertices (core/scene/sole_height.py) against the body model's
+"""Lowest heights from a few skinned vertices (core/body/sole_height.py) against the body model's
 own skinning of the whole mesh, and grounding a shape change with core.body.plant.ground_shift."""
 from __future__ import annotations
 
@@ -8,8 +8,8 @@ import torch
 
 from shapemove.core.body.plant import ground_shift
 from shapemove.core.body.skeleton import PARENTS
+from shapemove.core.body.sole_height import SOLE_BAND, lowest_heights, sole_vertices
 from shapemove.core.geometry.rotations import axis_angle_to_matrix
-from shapemove.core.scene.sole_height import SOLE_BAND, lowest_heights, sole_vertices
 
 
 def _forward(body, betas, poses, transl):

@@ -9,7 +9,7 @@ above the floor), so putting a foot *joint* on y = 0 sinks the mesh. Two tools:
   is a constant per body): the training losses use it to turn joint heights into sole heights.
 * ``GroundProbe(body, betas)``: the vertices that can ever be the lowest point of the mesh
   (``candidate_vertices``: the extreme points of every rigidly skinned part and all blended
-  vertices, ``scene.sole_height.sole_vertices`` over the whole body; about half the mesh, chosen
+  vertices, ``sole_height.sole_vertices`` over the whole body; about half the mesh, chosen
   once per body model), posed with their full skin weights for many frames at once: only the
   vertical row of each skinning transform is needed, one (T,96) x (96,n) product.
   ``lowest(rotations, transl)`` gives per frame the lowest vertex of each foot, of the feet and of
@@ -21,9 +21,9 @@ import numpy as np
 import torch
 
 from ..geometry.torch_ops import forward_kinematics
-from ..scene.sole_height import sole_vertices
 from .kinematics import skinning_transforms
 from .skeleton import FOOT_JOINTS
+from .sole_height import sole_vertices
 
 FOOT_IDS = FOOT_JOINTS   # left ankle, right ankle, left foot, right foot (SMPL order)
 
@@ -34,7 +34,7 @@ def _labels(body) -> np.ndarray:
 
 def candidate_vertices(body) -> np.ndarray:
     """Indices of the vertices that can be the lowest point of ``body``'s mesh in some pose:
-    ``scene.sole_height.sole_vertices`` with no height band, on the mean shape (a shape change
+    ``sole_height.sole_vertices`` with no height band, on the mean shape (a shape change
     moves an extreme point by a vertex at most: sub-mm). Computed once per body instance."""
     ids = getattr(body, "_ground_candidates", None)
     if ids is None:

@@ -82,7 +82,7 @@ class Generator:
     def picker(self) -> CandidatePicker | None:
         """The best-of-N chooser on the model folder's TMA (loaded on first use), or None without one."""
         if self._picker is None and self._tma_file is not None and self._tma_file.is_file():
-            from ..eval.tma_embed import load_tma
+            from ..models.tma_embed import load_tma
 
             self._picker = CandidatePicker(load_tma(self._tma_file))
         return self._picker

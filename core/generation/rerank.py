@@ -24,7 +24,7 @@ class CandidatePicker:
 
     def scores(self, prompt: str, feats: list) -> np.ndarray:
         """(N,) cosine similarity of each candidate's (T, 263) features to the prompt."""
-        from ..eval.tma_embed import embed_motions, embed_texts
+        from ..models.tma_embed import embed_motions, embed_texts
 
         text = embed_texts(self.model, self.tok, [prompt])[0]
         return embed_motions(self.model, feats, self.mean, self.std) @ text

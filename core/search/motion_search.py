@@ -121,7 +121,7 @@ def load_motion_features(path: Path) -> tuple[np.ndarray, str]:
 
 def resolve_tma(tma):
     """(tma tuple, checkpoint file or None) from a path, a load_tma() tuple or None (the default model)."""
-    from ..eval.tma_embed import load_tma, tma_path
+    from ..models.tma_embed import load_tma, tma_path
 
     if isinstance(tma, tuple):
         return tma, None
@@ -137,7 +137,7 @@ def resolve_tma(tma):
 def index_library(folder, tma=None, use_cache: bool = True, progress=None) -> LibraryIndex:
     """Embed every motion of ``folder`` with the TMA (path, load_tma() tuple or None = default).
     Files that cannot be read are skipped (listed in ``index.skipped``)."""
-    from ..eval.tma_embed import check_features, embed_motions
+    from ..models.tma_embed import check_features, embed_motions
 
     folder = Path(folder)
     if not folder.is_dir():
@@ -205,7 +205,7 @@ def check_query(query, top_k: int = 10) -> str:
 
 def search(index: LibraryIndex, query: str, top_k: int = 10) -> list[tuple[str, float, str, str]]:
     """The ``top_k`` motions closest to ``query``: (id, cosine similarity, path, caption), best first."""
-    from ..eval.tma_embed import embed_texts
+    from ..models.tma_embed import embed_texts
 
     query = check_query(query, top_k)
     model, tok, _, _ = index.tma

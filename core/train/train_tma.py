@@ -34,9 +34,10 @@ from ..config_presets import load_config
 from ..data.actions import stored_labels
 from ..data.paraphrase_bank import BANK_SHARE, training_caption
 from ..errors import ShapeMoveError
-from ..eval.tma_embed import KIND, eval_pairs, pad_batch, score_pairs, text_inputs
+from ..eval.tma_embed import eval_pairs, score_pairs
 from ..models.text_encoder import StateCache, fingerprint, load_text_encoder
 from ..models.tma import TMA, TMAConfig
+from ..models.tma_embed import KIND, pad_batch, text_inputs
 from ..models.tokenizer import load_tokenizer, tokenizer_from_sentencepiece, train_sentencepiece
 from . import distributed
 from .checkpoint_cadence import finish, save_if_due
