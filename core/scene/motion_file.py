@@ -7,6 +7,10 @@ rotations (SMPL convention, relative to the body's rest pose), ``transl`` (T,3) 
 (T,22,3: the joints the SA-VAE decoded, before IK and grounding) and ``contacts`` (T,4 uint8: foot
 contacts of joints 7, 8, 10, 11 that were planted), with ``contacts_measured`` (uint8 1) when those
 came from the source mocap (retargeting) rather than the decoder: re-decoding plants them again.
+Animation extras (``core/generation``, docs/animation.md): ``loop_advance`` (3,) float32, the root's
+travel per cycle of a looping motion (frame T continues as frame 0 moved by it); ``segment_bounds``
+(S,2) int32 [start, end) frames and ``segment_prompts`` (one str, the S prompts joined by newlines)
+of a timeline of prompts.
 
 A motion file is self-consistent: ``joints`` are the body's joints posed by (betas, poses, transl)
 (``make_motion`` computes them; ``check_consistent`` verifies it), which is what the rig plays.
@@ -38,6 +42,9 @@ class Motion:
     network_joints: np.ndarray | None = None
     contacts: np.ndarray | None = None
     contacts_measured: bool = False         # contacts came from the source mocap (retargeting), not the decoder
+    loop_advance: np.ndarray | None = None  # (3,) root travel per cycle of a loop (frame T = frame 0 + it)
+    segment_bounds: np.ndarray | None = None  # (S,2) [start, end) frames of a timeline's segments
+    segment_prompts: list[str] | None = None  # the S prompts of those segments
     # run-time facts of a generated motion, not stored in the file
     ik_error_cm: float | None = None        # decode: mean IK error of the planted joints
     shape_source: str | None = None         # generate: "[BETA] head", "measurements" or "given"
@@ -58,9 +65,11 @@ def make_motion(body, poses, transl, betas, fps: float = 20.0, prompt: str | Non
     poses = np.asarray(poses, dtype=np.float32)
     transl = np.asarray(transl, dtype=np.float32)
     betas = np.asarray(betas, dtype=np.float32).reshape(-1)
+    from ..body.kinematics import posed_joints   # FK only, in windows: no mesh (memory bounded by the window)
+
     with torch.no_grad():
-        out = body.forward(torch.as_tensor(betas)[None], torch.as_tensor(poses), torch.as_tensor(transl))
-    m = Motion(joints=out.joints[:, :NUM_BODY_JOINTS].numpy(), betas=betas, poses=poses, transl=transl,
+        joints = posed_joints(body, betas, poses, transl)
+    m = Motion(joints=joints[:, :NUM_BODY_JOINTS].numpy(), betas=betas, poses=poses, transl=transl,
                fps=float(fps), body_model=str(body.name), prompt=prompt, **extra)
     validate(m)
     return m
@@ -88,15 +97,27 @@ def validate(m: Motion) -> None:
                              f"got {m.network_joints.shape}")
     if m.contacts is not None and m.contacts.shape != (T, 4):
         raise ShapeMoveError(f"bad motion: contacts must be ({T},4), got {m.contacts.shape}")
+    if m.loop_advance is not None and (np.shape(m.loop_advance) != (3,) or not np.isfinite(m.loop_advance).all()):
+        raise ShapeMoveError(f"bad motion: loop_advance must be 3 finite numbers, got shape {np.shape(m.loop_advance)}")
+    if m.segment_bounds is not None:
+        b = np.asarray(m.segment_bounds)
+        ok = (b.ndim == 2 and b.shape[1] == 2 and len(b) >= 1 and b[0, 0] == 0 and b[-1, 1] == T
+              and (b[:, 1] > b[:, 0]).all() and (b[1:, 0] == b[:-1, 1]).all())
+        if not ok:
+            raise ShapeMoveError(f"bad motion: segment_bounds must be (S,2) consecutive [start, end) frames "
+                                 f"covering 0..{T}, got {b.tolist() if b.size < 40 else b.shape}")
+        if m.segment_prompts is None or len(m.segment_prompts) != len(b):
+            raise ShapeMoveError(f"bad motion: {len(b)} segments need as many segment_prompts")
 
 
 def fk_joints(body, m: Motion) -> np.ndarray:
     """(T,22,3) joints of ``body`` posed by the motion's (betas, poses, transl)."""
     import torch
 
+    from ..body.kinematics import posed_joints
+
     with torch.no_grad():
-        out = body.forward(torch.as_tensor(m.betas)[None], torch.as_tensor(m.poses), torch.as_tensor(m.transl))
-    return out.joints[:, :NUM_BODY_JOINTS].numpy()
+        return posed_joints(body, m.betas, m.poses, m.transl)[:, :NUM_BODY_JOINTS].numpy()
 
 
 def check_consistent(body, m: Motion, tol: float = 1e-3) -> float:
@@ -122,6 +143,11 @@ def save_motion(path, m: Motion) -> Path:
             arrays[name] = np.asarray(getattr(m, name))
     if m.contacts is not None and m.contacts_measured:
         arrays["contacts_measured"] = np.uint8(1)
+    if m.loop_advance is not None:
+        arrays["loop_advance"] = np.asarray(m.loop_advance, np.float32)
+    if m.segment_bounds is not None:
+        arrays["segment_bounds"] = np.asarray(m.segment_bounds, np.int32)
+        arrays["segment_prompts"] = np.str_("\n".join(m.segment_prompts))
 
     with atomic_path(path) as tmp:  # read-only folder, a parent that is a file, disk full: a sentence, no *.tmp
         with open(tmp, "wb") as f:
@@ -142,6 +168,9 @@ def load_motion(path) -> Motion:
     missing = [k for k in ("joints", "betas", "poses", "transl", "fps", "body_model") if k not in data]
     if missing:
         raise ShapeMoveError(f"motion file {path} lacks {', '.join(missing)}")
+    for key, kinds in (("loop_advance", "iuf"), ("segment_bounds", "iu")):
+        if key in data and data[key].dtype.kind not in kinds:
+            raise ShapeMoveError(f"motion file {path}: {key} must be numbers, got {data[key].dtype}")
     m = Motion(joints=data["joints"].astype(np.float32), betas=data["betas"].astype(np.float32).reshape(-1),
                poses=data["poses"].astype(np.float32), transl=data["transl"].astype(np.float32),
                fps=float(data["fps"]), body_model=str(data["body_model"]),
@@ -150,6 +179,12 @@ def load_motion(path) -> Motion:
                network_joints=data["network_joints"].astype(np.float32) if "network_joints" in data else None,
                contacts=data["contacts"].astype(np.uint8) if "contacts" in data else None,
                contacts_measured="contacts" in data and "contacts_measured" in data
-               and data["contacts_measured"].shape == () and bool(data["contacts_measured"]))
+               and data["contacts_measured"].shape == () and bool(data["contacts_measured"]),
+               loop_advance=data["loop_advance"].astype(np.float32).reshape(-1) if "loop_advance" in data else None)
+    if "segment_bounds" in data:
+        if "segment_prompts" not in data or data["segment_prompts"].shape != ():
+            raise ShapeMoveError(f"motion file {path} has segment_bounds without segment_prompts")
+        m.segment_bounds = np.asarray(data["segment_bounds"]).astype(np.int64)
+        m.segment_prompts = str(data["segment_prompts"]).split("\n")
     validate(m)
     return m

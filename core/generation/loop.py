@@ -1,0 +1,218 @@
+"""Loops: a motion whose last frame flows into its first, pose and velocity, for cycles.
+
+The model makes the loop where it can: ``generate_loop`` samples several token sequences for the
+prompt (``token_sampling``), and in each decoded joint track ``best_cut`` looks for two frames a < b,
+at least ``MIN_PERIOD`` s apart, where the body's pose relative to its root and heading, and the
+joints' velocities in that frame, are most alike. The candidate and cut with the smallest seam
+win; frames a..b-1 are the cycle. ``make_cycle`` then removes what is left:
+- the heading turns by the small angle between a and b, spread over the cycle, so every cycle
+  travels the same way (a straight walk stays straight; Blender's Cycles modifier repeats it with
+  an offset, never a rotation);
+- the remaining joint offset between frame b and frame a (moved by the cycle's advance) is blended
+  in over the last ``BLEND`` frames only (smoothstep), so frame b is frame a moved by the advance.
+``plant_loop`` plants the feet on three copies of the cycle in a row and keeps the middle one, so
+the contact runs that cross the seam are planted as one run. ``Motion.loop_advance`` is the
+root's travel per cycle: frame T continues as frame 0 moved by it.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..constants import FPS
+from ..errors import ShapeMoveError
+from ..scene.motion_file import Motion, make_motion
+from .prompts import check_prompt
+from .sampling_params import DEFAULT_CANDIDATES, check_candidates, check_sampling
+from .token_sampling import sample_codes
+from .track import Track, decoded_track, headings, plant, rotate_y, track_of
+
+MIN_PERIOD = 1.0       # s: the shortest cycle (two steps of a walk)
+BLEND = 6              # frames over which the seam's last offset is blended in
+VELOCITY_WEIGHT = 4.0  # a velocity mismatch of 1 cm/frame costs as much as 4 cm of pose
+SEAM_SPEED = 1.0       # x its mean step: a joint faster than this at the seam frame is penalised
+FAST_WEIGHT = 0.2      # m of cost per unit of speed ratio above SEAM_SPEED
+EDGE = 2               # frames at each end of a decoded clip that a cut avoids
+LOOP_MIN_SECONDS = 4.0  # candidates are at least this long, so a cycle has room
+
+
+@dataclass
+class Cut:
+    start: int
+    end: int
+    cost: float   # m: mean joint distance of the two poses + weighted velocity distance
+
+    @property
+    def period(self) -> int:
+        return self.end - self.start
+
+
+def _local(joints, heading) -> tuple[np.ndarray, np.ndarray]:
+    """Pose relative to the root's XZ and the heading, and backward velocity in that frame."""
+    J = np.asarray(joints, np.float64)
+    rel = J.copy()
+    rel[..., [0, 2]] -= J[:, :1, [0, 2]]
+    pose = rotate_y(rel, -heading)
+    vel = np.zeros_like(J)
+    vel[1:] = rotate_y(J[1:] - J[:-1], -heading[1:])
+    return pose, vel
+
+
+def best_cut(joints, fps: float = FPS, period: tuple[float, float] | None = None) -> Cut:
+    """The frames a < b whose pose and velocity are most alike, b - a within ``period`` (s)
+    (default: at least ``MIN_PERIOD`` and 40 % of the clip)."""
+    J = np.asarray(joints, np.float64)
+    T = len(J)
+    lo, hi = period if period is not None else (max(MIN_PERIOD, 0.4 * T / fps), T / fps)
+    lo_f, hi_f = max(2, int(round(lo * fps))), int(round(hi * fps))
+    pose, vel = _local(J, headings(J))
+    first, last = max(1, EDGE), T - 1 - EDGE
+    idx = np.arange(first, last + 1)
+    if len(idx) < 2 or idx[-1] - idx[0] < lo_f:
+        raise ShapeMoveError(f"a {T / fps:.1f} s motion is too short for a loop of at least {lo:.1f} s")
+    P, V = pose[idx], vel[idx]
+    d = np.linalg.norm(P[:, None] - P[None], axis=-1).mean(-1) + \
+        VELOCITY_WEIGHT * np.linalg.norm(V[:, None] - V[None], axis=-1).mean(-1)
+    # the seam's step is the step into frame b: a frame where some joint moves much faster than
+    # its mean (a swinging foot) would make the wrap look like a pop, so such ends cost more
+    speed = np.linalg.norm(vel, axis=-1)                                  # (T,22)
+    fast = np.maximum(speed / np.maximum(speed[1:].mean(0), 1e-4) - SEAM_SPEED, 0.0).max(1)
+    d += FAST_WEIGHT * fast[idx][None, :]
+    gap = idx[None] - idx[:, None]
+    d[(gap < lo_f) | (gap > hi_f)] = np.inf
+    i, j = np.unravel_index(np.argmin(d), d.shape)
+    if not np.isfinite(d[i, j]):
+        raise ShapeMoveError(f"no loop of {lo:.1f}..{hi:.1f} s fits in this {T / fps:.1f} s motion")
+    return Cut(int(idx[i]), int(idx[j]), float(d[i, j]))
+
+
+def _smoothstep(x):
+    x = np.clip(x, 0.0, 1.0)
+    return x * x * (3 - 2 * x)
+
+
+def make_cycle(track: Track, cut: Cut, blend: int = BLEND) -> tuple[Track, np.ndarray]:
+    """Frames cut.start..cut.end-1 of ``track`` as a cycle -> (cycle track, advance (3,), y = 0)."""
+    a, b = cut.start, cut.end
+    P = b - a
+    J = track.joints[a:b + 1].copy()
+    h = headings(track.joints)
+    turn = np.angle(np.exp(1j * (h[b] - h[a])))            # wrapped to (-pi, pi]
+    pivot = np.array([J[0, 0, 0], 0.0, J[0, 0, 2]])
+    J = rotate_y(J - pivot, -turn * np.arange(P + 1) / P) + pivot
+    advance = np.array([J[P, 0, 0] - J[0, 0, 0], 0.0, J[P, 0, 2] - J[0, 0, 2]])
+    residual = J[0] + advance - J[P]                        # (22,3)
+    n = max(1, min(int(blend), P - 1))
+    w = _smoothstep((np.arange(P + 1) - (P - n)) / n)
+    J += w[:, None, None] * residual[None]
+    return Track(J[:P], track.contacts[a:b]), advance
+
+
+def plant_loop(body, betas, cycle: Track, advance, ik_refine_iters: int = 10, prompt: str | None = None) -> Motion:
+    """Plant the feet of a cycle: three copies in a row (moved by -advance, 0, +advance) planted
+    together, the middle one kept, so runs that cross the seam stay one planted run."""
+    P = len(cycle)
+    adv = np.asarray(advance, np.float64)
+    tiles = Track(np.concatenate([cycle.joints - adv, cycle.joints, cycle.joints + adv]),
+                  np.concatenate([cycle.contacts] * 3))
+    m3 = plant(body, betas, tiles, ik_refine_iters, prompt=prompt)
+    planted_adv = m3.joints[2 * P, 0] - m3.joints[P, 0]
+    loop_adv = np.array([planted_adv[0], 0.0, planted_adv[2]], np.float32)
+    poses, transl = close_cycle(m3.poses[P:2 * P + 1], m3.transl[P:2 * P + 1], loop_adv)
+    m = make_motion(body, poses, transl, betas, fps=m3.fps, prompt=prompt,
+                    network_joints=cycle.joints.astype(np.float32), contacts=m3.contacts[P:2 * P],
+                    loop_advance=loop_adv)
+    m.ik_error_cm = m3.ik_error_cm
+    return m
+
+
+def close_cycle(poses, transl, advance) -> tuple[np.ndarray, np.ndarray]:
+    """(P+1,24,3) axis-angle poses and (P+1,3) transl of a planted cycle plus its natural next frame
+    -> the P frames of the cycle with that next frame made exactly frame 0 moved by ``advance``: the
+    (sub-millimetre, IK-refinement) difference is spread linearly over the whole cycle."""
+    from ..geometry.rotations import axis_angle_to_matrix, matrix_to_axis_angle
+
+    R = axis_angle_to_matrix(np.asarray(poses, np.float64))
+    P = len(R) - 1
+    fix = matrix_to_axis_angle(np.swapaxes(R[P], -1, -2) @ R[0])            # R[P] @ exp(fix) = R[0]
+    w = np.arange(P) / P
+    R = R[:P] @ axis_angle_to_matrix(w[:, None, None] * fix[None])
+    t = np.asarray(transl, np.float64)
+    t = t[:P] + w[:, None] * (t[0] + np.asarray(advance, np.float64) - t[P])[None]
+    return matrix_to_axis_angle(R).astype(np.float32), t.astype(np.float32)
+
+
+def loop_motion(motion: Motion, body, seconds: float | None = None, ik_refine_iters: int = 10) -> Motion:
+    """An existing motion made into a loop (its best cut, see the module doc)."""
+    track = track_of(motion)
+    period = None if seconds is None else (0.85 * seconds, 1.15 * seconds)
+    cycle, adv = make_cycle(track, best_cut(track.joints, motion.fps, period))
+    return plant_loop(body, motion.betas, cycle, adv, ik_refine_iters, prompt=motion.prompt)
+
+
+def generate_loop(gen, req, progress=None, cancel=None) -> Motion:
+    """A looping motion for ``req`` (a ``generate.Request``; ``seconds``: the cycle's length,
+    +-15 %): ``req.candidates`` token samples, the best seam of all (``best_cut``) kept."""
+    req.prompt = check_prompt(req.prompt)
+    req.shape_text = check_prompt(req.shape_text, "shape text", allow_empty=True) or None
+    req.seed, req.temperature, req.top_k = check_sampling(req.seed, req.temperature, req.top_k)
+    n = check_candidates(req.candidates or DEFAULT_CANDIDATES)
+    check = gen.check_text(req.prompt)
+    down = gen.vae.cfg.downsample
+    if req.seconds is not None:
+        if not 0.4 <= req.seconds <= 30:
+            raise ShapeMoveError(f"a loop's --seconds must be between 0.4 and 30, got {req.seconds}")
+        codes = max(2, int(round(max(req.seconds * 1.6, req.seconds + 2.0) * FPS / down)))
+        lo = hi = codes
+        period = (0.85 * req.seconds, 1.15 * req.seconds)
+    else:
+        lo, hi = int(round(LOOP_MIN_SECONDS * FPS / down)), max(gen.max_codes, int(round(LOOP_MIN_SECONDS * FPS / down)))
+        period = None
+    if progress is not None:
+        progress(0.1, "sampling loop candidates")
+    cands, pred = sample_codes(gen, req.prompt, req.shape_text, n, lo, hi, req.seed, req.temperature, req.top_k,
+                               req.guidance)
+    betas, source = gen.body_shape(req, pred)
+    best = None
+    for codes in cands:
+        if cancel is not None and cancel():
+            raise ShapeMoveError("cancelled")
+        track, _ = decoded_track(codes, gen.vae, betas)
+        try:
+            cut = best_cut(track.joints, FPS, period)
+        except ShapeMoveError:
+            continue
+        if best is None or cut.cost < best[1].cost:
+            best = (track, cut)
+    if best is None:
+        raise ShapeMoveError(f"none of the {len(cands)} samples of {req.prompt!r} holds a loop; try --seconds or another seed")
+    if progress is not None:
+        progress(0.5, "planting the cycle")
+    cycle, adv = make_cycle(*best)
+    m = plant_loop(gen.body, betas, cycle, adv, gen.ik_refine_iters, prompt=req.prompt)
+    m.shape_source = source
+    m.warnings = [check.warning] if check is not None and check.warning else []
+    m.prompt_check = check
+    m.seam_cost = best[1].cost
+    return m
+
+
+def seam_report(motion: Motion) -> dict:
+    """How well a loop closes: per joint, the jump from the last frame to the next cycle's first
+    (frame 0 moved by ``loop_advance``) over that joint's mean per-frame step (``jump_ratio``,
+    the worst joint); the root's advance per frame over its mean speed within the cycle."""
+    if motion.loop_advance is None:
+        raise ShapeMoveError("this motion is not a loop (no loop_advance)")
+    J = np.asarray(motion.joints, np.float64)
+    T = len(J)
+    adv = np.asarray(motion.loop_advance, np.float64)
+    jump = np.linalg.norm(J[0] + adv - J[-1], axis=-1)
+    step = np.linalg.norm(np.diff(J, axis=0), axis=-1).mean(0)
+    ratio = jump / np.maximum(step, 1e-6)
+    speed = np.linalg.norm(J[-1, 0, [0, 2]] - J[0, 0, [0, 2]]) / (T - 1)
+    per_frame = np.linalg.norm(adv[[0, 2]]) / T
+    rel = abs(per_frame / speed - 1.0) if speed > 1e-5 else abs(per_frame) * 1e5
+    return {"frames": T, "jump_ratio": float(ratio.max()), "worst_joint": int(ratio.argmax()),
+            "advance_m": float(np.linalg.norm(adv[[0, 2]])), "speed_m_per_frame": float(speed),
+            "advance_vs_speed": float(rel)}

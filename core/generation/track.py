@@ -1,0 +1,93 @@
+"""The decoder's joint track of a motion: what loop, path and speed edits work on before the feet
+are planted again.
+
+A generated Motion keeps the SA-VAE's joints (``network_joints``, Y up, before IK and grounding)
+and the contacts it planted. The animation edits (``loop``, ``path_follow``, ``time_warp``,
+``sequence``) change those joints and contacts and hand them to ``decode.motion_from_joints``
+(``body/plant.py``: one fixed point per contact run, IK, grounding on the mesh soles), so every
+edit ends with the feet re-planted instead of sliding. ``in_place`` is the exception: it moves the
+finished pose (a treadmill has no fixed footholds).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import torch
+
+from ..body.plant import contacts_from_features
+from ..errors import ShapeMoveError
+from ..motion.contacts import detect_contacts
+from ..motion.features import joints_from_features
+from ..motion.skeleton_ops import facing_directions, gaussian_smooth, heading_angles, smooth_directions
+from ..scene.motion_file import Motion
+from .decode import decode_features, motion_from_joints
+
+HEADING_SIGMA = 5.0   # frames: the body's heading without the hips' swing of each step
+CENTRE_SIGMA = 5.0    # frames: the root's path without its sway
+
+
+@dataclass
+class Track:
+    joints: np.ndarray     # (T,22,3) float64, metres, Y up
+    contacts: np.ndarray   # (T,4) uint8 of joints 7, 8, 10, 11
+
+    def __post_init__(self):
+        self.joints = np.asarray(self.joints, np.float64)
+        self.contacts = np.asarray(self.contacts, np.uint8)
+        if self.joints.ndim != 3 or self.joints.shape[1:] != (22, 3) or len(self.joints) < 2:
+            raise ShapeMoveError(f"a joint track needs (T>=2,22,3) joints, got {self.joints.shape}")
+        if self.contacts.shape != (len(self.joints), 4):
+            raise ShapeMoveError(f"a joint track needs ({len(self.joints)},4) contacts, got {self.contacts.shape}")
+
+    def __len__(self) -> int:
+        return len(self.joints)
+
+
+def track_of(motion: Motion) -> Track:
+    """The decoder's joints and planted contacts of ``motion``; a motion without them (e.g. read
+    from mocap) gives its posed joints and contacts detected on them."""
+    joints = motion.network_joints if motion.network_joints is not None else motion.joints
+    contacts = motion.contacts if motion.contacts is not None else detect_contacts(joints, motion.fps)
+    return Track(joints, contacts)
+
+
+@torch.no_grad()
+def decoded_track(codes: list[int], vae, betas) -> tuple[Track, np.ndarray]:
+    """Motion codes + betas -> (the SA-VAE's joint track, its (T,263) features)."""
+    feats = decode_features(codes, vae, betas)
+    joints = joints_from_features(feats.double()).numpy()
+    f = feats.numpy().astype(np.float32)
+    return Track(joints, contacts_from_features(f)), f
+
+
+def plant(body, betas, track: Track, ik_refine_iters: int = 10, prompt: str | None = None, **extra) -> Motion:
+    """A track -> Motion on ``body`` with its contacts planted (``decode.motion_from_joints``)."""
+    return motion_from_joints(body, betas, track.joints, track.contacts, ik_refine_iters, prompt=prompt, **extra)
+
+
+def headings(joints) -> np.ndarray:
+    """(T,) yaw of the body (0 facing +Z, +pi/2 facing +X), the step's hip swing smoothed away."""
+    return heading_angles(smooth_directions(facing_directions(np.asarray(joints, np.float64)), HEADING_SIGMA))
+
+
+def root_centre(joints) -> np.ndarray:
+    """(T,2) XZ of the root (pelvis) with its sway smoothed away."""
+    return gaussian_smooth(np.asarray(joints, np.float64)[:, 0, [0, 2]], CENTRE_SIGMA)
+
+
+def travel(joints) -> np.ndarray:
+    """(T,) distance (m) the smoothed root has travelled along its own path at each frame."""
+    c = root_centre(joints)
+    return np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(c, axis=0), axis=1))]
+
+
+def rotate_y(points, angle) -> np.ndarray:
+    """Rotate (...,3) points about +Y by ``angle`` (per leading frame when an array)."""
+    a = np.asarray(angle, np.float64)
+    c, s = np.cos(a), np.sin(a)
+    p = np.asarray(points, np.float64)
+    if a.ndim:
+        c, s = c.reshape(c.shape + (1,) * (p.ndim - 2)), s.reshape(s.shape + (1,) * (p.ndim - 2))
+    x, y, z = p[..., 0], p[..., 1], p[..., 2]
+    return np.stack([c * x + s * z, y, -s * x + c * z], axis=-1)
