@@ -45,6 +45,8 @@ bench: setup
 train-default: setup
 	$(PY) -m shapemove data build --source $(DATA)/bandai.tar.xz $(DATA)/hdm05.tar.xz $(DATA)/cmu.tar.xz $(DATA)/cmu_extra.tar.xz $(DATA)/deepmimic.tar.xz --out $(BUILT)
 	$(PY) -m shapemove data compose --data $(BUILT) --count 800 --seed 0
+	$(PY) -m shapemove data compose-parts --data $(BUILT) --count 800 --seed 0
+	$(PY) -m shapemove data mirror --data $(BUILT)
 	$(PY) -m shapemove train vae --data $(BUILT) --config configs/default_vae.json --out $(RUNS)/vae --resume
 	$(PY) -m shapemove train tma --data $(BUILT) --config configs/default_tma.json --out $(RUNS)/tma --resume
 	$(PY) -m shapemove train t5 --data $(BUILT) --config configs/default_t5.json --vae $(RUNS)/vae/savae.pt \

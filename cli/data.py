@@ -29,9 +29,31 @@ def add_arguments(p):
     c.add_argument("--count", type=int, default=1000, help="number of composed clips to add")
     c.add_argument("--seed", type=int, default=0)
     c.add_argument("--body-model", default=None, help="openbody (default) or a path to SMPL model files")
+    cp = sub.add_parser("compose-parts", help="add 'legs of a walk/run + arms of a gesture' clips (two things at once)")
+    cp.add_argument("--data", type=Path, required=True, help="a dataset folder made by `data build`")
+    cp.add_argument("--count", type=int, default=800, help="number of composed clips to add")
+    cp.add_argument("--seed", type=int, default=0)
+    cp.add_argument("--body-model", default=None, help="openbody (default) or a path to SMPL model files")
+    m = sub.add_parser("mirror", help="add the mirror image (left <-> right, captions too) of every training clip")
+    m.add_argument("--data", type=Path, required=True, help="a dataset folder made by `data build`")
+    m.add_argument("--body-model", default=None, help="openbody (default) or a path to SMPL model files")
 
 
 def run(args) -> int:
+    if args.action == "compose-parts":
+        from ..core.body.load import load_body_model
+        from ..core.data.compose_parts import compose_parts_dataset
+
+        ids = compose_parts_dataset(args.data, args.count, seed=args.seed, body=load_body_model(args.body_model))
+        print(f"legs-and-arms clips written: {len(ids)} (training split); split lists and Mean/Std refreshed")
+        return 0
+    if args.action == "mirror":
+        from ..core.body.load import load_body_model
+        from ..core.data.mirror import mirror_dataset
+
+        ids = mirror_dataset(args.data, body=load_body_model(args.body_model))
+        print(f"mirrored clips written: {len(ids)} (training split); split lists and Mean/Std refreshed")
+        return 0
     if args.action == "compose":
         from ..core.body.load import load_body_model
 

@@ -71,6 +71,7 @@ class PhenotypeMap:
         self.defaults = np.asarray(data["phenotype_defaults"], dtype=np.float64)
         self.intercept = np.asarray(data["phenotype_intercept"], dtype=np.float64)
         self.matrix = np.asarray(data["phenotype_matrix"], dtype=np.float64)
+        self.r2 = np.asarray(data["phenotype_r2"], dtype=np.float64) if "phenotype_r2" in data else None  # per beta
 
     def array(self, phenotype) -> np.ndarray:
         """dict (missing names take their defaults) or array (..., P) -> float array (..., P)."""

@@ -227,12 +227,20 @@ def _write_clip(out: Path, cid: str, arrays: dict, clip: ClipSource, split: str,
     atomic_write_text(out / "meta" / f"{cid}.json", json.dumps(meta))  # written last: marks the clip done
 
 
-def _augment_betas(cid: str) -> np.ndarray:
+def _augment_body(cid: str, pmap, r2) -> tuple[np.ndarray, np.ndarray | None]:
+    """(betas (10,), phenotype (P,) or None) of the sampled body for an augmented copy: drawn from
+    phenotypes (``body.phenotype_sample``) when the body model has a phenotype map, else betas
+    ~ N(0,1) clipped to +-AUGMENT_BETA_CLIP. Seeded by the whole id: every clip its own body."""
     import hashlib
 
-    seed = int(hashlib.sha1(cid.encode()).hexdigest()[:8], 16)  # the whole id: every clip its own body
+    seed = int(hashlib.sha1(cid.encode()).hexdigest()[:8], 16)
     rng = np.random.default_rng(seed)
-    return np.clip(rng.standard_normal(10), -AUGMENT_BETA_CLIP, AUGMENT_BETA_CLIP).astype(np.float32)
+    if pmap is None:
+        return np.clip(rng.standard_normal(10), -AUGMENT_BETA_CLIP, AUGMENT_BETA_CLIP).astype(np.float32), None
+    from ..body.phenotype_sample import betas_for_phenotypes, sample_phenotypes
+
+    p = sample_phenotypes(pmap, rng, 1)
+    return betas_for_phenotypes(pmap, p, rng, r2)[0], p[0]
 
 
 def _wants_augment(clip: ClipSource, share: float) -> bool:
@@ -265,6 +273,9 @@ def build_dataset(sources: list[Path], out: Path, body=None, augment_share: floa
     if not clips:
         raise ShapeMoveError(f"no motion clips found in {', '.join(map(str, sources))}")
     proc = ClipProcessor(body, ik_refine_iters=ik_refine_iters)
+    pmap = getattr(proc.body, "phenotype_map", None)
+    r2 = pmap.r2 if pmap is not None else None
+    aug_pheno: dict = {}
     report = BuildReport()
     bar = tqdm(clips, desc="building", unit="clip", disable=not verbose)
     for i, clip in enumerate(bar):
@@ -273,7 +284,8 @@ def build_dataset(sources: list[Path], out: Path, body=None, augment_share: floa
         split = split_of(clip.id, clip.subject, clip.dataset)
         todo = [(clip.id, None)]
         if _wants_augment(clip, augment_share):
-            todo.append((f"{clip.id}_aug", _augment_betas(clip.id)))
+            aug_betas, aug_pheno[f"{clip.id}_aug"] = _augment_body(clip.id, pmap, r2)
+            todo.append((f"{clip.id}_aug", aug_betas))
         todo = [(cid, b) for cid, b in todo if not (out / "meta" / f"{cid}.json").exists()]
         if not todo:
             report.skipped_done += 1
@@ -283,6 +295,8 @@ def build_dataset(sources: list[Path], out: Path, body=None, augment_share: floa
             for cid, b in todo:
                 arrays = proc.process(joints, b)
                 extra = {"augmented_from": clip.id} if b is not None else {}
+                if aug_pheno.get(cid) is not None:
+                    extra["phenotype"] = {n: round(float(v), 4) for n, v in zip(pmap.names, aug_pheno[cid])}
                 _write_clip(out, cid, arrays, clip, split, extra)
                 if b is None:
                     report.built += 1

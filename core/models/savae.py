@@ -34,6 +34,7 @@ class LossWeights:
     slide: float = 0.5        # horizontal foot speed while the target foot is in contact (m/frame)
     penetrate: float = 1.0    # depth of joints below y = 0 (m)
     dyn_stability: float = 0.0  # HUMOS dynamic stability: ZMP outside the contact feet (m); off by default
+    root: float = 0.0         # root travel: trajectory distance (m) + root channels (vae_losses.root_travel_loss)
 
 
 @dataclass
@@ -134,8 +135,9 @@ class SAVAEConfig:
         return load_config("SA-VAE", name_or_path, cls._presets(), lambda d, p: cls.from_dict(d))
 
     def validate(self) -> None:
-        if self.loss.dyn_stability < 0:
-            raise ShapeMoveError("loss.dyn_stability (HUMOS dynamic stability) must be >= 0")
+        for name, value in vars(self.loss).items():
+            if not value >= 0:
+                raise ShapeMoveError(f"loss.{name} must be >= 0, got {value!r}")
         if self.train.window % self.downsample:
             raise ShapeMoveError(f"train.window must be a multiple of {self.downsample}")
         if self.train.decay not in ("step", "cosine", "none"):
