@@ -30,9 +30,66 @@ COMMANDS: dict[str, tuple[str, str]] = {
 
 from ..core.errors import ShapeMoveError as UserError  # noqa: E402  (one error type everywhere)
 
+P = "python -m shapemove "
+# `python -m shapemove COMMAND [ACTION] --help` ends with one of these; each is also an example of
+# docs/command-line.md, which tests/test_docs_examples.py runs (so a renamed option fails a test)
+EXAMPLES: dict[str, str] = {
+    "body": P + "body info",
+    "body info": P + "body info",
+    "data": P + "data build --source ../shared/data/*.tar.xz --out data/built",
+    "data build": P + "data build --source ../shared/data/*.tar.xz --out data/built",
+    "data compose": P + "data compose --data data/built --count 800 --seed 0",
+    "train": P + "train vae --data data/built --config configs/default_vae.json --out runs/vae",
+    "train vae": P + "train vae --data data/built --config configs/default_vae.json --out runs/vae",
+    "train tma": P + "train tma --data data/built --config configs/default_tma.json --out runs/tma",
+    "train t5": P + "train t5 --data data/built --config configs/default_t5.json --vae runs/vae/savae.pt --out runs/t5",
+    "eval": P + "eval shape --bodies 200 --json out/eval_shape.json",
+    "eval recon": P + "eval recon --data data/built --split test --checkpoint weights/default/savae.pt --max-clips 40 "
+                      "--json out/eval_recon.json",
+    "eval generate": P + "eval generate --data data/built --split test --max-clips 60 --json out/eval_generate.json",
+    "eval retarget": P + "eval retarget --data data/built --checkpoint weights/default/savae.pt "
+                         "--json out/eval_retarget.json",
+    "eval paraphrase": P + "eval paraphrase --data data/built --prompts configs/heldout_paraphrases_blind.json "
+                           "--json out/eval_paraphrase_blind.json",
+    "eval shape": P + "eval shape --bodies 200 --json out/eval_shape.json",
+    "retarget": P + 'retarget --motion walk.bvh --shape-text "A person standing 190 cm tall" --out tall_walk.npz',
+    "retarget-rig": P + "retarget-rig --motion wave.npz --blend hero.blend --armature Hero --out hero_wave.blend "
+                        "--preset mixamo",
+    "generate": P + 'generate --prompt "a person waves" --shape-text "a short, slim woman" --seconds 4 --out wave.npz',
+    "search": P + 'search --library data/built --query "someone kicks" --top 5',
+    "blend": P + "blend --motion wave.npz --out wave.blend --render wave.png",
+    "render": P + "render --prompts prompts.txt --out renders/ --frames 4 --resolution 320 320",
+    "demo": P + 'demo --prompt "someone kicks with the left leg" --shape-text "a short, slim woman" --out out/kick',
+    "worker": P + "worker --list",
+    "bench": P + "bench sliders --quick --json out/bench_sliders.json",
+}
+
+
+class _HelpFormatter(argparse.HelpFormatter):
+    """Wraps descriptions as usual but prints the example epilog as written (one command a line)."""
+
+    def _fill_text(self, text, width, indent):
+        if text.startswith("example:"):
+            return "".join(indent + line for line in text.splitlines(keepends=True))
+        return super()._fill_text(text, width, indent)
+
+
+def with_example(parser: argparse.ArgumentParser, key: str) -> argparse.ArgumentParser:
+    """Let ``parser``'s help end with ``EXAMPLES[key]`` (when there is one); its sub-commands' too."""
+    if key in EXAMPLES:
+        parser.epilog = f"example:\n  {EXAMPLES[key]}"
+        parser.formatter_class = _HelpFormatter
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            for name, child in action.choices.items():
+                with_example(child, f"{key} {name}")
+    return parser
+
+
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="python -m shapemove", description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(prog="python -m shapemove", description=__doc__.splitlines()[0],
+                                     epilog=f"example:\n  {EXAMPLES['demo']}", formatter_class=_HelpFormatter)
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     for name, (module, help_text) in COMMANDS.items():
         p = sub.add_parser(name, help=help_text, description=help_text)
@@ -57,6 +114,7 @@ def main(argv: list[str] | None = None) -> int:
         raise
     sub = argparse.ArgumentParser(prog=f"python -m shapemove {name}", description=COMMANDS[name][1])
     module.add_arguments(sub)
+    with_example(sub, name)
     args = sub.parse_args(argv[1:])
     try:
         return int(module.run(args) or 0)
