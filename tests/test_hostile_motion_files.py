@@ -72,12 +72,12 @@ def test_bvh_and_amc_bombs(tmp_path):
     big = tmp_path / "big.asf"
     big.write_text(_asf(5000))
     add("big.amc", "1\nroot 0 0 0 0 0 0\n", asf=str(big), expect="more than 1000 bones")
-    # 6. a 100 MB (sparse) BVH is refused before it is read
+    # 6. a 300 MB (sparse) BVH is refused before it is read (BVH rows are streamed: up to 256 MB)
     huge = tmp_path / "huge.bvh"
     with open(huge, "wb") as fh:
-        fh.truncate(100 * 2**20)
+        fh.truncate(300 * 2**20)
     cases.append({"path": str(huge), "asf": None})
-    match.append("larger than 64 MB")
+    match.append("larger than 256 MB")
     # 7. a 50 MB hierarchy of junk tokens
     add("junk.bvh", "HIERARCHY\nROOT a\n{\n" + "x " * 5_000_000 + "\nMOTION\n", expect="BVH hierarchy is")
     # 8. DeepMimic: a 100 MB file is refused unread; deep nesting is a sentence

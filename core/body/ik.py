@@ -54,6 +54,7 @@ SPINE_BLEND = {3: 1.0 / 3.0, 6: 2.0 / 3.0}  # share of the chest's left-right ax
 _LIMB_OF = {l[0]: l for l in LIMBS}   # limb root -> its limb
 _HINGE_OF = {l[1]: l for l in LIMBS}  # knee/elbow -> its limb
 _EPS = 1e-9
+IK_WINDOW = 1024  # frames per batch in ``solve_ik``: ~50 s at 20 fps, ~120 MB of Jacobians at most
 
 
 @dataclass
@@ -464,7 +465,8 @@ def refine(rot0, transl0, target, rest, parents, iters: int = 2, end_weight: flo
     return rot, tr, pos
 
 
-def solve_ik(joints, rest_joints, parents=PARENTS, refine_iters: int = 2, max_turn_deg: float = 30.0) -> IKResult:
+def solve_ik(joints, rest_joints, parents=PARENTS, refine_iters: int = 2, max_turn_deg: float = 30.0,
+             window: int = IK_WINDOW) -> IKResult:
     """joints (T,22,3) metres Y-up; rest_joints (24,3) of the target body (e.g.
     ``BodyModel.rest_joints(betas)[0]``). Analytic IK then up to ``refine_iters`` Gauss-Newton
     steps (``refine``; 0 = analytic only; skipped when the analytic error is already below 0.01 mm).
@@ -474,16 +476,28 @@ def solve_ik(joints, rest_joints, parents=PARENTS, refine_iters: int = 2, max_tu
     ``max_turn_deg``: when the body's proportions differ from the targets', how far (degrees) a
     bone may turn away from the target bone's direction to reach a target joint; larger trades
     natural poses (a too-long spine would fold the neck) for lower joint error. Irrelevant when
-    the body fits. Bad input raises ShapeMoveError.
+    the body fits. Bad input raises ShapeMoveError. ``window``: frames solved per batch (memory
+    is bounded by it; each window's refinement stops on its own progress).
     Returns local rotations (T,24,3,3) and transl (T,3) such that FK + transl ~ joints."""
     target, rest, parents = _prepare(joints, rest_joints, parents)
+    parts = []
     with one_torch_thread(), torch.no_grad():
-        rot, transl = analytic_ik(target, rest, parents, max_turn_deg)
-        if refine_iters > 0:
-            rot, transl, pos = refine(rot, transl, target, rest, parents, iters=refine_iters)
-        else:
-            pos = _fk(rot, rest, parents, transl)
-        return _result(rot, transl, target, pos)
+        # frames are solved independently: ``window`` at a time keeps the Jacobians' memory a
+        # constant (a 10-minute take at once needed gigabytes); a clip up to a window is one batch
+        for s in range(0, target.shape[0], window):
+            tw = target[s:s + window]
+            rot, transl = analytic_ik(tw, rest, parents, max_turn_deg)
+            if refine_iters > 0:
+                rot, transl, pos = refine(rot, transl, tw, rest, parents, iters=refine_iters)
+            else:
+                pos = _fk(rot, rest, parents, transl)
+            parts.append(_result(rot, transl, tw, pos))
+    if len(parts) == 1:
+        return parts[0]
+    err = np.concatenate([p.joint_error for p in parts])
+    return IKResult(rotations=np.concatenate([p.rotations for p in parts]),
+                    transl=np.concatenate([p.transl for p in parts]), joint_error=err,
+                    mean_error_cm=float(err.astype(np.float64).mean()) * 100.0)
 
 
 def ik_lbfgs_baseline(joints, rest_joints, iters: int = 100, parents=PARENTS) -> IKResult:

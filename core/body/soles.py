@@ -21,7 +21,7 @@ import numpy as np
 import torch
 
 from ..geometry.torch_ops import forward_kinematics
-from .kinematics import skinning_transforms
+from .kinematics import WINDOW, skinning_transforms
 from .skeleton import FOOT_JOINTS
 from .sole_height import sole_vertices
 
@@ -93,10 +93,18 @@ class GroundProbe:
         y = ay.reshape(len(ay), -1).float() @ self.y_map
         return y.double().numpy() + np.asarray(transl, dtype=np.float64)[:, 1:2]
 
-    def lowest(self, rotations, transl) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def lowest(self, rotations, transl, window: int = WINDOW) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Per frame: lowest foot vertex of each foot (T,2), lowest foot vertex (T,), lowest probe
-        point of the whole body (T,), metres."""
-        v = self.heights(rotations, transl)
-        f = v[:, :self.num_feet]
-        per_foot = np.stack([f[:, self.foot_side == s].min(1) for s in (0, 1)], axis=1)
-        return per_foot, f.min(1), v.min(1)
+        point of the whole body (T,), metres. ``window`` frames at a time (``heights`` is (T,n):
+        thousands of points per frame), so memory does not grow with the take's length."""
+        rotations, transl = np.asarray(rotations), np.asarray(transl)
+        per_foot, feet, body = [], [], []
+        for s in range(0, len(rotations), window):
+            v = self.heights(rotations[s:s + window], transl[s:s + window])
+            f = v[:, :self.num_feet]
+            per_foot.append(np.stack([f[:, self.foot_side == k].min(1) for k in (0, 1)], axis=1))
+            feet.append(f.min(1))
+            body.append(v.min(1))
+        if not per_foot:
+            return np.zeros((0, 2)), np.zeros(0), np.zeros(0)
+        return np.concatenate(per_foot), np.concatenate(feet), np.concatenate(body)
