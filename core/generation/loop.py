@@ -25,7 +25,7 @@ from ..errors import ShapeMoveError
 from ..scene.motion_file import Motion, make_motion
 from .prompts import check_prompt
 from .sampling_params import DEFAULT_CANDIDATES, check_candidates, check_sampling
-from .token_sampling import sample_codes
+from .token_sampling import body_for, sample_codes
 from .track import Track, decoded_track, headings, plant, rotate_y, track_of
 
 MIN_PERIOD = 1.0       # s: the shortest cycle (two steps of a walk)
@@ -173,7 +173,7 @@ def generate_loop(gen, req, progress=None, cancel=None) -> Motion:
         progress(0.1, "sampling loop candidates")
     cands, pred = sample_codes(gen, req.prompt, req.shape_text, n, lo, hi, req.seed, req.temperature, req.top_k,
                                req.guidance)
-    betas, source = gen.body_shape(req, pred)
+    betas, source = body_for(gen, req.prompt, req.shape_text, req.betas, pred)
     best = None
     for codes in cands:
         if cancel is not None and cancel():

@@ -34,3 +34,17 @@ def sample_codes(gen, prompt: str, shape_text: str | None, n: int, min_codes: in
         out = decode(gen.t5, inputs, min_codes, max_codes, temperature=temperature, top_k=top_k, generator=g,
                      guidance=s, null_inputs=null, prefix_codes=list(prefix or []))
     return out.codes, out.betas[0].numpy().astype(np.float32)
+
+
+def body_for(gen, prompt: str, shape_text: str | None, betas, predicted) -> tuple[np.ndarray, str]:
+    """(betas, where they came from) of a request: given betas, else ``gen.body_shape`` for a
+    shape text (measurements or the [BETA] head's reading), else the [BETA] head's prediction."""
+    if betas is not None:
+        from .decode import check_betas
+
+        return check_betas(betas), "given"
+    if shape_text:
+        from .generate import Request
+
+        return gen.body_shape(Request(prompt, shape_text, None), np.asarray(predicted, np.float32))
+    return np.asarray(predicted, np.float32), "[BETA] head"

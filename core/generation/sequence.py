@@ -1,0 +1,186 @@
+"""A timeline of prompts: "walks forward" 4 s, then "sits down" 2 s, then "waves" 3 s, one body.
+
+Each segment's motion codes are sampled with the T5 continuing from the previous segment's last
+``PREFIX_CODES`` codes (``constrained_decoding.decode(prefix_codes=...)``): the decoder sees where
+the body is and writes the next prompt's motion from there, so the transition is the model's, not
+a cross-fade. Of ``candidates`` samples per segment the TMA keeps the one closest to that
+segment's prompt (``rerank``). All codes are then decoded as one sequence by the SA-VAE for one
+body (the first segment's [BETA] head, or the shape text's measurements, or given betas) and
+planted once (``track.plant``). The Motion keeps ``segment_bounds`` (frames) and
+``segment_prompts``; ``regenerate_segment`` samples one segment again (continuing from its
+predecessor) and keeps every other segment's codes.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import torch
+
+from ..constants import FPS
+from ..errors import ShapeMoveError
+from ..scene.motion_file import Motion
+from ..torch_threads import one_torch_thread
+from .prompts import check_prompt
+from .sampling_params import DEFAULT_CANDIDATES, check_candidates, check_sampling
+from .token_sampling import body_for, sample_codes
+from .track import decoded_track, plant
+
+PREFIX_CODES = 4          # codes (0.8 s at 4 frames a code) a segment continues from
+MAX_SEGMENTS = 32
+MAX_TOTAL_SECONDS = 120.0
+
+
+@dataclass
+class Segment:
+    prompt: str
+    seconds: float
+
+
+def check_segments(segments) -> list[Segment]:
+    out = []
+    if not segments:
+        raise ShapeMoveError("a timeline needs at least one --prompt with its --seconds")
+    if len(segments) > MAX_SEGMENTS:
+        raise ShapeMoveError(f"a timeline holds at most {MAX_SEGMENTS} prompts, got {len(segments)}")
+    for i, seg in enumerate(segments, 1):
+        prompt, seconds = (seg.prompt, seg.seconds) if isinstance(seg, Segment) else seg
+        try:
+            sec = float(seconds)
+        except (TypeError, ValueError):
+            raise ShapeMoveError(f"segment {i}: seconds must be a number, got {seconds!r}") from None
+        if not 0.4 <= sec <= 60:
+            raise ShapeMoveError(f"segment {i} ({str(prompt)[:30]!r}): seconds must be between 0.4 and 60, got {seconds}")
+        out.append(Segment(check_prompt(prompt), sec))
+    total = sum(s.seconds for s in out)
+    if total > MAX_TOTAL_SECONDS:
+        raise ShapeMoveError(f"a timeline is at most {MAX_TOTAL_SECONDS:g} s long, these segments add up to {total:g} s")
+    return out
+
+
+def _segment_codes(gen, prompt, shape_text, n, prefix, betas, seed, temperature, top_k, candidates, guidance):
+    cands, pred = sample_codes(gen, prompt, shape_text, candidates, n, n, seed, temperature, top_k, guidance,
+                               prefix=prefix)
+    best = 0
+    if len(cands) > 1 and gen.picker is not None:
+        b = pred if betas is None else betas
+        skip = len(prefix) * gen.vae.cfg.downsample   # judge the segment's own frames
+        feats = [f[skip:] for f in _batch_features(gen.vae, [list(prefix) + c for c in cands], b)]
+        best = gen.picker.pick(prompt, feats)
+    return cands[best], pred
+
+
+@torch.no_grad()
+def _batch_features(vae, codes: list[list[int]], betas) -> list[np.ndarray]:
+    """``decode.decode_features`` of equally long code lists in one SA-VAE pass."""
+    with one_torch_thread():
+        idx = torch.as_tensor(codes, dtype=torch.long)
+        b = torch.as_tensor(np.asarray(betas, np.float32))[None].expand(len(codes), -1)
+        out = vae.denormalize(vae.decode_long(vae.quantizer.indices_to_codes(idx), b))
+    return [f.numpy() for f in out]
+
+
+def _assemble(gen, codes_per_segment, prompts, betas) -> Motion:
+    codes = [c for seg in codes_per_segment for c in seg]
+    track, feats = decoded_track(codes, gen.vae, betas)
+    down = len(track) // len(codes)
+    motion = plant(gen.body, betas, track, gen.ik_refine_iters, prompt=" -> ".join(prompts),
+                   tokens=np.asarray(codes, np.int16), features=feats)
+    ends = np.cumsum([len(c) for c in codes_per_segment]) * down
+    motion.segment_bounds = np.stack([np.r_[0, ends[:-1]], ends], axis=1).astype(np.int64)
+    motion.segment_prompts = list(prompts)
+    return motion
+
+
+def generate_sequence(gen, segments, shape_text: str | None = None, betas=None, seed: int = 0,
+                      temperature: float = 1.0, top_k: int | None = 50, candidates: int = DEFAULT_CANDIDATES,
+                      guidance: float | None = None, progress=None, cancel=None) -> Motion:
+    """``segments``: [(prompt, seconds)] or ``Segment``s -> one Motion with segment_bounds."""
+    segs = check_segments(segments)
+    shape_text = check_prompt(shape_text, "shape text", allow_empty=True) or None
+    seed, temperature, top_k = check_sampling(seed, temperature, top_k)
+    candidates = check_candidates(candidates)
+    warnings = []
+    for s in segs:  # every text checked before any generation
+        check = gen.check_text(s.prompt)
+        if check is not None and check.warning:
+            warnings.append(check.warning)
+    if shape_text:
+        gen.check_text(shape_text, "shape text")
+    down = gen.vae.cfg.downsample
+    chosen, source = [], None
+    for i, s in enumerate(segs):
+        if cancel is not None and cancel():
+            raise ShapeMoveError("cancelled")
+        n = max(1, int(round(s.seconds * FPS / down)))
+        prefix = [c for seg in chosen for c in seg][-PREFIX_CODES:]
+        codes, pred = _segment_codes(gen, s.prompt, shape_text, n, prefix, betas, seed + i, temperature, top_k,
+                                     candidates, guidance)
+        if source is None:   # one body for the whole timeline: the first segment's
+            betas, source = body_for(gen, s.prompt, shape_text, betas, pred)
+        chosen.append(codes)
+        if progress is not None:
+            progress((i + 1) / (len(segs) + 1), f"segment {i + 1}/{len(segs)}: {s.prompt}")
+    motion = _assemble(gen, chosen, [s.prompt for s in segs], betas)
+    motion.shape_source = source
+    motion.warnings = warnings
+    if progress is not None:
+        progress(1.0, "timeline planted")
+    return motion
+
+
+def segment_codes(motion: Motion) -> list[list[int]]:
+    """The codes of each segment of a timeline motion."""
+    if motion.segment_bounds is None or motion.tokens is None or len(motion.tokens) == 0:
+        raise ShapeMoveError("this motion is not a timeline of prompts (no segments or no tokens)")
+    down = motion.num_frames // len(motion.tokens)
+    if down < 1 or down * len(motion.tokens) != motion.num_frames:
+        raise ShapeMoveError("this timeline's frames do not match its tokens (was it time-warped?); generate it again")
+    toks = [int(t) for t in motion.tokens]
+    return [toks[s // down:e // down] for s, e in np.asarray(motion.segment_bounds)]
+
+
+def regenerate_segment(gen, motion: Motion, index: int, seed: int, prompt: str | None = None,
+                       seconds: float | None = None, temperature: float = 1.0, top_k: int | None = 50,
+                       candidates: int = DEFAULT_CANDIDATES, guidance: float | None = None) -> Motion:
+    """Segment ``index`` sampled again (new ``seed``, optionally a new ``prompt``/``seconds``),
+    continuing from the previous segment; every other segment keeps its codes, the body its betas."""
+    per = segment_codes(motion)
+    prompts = list(motion.segment_prompts)
+    if not 0 <= index < len(per):
+        raise ShapeMoveError(f"segment {index + 1} does not exist: this timeline has {len(per)}")
+    seg = check_segments([(prompt or prompts[index], seconds if seconds is not None else
+                           len(per[index]) * gen.vae.cfg.downsample / FPS)])[0]
+    seed, temperature, top_k = check_sampling(seed, temperature, top_k)
+    n = max(1, int(round(seg.seconds * FPS / gen.vae.cfg.downsample)))
+    prefix = [c for s in per[:index] for c in s][-PREFIX_CODES:]
+    per[index], _ = _segment_codes(gen, seg.prompt, None, n, prefix, motion.betas, seed, temperature, top_k,
+                                   check_candidates(candidates), guidance)
+    prompts[index] = seg.prompt
+    out = _assemble(gen, per, prompts, motion.betas)
+    out.shape_source = "given"
+    return out
+
+
+def scaled_bounds(bounds, num_frames: int) -> np.ndarray:
+    """Segment bounds of a timeline re-timed to ``num_frames`` frames (consecutive, non-empty)."""
+    b = np.asarray(bounds, np.float64)
+    ends = np.round(b[:, 1] * num_frames / b[-1, 1]).astype(np.int64)
+    ends = np.maximum(ends, np.arange(1, len(ends) + 1))
+    ends[-1] = num_frames
+    return np.stack([np.r_[0, ends[:-1]], ends], axis=1)
+
+
+def boundary_report(motion: Motion) -> dict:
+    """Per boundary, the worst joint's jump (its step across the boundary) over the 99th percentile
+    of its per-frame steps inside the segments (``jump_ratio``: the worst over all boundaries)."""
+    if motion.segment_bounds is None:
+        raise ShapeMoveError("this motion has no segments")
+    J = np.asarray(motion.joints, np.float64)
+    step = np.linalg.norm(np.diff(J, axis=0), axis=-1)          # (T-1,22): step t -> t+1
+    starts = np.asarray(motion.segment_bounds)[1:, 0]
+    inside = np.ones(len(step), bool)
+    inside[starts - 1] = False
+    p99 = np.percentile(step[inside], 99, axis=0)
+    ratios = [float((step[s - 1] / np.maximum(p99, 1e-6)).max()) for s in starts]
+    return {"boundaries": [int(s) for s in starts], "ratios": ratios, "jump_ratio": max(ratios, default=0.0)}
