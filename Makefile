@@ -53,7 +53,7 @@ train-default: setup
 		--out $(RUNS)/t5 --resume $(if $(BASE_T5),--base-model $(BASE_T5),)
 	$(PY) tools/export_default.py --vae $(RUNS)/vae --t5 $(RUNS)/t5 --tma $(RUNS)/tma --out weights/default --card configs/model_card.json
 
-# Evaluation tables of the README (needs $(BUILT) from train-default); the 1-step SA-VAE is the untrained baseline.
+# Evaluation tables of docs/evaluation.md (needs $(BUILT) from train-default); the 1-step SA-VAE is the untrained baseline.
 eval: setup
 	$(PY) -m shapemove train vae --data $(BUILT) --config configs/default_vae.json --steps 1 --out runs/untrained --quiet --force
 	$(PY) -m shapemove eval recon --data $(BUILT) --split test --checkpoint weights/default/savae.pt --max-clips 40 --json out/eval_recon.json

@@ -1,4 +1,4 @@
-"""tools/eval_report.py writes the evaluation tables between the README's markers."""
+"""tools/eval_report.py writes the evaluation tables between the markers of docs/evaluation.md."""
 import importlib.util
 from pathlib import Path
 
@@ -18,12 +18,12 @@ RECON = {"mpjpe_mm": 358.104, "mpjpe_local_mm": 45.67, "bone_err_mm": 5.0011, "p
 def test_tables_replace_the_marked_blocks(tmp_path):
     import json
 
-    readme = tmp_path / "README.md"
+    readme = tmp_path / "evaluation.md"
     readme.write_text("intro\n<!-- eval:recon -->\nold table\n<!-- /eval:recon -->\n"
                       "<!-- eval:generate -->\nold\n<!-- /eval:generate -->\nend\n")
     (tmp_path / "r.json").write_text(json.dumps(RECON))
     args = ["--recon", str(tmp_path / "r.json"), "--untrained", str(tmp_path / "none.json"),
-            "--generate", str(tmp_path / "none.json"), "--readme", str(readme)]
+            "--generate", str(tmp_path / "none.json"), "--page", str(readme)]
     assert eval_report.main(args) == 0
     text = readme.read_text()
     assert "old table" not in text and text.startswith("intro\n") and text.endswith("end\n")
@@ -37,3 +37,14 @@ def test_tables_replace_the_marked_blocks(tmp_path):
 def test_missing_markers_are_a_clear_error(tmp_path):
     with pytest.raises(SystemExit, match="no <!-- eval:recon -->"):
         eval_report.replace_block("no markers here", "recon", "x")
+
+
+def test_the_default_page_is_the_manuals_and_holds_every_block():
+    """`make eval` writes docs/evaluation.md (not the README), which has every marked table."""
+    page = ROOT / "docs" / "evaluation.md"
+    text = page.read_text(encoding="utf-8")
+    for name in ("recon", "generate", "shape", "paraphrase"):
+        assert f"<!-- eval:{name} -->\n" in text and f"\n<!-- /eval:{name} -->" in text, name
+    assert "<!-- eval:" not in (ROOT / "README.md").read_text(encoding="utf-8")
+    src = (ROOT / "tools" / "eval_report.py").read_text()
+    assert 'default=ROOT / "docs" / "evaluation.md"' in src

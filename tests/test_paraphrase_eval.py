@@ -79,7 +79,7 @@ def test_eval_report_writes_the_paraphrase_table(tmp_path):
     readme = tmp_path / "README.md"
     readme.write_text("x\n<!-- eval:paraphrase -->\nstale table\n<!-- /eval:paraphrase -->\ny\n")
     none = ["--recon", str(tmp_path / "no.json"), "--generate", str(tmp_path / "no.json")]
-    args = none + ["--paraphrase", str(tmp_path / "p.json"), "--readme", str(readme)]
+    args = none + ["--paraphrase", str(tmp_path / "p.json"), "--page", str(readme)]
     assert rep.main(args + ["--paraphrase-blind", str(tmp_path / "missing.json")]) == 0
     text = readme.read_text()
     assert "stale table" not in text and "held-out paraphrases (141 prompts)" in text and "blind" not in text
@@ -95,5 +95,5 @@ def test_eval_report_writes_the_paraphrase_table(tmp_path):
     assert [c.strip(" |") for c in rows[strict]] == ["61.2 %", "55.0 %"]
     plain = tmp_path / "PLAIN.md"
     plain.write_text("no paraphrase block\n")
-    assert rep.main(none + ["--paraphrase", str(tmp_path / "p.json"), "--readme", str(plain)]) == 0
+    assert rep.main(none + ["--paraphrase", str(tmp_path / "p.json"), "--page", str(plain)]) == 0
     assert plain.read_text() == "no paraphrase block\n"

@@ -1,13 +1,14 @@
-"""Write the evaluation tables into the README from the JSON of `eval recon` / `eval generate` / `eval paraphrase`.
+"""Write the evaluation tables into docs/evaluation.md from the JSON of `eval recon` / `generate` / `paraphrase` / `shape`.
 
     python tools/eval_report.py [--recon out/eval_recon.json] [--untrained out/eval_recon_untrained.json]
                                 [--generate out/eval_generate.json] [--paraphrase out/eval_paraphrase.json]
-                                [--paraphrase-blind out/eval_paraphrase_blind.json] [--readme README.md]
+                                [--paraphrase-blind out/eval_paraphrase_blind.json] [--shape out/eval_shape.json]
+                                [--page docs/evaluation.md]
 
 Each table sits between ``<!-- eval:recon -->`` / ``<!-- /eval:recon -->`` (and ``eval:generate``)
-markers in the README and is replaced whole; the paper's figures stand beside for reference. The
-paraphrase table (``eval:paraphrase``, with the blind set's column when its JSON exists) is written
-only where the README has that block.
+markers in the page and is replaced whole; the paper's figures stand beside for reference. The
+paraphrase table (``eval:paraphrase``, with the blind set's column when its JSON exists) and the shape
+table (``eval:shape``) are written only where the page has that block.
 """
 from __future__ import annotations
 
@@ -135,7 +136,7 @@ def shape_table(res: dict) -> str:
 def replace_block(text: str, name: str, body: str) -> str:
     pattern = re.compile(rf"(<!-- eval:{name} -->\n).*?(\n<!-- /eval:{name} -->)", re.S)
     if not pattern.search(text):
-        raise SystemExit(f"README has no <!-- eval:{name} --> ... <!-- /eval:{name} --> block")
+        raise SystemExit(f"the page has no <!-- eval:{name} --> ... <!-- /eval:{name} --> block")
     return pattern.sub(lambda m: m.group(1) + body + m.group(2), text)
 
 
@@ -147,9 +148,10 @@ def main(argv=None) -> int:
     ap.add_argument("--paraphrase", type=Path, default=ROOT / "out" / "eval_paraphrase.json")
     ap.add_argument("--paraphrase-blind", type=Path, default=ROOT / "out" / "eval_paraphrase_blind.json")
     ap.add_argument("--shape", type=Path, default=ROOT / "out" / "eval_shape.json")
-    ap.add_argument("--readme", type=Path, default=ROOT / "README.md")
+    ap.add_argument("--page", "--readme", dest="page", type=Path, default=ROOT / "docs" / "evaluation.md",
+                    help="the Markdown page holding the marked tables (default docs/evaluation.md)")
     args = ap.parse_args(argv)
-    text = args.readme.read_text(encoding="utf-8")
+    text = args.page.read_text(encoding="utf-8")
     if args.recon.is_file():
         untrained = json.loads(args.untrained.read_text()) if args.untrained.is_file() else None
         text = replace_block(text, "recon", recon_table(json.loads(args.recon.read_text()), untrained))
@@ -162,9 +164,9 @@ def main(argv=None) -> int:
             blind = json.loads(args.paraphrase_blind.read_text()) if args.paraphrase_blind.is_file() else None
             text = replace_block(text, "paraphrase", paraphrase_table(json.loads(args.paraphrase.read_text()), blind))
         else:
-            print(f"{args.readme} has no <!-- eval:paraphrase --> block: paraphrase table not written")
-    atomic_write_text(args.readme, text)
-    print(f"updated the evaluation tables in {args.readme}")
+            print(f"{args.page} has no <!-- eval:paraphrase --> block: paraphrase table not written")
+    atomic_write_text(args.page, text)
+    print(f"updated the evaluation tables in {args.page}")
     return 0
 
 
