@@ -24,6 +24,21 @@ def add_arguments(p):
     p.add_argument("--out", type=Path, required=True, help="output motion file (.npz)")
     p.add_argument("--naive", action="store_true", help="copy the rotations instead of going through the SA-VAE")
     p.add_argument("--body-model", default=None, help="openbody (default) or an SMPL-family file")
+    add_reader_arguments(p)
+
+
+def add_reader_arguments(p):
+    """Overrides of what a mocap file declares (shared with the commands that read mocap)."""
+    p.add_argument("--source-fps", type=float, default=None,
+                   help="read the file at this frame rate instead of its own (BVH Frame Time, AMC rate): for a "
+                        "file whose header is wrong")
+    p.add_argument("--angle-unit", choices=["deg", "rad"], default=None,
+                   help="ASF/AMC: read rotation values in this unit whatever the files declare")
+
+
+def reader_overrides(args) -> dict:
+    return {k: v for k, v in (("source_fps", getattr(args, "source_fps", None)),
+                              ("angle_unit", getattr(args, "angle_unit", None))) if v is not None}
 
 
 def target_betas(body, betas_text: str | None, shape_text: str | None):
@@ -47,11 +62,12 @@ def run(args) -> int:
         raise ShapeMoveError(f"motion file not found: {args.motion}")
     body = load_body_model(args.body_model)
     betas = target_betas(body, args.betas, args.shape_text)
+    read = reader_overrides(args)
     if args.naive:
-        motion = naive_retarget(args.motion, body, betas)
+        motion = naive_retarget(args.motion, body, betas, read=read)
         how = "naive (rotations copied)"
     else:
-        motion = retarget(args.motion, load_vae(args.checkpoint, body), body, betas)
+        motion = retarget(args.motion, load_vae(args.checkpoint, body), body, betas, read=read)
         how = f"SA-VAE, {len(motion.tokens)} tokens"
     save_motion(args.out, motion)
     m = measure(body, motion.betas)

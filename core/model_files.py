@@ -133,6 +133,13 @@ def _check(folder: Path, entries: dict, what: Path) -> None:
                                  f"{folder / MANIFEST}; re-export or re-train the model")
 
 
+def listed_in_manifest(folder, rel: str) -> bool:
+    """Whether ``folder/manifest.json`` lists the file ``rel`` (so the folder was exported with it
+    and its absence is damage, not an older or smaller model)."""
+    manifest = Path(folder) / MANIFEST
+    return manifest.is_file() and rel in _read(manifest)["files"]
+
+
 def _note(path: Path) -> None:
     key = str(path.resolve())
     if key not in _noted:

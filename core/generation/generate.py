@@ -27,7 +27,7 @@ from ..models.text_encoder import load_text_encoder
 from ..scene.motion_file import Motion
 from ..torch_threads import one_torch_thread
 from .decode import decode_features, decode_tokens, redecode
-from .model_bundle import model_files, resolve_model_dir
+from .model_bundle import model_files, part_warnings, resolve_model_dir
 from .prompts import check_prompt
 from .rerank import CandidatePicker
 from .sampling_params import DEFAULT_CANDIDATES, DEFAULT_GUIDANCE, check_candidates, check_guidance, check_sampling
@@ -185,6 +185,8 @@ class Generator:
             motion = self.decode_motion(codes[0], betas, prompt=r.prompt)
             motion.shape_source = source
             motion.warnings = [check.warning] if check is not None and check.warning else []
+            if r.candidates > 1 and r.temperature > 0:  # best-of-N wanted: say when the model cannot pick
+                motion.warnings += part_warnings(self.model_dir)
             motion.prompt_check = check
             out.append(motion)
             if progress is not None:

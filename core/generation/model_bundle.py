@@ -12,6 +12,7 @@ from pathlib import Path
 
 from ..errors import ShapeMoveError
 from ..io.limits import read_json
+from ..model_files import listed_in_manifest
 
 PACKAGE_ROOT = Path(__file__).resolve().parents[2]
 DEFAULT_MODEL_DIR = PACKAGE_ROOT / "weights" / "default"
@@ -28,10 +29,27 @@ def resolve_model_dir(path=None) -> Path:
 
 
 def model_files(d: Path) -> dict:
+    """{"savae", "t5", "tma"} paths of a model folder. No savae.pt is an error; a part the folder's
+    manifest lists but that is gone (e.g. ``tma/tma.pt``) is an error naming it; a part the model
+    works without and never had is a warning (``part_warnings``)."""
     files = {"savae": d / "savae.pt", "t5": d / "t5", "tma": d / "tma" / "tma.pt"}
     if not files["savae"].is_file():
         raise ShapeMoveError(f"{d} has no savae.pt (the SA-VAE): train one with `python -m shapemove train vae`")
+    if not files["tma"].is_file() and listed_in_manifest(d, "tma/tma.pt"):
+        raise ShapeMoveError(f"model file {files['tma']} is missing (listed in {d / 'manifest.json'}): without it "
+                             "best-of-N picking is off and the motions change; copy the model folder again")
     return files
+
+
+def part_warnings(d: Path) -> list[str]:
+    """What a model folder cannot do for lack of an optional part, one sentence each (shown by the
+    CLI and the panel beside the motion): no ``tma/tma.pt`` -> no best-of-N picking."""
+    tma = Path(d) / "tma" / "tma.pt"
+    if tma.is_file():
+        return []
+    return [f"{tma} is missing: best-of-N picking is off (each prompt gets one sample instead of the best of "
+            "several candidates, so motions match their prompts less well); add the model's tma/ folder back "
+            "to turn it on"]
 
 
 MAX_KNOWN_BYTES = 64 << 20  # t5/known_texts.json (50,000 captions at most: a few MB)

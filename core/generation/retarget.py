@@ -61,8 +61,10 @@ def load_vae(checkpoint, body):
     return load_savae(savae_checkpoint(checkpoint), body=body)
 
 
-def source_joints(motion, body=None) -> tuple[np.ndarray, str]:
-    """A mocap file path or a ``Motion22`` -> (T,22,3) joints at 20 fps (metres, Y up), name."""
+def source_joints(motion, body=None, read: dict | None = None) -> tuple[np.ndarray, str]:
+    """A mocap file path or a ``Motion22`` -> (T,22,3) joints at 20 fps (metres, Y up), name.
+    ``read``: the user's overrides of the file's declarations, ``io.mocap.reader_options``
+    keywords (``source_fps``, ``angle_unit``)."""
     from ..data.build import MIN_FRAMES
     from ..io.mocap import load_smpl22
     from ..io.resample import resample_positions
@@ -71,7 +73,7 @@ def source_joints(motion, body=None) -> tuple[np.ndarray, str]:
         path = Path(motion)
         if not path.is_file():
             raise ShapeMoveError(f"motion file not found: {path}")
-        motion = load_smpl22(path, fps=FPS, body_model=body)
+        motion = load_smpl22(path, fps=FPS, body_model=body, **(read or {}))
     if not isinstance(motion, Motion22):
         raise ShapeMoveError("retarget needs a motion file (.bvh, .amc, AMASS .npz) or a Motion22, "
                              f"got {type(motion).__name__}")
@@ -94,15 +96,48 @@ def processor(body, ik_refine_iters: int = 10):
     return ClipProcessor(body, ik_refine_iters=ik_refine_iters)
 
 
+ENCODE_WINDOW = 1024  # feature frames encoded at once (plus the encoder's reach on both sides)
+
+
+def encoder_reach(vae) -> int:
+    """Frames on each side of a token that can change it: the encoder's receptive field (every
+    Conv1d's (kernel - 1) * dilation, in input frames), rounded up to whole tokens."""
+    reach, jump = 0, 1
+    for m in vae.encoder.modules():
+        if isinstance(m, torch.nn.Conv1d):
+            reach += (m.kernel_size[0] - 1) * m.dilation[0] * jump
+            jump *= m.stride[0]
+    down = vae.cfg.downsample
+    return -(-reach // down) * down
+
+
+@torch.no_grad()
+def encode_windowed(vae, x: torch.Tensor, window: int = ENCODE_WINDOW) -> torch.Tensor:
+    """Normalized features (T,D) (T a multiple of the downsampling) -> (T/down,) token indices,
+    encoded ``window`` frames at a time with ``encoder_reach`` frames of context on each side:
+    every token sees what it sees in one pass over the whole take (the same tokens), and memory
+    stays a constant however long the take."""
+    down = vae.cfg.downsample
+    window = max(down, window // down * down)
+    reach, n = encoder_reach(vae), len(x)
+    if n <= window + 2 * reach:
+        return vae.encode(x[None])[1][0]
+    out = []
+    for s in range(0, n, window):
+        lo, hi = max(0, s - reach), min(n, s + window + reach)
+        idx = vae.encode(x[lo:hi][None])[1][0]
+        out.append(idx[(s - lo) // down:(min(n, s + window) - lo) // down])
+    return torch.cat(out)
+
+
 def encode_source(joints: np.ndarray, vae, body, ik_refine_iters: int = 10) -> list[int]:
-    """(T,22,3) source joints -> motion tokens: the builder's canonical features, SA-VAE encoded.
-    T-1 feature rows are cut to a multiple of the VAE's downsampling (4): (T-1)//4 tokens."""
+    """(T,22,3) source joints -> motion tokens: the builder's canonical features, SA-VAE encoded
+    (``encode_windowed``). T-1 feature rows are cut to a multiple of the VAE's downsampling (4):
+    (T-1)//4 tokens."""
     feats = processor(body, ik_refine_iters).process(joints)["norm_joint_vecs"]
     n = len(feats) // vae.cfg.downsample * vae.cfg.downsample
-    x = vae.normalize(torch.as_tensor(feats[:n], dtype=torch.float32))[None]
-    with torch.no_grad():
-        _, indices = vae.encode(x)
-    return [int(i) for i in indices[0]]
+    x = vae.normalize(torch.as_tensor(feats[:n], dtype=torch.float32))
+    return [int(i) for i in encode_windowed(vae, x)]
 
 
 def source_contacts(joints) -> np.ndarray:
@@ -113,13 +148,14 @@ def source_contacts(joints) -> np.ndarray:
     return detect_contacts(joints, FPS)
 
 
-def retarget(motion, vae, body, betas, ik_refine_iters: int = 10, plant_source_contacts: bool = True) -> Motion:
+def retarget(motion, vae, body, betas, ik_refine_iters: int = 10, plant_source_contacts: bool = True,
+             read: dict | None = None) -> Motion:
     """``motion`` (mocap file path or Motion22) performed by the body ``betas`` (10,), through the
     SA-VAE ``vae`` (trained for ``body``). Returns a validated Motion with tokens: 4*((T-1)//4)
     frames at 20 fps. ``plant_source_contacts``: plant the source's contacts (default) rather
-    than the decoder's predicted ones."""
+    than the decoder's predicted ones. ``read``: see ``source_joints``."""
     betas = check_betas(betas)
-    joints, _ = source_joints(motion, body)
+    joints, _ = source_joints(motion, body, read)
     codes = encode_source(joints, vae, body, ik_refine_iters)
     out = decode_tokens(codes, vae, body, betas, ik_refine_iters,
                         contacts=source_contacts(joints) if plant_source_contacts else None)
@@ -141,7 +177,8 @@ def swap_betas_retarget(motion, body, betas, ik_refine_iters: int = 10) -> Motio
                        (sol["root"] - sol["rest"][0]).astype(np.float32), betas, fps=float(FPS))
 
 
-def naive_retarget(motion, body, betas, ik_refine_iters: int = 10, ground: str = "clip") -> Motion:
+def naive_retarget(motion, body, betas, ik_refine_iters: int = 10, ground: str = "clip",
+                   read: dict | None = None) -> Motion:
     """Local rotations copied from the subject's IK onto the body ``betas``; root trajectory
     scaled by the pelvis-height (leg length) ratio; ``ground`` "clip": the clip's lowest mesh
     point put on the floor (one offset for the whole clip: no contact handling), "frame":
@@ -149,7 +186,7 @@ def naive_retarget(motion, body, betas, ik_refine_iters: int = 10, ground: str =
     if ground not in ("clip", "frame"):
         raise ShapeMoveError(f"ground must be 'clip' or 'frame', got {ground!r}")
     betas = check_betas(betas)
-    joints, _ = source_joints(motion, body)
+    joints, _ = source_joints(motion, body, read)
     proc = processor(body, ik_refine_iters)
     sol = proc.solve(joints)
     shaped = proc.pose_on(sol["rotations"], sol["root"], betas, proc.stride_scale(sol["rest"], betas), None)

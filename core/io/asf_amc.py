@@ -22,7 +22,8 @@ import numpy as np
 from ..errors import ShapeMoveError
 from ..geometry.fk import forward_kinematics, joints_from_offsets
 from ..geometry.rotations import euler_matrix
-from .limits import MAX_HIERARCHY_BYTES, MAX_JOINT_FRAMES, check_joint_frames, parse_floats, read_text
+from .limits import (MAX_FRAME_TIME, MAX_HIERARCHY_BYTES, MAX_JOINT_FRAMES, MIN_FRAME_TIME, check_joint_frames,
+                     parse_floats, read_text)
 from .mocap_clip import Mocap, finish_mocap
 from .rig_map import find_rig
 
@@ -199,24 +200,32 @@ def _joint_order(skel: Skeleton):
     return names, np.array(parents, dtype=np.int64), owners
 
 
-def parse_amc(text: str, skel: Skeleton, source="AMC"):
-    """AMC text -> (root values (T, len(root order)), {bone: (T, len(dof))}, radians per angle)."""
+def parse_amc(text: str, skel: Skeleton, source="AMC", angle_unit: str | None = None):
+    """AMC text -> (root values (T, len(root order)), {bone: (T, len(dof))}, radians per angle).
+    Strict: each bone line holds exactly its ASF dof count, once per frame (else a ShapeMoveError
+    naming the line). Angles in radians (``angle rad`` in the ASF or ``:RADIANS``) whose values go
+    beyond +-2 pi on most frames are refused as degrees in disguise; ``angle_unit`` ('deg' or
+    'rad') overrides what the files declare (and that check)."""
+    if angle_unit not in (None, "deg", "rad"):
+        raise ShapeMoveError(f"angle unit must be 'deg' or 'rad', got {angle_unit!r}")
     angle = skel.angle_scale
+    declared = "the ASF (angle rad)" if angle == 1.0 else None
     dofs = {name: len(b.dof) for name, b in skel.bones.items() if b.dof}
     dofs["root"] = len(skel.root_order)
     chunks = {name: [] for name in dofs}
+    seen = dict.fromkeys(dofs, 0)  # frame number in which each bone was last given
     frames = 0
     joints = 2 * len(skel.bones) + 1  # upper bound of bones + End Sites
-    for raw in text.splitlines():
+    for line_no, raw in enumerate(text.splitlines(), 1):
         line = raw.strip()
         if not line or line[0] == "#":
             continue
         if line[0] == ":":
             key = line.upper()
             if key.startswith(":RADIANS"):
-                angle = 1.0
+                angle, declared = 1.0, f"the AMC (:RADIANS, line {line_no})"
             elif key.startswith(":DEGREES"):
-                angle = np.pi / 180
+                angle, declared = np.pi / 180, None
             continue
         name, rest = (line.split(None, 1) + [""])[:2]
         if name.isdigit():
@@ -225,16 +234,27 @@ def parse_amc(text: str, skel: Skeleton, source="AMC"):
                 check_joint_frames(frames, joints, source, "AMC")
             continue
         if frames == 0:
-            raise ShapeMoveError(f"{source}: AMC data before the first frame number: {line[:40]!r}")
+            raise ShapeMoveError(f"{source}: line {line_no}: AMC data before the first frame number: {line[:40]!r}")
         if name not in chunks:
             if name in skel.bones:  # a bone without dof listed with no values is harmless
                 if rest.strip():
-                    raise ShapeMoveError(f"{source}: AMC gives values for {name!r}, which has no dof in the ASF")
+                    raise ShapeMoveError(f"{source}: line {line_no}: AMC gives values for {name!r}, which has no "
+                                         "dof in the ASF")
                 continue
-            raise ShapeMoveError(f"{source}: AMC names bone {name[:40]!r}, which the ASF does not define")
+            raise ShapeMoveError(f"{source}: line {line_no}: AMC names bone {name[:40]!r}, which the ASF does not define")
+        n = len(rest.split())
+        if n != dofs[name]:
+            raise ShapeMoveError(f"{source}: line {line_no}: AMC gives {n} values for {name!r}, expected {dofs[name]} "
+                                 f"per frame (its ASF dof: {' '.join(skel.bones[name].dof) if name in skel.bones else ' '.join(skel.root_order).lower()}): "
+                                 "wrong skeleton or a damaged file")
+        if seen[name] == frames:
+            raise ShapeMoveError(f"{source}: line {line_no}: AMC gives {name!r} twice in frame {frames}")
+        seen[name] = frames
         chunks[name].append(rest)
     if frames == 0:
         raise ShapeMoveError(f"{source}: AMC has no frames")
+    if angle_unit is not None:
+        angle, declared = (1.0 if angle_unit == "rad" else np.pi / 180), None
     values = {}
     for name, lines in chunks.items():
         if len(lines) != frames:
@@ -247,7 +267,27 @@ def parse_amc(text: str, skel: Skeleton, source="AMC"):
             raise ShapeMoveError(f"{source}: AMC values for {name!r} are NaN, inf or absurdly large")
         values[name] = arr.reshape(frames, dofs[name])
     root = values.pop("root")
+    if declared is not None:
+        _check_radians(skel, root, values, source, declared)
     return root, values, angle
+
+
+RADIANS_SHARE = 0.5  # share of frames with a rotation beyond +-2 pi that makes declared radians implausible
+
+
+def _check_radians(skel: Skeleton, root: np.ndarray, values: dict, source, declared: str) -> None:
+    """Refuse rotation values declared in radians that are degrees: beyond +-2 pi on most frames."""
+    cols = [root[:, i] for i, k in enumerate(skel.root_order) if k.startswith("R")]
+    for name, v in values.items():
+        cols += [v[:, i] for i, d in enumerate(skel.bones[name].dof) if d.startswith("r")]
+    if not cols:
+        return
+    big = np.abs(np.stack(cols, 1))
+    share = float((big > 2 * np.pi).any(1).mean())
+    if share > RADIANS_SHARE:
+        raise ShapeMoveError(f"{source}: {declared} declares angles in radians, but on {100 * share:.0f}% of the frames "
+                             f"rotation values go beyond +-2 pi (up to {big.max():.1f}): they look like degrees; pass "
+                             "--angle-unit deg to read them as degrees (or --angle-unit rad to keep radians)")
 
 
 def amc_to_positions(skel: Skeleton, root: np.ndarray, values: dict, angle: float):
@@ -325,13 +365,18 @@ def amc_fps(amc_path, default: float = 120.0) -> float:
     return float(m.group(1)) if m and 1 <= int(m.group(1)) <= 1000 else default
 
 
-def load_amc(path, asf=None, fps: float | None = None, up_axis: str | None = None) -> Mocap:
+def load_amc(path, asf=None, fps: float | None = None, up_axis: str | None = None,
+             angle_unit: str | None = None) -> Mocap:
     """Read an AMC with its ASF into a Mocap (metres, Y up). The up axis is detected for a
-    humanoid we can map (CMU/HDM05 are Y up) and taken as Acclaim's Y otherwise."""
+    humanoid we can map (CMU/HDM05 are Y up) and taken as Acclaim's Y otherwise. ``angle_unit``
+    ('deg'/'rad') overrides the unit the files declare (see ``parse_amc``)."""
     path = Path(path)
+    if fps is not None and not (np.isfinite(fps) and 1.0 / MAX_FRAME_TIME <= fps <= 1.0 / MIN_FRAME_TIME):
+        raise ShapeMoveError(f"source frame rate {fps} must lie between {1 / MAX_FRAME_TIME:g} and "
+                             f"{1 / MIN_FRAME_TIME:g} fps")
     asf_path = Path(asf) if asf else find_asf(path)
     skel = load_asf(asf_path)
-    root, values, angle = parse_amc(_read_text(path, "AMC"), skel, path)
+    root, values, angle = parse_amc(_read_text(path, "AMC"), skel, path, angle_unit)
     names, parents, offsets, positions, rots = amc_to_positions(skel, root, values, angle)
     subject = asf_path.stem[4:] if asf_path.stem.startswith("HDM_") else asf_path.stem
     if up_axis is None and find_rig(names) is None:

@@ -93,6 +93,26 @@ def mocap_to_smpl22(mocap: Mocap, fps: float = FPS, drop_tpose: bool = True) -> 
     return Motion22(joints, float(fps), mocap.source, mocap.subject, offsets, rig.name, int(cut))
 
 
-def load_smpl22(path, fps: float = FPS, body_model=None, drop_tpose: bool = True) -> Motion22:
-    """Any supported mocap file -> Motion22 at ``fps`` (default 20), T-pose lead-in removed."""
-    return mocap_to_smpl22(load_mocap(path, body_model=body_model), fps=fps, drop_tpose=drop_tpose)
+def reader_options(path, source_fps: float | None = None, angle_unit: str | None = None) -> dict:
+    """The user's overrides of what a mocap file declares, as keyword arguments of its reader:
+    ``source_fps`` (BVH Frame Time, AMC frame rate) and ``angle_unit`` ('deg'/'rad', ASF/AMC only).
+    An override the file's format does not have is a ShapeMoveError, not silently ignored."""
+    ext = Path(path).suffix.lower()
+    out = {}
+    if source_fps is not None:
+        if ext not in (".bvh", ".amc"):
+            raise ShapeMoveError(f"{path}: --source-fps applies to BVH and AMC files only")
+        out["fps"] = float(source_fps)
+    if angle_unit is not None:
+        if ext != ".amc":
+            raise ShapeMoveError(f"{path}: --angle-unit applies to ASF/AMC files only")
+        out["angle_unit"] = angle_unit
+    return out
+
+
+def load_smpl22(path, fps: float = FPS, body_model=None, drop_tpose: bool = True, source_fps: float | None = None,
+                angle_unit: str | None = None) -> Motion22:
+    """Any supported mocap file -> Motion22 at ``fps`` (default 20), T-pose lead-in removed.
+    ``source_fps`` / ``angle_unit``: see ``reader_options``."""
+    return mocap_to_smpl22(load_mocap(path, body_model=body_model, **reader_options(path, source_fps, angle_unit)),
+                           fps=fps, drop_tpose=drop_tpose)
