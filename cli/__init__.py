@@ -19,6 +19,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "retarget": ("retarget", "move a motion onto another body through the SA-VAE"),
     "retarget-rig": ("retarget_rig", "bake a motion onto your own armature in a .blend (Rigify, Mixamo, CC, ...)"),
     "generate": ("generate", "text prompt -> body shape and motion (.npz)"),
+    "sequence": ("sequence", "a timeline of prompts -> one motion with a segment per prompt (.npz)"),
     "search": ("search", "rank a folder of motions by a text query (TMA)"),
     "blend": ("blend", "build a .blend scene from a motion (.npz), optionally render a frame"),
     "render": ("render", "generate and render a batch of prompts headless"),
@@ -56,6 +57,8 @@ EXAMPLES: dict[str, str] = {
     "retarget-rig": P + "retarget-rig --motion wave.npz --blend hero.blend --armature Hero --out hero_wave.blend "
                         "--preset mixamo",
     "generate": P + 'generate --prompt "a person waves" --shape-text "a short, slim woman" --seconds 4 --out wave.npz',
+    "sequence": P + 'sequence --prompt "a person walks forward" --seconds 4 --prompt "a person sits down" --seconds 2 '
+                    '--out seq.npz',
     "search": P + 'search --library data/built --query "someone kicks" --top 5',
     "blend": P + "blend --motion wave.npz --out wave.blend --render wave.png",
     "render": P + "render --prompts prompts.txt --out renders/ --frames 4 --resolution 320 320",

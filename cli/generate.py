@@ -1,8 +1,11 @@
 """`python -m shapemove generate --prompt TEXT [--shape-text TEXT] [--betas b0,…,b9] [--seconds S]
-[--seed N] [--temperature T] --out OUT.npz`: text -> body shape + motion file."""
+[--seed N] [--temperature T] [--loop] [--in-place] [--path PATH.json] [--speed X | --stretch S]
+--out OUT.npz`: text -> body shape + motion file (animation options: docs/animation.md)."""
 from __future__ import annotations
 
 from pathlib import Path
+
+import numpy as np
 
 from ..core.atomic import ensure_parent
 from ..core.errors import ShapeMoveError
@@ -28,6 +31,31 @@ def add_arguments(p):
     p.add_argument("--model", type=Path, default=None, help="model folder (default: the embedded default model)")
     p.add_argument("--body-model", default=None, help="openbody (default) or a path to SMPL-family model files")
     p.add_argument("--out", type=Path, required=True)
+    add_animation_arguments(p)
+
+
+def add_animation_arguments(p):
+    """The animation options (docs/animation.md), shared with ``render``'s defaults."""
+    g = p.add_argument_group("animation")
+    g.add_argument("--loop", action="store_true",
+                   help="a cycle whose last frame flows into its first (--seconds: the cycle's length)")
+    g.add_argument("--in-place", action="store_true", help="remove the root's horizontal travel (facing kept)")
+    g.add_argument("--path", type=Path, default=None,
+                   help="JSON list of [x, z] points (metres, Y up) to walk along; the length follows the path "
+                        "unless --seconds is given")
+    g.add_argument("--speed", type=float, default=None, help="play 0.5 to 2 times as fast (feet re-planted)")
+    g.add_argument("--stretch", type=float, default=None, metavar="SECONDS",
+                   help="stretch or squeeze the motion to this many seconds (feet re-planted)")
+
+
+def animation_of(args):
+    """The ``Animation`` of parsed arguments (checked before any model loads)."""
+    from ..core.generation.animate import Animation, check_animation
+    from ..core.generation.path_follow import read_path
+
+    return check_animation(Animation(loop=args.loop, in_place=args.in_place,
+                                     path=read_path(args.path) if args.path is not None else None,
+                                     speed=args.speed, stretch=args.stretch))
 
 
 def run(args) -> int:
@@ -43,11 +71,13 @@ def run(args) -> int:
     guidance = check_guidance(args.guidance)
     ensure_parent(args.out)  # a parent that is a file, or no permission: said now, not after generating
     betas = parse_betas(args.betas) if args.betas else None
+    animation = animation_of(args)
     gen = Generator(args.model, body=args.body_model)
+    from ..core.generation.animate import animate
     from ..core.generation.generate import Request
 
-    motion = gen.generate_batch([Request(args.prompt, args.shape_text, betas, args.seconds, args.seed, args.temperature,
-                                         args.top_k, args.shape_from, candidates, guidance)])[0]
+    motion = animate(gen, Request(args.prompt, args.shape_text, betas, args.seconds, args.seed, args.temperature,
+                                  args.top_k, args.shape_from, candidates, guidance), animation)
     save_motion(args.out, motion)
     import sys
 
@@ -55,6 +85,8 @@ def run(args) -> int:
         print(f"warning: {w}", file=sys.stderr)
     m = measure(gen.body, motion.betas)
     print(f"wrote {args.out}: {motion.num_frames} frames ({motion.num_frames / motion.fps:.1f} s), "
-          f"{len(motion.tokens)} tokens, IK error {motion.ik_error_cm:.2f} cm")
+          f"{len(motion.tokens) if motion.tokens is not None else 0} tokens, IK error {motion.ik_error_cm:.2f} cm")
+    if motion.loop_advance is not None:
+        print(f"loop: the root advances {float(np.linalg.norm(motion.loop_advance[[0, 2]])):.2f} m per cycle")
     print(f"body ({motion.shape_source or '[BETA] head'}): " + ", ".join(f"{k.replace('_cm', '')} {v:.0f} cm" for k, v in m.items()))
     return 0

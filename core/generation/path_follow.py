@@ -103,7 +103,7 @@ class Polyline:
         return d[np.arange(len(xz)), i], self.yaw[i]
 
 
-def speed(motion_or_joints, fps: float = FPS) -> float:
+def motion_speed(motion_or_joints, fps: float = FPS) -> float:
     """Mean speed (m/s) of the smoothed root along its own course."""
     joints = motion_or_joints.joints if isinstance(motion_or_joints, Motion) else motion_or_joints
     s = travel(joints)
@@ -135,7 +135,7 @@ def follow_track(track: Track, line: Polyline, crop: bool = True) -> Track:
 def follow_path(motion: Motion, body, path, crop: bool = True, ik_refine_iters: int = 10) -> Motion:
     """``motion`` walked along ``path`` ((N,2) [x, z] points or a ``Polyline``), feet re-planted."""
     line = path if isinstance(path, Polyline) else Polyline(path)
-    v = speed(track_of(motion).joints, motion.fps)
+    v = motion_speed(track_of(motion).joints, motion.fps)
     if v < MIN_SPEED:
         raise ShapeMoveError(f"this motion travels {v:.2f} m/s: following a path needs a motion that moves "
                              "forward, e.g. 'a person walks forward'")
@@ -145,28 +145,34 @@ def follow_path(motion: Motion, body, path, crop: bool = True, ik_refine_iters: 
     return out
 
 
-def generate_along_path(gen, req, path, progress=None) -> Motion:
+def generate_along_path(gen, req, path, progress=None, speed: float | None = None) -> Motion:
     """``req`` (a ``generate.Request``) walked along ``path``. Without ``req.seconds`` the length
     follows the path: a first motion measures the prompt's speed, and when it does not reach the
-    end, a second one of the length the path needs (<= 60 s) replaces it."""
+    end, a second one of the length the path needs (<= 60 s) replaces it. ``speed`` (0.5..2):
+    the motion is played that much faster before it walks the path (``time_warp``)."""
+    from .time_warp import time_warp
+
     line = path if isinstance(path, Polyline) else Polyline(path)
     fixed = req.seconds is not None
     motion = gen.generate_batch([req])[0]
-    v = speed(track_of(motion).joints, motion.fps)
+    factor = 1.0 if speed is None else float(speed)
+    v = motion_speed(track_of(motion).joints, motion.fps) * factor
     if v < MIN_SPEED:
         raise ShapeMoveError(f"{req.prompt!r} travels {v:.2f} m/s: following a path needs a prompt that moves "
                              "forward, e.g. 'a person walks forward'")
     if not fixed and travel(track_of(motion).joints)[-1] < line.length:
         need = line.length / v * 1.1 + 0.5
-        if need > 60:
+        if need * factor > 60:
             raise ShapeMoveError(f"walking {line.length:.1f} m at {v:.2f} m/s takes {need:.0f} s, over 60 s: "
                                  "use a shorter path or give --seconds")
         if progress is not None:
             progress(0.5, f"a {need:.1f} s motion for a {line.length:.1f} m path")
-        req.seconds = need
+        req.seconds = need * factor
         motion = gen.generate_batch([req])[0]
         req.seconds = None
     warnings = list(motion.warnings)
+    if speed is not None:
+        motion = time_warp(motion, gen.body, speed=speed, ik_refine_iters=gen.ik_refine_iters)
     out = follow_path(motion, gen.body, line, crop=not fixed, ik_refine_iters=gen.ik_refine_iters)
     out.warnings = warnings + out.warnings
     out.shape_source = motion.shape_source
