@@ -16,9 +16,11 @@ RUNNING: dict[str, str] = {}  # panel kind ("generate", "train", ...) -> its run
 
 def _ensure_ops() -> None:
     """The in-process runner serves ``core.worker.ops.JOBS``: add the panel ops to it."""
+    from ..core.worker.jobs_animation import OPS as animation_ops
     from ..core.worker.jobs_shapemove import register
 
     register(ops.JOBS)
+    ops.JOBS.update(animation_ops)
 
 
 def _auto_python() -> bool:

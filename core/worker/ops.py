@@ -117,9 +117,11 @@ def default_jobs() -> dict:
     ``panel_ops_problem()`` says why."""
     if not _PANEL_OPS:
         try:
+            from .jobs_animation import OPS as animation_ops  # loop, path, timeline (docs/animation.md)
             from .jobs_shapemove import register as add_panel_ops
 
             add_panel_ops(JOBS)
+            JOBS.update(animation_ops)
             _PANEL_OPS.append("")
         except ModuleNotFoundError as exc:
             _PANEL_OPS.append(f"the panel ops (generate, train, ...) need the Python package {exc.name!r}, "

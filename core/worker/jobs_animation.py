@@ -1,0 +1,85 @@
+"""Worker ops of the animation features (docs/animation.md), for the Blender panel:
+
+- ``animate``: the ``generate`` op's params plus "loop", "in_place", "path" ([[x, z], ...] metres,
+  Y up), "speed", "stretch" -> the motion file written and its facts;
+- ``sequence``: {"segments": [{"prompt", "seconds"}, ...], "shape_text", "betas", "seed", "model",
+  "body", "out"} -> a timeline motion; with "regenerate": K (0-based) and "motion" (a timeline
+  file) segment K is sampled again with "seed" and the others are kept.
+"""
+from __future__ import annotations
+
+from ..errors import ShapeMoveError
+from ..scene.motion_file import load_motion, save_motion
+from .jobs_shapemove import _betas, _generator, _measurements, _motion_facts, _out_path
+from .op_support import JobCancelled, param
+
+
+def _facts(out, motion, body) -> dict:
+    facts = {**_motion_facts(out, motion), "measurements": _measurements(body, motion.betas),
+             "ik_error_cm": float(motion.ik_error_cm or 0.0), "warnings": list(motion.warnings)}
+    if motion.loop_advance is not None:
+        facts["loop_advance"] = [float(v) for v in motion.loop_advance]
+    if motion.segment_bounds is not None:
+        facts["segments"] = [{"prompt": p, "start": int(s), "end": int(e)}
+                             for p, (s, e) in zip(motion.segment_prompts, motion.segment_bounds)]
+    return facts
+
+
+def animate(params, progress, cancel) -> dict:
+    from ..generation.animate import animation_from, animate as _animate
+    from ..generation.generate import Request
+
+    op = "animate"
+    out = _out_path(params, op)
+    options = animation_from({k: params.get(k) for k in ("loop", "in_place", "path", "speed", "stretch")})
+    req = Request(prompt=param(params, op, "prompt", str), shape_text=param(params, op, "shape_text", str, None) or None,
+                  betas=_betas(params, op), seconds=param(params, op, "seconds", (int, float), None),
+                  seed=int(param(params, op, "seed", int, 0)),
+                  temperature=float(param(params, op, "temperature", (int, float), 1.0)),
+                  top_k=param(params, op, "top_k", int, 50))
+    progress(0.05, "loading models")
+    gen = _generator(param(params, op, "model", str, None), param(params, op, "body", str, None))
+    if cancel():
+        raise JobCancelled
+    try:
+        motion = _animate(gen, req, options, progress=lambda f, m: progress(0.1 + 0.8 * f, m), cancel=cancel)
+    except ShapeMoveError as exc:
+        if cancel() and "cancelled" in str(exc):
+            raise JobCancelled from None
+        raise
+    save_motion(out, motion)
+    progress(1.0, "done")
+    return _facts(out, motion, gen.body)
+
+
+def sequence(params, progress, cancel) -> dict:
+    from ..generation.sequence import generate_sequence, regenerate_segment
+
+    op = "sequence"
+    out = _out_path(params, op)
+    seed = int(param(params, op, "seed", int, 0))
+    regen = param(params, op, "regenerate", int, None)
+    progress(0.05, "loading models")
+    gen = _generator(param(params, op, "model", str, None), param(params, op, "body", str, None))
+    if regen is not None:
+        motion = regenerate_segment(gen, load_motion(param(params, op, "motion", str)), regen, seed,
+                                    param(params, op, "prompt", str, None) or None,
+                                    param(params, op, "seconds", (int, float), None))
+    else:
+        segs = param(params, op, "segments", list)
+        if not all(isinstance(s, dict) and "prompt" in s and "seconds" in s for s in segs):
+            raise ShapeMoveError("op 'sequence': 'segments' must be a list of {\"prompt\", \"seconds\"} objects")
+        try:
+            motion = generate_sequence(gen, [(s["prompt"], s["seconds"]) for s in segs],
+                                       param(params, op, "shape_text", str, None) or None, _betas(params, op), seed,
+                                       progress=lambda f, m: progress(0.1 + 0.85 * f, m), cancel=cancel)
+        except ShapeMoveError as exc:
+            if cancel() and "cancelled" in str(exc):
+                raise JobCancelled from None
+            raise
+    save_motion(out, motion)
+    progress(1.0, "done")
+    return _facts(out, motion, gen.body)
+
+
+OPS = {"animate": animate, "sequence": sequence}
