@@ -1,10 +1,11 @@
 """The README's picture: a few prompts on different bodies, generated with a model folder (the embedded
 default model unless --model) and rendered headless the same way as `python -m shapemove render`
 (``shapemove_addon.headless.build_scene_file``: Workbench preview strip), one row per prompt with its
-texts and the body's measured height above it.
+texts and the body's measured height above it (two lines, large enough to read when the README
+shows the picture at about half size).
 
     python tools/contact_sheet.py [--model weights/default] [--out docs/contact_sheet.png]
-                                  [--frames 4] [--size 240] [--seed 0]
+                                  [--frames 3] [--size 200] [--seed 0]
 
 Needs bpy and Pillow (both installed by `make setup`). Takes about a minute on a CPU.
 """
@@ -23,12 +24,13 @@ SHEET = [
     ("somebody crouches down and stands back up", "a stocky man"),
     ("a person walks forward", "a very tall, lanky person"),
 ]
-LABEL_H = 28
+FONT_SIZE = 20
+LABEL_H = 2 * FONT_SIZE + 16  # two lines of text
 BACKGROUND = (255, 255, 255)
 
 
 def render_rows(model, frames: int, size: int, seed: int, tmp: Path) -> list[tuple[Path, str]]:
-    """One preview strip per SHEET row: (png, label)."""
+    """One preview strip per SHEET row: (png, two-line label)."""
     from shapemove.core.body.measure import measure
     from shapemove.core.generation.generate import Generator
     from shapemove.shapemove_addon.headless import build_scene_file
@@ -40,9 +42,9 @@ def render_rows(model, frames: int, size: int, seed: int, tmp: Path) -> list[tup
         png = tmp / f"{i}.png"
         build_scene_file(motion, gen.body, tmp / f"{i}.blend", png, frames=frames, resolution=(size, size))
         height = measure(gen.body, motion.betas)["height_cm"]
-        label = f'"{prompt}"  /  "{shape}"  ({height:.0f} cm, {motion.num_frames / motion.fps:.1f} s)'
+        label = f'"{prompt}"\n"{shape}": {height:.0f} cm, {motion.num_frames / motion.fps:.1f} s'
         rows.append((png, label))
-        print(f"{i + 1}/{len(SHEET)} {label}")
+        print(f"{i + 1}/{len(SHEET)} " + label.replace("\n", "  /  "))
     return rows
 
 
@@ -55,12 +57,12 @@ def compose(rows: list[tuple[Path, str]], out: Path) -> Path:
     sheet = Image.new("RGB", (width, sum(s.height + LABEL_H for s in strips)), BACKGROUND)
     draw = ImageDraw.Draw(sheet)
     try:
-        font = ImageFont.load_default(size=15)
+        font = ImageFont.load_default(size=FONT_SIZE)
     except TypeError:  # Pillow < 10.1: one fixed size
         font = ImageFont.load_default()
     y = 0
     for strip, (_, label) in zip(strips, rows):
-        draw.text((8, y + 6), label, fill=(20, 20, 20), font=font)
+        draw.multiline_text((8, y + 5), label, fill=(20, 20, 20), font=font, spacing=4)
         sheet.paste(strip, (0, y + LABEL_H))
         y += strip.height + LABEL_H
     out.parent.mkdir(parents=True, exist_ok=True)
@@ -72,8 +74,8 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--model", type=Path, default=ROOT / "weights" / "default")
     ap.add_argument("--out", type=Path, default=ROOT / "docs" / "contact_sheet.png")
-    ap.add_argument("--frames", type=int, default=4, help="frames per prompt")
-    ap.add_argument("--size", type=int, default=240, help="pixels per frame (square)")
+    ap.add_argument("--frames", type=int, default=3, help="frames per prompt")
+    ap.add_argument("--size", type=int, default=200, help="pixels per frame (square)")
     ap.add_argument("--seed", type=int, default=0)
     args = ap.parse_args(argv)
     with tempfile.TemporaryDirectory() as tmp:
