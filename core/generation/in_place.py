@@ -13,13 +13,12 @@ import dataclasses
 import numpy as np
 
 from ..scene.motion_file import Motion
+from ..scene.root_motion import root_travel as travel_of_joints
 
 
 def root_travel(motion: Motion) -> np.ndarray:
     """(T,3) horizontal offset of the root from its first frame (y = 0)."""
-    d = np.zeros((motion.num_frames, 3), np.float64)
-    d[:, [0, 2]] = motion.joints[:, 0, [0, 2]] - motion.joints[0, 0, [0, 2]]
-    return d
+    return travel_of_joints(motion.joints)
 
 
 def root_drift(motion: Motion) -> float:
