@@ -54,6 +54,9 @@ class T5Size:
     dropout_rate: float = 0.1
     sentence_token: bool = False   # MiniLM reader: add the pooled sentence vector as a memory slot
     text_dropout: float = 0.0      # MiniLM reader: share of training prompts read from that slot alone
+    memory_k: int = 0              # MiniLM reader: retrieved clips read as memory (motion_memory.py); 0 = none
+    memory_codes: int = 40         # tokens kept of each retrieved clip (40 = 8 s)
+    memory_dropout: float = 0.0    # share of training prompts given no retrieved clips
 
     @classmethod
     def tiny(cls) -> "T5Size":
@@ -82,6 +85,13 @@ class MiniLMDecoder(nn.Module):
         if config.sentence_token:
             self.sentence_proj = nn.Sequential(nn.Linear(text_dim, d), nn.LayerNorm(d))
         self.decoder = T5Decoder(config)
+        if getattr(config, "memory_k", 0):
+            # retrieved clips' tokens: the decoder's own token embedding (so a code can be copied)
+            # + position in the clip + rank of the clip + its caption's similarity to the prompt
+            self.memory_pos = nn.Embedding(config.memory_codes, d)
+            self.memory_rank = nn.Embedding(config.memory_k, d)
+            self.memory_sim = nn.Linear(1, d)
+            self.memory_norm = nn.LayerNorm(d)
         self.lm_head = nn.Linear(d, config.vocab_size, bias=False)
 
     @staticmethod
@@ -91,10 +101,32 @@ class MiniLMDecoder(nn.Module):
         return T5DecoderConfig(vocab_size=vocab_size, d_model=size.d_model, d_ff=size.d_ff, d_kv=size.d_kv,
                                num_heads=size.num_heads, num_layers=size.num_decoder_layers,
                                dropout_rate=size.dropout_rate, sentence_token=size.sentence_token,
-                               text_dropout=size.text_dropout)
+                               text_dropout=size.text_dropout, memory_k=size.memory_k,
+                               memory_codes=size.memory_codes, memory_dropout=size.memory_dropout)
 
-    def encode(self, states, mask, segments):
-        """Memory (B, L', d) and its mask: the projected token states (+ segment embedding), led by
+    def encode(self, states, mask, segments, memory_ids=None, memory_sims=None):
+        """Memory (B, L', d) and its mask: the text (``encode_text``) followed, when the model reads
+        retrieved clips, by their tokens (``memory_ids`` (B, k, C) vocab ids, -1 empty; ``memory_sims``
+        (B, k) cosine similarity of each clip's caption to the prompt)."""
+        enc, mask = self.encode_text(states, mask, segments)
+        k = getattr(self.config, "memory_k", 0)
+        if not k or memory_ids is None:
+            return enc, mask
+        B, kk, C = memory_ids.shape
+        if kk != k or C > self.config.memory_codes:
+            raise ShapeMoveError(f"retrieval memory of {kk} clips x {C} codes given; the model reads "
+                                 f"{k} x {self.config.memory_codes}")
+        present = memory_ids >= 0
+        if self.training and self.config.memory_dropout > 0:
+            drop = torch.rand(B, device=present.device) < self.config.memory_dropout
+            present = present & ~drop[:, None, None]
+        tok = self.decoder.embed_tokens(memory_ids.clamp(min=0))
+        tok = tok + self.memory_pos.weight[:C][None, None] + self.memory_rank.weight[None, :, None]
+        mem = self.memory_norm(tok) + self.memory_sim(memory_sims[..., None].to(tok))[:, :, None]
+        return torch.cat([enc, mem.reshape(B, k * C, -1)], 1), torch.cat([mask, present.reshape(B, k * C)], 1)
+
+    def encode_text(self, states, mask, segments):
+        """Text memory (B, L', d) and its mask: the projected token states (+ segment embedding), led by
         the motion text's pooled sentence vector when ``config.sentence_token``. MiniLM was trained
         so that paraphrases have near sentence vectors; hiding the motion text's token states from a
         share (``text_dropout``) of training prompts makes the decoder read that vector, which
@@ -126,6 +158,21 @@ class ShapeMoveT5(nn.Module):
         self.beta_weight = beta_weight
         self.encoder_kind = encoder
         self.info: dict = {}
+        self.memory = None  # motion_memory.MotionMemory the decoder reads, when it was trained with one
+
+    @property
+    def memory_k(self) -> int:
+        return int(getattr(self.lm.config, "memory_k", 0)) if self.encoder_kind == "minilm" else 0
+
+    def memory_inputs(self, reader, motion_texts: list[str], exclude=None, rng=None) -> tuple:
+        """(ids (B, k, C), sims (B, k)) of the clips retrieved for each motion text (none for the
+        null prompt). ``exclude``: per text, clip families to leave out (training)."""
+        if self.memory is None:
+            raise ShapeMoveError("this model reads retrieved clips but has no motion memory "
+                                 "(motion_memory.json/.safetensors missing from its folder)")
+        return self.memory.lookup(reader, motion_texts, self.memory_k, self.lm.config.memory_codes,
+                                  self.vocab.first_code_id, exclude, rng,
+                                  empty=[t == NULL_PROMPT for t in motion_texts])
 
     @property
     def d_model(self) -> int:
@@ -172,7 +219,8 @@ class ShapeMoveT5(nn.Module):
         """The encoder inputs of a batch of prompts. ``reader``: the T5's tokenizer, or for MiniLM
         the TextEncoder / a StateCache of it."""
         if self.encoder_kind == "minilm":
-            return minilm_inputs(reader, motion_texts, shape_texts)
+            inputs = minilm_inputs(reader, motion_texts, shape_texts)
+            return inputs + self.memory_inputs(reader, motion_texts) if self.memory_k else inputs
         enc = reader([shapemove_prompt(m, s) for m, s in zip(motion_texts, shape_texts)], return_tensors="pt",
                      padding=True, truncation=True, max_length=256)
         return enc.input_ids, enc.attention_mask
@@ -210,12 +258,13 @@ class ShapeMoveT5(nn.Module):
         return self.beta_head(self.beta_state(inputs))
 
     # -- training -----------------------------------------------------------------------------
-    def forward(self, inputs_a, inputs_b, labels, betas=None, segments=None):
+    def forward(self, inputs_a, inputs_b, labels, betas=None, segments=None, memory=None):
         """``inputs_a``, ``inputs_b``: input ids + attention mask (T5), or MiniLM states + mask with
         ``segments`` (minilm). labels (B,L): [BETA] [SOM] codes [EOM] </s>, padded with -100 (text
-        targets for the motion-to-text task have no [BETA]). Returns dict(loss, ce, l1, betas_pred)."""
+        targets for the motion-to-text task have no [BETA]). ``memory``: (ids, sims) of the retrieved
+        clips (``memory_inputs``) for a model that reads them. Returns dict(loss, ce, l1, betas_pred)."""
         if self.encoder_kind == "minilm":
-            enc, mask = self.lm.encode(inputs_a, inputs_b, segments)
+            enc, mask = self.lm.encode(inputs_a, inputs_b, segments, *(memory or ()))
             start = torch.full_like(labels[:, :1], self.vocab.pad_id)
             dec_in = torch.cat([start, labels[:, :-1].masked_fill(labels[:, :-1] < 0, self.vocab.pad_id)], 1)
             logits, hidden, _ = self.lm.step(enc, mask, dec_in)
@@ -239,7 +288,8 @@ class ShapeMoveT5(nn.Module):
         return {"loss": ce + self.beta_weight * l1, "ce": ce.detach(), "l1": l1.detach(), "betas_pred": pred}
 
     # -- persistence --------------------------------------------------------------------------
-    def save(self, directory: Path, tokenizer=None, meta: dict | None = None, known: dict | None = None) -> None:
+    def save(self, directory: Path, tokenizer=None, meta: dict | None = None, known: dict | None = None,
+             memory=None) -> None:
         """Atomic: written into ``directory.tmp`` then renamed over ``directory``. ``known``: the
         training captions/actions and their MiniLM vectors (``known_texts.py``)."""
         import shutil
@@ -270,6 +320,8 @@ class ShapeMoveT5(nn.Module):
             from .known_texts import write_known
 
             write_known(tmp, known)
+        if memory is not None:
+            memory.save(tmp)
         (tmp / "shapemove.json").write_text(json.dumps(info, indent=2, default=str))
         write_manifest(tmp)  # sha256 of every file: loading refuses a damaged or swapped file
         old = directory.with_name(directory.name + ".old")
@@ -332,6 +384,18 @@ class ShapeMoveT5(nn.Module):
             head.load_state_dict({k: v.float() for k, v in load_file(str(directory / "beta_head.safetensors")).items()})
         model = cls(lm, head, vocab, info.get("beta_weight", 1.0), encoder)
         model.info = info
+        if model.memory_k:
+            from .motion_memory import MEMORY_JSON, MEMORY_TENSORS, MotionMemory
+
+            model.memory = MotionMemory.load(directory)
+            if model.memory is None:
+                raise ShapeMoveError(f"{directory}: this model reads retrieved clips but {MEMORY_JSON} and "
+                                     f"{MEMORY_TENSORS} are missing; copy the whole model folder again")
+            bad = [c for c, t in zip(model.memory.clip_ids, model.memory.clip_tokens)
+                   if len(t) and (t.min() < 0 or t.max() >= vocab.num_codes)]
+            if bad:
+                raise ShapeMoveError(f"{directory}: {MEMORY_TENSORS} holds codes outside the model's "
+                                     f"{vocab.num_codes} (clip {bad[0]}); copy the model folder again")
         return model.eval(), reader
 
 

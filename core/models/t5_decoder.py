@@ -37,6 +37,12 @@ class T5DecoderConfig:
     # states are hidden so that the decoder learns to read that sentence vector
     sentence_token: bool = False
     text_dropout: float = 0.0
+    # retrieval memory (shapemove_t5.MiniLMDecoder, ``motion_memory.py``): the motion tokens of the
+    # ``memory_k`` clips whose captions are nearest to the prompt, ``memory_codes`` each, read as extra
+    # cross-attention memory; ``memory_dropout``: share of training prompts given none
+    memory_k: int = 0
+    memory_codes: int = 40
+    memory_dropout: float = 0.0
 
     def to_json_string(self) -> str:
         return json.dumps({"model_type": "t5-decoder", **asdict(self)}, indent=2)

@@ -33,29 +33,40 @@ def head_loss(head, states: torch.Tensor, betas: torch.Tensor, measure, weight: 
 
 
 def synthetic_bodies(body, girths, seed: int, n: int) -> tuple[list[str], torch.Tensor]:
-    """A pool of ``n`` NEW bodies (the shape augmentation without a clip), the same for a seed:
-    betas ~ N(0,1) clipped to +-2.5, measured (``fast_measure``: exact height and lengths, girths
-    from ``girths``), each described by one of the dataset's shape texts (the long sentence, a
-    short numeric text or size words). (shape texts, (n, 10) betas). The head phase encodes the
-    pool once and draws from it, so each step costs no text encoding."""
+    """A pool of ``n`` NEW bodies, the same for a seed: drawn from phenotypes (gender, age, muscle,
+    weight, height: ``body.phenotype_sample``) when the body model has a phenotype map, else betas
+    ~ N(0,1) clipped to +-2.5; measured (``fast_measure``: exact height and lengths, girths from
+    ``girths``); each described either in the words people use (``phenotype_texts``: "a muscular
+    young man", "a 72-year-old woman, slim", "a man, 6 ft 2, 200 lb") or by one of the dataset's
+    measurement texts (the long sentence, a short numeric text or size words). (shape texts,
+    (n, 10) betas). The head phase encodes the pool once and draws from it."""
     import random
 
     import numpy as np
 
     from ..body.measure import MEASUREMENTS
+    from ..body.phenotype_sample import sample_bodies
     from ..body.shape_from_measurements import fast_measure
+    from ..data.phenotype_captions import phenotype_texts
     from ..data.shape_text import adjective_shape_text, numeric_shape_text, shape_sentence
 
     rng = random.Random(seed)
-    b = np.clip(np.random.default_rng(seed).standard_normal((n, body.num_betas)), -2.5, 2.5)
+    pmap = getattr(body, "phenotype_map", None)
+    if pmap is not None:
+        pheno, b = sample_bodies(pmap, seed, n, pmap.r2)
+    else:
+        pheno, b = None, np.clip(np.random.default_rng(seed).standard_normal((n, body.num_betas)), -2.5, 2.5)
     m = fast_measure(body, b, MEASUREMENTS, girths)
     shapes = []
     for i in range(n):
         mi = {k: float(m[i, j]) for j, k in enumerate(MEASUREMENTS)}
-        key, kind = f"synthetic/{seed}/{i}", rng.randrange(3)
-        shapes.append(shape_sentence(mi) if kind == 0 else numeric_shape_text(mi, key) if kind == 1
-                      else adjective_shape_text(mi, key))
-    return shapes, torch.as_tensor(b, dtype=torch.float32)
+        key, kind = f"synthetic/{seed}/{i}", rng.randrange(6)
+        if pheno is not None and kind >= 3:
+            shapes.append(phenotype_texts(dict(zip(pmap.names, pheno[i])), mi, key, 1)[0])
+        else:
+            shapes.append(shape_sentence(mi) if kind == 0 else numeric_shape_text(mi, key) if kind == 1
+                          else adjective_shape_text(mi, key))
+    return shapes, torch.as_tensor(np.asarray(b), dtype=torch.float32)
 
 
 class HeadExamples:

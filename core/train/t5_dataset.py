@@ -56,6 +56,21 @@ def all_texts(root: Path, ids: list[str]) -> list[str]:
     return texts
 
 
+def body_words(meta: dict, betas: np.ndarray, key: str, n: int = 3) -> list[str]:
+    """Shape texts of a clip's body in phenotype words (``phenotype_captions``): from the phenotype
+    it was drawn from (augmented copies), else the OpenBody phenotype read back from its betas."""
+    from ..body.load import load_body_model
+    from ..data.phenotype_captions import phenotype_texts
+
+    pmap = getattr(load_body_model(None), "phenotype_map", None)
+    pheno = meta.get("phenotype")
+    if pheno is None:
+        if pmap is None:
+            return []
+        pheno = dict(zip(pmap.names, pmap.from_betas(betas)))
+    return phenotype_texts(pheno, meta.get("measure") or {}, key, n)
+
+
 def clip_weights(ids: list[str], labels: dict, balance: float) -> np.ndarray:
     """Sampling weight per clip: 1 / (clips sharing its main action) ** ``balance``. 0 draws every
     clip equally (common actions dominate: thousands of Bandai hand raises against five
@@ -84,6 +99,12 @@ class T2MExamples:
         self.bank_share = bank_share
         self.null_share = null_share  # share of examples whose motion text is NULL_PROMPT (guidance)
         self.cumulative = clip_weights(self.ids, self.labels, action_balance).cumsum()
+        from ..data.built_meta import clip_meta
+        from ..models.motion_memory import family
+
+        self.family = {c: family(c, clip_meta(root, c)) for c in self.ids}  # left out of its own retrieval
+        for c in self.ids:  # the body also in the words people use (man/woman, age, build, weight)
+            self.shapes[c] = self.shapes[c] + body_words(clip_meta(root, c), self.betas[c], c)
 
     def __len__(self) -> int:
         return len(self.ids)
@@ -105,7 +126,8 @@ class T2MExamples:
         shapes = self.shapes[cid]
         shape = None if (not shapes or rng.random() < self.no_shape_share) else rng.choice(shapes)
         return {"input": shapemove_prompt(caption, shape), "codes": codes.tolist(), "text": None,
-                "betas": self.betas[cid], "key": caption, "motion_text": caption, "shape_text": shape}
+                "betas": self.betas[cid], "key": caption, "motion_text": caption, "shape_text": shape,
+                "family": self.family[cid]}
 
 
 def collate(examples: list[dict], tok, vocab, max_input: int = 160):
@@ -115,15 +137,21 @@ def collate(examples: list[dict], tok, vocab, max_input: int = 160):
     return enc.input_ids, enc.attention_mask, labels, betas
 
 
-def collate_minilm(examples: list[dict], states, vocab):
-    """MiniLM encoder: ((states, mask, segments), labels, betas); ``states``: a StateCache."""
+def collate_minilm(examples: list[dict], states, vocab, model=None, rng: random.Random | None = None):
+    """MiniLM encoder: ((states, mask, segments), labels, betas, memory); ``states``: a StateCache;
+    ``memory``: for a ``model`` that reads retrieved clips, those of each example's caption (its own
+    clip's family left out, ``rng`` choosing among clips that share a caption), else None."""
     from ..models.shapemove_t5 import minilm_inputs
 
     if any(e["codes"] is None for e in examples):
         raise ShapeMoveError("motion-to-text examples need the T5 encoder (set m2t_share to 0 for MiniLM)")
     inputs = minilm_inputs(states, [e["motion_text"] for e in examples], [e["shape_text"] for e in examples])
     labels, betas = _targets(examples, None, vocab)
-    return inputs, labels, betas
+    memory = None
+    if model is not None and model.memory_k:
+        memory = model.memory_inputs(states, [e["motion_text"] for e in examples],
+                                     exclude=[e.get("family", frozenset()) for e in examples], rng=rng)
+    return inputs, labels, betas, memory
 
 
 def _targets(examples: list[dict], tok, vocab):

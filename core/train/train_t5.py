@@ -181,6 +181,10 @@ def _train(data, vae_path, out, c, base_model, resume, dist, progress, cancel, v
         states.add(all_texts(data, train_ids), progress=dist.is_main and verbose)
         tok = states
         model = ShapeMoveT5.build_minilm(num_codes, size_from_dict(c.size), beta_weight=c.beta_weight)
+        if model.memory_k:  # the training clips' tokens, read back by caption similarity
+            from ..models.motion_memory import MotionMemory
+
+            model.memory = MotionMemory.from_dataset(data, train_ids, tokens, states)
     else:
         tok_dir = out / "tokenizer"
         if (tok_dir / "tokenizer.json").is_file():
@@ -238,7 +242,7 @@ def _train(data, vae_path, out, c, base_model, resume, dist, progress, cancel, v
             from ..models.known_texts import build_known
 
             raw.save(out / "t5", None if c.encoder == "minilm" else tok, meta | {"step": step},
-                     known=build_known(data, train_ids, states))
+                     known=build_known(data, train_ids, states), memory=raw.memory)
 
     log = StepLog(out, total, step, dist, progress, "train t5", verbose)
     model.train()
@@ -247,9 +251,9 @@ def _train(data, vae_path, out, c, base_model, resume, dist, progress, cancel, v
             break
         batch = [train_set.sample(rng) for _ in range(c.batch_size // dist.world_size)]
         if c.encoder == "minilm":
-            (x, mask, seg), labels, betas = collate_minilm(batch, states, raw.vocab)
+            (x, mask, seg), labels, betas, memory = collate_minilm(batch, states, raw.vocab, raw, rng)
             res = model(x.to(dist.device), mask.to(dist.device), labels.to(dist.device), betas.to(dist.device),
-                        seg.to(dist.device))
+                        seg.to(dist.device), tuple(m.to(dist.device) for m in memory) if memory else None)
         else:
             input_ids, attn, labels, betas = (t.to(dist.device) for t in collate(batch, tok, raw.vocab))
             res = model(input_ids, attn, labels, betas)
