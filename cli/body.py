@@ -41,6 +41,7 @@ def licence_text(body) -> str:
 def run(args) -> int:
     import numpy as np
 
+    from ..core.body.body_mass import DENSITY_KG_M3
     from ..core.body.measure import measure
 
     body = _load(args.model)
@@ -65,5 +66,6 @@ def run(args) -> int:
     print("mean body (betas = 0):")
     for k, v in measure(body).items():
         print(f"  {k:15s} {v:6.1f}")
+    print(f"  (mass: mesh volume x {DENSITY_KG_M3:g} kg/m^3; BMI: kg/m^2)")
     print(f"licence:     {licence_text(body)}")
     return 0

@@ -29,7 +29,7 @@ def add_arguments(p):
 def run(args) -> int:
     import time
 
-    from ..core.body.measure import measure
+    from ..core.body.measure import format_body, measure
     from ..core.generation.generate import Generator
 
     t0 = time.time()
@@ -47,8 +47,7 @@ def run(args) -> int:
     print(f"shape text:  {args.shape_text}  (body from: {motion.shape_source or '[BETA] head'})")
     print(f"motion:      {motion.num_frames} frames at {motion.fps:g} fps ({motion.num_frames / motion.fps:.1f} s), "
           f"{len(motion.tokens)} tokens, generated in {t1 - t0:.1f} s")
-    print(f"body:        {shape_adjectives(m)}: " + ", ".join(f"{k.replace('_cm', '').replace('_', ' ')} {v:.0f} cm"
-                                                         for k, v in m.items()))
+    print(f"body:        {shape_adjectives(m)}: " + format_body(m))
     print(f"scene:       {(args.out / 'shapemove.blend').resolve()}  ({info['vertices']} vertices, {info['bones']} bones, "
           f"frames {info['frame_start']}-{info['frame_end']})")
     print(f"preview:     {(args.out / 'preview.png').resolve()}  (frames {info['preview_frames']})")

@@ -31,6 +31,10 @@ def add_arguments(p):
     p.add_argument("--model", type=Path, default=None, help="model folder (default: the embedded default model)")
     p.add_argument("--body-model", default=None, help="openbody (default) or a path to SMPL-family model files")
     p.add_argument("--out", type=Path, required=True)
+    p.add_argument("--library", type=Path, default=None,
+                   help="a folder of your own captioned motions added to the retrieval memory (no retraining)")
+    p.add_argument("--no-retrieval", action="store_true",
+                   help="the decoder reads the prompt alone, without the retrieved training clips")
     add_animation_arguments(p)
 
 
@@ -59,7 +63,7 @@ def animation_of(args):
 
 
 def run(args) -> int:
-    from ..core.body.measure import measure
+    from ..core.body.measure import format_body, measure
     from ..core.generation.generate import Generator, parse_betas
 
     if args.out.suffix.lower() != ".npz":
@@ -73,6 +77,9 @@ def run(args) -> int:
     betas = parse_betas(args.betas) if args.betas else None
     animation = animation_of(args)
     gen = Generator(args.model, body=args.body_model)
+    gen.set_retrieval(not args.no_retrieval)
+    if args.library is not None:
+        print(f"retrieval memory: {gen.add_library(args.library)} motions added from {args.library}")
     from ..core.generation.animate import animate
     from ..core.generation.generate import Request
 
@@ -88,5 +95,5 @@ def run(args) -> int:
           f"{len(motion.tokens) if motion.tokens is not None else 0} tokens, IK error {motion.ik_error_cm:.2f} cm")
     if motion.loop_advance is not None:
         print(f"loop: the root advances {float(np.linalg.norm(motion.loop_advance[[0, 2]])):.2f} m per cycle")
-    print(f"body ({motion.shape_source or '[BETA] head'}): " + ", ".join(f"{k.replace('_cm', '')} {v:.0f} cm" for k, v in m.items()))
+    print(f"body ({motion.shape_source or '[BETA] head'}): " + format_body(m))
     return 0

@@ -53,7 +53,7 @@ def target_betas(body, betas_text: str | None, shape_text: str | None):
 
 def run(args) -> int:
     from ..core.body.load import load_body_model
-    from ..core.body.measure import measure
+    from ..core.body.measure import format_body, measure
     from ..core.generation.retarget import load_vae, naive_retarget, retarget
 
     if args.out.suffix.lower() != ".npz":
@@ -73,5 +73,5 @@ def run(args) -> int:
     m = measure(body, motion.betas)
     print(f"wrote {args.out}: {motion.num_frames} frames ({motion.num_frames / motion.fps:.1f} s), {how}")
     print("betas: " + ",".join(f"{v:.2f}" for v in motion.betas))
-    print("body: " + ", ".join(f"{k.replace('_cm', '')} {v:.0f} cm" for k, v in m.items()))
+    print("body: " + format_body(m))
     return 0

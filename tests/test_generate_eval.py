@@ -166,7 +166,7 @@ def test_body_shape_from_stated_measurements_or_the_beta_head(generator):
     head = generator.generate_batch([Request("a person walks", "A person standing 190 cm tall", seconds=1.2,
                                              shape_from="head")])[0]
     assert head.shape_source == "[BETA] head"
-    free = generator.generate_batch([Request("a person walks", "an athletic dancer", seconds=1.2)])[0]
-    assert free.shape_source == "[BETA] head"  # free text the measurement fit cannot read
+    free = generator.generate_batch([Request("a person walks", "someone with broad shoulders", seconds=1.2)])[0]
+    assert free.shape_source == "[BETA] head"  # free text: no shape word or number the parser reads
     given = generator.generate_batch([Request("a person walks", "tall", betas=np.full(10, 0.5), seconds=1.2)])[0]
     assert given.shape_source == "given" and np.allclose(given.betas, 0.5)

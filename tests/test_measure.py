@@ -4,7 +4,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from shapemove.core.body.measure import contains, cross_section, hull_perimeter, measure, measure_mesh
+from shapemove.core.body.measure import MEASUREMENTS, contains, cross_section, hull_perimeter, measure, measure_mesh
 from shapemove.core.body.model import BodyModel
 from shapemove.core.errors import ShapeMoveError
 
@@ -135,5 +135,7 @@ def test_openbody_measurements_are_plausible(openbody):
     v = openbody.rest_vertices()[0].numpy()
     j = openbody.rest_joints()[0].numpy()
     m2 = measure_mesh(1.1 * v, openbody.faces, 1.1 * j)
-    for k in m:
+    for k in MEASUREMENTS:
         assert m2[k] == pytest.approx(1.1 * m[k], rel=0.02), k
+    assert m2["mass_kg"] == pytest.approx(1.1 ** 3 * m["mass_kg"], rel=1e-5)   # volume: the cube
+    assert m2["bmi"] == pytest.approx(1.1 * m["bmi"], rel=1e-5)                # kg / m^2

@@ -11,7 +11,12 @@ serves OpenBody and the SMPL family:
 - hip:   largest girth from 12% below to 15% above the hip joints (buttocks; below the crotch
          the two thighs are measured together, as a tape around both would),
 - arm length: shoulder -> elbow -> wrist joint path; leg length: hip -> knee -> ankle joint
-  path plus the ankle height above the floor (lowest vertex); height: top minus lowest vertex.
+  path plus the ankle height above the floor (lowest vertex); height: top minus lowest vertex;
+- mass (kg): the closed mesh's volume x a whole-body density, and BMI (kg/m^2) from that mass and
+  the height (``body_mass``: the density and its source).
+
+``format_body(m)`` is the one-line readout the command line prints ("height 175 cm, ..., mass 76
+kg, BMI 24.6").
 """
 from __future__ import annotations
 
@@ -21,9 +26,11 @@ from scipy.sparse.csgraph import connected_components
 from scipy.spatial import ConvexHull, QhullError
 
 from ..errors import ShapeMoveError
+from .body_mass import bmi, mass_kg
 from .skeleton import JOINT_INDEX as JI
 
-MEASUREMENTS = ["height_cm", "chest_cm", "waist_cm", "hip_cm", "arm_length_cm", "leg_length_cm"]
+MEASUREMENTS = ["height_cm", "chest_cm", "waist_cm", "hip_cm", "arm_length_cm", "leg_length_cm"]  # cm
+MASS = ["mass_kg", "bmi"]  # kg, kg/m^2
 _LEVELS = 16  # levels scanned per band
 
 
@@ -134,12 +141,16 @@ def measure_mesh(vertices: np.ndarray, faces: np.ndarray, joints: np.ndarray) ->
         "leg_length_cm": np.mean([_path(j, [f"{s}_hip", f"{s}_knee", f"{s}_ankle"]) + j[JI[f"{s}_ankle"], 1] - floor
                                   for s in ("left", "right")]),
     }
-    return {k: float(100.0 * x) for k, x in out.items()}
+    out = {k: float(100.0 * x) for k, x in out.items()}
+    out["mass_kg"] = float(mass_kg(v, faces))
+    out["bmi"] = float(bmi(out["mass_kg"], out["height_cm"]))
+    return out
 
 
 def measure(body, betas=None) -> dict:
     """Measurements of ``body`` (any BodyModel) in its rest pose. betas (10,) or None -> dict of
-    floats in cm (keys MEASUREMENTS); betas (B,10) -> dict of (B,) float arrays."""
+    floats (keys MEASUREMENTS in cm, then MASS: kg and kg/m^2); betas (B,10) -> dict of (B,) float
+    arrays."""
     b = np.zeros(body.num_betas, np.float32) if betas is None else np.asarray(betas, np.float32)
     if b.ndim not in (1, 2) or b.shape[-1] != body.num_betas or not np.all(np.isfinite(b)):
         raise ShapeMoveError(f"betas must be finite with shape ({body.num_betas},) or (B, {body.num_betas}), "
@@ -151,4 +162,15 @@ def measure(body, betas=None) -> dict:
     rows = [measure_mesh(v, body.faces, j) for v, j in zip(verts, joints)]
     if single:
         return rows[0]
-    return {k: np.array([r[k] for r in rows]) for k in MEASUREMENTS}
+    return {k: np.array([r[k] for r in rows]) for k in MEASUREMENTS + MASS}
+
+
+def format_body(m: dict) -> str:
+    """'height 175 cm, chest 110 cm, waist 89 cm, hip 102 cm, arm length 56 cm, leg length 84 cm,
+    mass 76 kg, BMI 24.6' for one ``measure`` dict (keys it lacks are left out)."""
+    parts = [f"{k.replace('_cm', '').replace('_', ' ')} {float(m[k]):.0f} cm" for k in MEASUREMENTS if k in m]
+    if "mass_kg" in m:
+        parts.append(f"mass {float(m['mass_kg']):.0f} kg")
+    if "bmi" in m:
+        parts.append(f"BMI {float(m['bmi']):.1f}")
+    return ", ".join(parts)

@@ -29,9 +29,10 @@ from pathlib import Path
 import numpy as np
 
 from ..atomic import atomic_path
-from ..data.shape_text import parse_shape_sentence
 from ..errors import ShapeMoveError
-from .measure import MEASUREMENTS, measure_mesh
+from ..text.shape_words import PERSON_RANGES, SIZE_TARGETS, ShapeWords, parse_shape_words, word_conflict
+from .body_mass import DENSITY_KG_M3, bmi as bmi_of
+from .measure import MASS, MEASUREMENTS, measure_mesh
 from .skeleton import JOINT_INDEX as JI
 
 REG = 0.01            # cm^2 per unit beta^2: a 1-beta move is worth 0.1 cm of mismatch
@@ -46,12 +47,9 @@ _regressions: dict = {}
 _keys: dict = {}     # id(body) -> (body, body_key): the key is computed once per body object
 _arrays: dict = {}   # id(body) -> (body, linear arrays of fast_measure)
 PLAUSIBLE_CM = {"height_cm": (50, 260), "chest_cm": (40, 200), "waist_cm": (30, 200), "hip_cm": (40, 200),
-                "arm_length_cm": (15, 110), "leg_length_cm": (30, 140)}
-
-# adjectives of data.shape_text -> the middle of their band (height cm; waist-to-height ratio)
-HEIGHT_WORDS = {"very short": 150.0, "short": 160.0, "very tall": 195.0, "tall": 185.0}
-BUILD_WORDS = {"very heavy": 0.64, "heavy-set": 0.565, "heavyset": 0.565, "heavy": 0.565, "slim": 0.41,
-               "average-sized": None, "average": None}
+                "arm_length_cm": (15, 110), "leg_length_cm": (30, 140),
+                "mass_kg": PERSON_RANGES["mass_kg"], "bmi": PERSON_RANGES["bmi"]}
+UNITS = {"mass_kg": "kg", "bmi": "kg/m^2"}
 
 
 def _path(joints: np.ndarray, names) -> np.ndarray:
@@ -146,6 +144,11 @@ def girth_regression(body) -> GirthRegression | None:
 def _linear_arrays(body) -> tuple:
     """Per body, once: the rest vertices' heights and the joints as linear functions of the betas
     (float64 numpy): y0 (V,), ydirs (V,n), j0 (24,3), jdirs (24,3,n)."""
+    return _linear_vertices(body)[:4]
+
+
+def _linear_vertices(body) -> tuple:
+    """``_linear_arrays`` plus the whole rest vertices: v0 (V,3), vdirs (V*3, n)."""
     entry = _arrays.get(id(body))
     if entry is None or entry[0] is not body:
         with torch_no_grad():
@@ -153,9 +156,22 @@ def _linear_arrays(body) -> tuple:
             yd = body.shapedirs[:, 1, :].double().numpy()
             j0 = body.joint_template.double().numpy()
             jd = body.joint_shapedirs.double().numpy()
-        entry = (body, (y0, yd, j0, jd))
+            v0 = body.v_template.double().numpy()
+            vd = body.shapedirs.double().numpy().reshape(-1, body.num_betas)
+        entry = (body, (y0, yd, j0, jd, v0, vd))
         _arrays[id(body)] = entry
     return entry[1]
+
+
+def fast_mass(body, betas: np.ndarray) -> np.ndarray:
+    """(B,10) betas -> (B,) mass in kg: the rest mesh's volume x ``body_mass.DENSITY_KG_M3`` (the
+    same number ``measure`` gives, without slicing the mesh)."""
+    from .body_mass import mass_kg
+
+    b = np.asarray(betas, np.float64).reshape(-1, body.num_betas)
+    _, _, _, _, v0, vd = _linear_vertices(body)
+    verts = v0[None] + (b @ vd.T).reshape(len(b), *v0.shape)
+    return mass_kg(verts, body.faces, DENSITY_KG_M3)
 
 
 def torch_no_grad():
@@ -165,8 +181,9 @@ def torch_no_grad():
 
 
 def fast_measure(body, betas: np.ndarray, keys, girths: GirthRegression | None = None) -> np.ndarray:
-    """(B,10) betas -> (B, len(keys)) measurements in cm, as ``measure`` defines them; height and
-    limb lengths straight from the rest vertices/joints (linear in the betas, batched), girths via
+    """(B,10) betas -> (B, len(keys)) measurements in cm (mass_kg in kg, bmi in kg/m^2), as
+    ``measure`` defines them; height and limb lengths straight from the rest vertices/joints
+    (linear in the betas, batched), mass from the mesh volume (``fast_mass``), girths via
     ``measure_mesh``, or from the regression ``girths`` when given."""
     b = np.asarray(betas, np.float64).reshape(-1, body.num_betas)
     y0, yd, j0, jd = _linear_arrays(body)
@@ -174,7 +191,11 @@ def fast_measure(body, betas: np.ndarray, keys, girths: GirthRegression | None =
     joints = j0[None] + np.einsum("jcn,bn->bjc", jd, b)        # (B,24,3)
     floor = ys.min(1)
     cols = []
+    mass = fast_mass(body, b) if ("mass_kg" in keys or "bmi" in keys) else None
     for k in keys:
+        if k in ("mass_kg", "bmi"):
+            cols.append(mass if k == "mass_kg" else bmi_of(mass, 100.0 * (ys.max(1) - floor)))
+            continue
         if k == "height_cm":
             v = ys.max(1) - floor
         elif k == "arm_length_cm":
@@ -237,15 +258,16 @@ def _check_targets(targets: dict) -> dict:
         raise ShapeMoveError("no target measurements given (e.g. {'height_cm': 190})")
     out = {}
     for k, v in targets.items():
-        if k not in MEASUREMENTS:
-            raise ShapeMoveError(f"unknown measurement {k!r}; use {', '.join(MEASUREMENTS)}")
+        if k not in MEASUREMENTS + MASS:
+            raise ShapeMoveError(f"unknown measurement {k!r}; use {', '.join(MEASUREMENTS + MASS)}")
+        unit = UNITS.get(k, "cm")
         try:
             v = float(v)
         except (TypeError, ValueError):
-            raise ShapeMoveError(f"measurement {k} must be a number of cm, got {v!r}") from None
+            raise ShapeMoveError(f"measurement {k} must be a number of {unit}, got {v!r}") from None
         lo, hi = PLAUSIBLE_CM[k]
         if not (np.isfinite(v) and lo <= v <= hi):
-            raise ShapeMoveError(f"{k} = {v} cm is outside the plausible range [{lo}, {hi}] cm")
+            raise ShapeMoveError(f"{k} = {v} {unit} is outside the plausible range [{lo}, {hi}] {unit}")
         out[k] = v
     return out
 
@@ -290,67 +312,230 @@ def betas_for_measurements(body, targets: dict, reg: float = REG, max_iters: int
     return b.astype(np.float32)
 
 
-UNIT_NUMBER = re.compile(r"\d\s*(?:cm\b|centimet|m\b|met(?:er|re)s?\b|ft\b|feet\b|foot\b|inch|in\b|'|\")")
-NEGATIVE = re.compile(r"(?<![\w.])[-\u2212]\s*\d")  # "-170 cm", "−2 m" (not "39-inch", "170-180")
+# ----------------------------------------------------------------------------------------------
+# shape text -> body: phenotype words set the sliders, stated numbers are met on the mesh
+
+STATED_TOLERANCE = {"height_cm": 1.0, "mass_kg": 2.0, "bmi": 0.7}  # a stated number missed by more: refused
+ERROR_UNIT = {"mass_kg": 1.0, "bmi": 0.3}      # residual scale (cm for the rest): 1 kg ~ 1 cm, 0.3 BMI ~ 1 cm
+SLIDER_SIGMA = {"gender": 0.3, "age": 15.0, "muscle": 0.25, "weight": 0.25, "height": 0.08, "proportions": 0.25}
+SLIDER_EXTRA = 0.6   # free sliders may extrapolate this share of their range beyond it (gender: none)
+FIXED_BY_WORDS = ("gender", "age", "muscle")   # set by words, held exactly (their read-back is exact)
+RESIDUAL_LIMIT = 3.0
+
+
+def shape_words(text: str) -> ShapeWords:
+    """The parsed shape text (``text.shape_words.parse_shape_words``), with the text's errors
+    named: empty text, contradictions, impossible numbers."""
+    if not isinstance(text, str) or not text.strip():
+        raise ShapeMoveError("the shape text is empty")
+    try:
+        return parse_shape_words(text)
+    except ShapeMoveError as exc:
+        raise ShapeMoveError(f"the shape text {text!r}: {exc}") from None
+
+
+def _size_targets(d: ShapeWords) -> tuple[float | None, float | None]:
+    """(height cm, waist-to-height ratio) the size words aim at (their mean), None where none."""
+    hs = [SIZE_TARGETS[w][0] for w in d.size_words if SIZE_TARGETS[w][0] is not None]
+    rs = [SIZE_TARGETS[w][1] for w in d.size_words if SIZE_TARGETS[w][1] is not None]
+    return (sum(hs) / len(hs) if hs else None), (sum(rs) / len(rs) if rs else None)
+
+
+def _targets(d: ShapeWords, default_height) -> dict:
+    """Target measurements of a parsed text: stated numbers win; size words give a height and a
+    waist (ratio x height; ``default_height()`` when the text gives none); weight words that are no
+    size word ("obese", "skinny") a BMI when no weight is stated."""
+    out = d.measurements()
+    h_word, ratio = _size_targets(d)
+    if "height_cm" not in out and h_word is not None:
+        out["height_cm"] = h_word
+    if d.mass_kg is not None:
+        out["mass_kg"] = d.mass_kg
+    elif d.bmi is not None:
+        out["bmi"] = d.bmi
+    elif d.bmi_target() is not None:
+        out["bmi"] = d.bmi_target()
+    weight_stated = d.mass_kg is not None or d.bmi is not None
+    if ratio is not None and "waist_cm" not in out and not weight_stated:
+        out["waist_cm"] = ratio * (out["height_cm"] if "height_cm" in out else default_height())
+    return out
 
 
 def shape_targets(text: str, body=None) -> dict | None:
-    """Shape text -> target measurements (cm), or None when it states neither numbers nor size
-    words (free text: the [BETA] head reads it). Numbers it states must be plausible: "5000 cm
-    tall", "waist 0 cm" or "-170 cm" are a ShapeMoveError naming the number, never ignored."""
-    if not isinstance(text, str) or not text.strip():
-        raise ShapeMoveError("the shape text is empty")
-    neg = NEGATIVE.search(text)
-    if neg:
-        raise ShapeMoveError(f"the shape text states a negative number ({text[neg.start():neg.end() + 8].strip()!r}); "
-                             "body measurements are positive, e.g. '170 cm tall'")
-    found = parse_shape_sentence(text)
-    if found:
-        try:
-            return _check_targets(found)
-        except ShapeMoveError as exc:
-            raise ShapeMoveError(f"the shape text {text!r}: {exc}") from None
-    if UNIT_NUMBER.search(text.lower()):  # a number the parser could not place ("999 m tall"): never guessed
-        raise ShapeMoveError(f"cannot read the measurements in {text!r}: write them as '182 cm tall', "
-                             "'1.82 m tall', '6 ft 0 in tall' or 'waist 90 cm' (a person is 50-260 cm tall)")
-    low = " " + re.sub(r"[^a-z\- ]+", " ", text.lower()) + " "
-    height = next((v for w, v in HEIGHT_WORDS.items() if f" {w} " in low), None)
-    build = [w for w in BUILD_WORDS if f" {w} " in low]
-    if height is None and not build:
+    """Shape text -> target measurements (cm; mass_kg in kg, bmi), or None when it states neither
+    numbers nor any shape word (free text: the [BETA] head reads it). {} when it has shape words
+    but no measurement to aim at ("a man", "an average-sized person"). Numbers it states must be
+    plausible: "5000 cm tall", "waist 0 cm", "-170 cm", "weighs 900 kg" or a contradiction are a
+    ShapeMoveError naming them, never ignored."""
+    d = shape_words(text)
+    if not d:
         return None
-    out = {}
-    if height is not None:
-        out["height_cm"] = height
-    ratio = BUILD_WORDS[build[0]] if build else None
-    if ratio is not None:
-        if height is None:
-            if body is None:
-                from .load import load_body_model
 
-                body = load_body_model(None)
-            height = float(fast_measure(body, np.zeros((1, body.num_betas)), ["height_cm"])[0, 0])
-            out["height_cm"] = height
-        out["waist_cm"] = ratio * height
-    return out
+    def default_height():
+        b = body
+        if b is None:
+            from .load import load_body_model
+
+            b = load_body_model(None)
+        return float(fast_measure(b, start_betas(b, d)[None], ["height_cm"])[0, 0])
+
+    try:
+        raw = _targets(d, default_height)
+        return _check_targets(raw) if raw else {}
+    except ShapeMoveError as exc:
+        raise ShapeMoveError(f"the shape text {text!r}: {exc}") from None
 
 
 def targets_from_shape_text(text: str, body=None) -> dict:
-    """Shape text -> target measurements (cm). Numbers win ("standing 190 cm tall, with a waist
-    circumference of 100 cm"); otherwise height/build adjectives ("a tall, heavy-set man") give
-    the middle of their ``data.shape_text`` band (build = waist-to-height ratio, at the stated
-    height or the body's mean height). ShapeMoveError when the text states neither."""
+    """Shape text -> target measurements (cm) as ``shape_targets``; ShapeMoveError when the text
+    has no shape word or number at all."""
     out = shape_targets(text, body)
     if out is None:
-        raise ShapeMoveError(f"cannot read a body shape from {text!r}: state measurements (\"A person standing "
-                             "180 cm tall, with a waist circumference of 90 cm\") or use words such as "
-                             + ", ".join(list(HEIGHT_WORDS) + ["slim", "heavy-set", "very heavy", "average-sized"]))
+        raise ShapeMoveError(f"cannot read a body shape from {text!r}: state measurements (\"180 cm tall, 75 kg\", "
+                             "\"6 ft 2, 200 lb\", \"waist 90 cm\") or use words such as man, woman, elderly, young, "
+                             "muscular, slim, overweight, tall, short, heavy-set")
     return out
 
 
+def start_betas(body, d: ShapeWords) -> np.ndarray:
+    """The body the words describe before any number is met: OpenBody's sliders at their defaults,
+    with the ones the words set (gender, age, muscle, weight) -> (10,) float64 betas; zeros for a
+    body without a phenotype map (the SMPL family) or a text without phenotype words."""
+    pmap = getattr(body, "phenotype_map", None)
+    if pmap is None or not d.phenotype():
+        return np.zeros(body.num_betas)
+    return pmap.to_betas(d.phenotype())
+
+
+def _phenotype_frame(pmap, d: ShapeWords):
+    """The fit's parametrisation for a phenotype body: betas(theta) = base + theta @ A, theta the
+    free sliders then 4 coordinates along the null space of the map (moves the read-back of
+    the sliders cannot see), so the sliders the words fixed read back exactly."""
+    names = pmap.names
+    p0 = pmap.array(d.phenotype())
+    fixed = [i for i, n in enumerate(names) if n in FIXED_BY_WORDS and n in d.phenotype()]
+    free = [i for i in range(len(names)) if i not in fixed]
+    _, _, vt = np.linalg.svd(pmap.matrix)
+    null = vt[len(names):]                                  # (10-P, 10), orthonormal, matrix @ null.T = 0
+    A = np.vstack([pmap.matrix[free], null])                # (k, 10)
+    base = pmap.to_betas(p0) - p0[free] @ pmap.matrix[free]
+    mu = np.concatenate([p0[free], np.zeros(len(null))])
+    sigma = np.array([SLIDER_SIGMA.get(names[i], 0.25) for i in free] + [1.0] * len(null))
+    lo, hi = pmap.ranges[:, 0], pmap.ranges[:, 1]
+    ext = np.where(np.array(names) == "gender", 0.0, SLIDER_EXTRA) * (hi - lo)
+    lo_b = np.concatenate([(lo - ext)[free], -RESIDUAL_LIMIT * np.ones(len(null))])
+    hi_b = np.concatenate([(hi + ext)[free], RESIDUAL_LIMIT * np.ones(len(null))])
+    return base, A, mu, sigma, lo_b, hi_b
+
+
+def _fit_frame(body, targets: dict, base, A, mu, sigma, lo_b, hi_b, reg: float = REG, iters: int = 30) -> np.ndarray:
+    """Levenberg-Marquardt over theta: min sum ((m(base + theta A) - t) / unit)^2 + reg |(theta - mu)
+    / sigma|^2, theta inside [lo_b, hi_b]; forward-difference Jacobian (one batch per step)."""
+    keys = list(targets)
+    girths = girth_regression(body)
+    t = np.array([targets[k] for k in keys])
+    unit = np.array([ERROR_UNIT.get(k, 1.0) for k in keys])
+    w = np.sqrt(reg) / sigma
+    theta = np.clip(mu.copy(), lo_b, hi_b)
+    h = 1e-3 * np.maximum(sigma, 1e-3) * 10
+
+    def residual(th, m):
+        return np.concatenate([(m - t) / unit, w * (th - mu)])
+
+    def meas(ths):
+        return fast_measure(body, base[None] + ths @ A, keys, girths)
+
+    if not keys:
+        return base + theta @ A
+    m = meas(theta[None])[0]
+    r = residual(theta, m)
+    cost, lam = float(r @ r), 1e-3
+    for _ in range(iters):
+        probe = theta[None] + np.diag(h)
+        mp = meas(probe)
+        J = np.vstack([((mp - m) / h[:, None] / unit[None]).T, np.diag(w)])
+        H = J.T @ J
+        g = J.T @ r
+        improved = False
+        for _ in range(8):
+            step = np.linalg.solve(H + lam * (np.diag(np.diag(H)) + 1e-9 * np.eye(len(H))), -g)
+            th_new = np.clip(theta + step, lo_b, hi_b)
+            m_new = meas(th_new[None])[0]
+            r_new = residual(th_new, m_new)
+            c_new = float(r_new @ r_new)
+            if c_new < cost:
+                theta, m, r, cost, lam, improved = th_new, m_new, r_new, c_new, max(lam / 10, 1e-9), True
+                break
+            lam *= 10
+        if not improved or np.abs((m - t) / unit).max() < 0.05:
+            break
+    return base + theta @ A
+
+
+def betas_for_shape_words(body, d: ShapeWords) -> np.ndarray:
+    """(10,) float32 betas for a parsed shape text. On OpenBody the words set the phenotype
+    sliders (gender, age, muscle held exactly; weight, height, proportions as a prior) and the
+    stated numbers (height, girths, mass or BMI) are then met on the mesh by moving the free
+    sliders and the shape directions the sliders do not reach; other bodies (no phenotype map)
+    fit the numbers alone (``betas_for_measurements``). A stated height or weight the body cannot
+    reach, or a weight word the result contradicts, is a ShapeMoveError naming it."""
+    pmap = getattr(body, "phenotype_map", None)
+    start = start_betas(body, d)
+    raw = _targets(d, lambda: float(fast_measure(body, start[None], ["height_cm"])[0, 0]))
+    targets = _check_targets(raw) if raw else {}
+    if pmap is None or not d.phenotype():
+        betas = betas_for_measurements(body, targets) if targets else np.zeros(body.num_betas, np.float32)
+    else:
+        frame = _phenotype_frame(pmap, d)
+        betas = _fit_frame(body, targets, *frame).astype(np.float32)
+    _check_result(body, d, targets, betas)
+    return betas
+
+
+def _describe(d: ShapeWords) -> str:
+    return d.text.strip() or "this body"
+
+
+def _check_result(body, d: ShapeWords, targets: dict, betas: np.ndarray) -> None:
+    """The stated height and weight met (``STATED_TOLERANCE``), the betas inside the shape space,
+    the weight words agreeing with the result's BMI; else a ShapeMoveError saying what is missed."""
+    if np.abs(betas).max() > BETA_LIMIT:
+        raise ShapeMoveError(f"{_describe(d)!r} lies outside the body model's shape space (|beta| "
+                             f"{np.abs(betas).max():.1f} > {BETA_LIMIT:g}): ask for a less extreme body")
+    stated = {k: v for k, v in targets.items() if k in STATED_TOLERANCE and (
+        (k == "height_cm" and d.height_cm is not None) or (k == "mass_kg" and d.mass_kg is not None)
+        or (k == "bmi" and d.bmi is not None))}
+    got = fast_measure(body, betas[None], list(stated) + ["height_cm", "mass_kg", "bmi"])[0]
+    for i, (k, v) in enumerate(stated.items()):
+        if abs(got[i] - v) > STATED_TOLERANCE[k]:
+            unit = UNITS.get(k, "cm")
+            raise ShapeMoveError(f"the body model cannot make {_describe(d)!r}: {k.replace('_cm', '').replace('_kg', '')} "
+                                 f"{v:.1f} {unit} asked, {got[i]:.1f} {unit} is the closest it reaches with the rest "
+                                 "of the description (height and weight together decide the build)")
+    bmi = got[-1]
+    band = d.bmi_band()
+    if band is not None and (d.mass_kg is not None or d.bmi is not None) and not band[0] - 0.5 <= bmi <= band[1] + 0.5:
+        raise ShapeMoveError(f"the shape text {_describe(d)!r} contradicts itself: its body has BMI {bmi:.1f} "
+                             f"({got[-3]:.0f} cm, {got[-2]:.0f} kg)" + word_conflict(d, bmi))
+
+
+def betas_for_shape_text(body, text: str) -> np.ndarray | None:
+    """(10,) betas of ``body`` for a shape text, or None when the text has no shape word or number
+    (free text: the [BETA] head's to read). See ``betas_for_shape_words``."""
+    d = shape_words(text)
+    if not d:
+        return None
+    try:
+        return betas_for_shape_words(body, d)
+    except ShapeMoveError as exc:
+        msg = str(exc)
+        raise ShapeMoveError(msg if text in msg else f"the shape text {text!r}: {msg}") from None
+
+
 def betas_from_shape_text(body, text: str) -> np.ndarray:
-    """(10,) betas of ``body`` for a shape text (see ``targets_from_shape_text``); an
-    "average-sized" text with no height gives the mean body (zeros)."""
-    targets = targets_from_shape_text(text, body)
-    if not targets:
-        return np.zeros(body.num_betas, np.float32)
-    return betas_for_measurements(body, targets)
+    """(10,) betas of ``body`` for a shape text (``betas_for_shape_text``); ShapeMoveError when
+    the text has no shape word or number. An "average-sized person" is the mean body (zeros)."""
+    betas = betas_for_shape_text(body, text)
+    if betas is None:
+        targets_from_shape_text(text, body)  # raises, saying what the text may say
+    return betas

@@ -11,9 +11,11 @@ hip_cm, arm_length_cm, leg_length_cm).
   lanky person", "petite", "stocky");
 - ``mix_into_prompt``: the shape inside the motion prompt ("A tall, heavy-set man jogs.");
 - ``shape_texts``: the set the dataset builder writes per clip (first line: the long sentence);
-- ``parse_shape_text``: the numbers a text states (all the numeric forms above), in cm.
+- ``parse_shape_text``: the numbers a text states (all the numeric forms above), in cm: THE parser
+  is ``core/text/shape_words.py`` (re-exported here for the builder's users).
 
-THE size-word table is ``ADJECTIVES``: for each word the range of height (cm) and of waist-to-
+THE size-word table is ``ADJECTIVES`` (defined in ``text/shape_words.py``, the parser's vocabulary):
+for each word the range of height (cm) and of waist-to-
 height ratio (WHtR, waist = WHtR x height) of the bodies it is written for. The generator only
 writes a word for a body inside its ranges (tests check it), so a model trained on these texts can
 be tested against them: "tall" -> 180-190 cm, "slim" -> waist < 0.43 x height, and so on.
@@ -26,34 +28,10 @@ from __future__ import annotations
 import hashlib
 import re
 
+from ..text.shape_words import ADJECTIVES, H_MAX, H_MIN, R_MAX, R_MIN, parse_shape_text
+
 NOUNS = {"male": "man", "female": "woman", None: "person"}
 
-H_MIN, H_MAX = 130.0, 215.0   # heights the table covers (cm)
-R_MIN, R_MAX = 0.28, 0.75     # waist-to-height ratios the table covers
-
-# word -> ((height_cm low, high) or None, (WHtR low, high) or None); low inclusive, high exclusive
-ADJECTIVES: dict[str, tuple] = {
-    # height
-    "very short": ((H_MIN, 155.0), None),
-    "short": ((155.0, 165.0), None),
-    "of average height": ((165.0, 180.0), None),
-    "tall": ((180.0, 190.0), None),
-    "very tall": ((190.0, H_MAX), None),
-    # build
-    "slim": (None, (R_MIN, 0.43)),
-    "slender": (None, (R_MIN, 0.43)),
-    "thin": (None, (R_MIN, 0.43)),
-    "of average build": (None, (0.43, 0.53)),
-    "heavy-set": (None, (0.53, 0.60)),
-    "heavy": (None, (0.53, 0.60)),
-    "very heavy": (None, (0.60, R_MAX)),
-    # both
-    "average-sized": ((165.0, 180.0), (0.43, 0.53)),
-    "petite": ((H_MIN, 165.0), (R_MIN, 0.43)),
-    "lanky": ((180.0, H_MAX), (R_MIN, 0.43)),
-    "stocky": ((H_MIN, 180.0), (0.53, R_MAX)),
-    "big": ((180.0, H_MAX), (0.53, R_MAX)),
-}
 HEIGHT_WORDS = ["very short", "short", "of average height", "tall", "very tall"]
 BUILD_WORDS = {"slim": ["slim", "slender", "thin"], "of average build": ["of average build"],
                "heavy-set": ["heavy-set", "heavy"], "very heavy": ["very heavy"]}
@@ -224,57 +202,6 @@ def shape_texts(m: dict, key: str) -> list[str]:
     out = [shape_sentence(m), shape_adjectives(m), numeric_shape_text(m, key), adjective_shape_text(m, key),
            numeric_shape_text(m, key + "/2"), adjective_shape_text(m, key + "/2")]
     return list(dict.fromkeys(out))
-
-
-_NUM = r"(\d+(?:\.\d+)?)"
-_FIELDS = {
-    "chest_cm": r"chest circumference of " + _NUM,
-    "hip_cm": r"hip circumference of " + _NUM,
-    "arm_length_cm": r"arm length of " + _NUM,
-    "leg_length_cm": r"leg length of " + _NUM,
-}
-_HEIGHT_CM = [r"\b" + _NUM + r"\s*(?:cm|centimet(?:er|re)s?)\s*(?:tall|high|in height)",
-              r"\b(?:height|stands?|standing)\s*(?:of|is|:)?\s*" + _NUM + r"\s*(?:cm|centimet(?:er|re)s?)\b",
-              r"\ba person " + _NUM + r" cm tall"]
-_HEIGHT_M = [r"\b(\d(?:\.\d+)?)\s*(?:m|metres?|meters?)\s*(?:tall|high|in height)",
-             r"\b(?:height|stands?|standing)\s*(?:of|is|:)?\s*(\d(?:\.\d+)?)\s*(?:m|metres?|meters?)\b"]
-_HEIGHT_FT = [r"\b(\d)\s*(?:ft|feet|foot|')\s*(\d{1,2})?\s*(?:in|inches|inch|\"|'')?\s*(?:tall|high|person\b)",
-              r"\b(?:height|stands?|standing)\s*(?:of|is|:)?\s*(\d)\s*(?:ft|feet|foot|')\s*(\d{1,2})?"]
-_WAIST = [r"\bwaist(?: circumference)?(?: of| is| measuring|:)?\s*" + _NUM + r"\s*(cm|centimet\w*|in\b|inch\w*|\")?",
-          r"\b" + _NUM + r"-(inch|cm) waist\b",
-          r"\b" + _NUM + r"\s*(cm|in|inch|inches|\")?\s*waist\b"]
-
-
-def parse_shape_text(text: str) -> dict:
-    """The measurements a shape text states, in cm (only those present): height in cm, m or
-    feet/inches ("182 cm tall", "1.82 m tall", "6 ft 0 in tall", "5'11\" tall", "height 182 cm"),
-    waist in cm or inches ("waist 100 cm", "a 39-inch waist", "waist circumference of 99 cm"),
-    and the long sentence's chest / hip / arm / leg lengths."""
-    t = text.lower()
-    out = {}
-    for pats, scale in ((_HEIGHT_CM, 1.0), (_HEIGHT_M, 100.0)):
-        for p in pats:
-            mt = re.search(p, t)
-            if mt and "height_cm" not in out:
-                out["height_cm"] = float(mt.group(1)) * scale
-    if "height_cm" not in out:
-        for p in _HEIGHT_FT:
-            mt = re.search(p, t)
-            if mt:
-                out["height_cm"] = (int(mt.group(1)) * 12 + int(mt.group(2) or 0)) * 2.54
-                break
-    for p in _WAIST:
-        mt = re.search(p, t)
-        if mt:
-            unit = (mt.group(2) or "cm") if mt.lastindex and mt.lastindex >= 2 else "cm"
-            v = float(mt.group(1))
-            out["waist_cm"] = v * 2.54 if unit.startswith(("in", '"')) else v
-            break
-    for key, pattern in _FIELDS.items():
-        mt = re.search(pattern, t)
-        if mt:
-            out[key] = float(mt.group(1))
-    return out
 
 
 def parse_shape_sentence(text: str) -> dict:

@@ -126,6 +126,37 @@ class Generator:
         """The actions of the model's training data, most frequent first ([] for older models)."""
         return self.known.action_names if self.known is not None else []
 
+    # -- retrieval memory ----------------------------------------------------------------------
+    @property
+    def reads_memory(self) -> bool:
+        """Whether the model's decoder reads retrieved clips (``models/motion_memory.py``)."""
+        return self.t5 is not None and self.t5.memory_k > 0
+
+    def set_retrieval(self, on: bool) -> None:
+        """Turn the retrieved clips on or off (off: the decoder reads the prompt alone)."""
+        if self.t5 is not None:
+            self.t5.memory_enabled = bool(on)
+
+    def add_library(self, folder, progress=None) -> int:
+        """Add a folder of the user's own motions (the Library panel's folder: motion .npz, BVH/AMC
+        or a built dataset, each with a caption) to the retrieval memory, without retraining: their
+        SA-VAE tokens become clips the decoder can read. Returns the number of clips added."""
+        from ..search.motion_search import library_clips
+
+        if not self.reads_memory:
+            raise ShapeMoveError(f"{self.model_dir}: this model does not read retrieved clips; "
+                                 "a motion library cannot be added to it (retrain with memory_k > 0)")
+        ids, captions, feats = library_clips(folder, progress=progress)
+        tokens = []
+        down = self.vae.cfg.downsample
+        with torch.no_grad(), one_torch_thread():
+            for f in feats:
+                n = (len(f) // down) * down
+                _, idx = self.vae.encode(self.vae.normalize(torch.as_tensor(f[:n], dtype=torch.float32)[None]))
+                tokens.append(idx[0].numpy())
+        self.t5.memory.add_clips([f"library:{i}" for i in ids], [[c] for c in captions], tokens, self.tok)
+        return len(ids)
+
     def _text_encoder(self):
         if self.t5 is not None and self.t5.encoder_kind == "minilm":
             return self.tok
@@ -173,9 +204,9 @@ class Generator:
                 if r.shape_text:
                     self.check_text(r.shape_text, "shape text")
             if r.shape_text and r.betas is None and r.shape_from == "auto":
-                from ..body.shape_from_measurements import shape_targets
+                from ..body.shape_from_measurements import betas_for_shape_text
 
-                shape_targets(r.shape_text, self.body)  # impossible numbers: refused before generating
+                betas_for_shape_text(self.body, r.shape_text)  # contradictions, impossible bodies: refused first
         out = []
         for i, (r, check) in enumerate(zip(reqs, checks)):
             if cancel is not None and cancel():
@@ -199,14 +230,14 @@ class Generator:
         those numbers (milliseconds: girths from the body's precomputed regression); else the
         T5's [BETA] head. Numbers that no body has ("5000 cm tall", "waist 0 cm", "-170 cm") are
         refused with a ShapeMoveError, never replaced by a guess."""
-        from ..body.shape_from_measurements import betas_for_measurements, shape_targets
+        from ..body.shape_from_measurements import betas_for_shape_text
 
         if r.betas is not None:
             return np.asarray(r.betas, np.float32), "given"
         if r.shape_text and r.shape_from == "auto":
-            targets = shape_targets(r.shape_text, self.body)  # None: free text, the model's reading of it
-            if targets:
-                return np.asarray(betas_for_measurements(self.body, targets), np.float32), "measurements"
+            betas = betas_for_shape_text(self.body, r.shape_text)  # None: free text, the model's reading of it
+            if betas is not None:  # shape words (phenotype sliders) and stated numbers met on the mesh
+                return np.asarray(betas, np.float32), "measurements"
         return np.asarray(predicted, np.float32), "[BETA] head"
 
     def redecode(self, motion: Motion, betas) -> Motion:

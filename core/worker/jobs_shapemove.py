@@ -294,17 +294,17 @@ def train(params, progress, cancel) -> dict:
 
 
 def betas_from_text(params, progress, cancel) -> dict:
-    """params {"text": shape text ("a tall, heavy-set man", "standing 185 cm tall, with a waist
-    circumference of 90 cm"), "body"} -> {"betas": 10 numbers, "measurements": the targets (cm),
-    "achieved": measured on the result (cm)}."""
+    """params {"text": shape text ("a tall, heavy-set man", "an elderly woman, 160 cm, 70 kg",
+    "standing 185 cm tall, with a waist circumference of 90 cm"), "body"} -> {"betas": 10 numbers,
+    "measurements": the targets (cm, kg), "achieved": measured on the result (cm, kg, BMI)}."""
     from ..body.load import load_body_model
-    from ..body.shape_from_measurements import betas_for_measurements, targets_from_shape_text
+    from ..body.shape_from_measurements import betas_from_shape_text, targets_from_shape_text
 
     op = "betas_from_text"
     text = param(params, op, "text", str)
     body = load_body_model(param(params, op, "body", str, None))
     wanted = targets_from_shape_text(text, body)
-    betas = np.asarray(betas_for_measurements(body, wanted) if wanted else np.zeros(10), np.float32).reshape(-1)
+    betas = np.asarray(betas_from_shape_text(body, text), np.float32).reshape(-1)  # words set the sliders too
     return {"betas": betas.tolist(), "measurements": wanted, "achieved": _measurements(body, betas)}
 
 
