@@ -275,6 +275,18 @@ def parse_amc(text: str, skel: Skeleton, source="AMC", angle_unit: str | None = 
 RADIANS_SHARE = 0.5  # share of frames with a rotation beyond +-2 pi that makes declared radians implausible
 
 
+def _check_asf_radians(skel: Skeleton, source) -> None:
+    """Refuse an ASF that declares radians while most of its non-zero bone axis angles lie beyond
+    +-2 pi (degrees in disguise: read as radians they turn every bone's frame by up to radians)."""
+    axes = np.concatenate([np.asarray(b.axis, dtype=np.float64) for b in skel.bones.values()] or [np.zeros(0)])
+    axes = np.abs(axes[axes != 0])
+    if len(axes) and (axes > 2 * np.pi).mean() > RADIANS_SHARE:
+        raise ShapeMoveError(f"{source}: the ASF declares angles in radians (angle rad), but {int((axes > 2 * np.pi).sum())} "
+                             f"of its {len(axes)} non-zero bone axis angles go beyond +-2 pi (up to {axes.max():.1f}): "
+                             "they look like degrees; pass --angle-unit deg to read them as degrees (or --angle-unit "
+                             "rad to keep radians)")
+
+
 def _check_radians(skel: Skeleton, root: np.ndarray, values: dict, source, declared: str) -> None:
     """Refuse rotation values declared in radians that are degrees: beyond +-2 pi on most frames."""
     cols = [root[:, i] for i, k in enumerate(skel.root_order) if k.startswith("R")]
@@ -376,6 +388,12 @@ def load_amc(path, asf=None, fps: float | None = None, up_axis: str | None = Non
                              f"{1 / MIN_FRAME_TIME:g} fps")
     asf_path = Path(asf) if asf else find_asf(path)
     skel = load_asf(asf_path)
+    if angle_unit is not None:  # the override covers the ASF's own angles (bone axes, root orientation)
+        scale = 1.0 if angle_unit == "rad" else np.pi / 180
+        skel.root_orientation = skel.root_orientation * (scale / skel.angle_scale)
+        skel.angle_scale = scale
+    elif skel.angle_scale == 1.0:
+        _check_asf_radians(skel, asf_path)
     root, values, angle = parse_amc(_read_text(path, "AMC"), skel, path, angle_unit)
     names, parents, offsets, positions, rots = amc_to_positions(skel, root, values, angle)
     subject = asf_path.stem[4:] if asf_path.stem.startswith("HDM_") else asf_path.stem

@@ -124,6 +124,7 @@ def _hierarchy(text: str, source):
             channels[cur] = chans
             has_channels[cur] = True
         elif key in ("JOINT", "END"):
+            where = tk.at()  # the JOINT keyword's line
             if is_end[cur]:
                 raise ShapeMoveError(f"{source}: BVH End Site cannot have children")
             if key == "END":
@@ -138,7 +139,7 @@ def _hierarchy(text: str, source):
             names.append(name)
             taken.add(name)
             has_channels.append(key == "END")
-            opened.append(tk.at())
+            opened.append(where)
             parents.append(cur)
             offsets.append(None)
             channels.append([])
