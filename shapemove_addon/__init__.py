@@ -6,10 +6,10 @@ from __future__ import annotations
 
 import bpy
 
-from . import jobs, operators, panels, preferences, properties, rig_retarget, shape_sync
+from . import animation_ui, jobs, operators, panels, preferences, properties, rig_retarget, shape_sync
 
 classes = (*properties.classes, *preferences.classes, *jobs.classes, *operators.classes, *panels.classes,
-           *rig_retarget.classes)
+           *rig_retarget.classes, *animation_ui.classes)
 
 
 def register():
@@ -19,9 +19,11 @@ def register():
     shape_sync.register()
     jobs.register()
     rig_retarget.register()
+    animation_ui.register()
 
 
 def unregister():
+    animation_ui.unregister()
     rig_retarget.unregister()
     jobs.unregister()
     shape_sync.unregister()

@@ -25,7 +25,8 @@ from .jobs import report_error
 from .preferences import body_spec, preferences, setting
 from .redecode import HAS_TOKENS_KEY, MOTION_FILE_KEY
 from .rig_state import PHYSICS_KEY, current_betas, rig_body_spec, rig_of
-from .scene_build import SLIDER_RANGE, build_rig
+from .animation_rig import ROOT_MOTION_ITEMS, build_animated_rig
+from .scene_build import SLIDER_RANGE
 
 MEASUREMENT_PROPS = ("height_cm", "chest_cm", "waist_cm", "hip_cm")
 
@@ -130,6 +131,8 @@ class SHAPEMOVE_OT_build_from_motion(ReportingOperator, bpy.types.Operator, Impo
         name="Body Model File", subtype="FILE_PATH", default="",
         description="Only for motions made for an SMPL-family body: your SMPL/SMPL-H/SMPL-X model file",
     )
+    root_motion: EnumProperty(name="Root Motion", items=ROOT_MOTION_ITEMS, default="PELVIS",
+                              description="Where the horizontal travel goes (docs/animation.md)")
 
     @classmethod
     def poll(cls, context):
@@ -140,8 +143,8 @@ class SHAPEMOVE_OT_build_from_motion(ReportingOperator, bpy.types.Operator, Impo
         model_file = self.body_model_file or (body_spec(context) if not is_openbody(motion.body_model) else None)
         if model_file == "openbody":
             model_file = None
-        rig = build_rig(context, motion, load_body(motion.body_model, model_file), name=self.rig_name,
-                        collection=context.collection)
+        rig = build_animated_rig(context, motion, load_body(motion.body_model, model_file), name=self.rig_name,
+                                 collection=context.collection, root_motion=self.root_motion)
         rig.armature[MOTION_FILE_KEY] = os.path.abspath(self.filepath)
         rig.armature[HAS_TOKENS_KEY] = motion.tokens is not None and len(motion.tokens) > 0
         for obj in context.view_layer.objects:

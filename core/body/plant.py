@@ -98,7 +98,7 @@ def contact_weights(contacts, fade: int = FADE) -> np.ndarray:
     return w
 
 
-def pin_feet(rotations, transl, rest, parents, targets, weights) -> np.ndarray:
+def pin_feet(rotations, transl, rest, parents, targets, weights, soft_reach: float = SOFT_REACH) -> np.ndarray:
     """The contact-aware IK pass: after the whole-body IK, each leg's hip and knee are turned
     (two-bone IK in the knee's own bending plane) so that a planted heel (ankle joint) lands on its
     target, and the ankle turned so that a planted ball joint does too; where the ball is planted
@@ -129,7 +129,7 @@ def pin_feet(rotations, transl, rest, parents, targets, weights) -> np.ndarray:
         l1, l2 = np.linalg.norm(rest[knee] - rest[hip]), np.linalg.norm(rest[ankle] - rest[knee])
         v = want - h
         d = np.linalg.norm(v, axis=-1, keepdims=True).clip(1e-9)
-        reach, soft = l1 + l2, SOFT_REACH * (l1 + l2)         # soft IK: no knee snap near full stretch
+        reach, soft = l1 + l2, soft_reach * (l1 + l2)         # soft IK: no knee snap near full stretch
         dc = np.where(d > soft, soft + (reach - soft) * (1 - np.exp(-(d - soft) / (reach - soft))), d)
         dc = dc.clip(abs(l1 - l2) + 1e-4, reach - 1e-4)
         vh = v / d
@@ -233,7 +233,8 @@ def gate_contacts(joints, contacts, sole_offsets, max_height: float = GATE_HEIGH
 
 
 def plant_motion(body, betas, joints, contacts, refine_iters: int = 10, gate: bool = True,
-                 max_flight: int | None = MAX_FLIGHT, smooth: float = 0.0, pin: bool = True) -> Planted:
+                 max_flight: int | None = MAX_FLIGHT, smooth: float = 0.0, pin: bool = True,
+                 soft_reach: float = SOFT_REACH) -> Planted:
     """Joint positions (T,22,3) (e.g. decoded by the SA-VAE) -> rotations and translation of
     ``body`` with ``betas`` whose feet in ``contacts`` (T,4) are planted and whose mesh stands on
     the floor: ``plant_targets`` + ``ik.solve_ik`` + ``ground_shift`` on the body's sole probe.
@@ -242,7 +243,8 @@ def plant_motion(body, betas, joints, contacts, refine_iters: int = 10, gate: bo
     ``smooth`` > 0: ``smooth_body`` with that sigma (frames) first. ``pin``: after the IK, the
     contact-aware leg pass ``pin_feet`` puts the planted joints on their targets (the whole-body
     IK spreads its misses over all joints, so a planted foot would otherwise slide by millimetres to
-    centimetres where the decoded body drifts away from it)."""
+    centimetres where the decoded body drifts away from it). ``soft_reach``: ``pin_feet``'s soft limit
+    (of the leg's length; closer to 1 lands straighter legs on their targets, e.g. animation edits)."""
     import torch
 
     from .ik import solve_ik
@@ -257,7 +259,7 @@ def plant_motion(body, betas, joints, contacts, refine_iters: int = 10, gate: bo
         rest = body.rest_joints(torch.as_tensor(b)[None])[0].numpy()
     ik = solve_ik(targets, rest, refine_iters=refine_iters)
     if pin:
-        ik.rotations = pin_feet(ik.rotations, ik.transl, rest, body.parents, targets, contact_weights(c))
+        ik.rotations = pin_feet(ik.rotations, ik.transl, rest, body.parents, targets, contact_weights(c), soft_reach)
     transl = np.asarray(ik.transl, dtype=np.float64).copy()
     per_foot, _, low = probe.lowest(ik.rotations, transl)
     shift = ground_shift(per_foot, low, c, max_flight=max_flight)  # predicted contacts can miss steps

@@ -10,19 +10,23 @@ finished pose (a treadmill has no fixed footholds).
 """
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
 import torch
 
-from ..body.plant import contacts_from_features
+from ..body.plant import contacts_from_features, plant_motion
+from ..constants import FPS
+from ..geometry.rotations import matrix_to_axis_angle
 from ..errors import ShapeMoveError
-from ..motion.contacts import detect_contacts
+from ..motion.contacts import CONTACT_IDS, detect_contacts, runs
 from ..motion.features import joints_from_features
 from ..motion.skeleton_ops import facing_directions, gaussian_smooth, heading_angles, smooth_directions
-from ..scene.motion_file import Motion
-from .decode import decode_features, motion_from_joints
+from ..scene.motion_file import Motion, make_motion
+from .decode import decode_features
 
+SOFT_REACH = 0.99     # of the leg's length (plant.SOFT_REACH is 0.97): see ``plant``
 HEADING_SIGMA = 5.0   # frames: the body's heading without the hips' swing of each step
 CENTRE_SIGMA = 5.0    # frames: the root's path without its sway
 
@@ -62,8 +66,46 @@ def decoded_track(codes: list[int], vae, betas) -> tuple[Track, np.ndarray]:
 
 
 def plant(body, betas, track: Track, ik_refine_iters: int = 10, prompt: str | None = None, **extra) -> Motion:
-    """A track -> Motion on ``body`` with its contacts planted (``decode.motion_from_joints``)."""
-    return motion_from_joints(body, betas, track.joints, track.contacts, ik_refine_iters, prompt=prompt, **extra)
+    """A track -> Motion on ``body`` with its contacts planted (``plant.plant_motion``, as
+    ``decode.motion_from_joints`` with a straighter soft reach ``SOFT_REACH``: an edited stance
+    leg lands its foot instead of stopping short), then ``lock_stance``."""
+    planted = plant_motion(body, betas, track.joints, track.contacts, refine_iters=ik_refine_iters,
+                           soft_reach=SOFT_REACH)
+    m = make_motion(body, matrix_to_axis_angle(planted.rotations).astype(np.float32), planted.transl, betas,
+                    fps=float(FPS), prompt=prompt, network_joints=track.joints.astype(np.float32),
+                    contacts=planted.contacts, **extra)
+    m = lock_stance(m)
+    m.ik_error_cm = planted.ik_error_cm
+    return m
+
+
+def lock_stance(motion: Motion) -> Motion:
+    """The planted feet held still by moving the whole body horizontally by millimetres.
+
+    ``plant.pin_feet`` is a soft two-bone IK: a leg near full stretch (heel strike, push-off)
+    stops short of its target, so a planted foot still drifts ~0.5 mm per frame. Here each frame
+    with a contact is shifted in XZ by the mean offset of its planted joints from their run's
+    mean position; frames without contact take the shift interpolated between their neighbours
+    (so the body's path stays smooth). Rotations, heights and the contacts are unchanged."""
+    c = np.asarray(motion.contacts).astype(bool) if motion.contacts is not None else None
+    if c is None or not c.any():
+        return motion
+    J = np.asarray(motion.joints, np.float64)
+    res = np.zeros((len(J), 4, 2))
+    for k, joint in enumerate(CONTACT_IDS):
+        for s, e in runs(c[:, k]):
+            xz = J[s:e, joint][:, [0, 2]]
+            res[s:e, k] = xz.mean(0) - xz
+    support = c.any(1)
+    shift = (res * c[..., None]).sum(1) / np.maximum(c.sum(1), 1)[:, None]
+    t = np.arange(len(J))
+    shift = np.stack([np.interp(t, t[support], shift[support, i]) for i in range(2)], axis=1)
+    d = np.zeros((len(J), 3))
+    d[:, [0, 2]] = shift
+    out = dataclasses.replace(motion, transl=(motion.transl + d).astype(np.float32),
+                              joints=(J + d[:, None]).astype(np.float32))
+    out.warnings = list(motion.warnings)
+    return out
 
 
 def headings(joints) -> np.ndarray:
