@@ -52,6 +52,17 @@ class _SubPanel(_Panel):
     bl_parent_id = "SHAPEMOVE_PT_main"
 
 
+class _SettingsPanel(_SubPanel):
+    """A sub-panel, closed at first, of scene settings in one column: subclasses write
+    ``draw_settings(context, settings, col)``; ``settings`` is the scene's ``SETTINGS`` group."""
+
+    bl_options = {"DEFAULT_CLOSED"}
+    SETTINGS = "shapemove"
+
+    def draw(self, context):
+        self.draw_settings(context, getattr(context.scene, self.SETTINGS), self.layout.column())
+
+
 class _RigPanel(_SubPanel):
     """A sub-panel shown only while a ShapeMove rig (or one of its meshes) is active."""
 
@@ -175,14 +186,11 @@ class SHAPEMOVE_PT_shape_betas(_RigPanel, bpy.types.Panel):
             col.prop(rig.shapemove, "betas", index=i, text=f"Beta {i}", slider=True)
 
 
-class SHAPEMOVE_PT_retarget(_SubPanel, bpy.types.Panel):
+class SHAPEMOVE_PT_retarget(_SettingsPanel, bpy.types.Panel):
     bl_label = "Retarget"
     bl_idname = "SHAPEMOVE_PT_retarget"
-    bl_options = {"DEFAULT_CLOSED"}
 
-    def draw(self, context):
-        s = context.scene.shapemove
-        col = self.layout.column()
+    def draw_settings(self, context, s, col):
         col.row().prop(s, "retarget_source", expand=True)
         if s.retarget_source == "FILE":
             col.prop(s, "retarget_path", text="")
@@ -201,14 +209,11 @@ class SHAPEMOVE_UL_library(bpy.types.UIList):
         row.label(text=f"{item.score:.2f}")
 
 
-class SHAPEMOVE_PT_library(_SubPanel, bpy.types.Panel):
+class SHAPEMOVE_PT_library(_SettingsPanel, bpy.types.Panel):
     bl_label = "Library"
     bl_idname = "SHAPEMOVE_PT_library"
-    bl_options = {"DEFAULT_CLOSED"}
 
-    def draw(self, context):
-        s = context.scene.shapemove
-        col = self.layout.column()
+    def draw_settings(self, context, s, col):
         col.prop(s, "library_folder", text="")
         row = col.row(align=True)
         row.prop(s, "library_query", text="", icon="VIEWZOOM")
@@ -219,14 +224,11 @@ class SHAPEMOVE_PT_library(_SubPanel, bpy.types.Panel):
             col.operator("shapemove.library_import", icon="IMPORT").index = -1
 
 
-class SHAPEMOVE_PT_train(_SubPanel, bpy.types.Panel):
+class SHAPEMOVE_PT_train(_SettingsPanel, bpy.types.Panel):
     bl_label = "Train"
     bl_idname = "SHAPEMOVE_PT_train"
-    bl_options = {"DEFAULT_CLOSED"}
 
-    def draw(self, context):
-        s = context.scene.shapemove
-        col = self.layout.column()
+    def draw_settings(self, context, s, col):
         col.prop(s, "train_data")
         col.row().prop(s, "train_kind", expand=True)
         col.prop(s, "train_model_name")

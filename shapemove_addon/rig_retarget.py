@@ -24,7 +24,7 @@ from ..core.scene.rig_retarget import retarget_to_armature
 from .headless import save_blend
 from .keyframes import write_pose_action
 from .operators import ReportingOperator
-from .panels import _SubPanel
+from .panels import _SettingsPanel
 from .redecode import MOTION_FILE_KEY
 from .rig_state import rig_of
 
@@ -254,14 +254,12 @@ class SHAPEMOVE_OT_retarget_rig(ReportingOperator, bpy.types.Operator):
 
 # ---- panel ----
 
-class SHAPEMOVE_PT_your_rig(_SubPanel, bpy.types.Panel):
+class SHAPEMOVE_PT_your_rig(_SettingsPanel, bpy.types.Panel):
     bl_label = "Your Rig"
     bl_idname = "SHAPEMOVE_PT_your_rig"
-    bl_options = {"DEFAULT_CLOSED"}
+    SETTINGS = "shapemove_rig"
 
-    def draw(self, context):
-        s = context.scene.shapemove_rig
-        col = self.layout.column()
+    def draw_settings(self, context, s, col):
         col.prop(s, "target")
         col.prop(s, "source_rig")
         col.prop(s, "motion_path")

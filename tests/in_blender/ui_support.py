@@ -16,7 +16,7 @@ import json
 import os
 import sys
 import time
-from types import SimpleNamespace
+from types import FunctionType, SimpleNamespace
 
 import numpy as np
 
@@ -142,6 +142,18 @@ class RnaLayout:
         pass
 
 
+class PanelSelf:
+    """Stands in for the panel instance Blender passes to ``draw``: the layout, and the panel class's
+    attributes and methods (a panel's draw may call its own helpers)."""
+
+    def __init__(self, cls, layout):
+        self.cls, self.layout = cls, layout
+
+    def __getattr__(self, name):
+        value = getattr(self.cls, name)
+        return value.__get__(self) if isinstance(value, FunctionType) else value
+
+
 def addon_panels():
     mod = ext("shapemove_addon.panels")
     return [c for c in mod.classes if issubclass(c, bpy.types.Panel)]
@@ -156,7 +168,7 @@ def draw_panels(context=None) -> dict:
             out[cls.bl_idname] = None
             continue
         log: list = []
-        cls.draw(SimpleNamespace(layout=RnaLayout(log)), context)
+        cls.draw(PanelSelf(cls, RnaLayout(log)), context)
         out[cls.bl_idname] = log
     return out
 
