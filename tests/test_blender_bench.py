@@ -1,6 +1,6 @@
 """`python -m shapemove bench keys --quick` runs, and the keyframe writer it times keys exactly what
 a ``keyframe_insert`` loop keys (the bench compares the two key by key and fails otherwise). The
-speed ratio is the bench's to report (README benchmarks), not a test's to assert: timings depend
+speed ratio is the bench's to report (docs/evaluation.md, Benchmarks), not a test's to assert: timings depend
 on the machine. Runs in a subprocess (bpy)."""
 from __future__ import annotations
 
