@@ -1,0 +1,101 @@
+"""How often the part judge (``part_judge.py``) is right on real captured clips it was not built from.
+
+    res = real_accuracy(judge, "data/built", "test")
+    res["legs"]["accuracy"], res["arms"]["accuracy"], res["side"]["accuracy"], res["path"]
+
+- ``legs``: the gait of each real clip of ``split`` whose labels give one (``part_judge.legs_label``:
+  a locomotion of ``LEGS_ACTIONS`` or a standing gesture, "stand"); ``path``: circle or straight
+  for the locomotion clips (``path_label``);
+- ``arms``: the gesture of each standing gesture clip, ``NO_GESTURE`` for the locomotion clips;
+- ``side``: the clips whose source label names a side (``named_side``: Bandai's
+  raise-up-left-hand / wave-right-hand ..., HDM05's kickLFront, grabHighR, depositFloorR) and the
+  mirror image of each (``data/mirror.py``, the other side), judged by ``side_of`` on the named part.
+
+Each as {"accuracy", "n", "per_class": {label: {"n", "accuracy"}}, "confusion": {label: {pred: n}}}.
+``leave_one_out(judge)`` is the same on the judge's own references, each without its own clip.
+"""
+from __future__ import annotations
+
+import re
+
+import numpy as np
+
+from ..data.mirror import mirror_joints
+from .part_judge import actions_of, arms_label, best, legs_label, load_joints, path_label, path_of, real_clips, side_of
+
+_BANDAI_SIDE = re.compile(r"(left|right)-hand")
+_HDM05_SIDE = {re.compile(r"^kick(L|R)"): "foot", re.compile(r"^(?:grabHigh|depositFloor)(L|R)"): "hand"}
+
+
+def named_side(meta: dict) -> tuple[str, str] | None:
+    """(side, part) named by a real clip's source label ("left", "hand"), or None."""
+    labels = meta.get("labels") if isinstance(meta.get("labels"), dict) else {}
+    if meta.get("dataset") == "bandai":
+        m = _BANDAI_SIDE.search(str(labels.get("content", "")))
+        return (m.group(1), "hand") if m else None
+    if meta.get("dataset") == "hdm05":
+        cls = str(labels.get("class", ""))
+        for rx, part in _HDM05_SIDE.items():
+            m = rx.match(cls)
+            if m:
+                return ("left" if m.group(1) == "L" else "right", part)
+    return None
+
+
+def tally(pairs: list[tuple[str, str]]) -> dict:
+    """[(truth, prediction)] -> accuracy overall, per class and the confusion counts."""
+    per: dict = {}
+    conf: dict = {}
+    for t, p in pairs:
+        d = per.setdefault(t, [0, 0])
+        d[0] += 1
+        d[1] += t == p
+        conf.setdefault(t, {}).setdefault(p, 0)
+        conf[t][p] += 1
+    n = len(pairs)
+    return {"accuracy": sum(t == p for t, p in pairs) / n if n else None, "n": n,
+            "per_class": {c: {"n": d[0], "accuracy": d[1] / d[0]} for c, d in sorted(per.items())},
+            "confusion": {c: dict(sorted(v.items())) for c, v in sorted(conf.items())}}
+
+
+def real_accuracy(judge, data, split: str = "test", max_clips: int | None = None, seed: int = 0,
+                  progress: bool = True, metas: list[dict] | None = None) -> dict:
+    """The judge on the real clips of ``split`` (module docstring); ``max_clips``: a seeded random
+    subset of the labelled ones; ``metas``: those clips' metas instead of the split's."""
+    from tqdm import tqdm
+
+    metas = real_clips(data, split) if metas is None else metas
+    metas = [m for m in metas if legs_label(actions_of(m)) is not None or named_side(m) is not None]
+    if max_clips is not None and len(metas) > max_clips:
+        keep = np.sort(np.random.default_rng(seed).choice(len(metas), max_clips, replace=False))
+        metas = [metas[i] for i in keep]
+    legs, arms, path, side = [], [], [], []
+    for m in tqdm(metas, desc=f"part judge on real {split} clips", unit="clip", disable=not progress):
+        j = load_joints(data, m["id"])
+        if j is None:
+            continue
+        acts = actions_of(m)
+        if (g := legs_label(acts)) is not None:
+            legs.append((g, judge.legs.classify(j)))
+        if (a := arms_label(acts)) is not None:
+            arms.append((a, judge.arms.classify(j)))
+        if (p := path_label(acts)) is not None:
+            path.append((p, path_of(j)))
+        if (named := named_side(m)) is not None:
+            s, part = named
+            side.append((s, side_of(j, part)))
+            side.append(("right" if s == "left" else "left", side_of(mirror_joints(j), part)))
+    return {"split": split, "legs": tally(legs), "arms": tally(arms), "path": tally(path), "side": tally(side),
+            "references": dict(judge.info)}
+
+
+def leave_one_out(judge) -> dict:
+    """Each reference classified among the others without its own clip (nor its mirror)."""
+    out = {}
+    for name, knn in (("legs", judge.legs), ("arms", judge.arms)):
+        pairs = []
+        for i in range(0, len(knn.labels), 2):  # the clip itself; its mirror follows it
+            pairs.append((str(knn.labels[i]), best(knn.scores_of(knn.X[i], knn.sources[i]))))
+        out[name] = tally(pairs)
+    return out
+
