@@ -1,0 +1,145 @@
+"""Animation features on the default model (docs/animation.md): loop seam, in place, along a
+path, speed, timeline of prompts continuing from the previous segment's tokens."""
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from shapemove.core.errors import ShapeMoveError
+
+pytestmark = pytest.mark.usefixtures("one_thread")
+
+
+@pytest.fixture(scope="module")
+def gen():
+    from shapemove.core.generation.generate import Generator
+
+    return Generator(None)
+
+
+@pytest.fixture(scope="module")
+def walk(gen):
+    from shapemove.core.generation.generate import Request
+
+    return gen.generate_batch([Request("a person walks forward", seconds=4, seed=0)])[0]
+
+
+def _slide(m):
+    from shapemove.core.eval.physics import stance_slide
+
+    return stance_slide(m.joints, m.contacts)[0].value
+
+
+def test_prefix_codes_continue_and_count_only_new(gen):
+    from shapemove.core.models.constrained_decoding import decode
+
+    inputs = gen.t5.inputs_for(gen.tok, ["a person walks forward"], [None])
+    out = decode(gen.t5, inputs, 3, 3, temperature=0, prefix_codes=[5, 6, 7, 8])
+    assert len(out.codes[0]) == 3
+    assert out.token_ids[0][2:6] == [gen.t5.vocab.first_code_id + c for c in (5, 6, 7, 8)]
+    with pytest.raises(ValueError):
+        decode(gen.t5, inputs, 3, 3, temperature=0, prefix_codes=[10**6])
+
+
+def test_loop_seam_and_advance(gen):
+    from shapemove.core.generation.generate import Request
+    from shapemove.core.generation.loop import generate_loop, seam_report
+
+    m = generate_loop(gen, Request("a person walks forward", seed=0))
+    r = seam_report(m)
+    assert r["jump_ratio"] <= 1.5, r
+    assert r["advance_vs_speed"] <= 0.05, r
+    assert r["advance_m"] > 1.0          # a walk cycle travels
+    assert _slide(m) <= 0.5
+
+
+def test_in_place_no_drift_feet_alternate(walk):
+    from shapemove.core.generation.in_place import in_place, root_drift
+
+    m = in_place(walk)
+    assert root_drift(walk) > 1.0 and root_drift(m) <= 0.01
+    np.testing.assert_array_equal(m.poses, walk.poses)                    # facing and limbs kept
+    rel = lambda x: x.joints[:, [7, 8]] - x.joints[:, :1]                  # noqa: E731
+    np.testing.assert_allclose(rel(m), rel(walk), atol=1e-5)              # the feet step as before
+    left, right = walk.contacts[:, [0, 2]].any(1), walk.contacts[:, [1, 3]].any(1)
+    only = np.where(left & ~right, 1, np.where(right & ~left, 2, 0))
+    seq = [v for i, v in enumerate(only) if v and (i == 0 or v != only[i - 1])]
+    changes = sum(a != b for a, b in zip(seq, seq[1:]))
+    assert changes >= 3                                                   # left, right, left, right
+
+
+def test_path_follow_s_curve(gen, walk):
+    from shapemove.core.generation.path_follow import follow_path, path_report
+
+    t = np.linspace(0, 1, 40)
+    path = np.stack([0.6 * np.sin(2 * np.pi * t), 3.0 * t], 1)
+    m = follow_path(walk, gen.body, path, crop=False)
+    r = path_report(m, path)
+    assert r["root_mean_m"] <= 0.05 and r["root_max_m"] <= 0.15, r
+    assert r["facing_max_deg"] <= 20, r
+    assert _slide(m) <= 0.5
+
+
+def test_speed_exact_duration_and_planted(gen, walk):
+    from shapemove.core.generation.time_warp import time_warp
+
+    for speed, frames in ((0.5, 2 * walk.num_frames), (2.0, walk.num_frames // 2)):
+        m = time_warp(walk, gen.body, speed=speed)
+        assert m.num_frames == frames
+        assert _slide(m) <= 0.5, speed
+    assert time_warp(walk, gen.body, seconds=3.0).num_frames == 60
+    with pytest.raises(ShapeMoveError, match="between 0.5 and 2"):
+        time_warp(walk, gen.body, speed=3.0)
+
+
+def test_timeline_boundaries_and_regenerate(gen):
+    from shapemove.core.generation.sequence import boundary_report, generate_sequence, regenerate_segment, segment_codes
+
+    segs = [("a person walks forward", 2.0), ("a person sits down", 2.0), ("a person waves", 2.0)]
+    m = generate_sequence(gen, segs, seed=0, candidates=2)
+    assert m.segment_bounds.tolist() == [[0, 40], [40, 80], [80, 120]]
+    assert m.segment_prompts == [s for s, _ in segs]
+    r = boundary_report(m)
+    assert r["jump_ratio"] <= 2.0, r
+    m2 = regenerate_segment(gen, m, 1, seed=7, candidates=2)
+    a, b = segment_codes(m), segment_codes(m2)
+    assert a[0] == b[0] and a[2] == b[2] and a[1] != b[1]
+    np.testing.assert_allclose(m2.betas, m.betas)
+    from shapemove.core.generation.loop import _local
+    from shapemove.core.generation.track import headings
+
+    def rel(x):   # the decoder's pose in the root's place and heading
+        return _local(x.network_joints, headings(x.network_joints))[0]
+    assert np.abs(rel(m2)[:30] - rel(m)[:30]).max() <= 0.03               # the first segment kept
+    assert np.abs(rel(m2)[95:] - rel(m)[95:]).max() <= 0.05               # the last segment kept
+    assert np.abs(rel(m2)[50:70] - rel(m)[50:70]).max() > 0.1             # the middle one is new
+
+
+def test_motion_file_round_trip(tmp_path, walk, gen):
+    from shapemove.core.generation.loop import loop_motion
+    from shapemove.core.scene.motion_file import load_motion, save_motion
+
+    m = loop_motion(walk, gen.body)
+    m.segment_bounds, m.segment_prompts = np.array([[0, m.num_frames]]), ["a person walks forward"]
+    back = load_motion(save_motion(tmp_path / "m.npz", m))
+    np.testing.assert_allclose(back.loop_advance, m.loop_advance)
+    assert back.segment_prompts == ["a person walks forward"] and back.segment_bounds.tolist() == [[0, m.num_frames]]
+
+
+@pytest.mark.parametrize("args, message", [
+    (["generate", "--prompt", "a person walks", "--speed", "3", "--out", "x.npz"], "--speed must be between"),
+    (["generate", "--prompt", "a person walks", "--loop", "--path", "p.json", "--out", "x.npz"], "do not go together"),
+    (["generate", "--prompt", "a person walks", "--path", "bad.json", "--out", "x.npz"], "not valid JSON"),
+    (["sequence", "--prompt", "a", "--prompt", "b", "--seconds", "2", "--out", "x.npz"], "one --seconds per --prompt"),
+])
+def test_cli_refuses_bad_animation_input(tmp_path, args, message):
+    (tmp_path / "p.json").write_text(json.dumps([[0, 0], [0, 2]]))
+    (tmp_path / "bad.json").write_text("[[0, 0], [0")
+    res = subprocess.run([sys.executable, "-m", "shapemove", *args], cwd=tmp_path, capture_output=True, text=True)
+    assert res.returncode == 2, res.stderr
+    lines = res.stderr.strip().splitlines()
+    assert len(lines) == 1 and message in lines[0], res.stderr
