@@ -22,7 +22,7 @@ from ..core.scene.axes import points_to_y_up
 from . import job_submit, paths
 from .animation_rig import ROOT_MOTION_ITEMS, SEGMENTS_KEY, TRACK_NAME
 from .operators import ReportingOperator, JobOperator, build_rig_from_file
-from .panels import _SubPanel, draw_job
+from .panels import _SettingsPanel, draw_job, draw_optional
 from .preferences import body_spec, setting
 from .redecode import MOTION_FILE_KEY
 from .rig_state import rig_of
@@ -265,23 +265,17 @@ class SHAPEMOVE_UL_timeline(bpy.types.UIList):
         row.prop(item, "seconds", text="")
 
 
-class SHAPEMOVE_PT_animation(_SubPanel, bpy.types.Panel):
+class SHAPEMOVE_PT_animation(_SettingsPanel, bpy.types.Panel):
     bl_label = "Animation"
     bl_idname = "SHAPEMOVE_PT_animation"
-    bl_options = {"DEFAULT_CLOSED"}
+    SETTINGS = "shapemove_animation"
 
-    def draw(self, context):
-        a = context.scene.shapemove_animation
-        col = self.layout.column()
+    def draw_settings(self, context, a, col):
         col.prop(a, "root_motion")
         row = col.row(align=True)
         row.prop(a, "loop")
         row.prop(a, "speed")
-        row = col.row(align=True)
-        row.prop(a, "use_stretch", text="")
-        sub = row.row(align=True)
-        sub.enabled = a.use_stretch
-        sub.prop(a, "stretch")
+        draw_optional(col, a, "use_stretch", "stretch")
         col.prop(a, "path_curve")
         draw_job(col, "animate", "shapemove.animate", "Generate Animated", icon="ANIM")
         col.separator()

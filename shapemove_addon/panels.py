@@ -42,6 +42,15 @@ def draw_job(layout, kind: str, operator: str, text: str, icon: str = "PLAY", **
     row.operator("shapemove.cancel_job", text="", icon="CANCEL").kind = kind
 
 
+def draw_optional(layout, data, toggle: str, value: str) -> None:
+    """The property ``value`` beside its checkbox ``toggle``, greyed out while the box is off."""
+    row = layout.row(align=True)
+    row.prop(data, toggle, text="")
+    sub = row.row(align=True)
+    sub.enabled = getattr(data, toggle)
+    sub.prop(data, value)
+
+
 class _Panel:
     bl_space_type = "VIEW_3D"
     bl_region_type = "UI"
@@ -99,11 +108,7 @@ class SHAPEMOVE_PT_generate(_SubPanel, bpy.types.Panel):
         if known:
             col.label(text="Knows: " + ", ".join(known), icon="INFO")
         col.prop(s, "shape_text")
-        row = col.row(align=True)
-        row.prop(s, "use_seconds", text="")
-        sub = row.row(align=True)
-        sub.enabled = s.use_seconds
-        sub.prop(s, "seconds")
+        draw_optional(col, s, "use_seconds", "seconds")
         row = col.row(align=True)
         row.prop(s, "seed")
         row.prop(s, "temperature")
