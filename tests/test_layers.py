@@ -6,7 +6,6 @@ from __future__ import annotations
 import ast
 from pathlib import Path
 
-import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 CORE = ROOT / "core"
@@ -69,8 +68,5 @@ def test_body_does_not_import_the_scene():
 
 
 def test_body_does_not_import_the_dataset_builder():
-    bad = offenders("body", ("core.data",))
-    if bad == ["core/body/shape_from_measurements.py imports core.data.shape_text"]:
-        pytest.skip("issue #25 moves shape-word parsing out of core/data/shape_text.py into a low module; "
-                    "until it lands, core/body/shape_from_measurements.py is the one known exception")
-    assert bad == []
+    """Shape words are read by the leaf core/text/shape_words.py (issue #25), not by the dataset builder."""
+    assert offenders("body", ("core.data",)) == []
