@@ -106,6 +106,15 @@ def add_paraphrase(sub):
     p.set_defaults(_run=paraphrase_eval.from_cli)
 
 
+def add_parts(sub):
+    from ..core.eval import parts_eval
+
+    p = sub.add_parser("parts", help="held-out left/right and two-things prompts, judged by body part (legs, arms, side)",
+                       description=parts_eval.__doc__.splitlines()[0])
+    parts_eval.add_arguments(p)
+    p.set_defaults(_run=parts_eval.from_cli)
+
+
 # -- eval retarget (HUMOS's application: SA-VAE retargeting against naive) ----------------------------
 RETARGET_BODIES = {"a very tall, heavy-set man": "height 195 cm, waist 110 cm", "a short, slim woman": "height 152 cm, waist 64 cm"}
 
@@ -156,7 +165,17 @@ def run_retarget(args) -> int:
     return 0
 
 
-KINDS = [add_recon, add_generate, add_paraphrase, add_shape, add_retarget]
+# -- eval speed (issue #24: does the codec keep locomotion's root speed? core/eval/speed.py) ----------
+def add_speed(sub):
+    from ..core.eval import speed_report
+
+    p = sub.add_parser("speed", help="root speed of decoded and generated walks/jogs/runs against the real clips",
+                       description=speed_report.__doc__.splitlines()[0])
+    speed_report.add_arguments(p)
+    p.set_defaults(_run=speed_report.from_cli)
+
+
+KINDS = [add_recon, add_generate, add_paraphrase, add_parts, add_shape, add_retarget, add_speed]
 
 
 def add_arguments(p):

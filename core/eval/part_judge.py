@@ -30,7 +30,8 @@ Both k-NN readings are side-invariant: every reference clip is also matched as i
 (``data/mirror.py``'s ``mirror_joints``), with the same label. A class's score is the mean distance
 to its ``k`` nearest references (class-balanced: a class of 4 clips is not outvoted by one of
 1000); each descriptor group counts equally (z-scored by the references' spread, divided by the
-square root of its size). References are the real captured clips of a split (not the
+square root of its size), except the root's velocity for the legs, which counts double
+(``LEGS_WEIGHTS``). References are the real captured clips of a split (not the
 shape-augmented, mirrored or composed copies), at most ``max_per_class`` source clips per class.
 """
 from __future__ import annotations
@@ -65,6 +66,7 @@ ARM_JOINTS = [13, 14, 16, 17, 18, 19, 20, 21]
 CHEST = 9
 SIDE_JOINTS = {"hand": ([18, 20], [19, 21]), "foot": ([7, 10], [8, 11])}   # (left, right)
 FEATURES = "new_joint_vecs"
+LEGS_WEIGHTS = {"root": 2.0}  # where the pelvis goes (forward, back, sideways, how fast) counts double
 
 
 # -- the body's own frame -----------------------------------------------------------------------
@@ -221,7 +223,8 @@ class PartKNN:
     nearest references; the lowest wins. Groups are z-scored by the references' spread and weighted
     so each counts equally."""
 
-    def __init__(self, descriptors: list[dict], labels: list[str], sources: list[str], describe: Callable, k: int = 5):
+    def __init__(self, descriptors: list[dict], labels: list[str], sources: list[str], describe: Callable, k: int = 5,
+                 weights: dict[str, float] | None = None):
         if not descriptors or len(descriptors) != len(labels) or len(labels) != len(sources):
             raise ShapeMoveError(f"part judge: {len(descriptors)} reference descriptors for {len(labels)} labels; "
                                  "need at least one of each, equal")
@@ -230,7 +233,8 @@ class PartKNN:
         X = np.stack([self._flat(d) for d in descriptors])
         self.mean = X.mean(0)
         self.scale = np.where(X.std(0) > 1e-8, X.std(0), 1.0)
-        self.weights = np.concatenate([np.full(n, 1.0 / np.sqrt(n)) for n in self.sizes])
+        w = weights or {}
+        self.weights = np.concatenate([np.full(n, w.get(g, 1.0) / np.sqrt(n)) for g, n in zip(self.groups, self.sizes)])
         self.X = self._norm(X)
         self.labels, self.sources = np.asarray(labels), np.asarray(sources)
         self.classes = sorted(set(labels))
@@ -375,7 +379,7 @@ class PartJudge:
             if m["id"] not in joints:
                 joints[m["id"]] = load_joints(data, m["id"])
         knns = []
-        for refs, describe in ((legs_refs, legs_descriptor), (arms_refs, arms_descriptor)):
+        for refs, describe, weights in ((legs_refs, legs_descriptor, LEGS_WEIGHTS), (arms_refs, arms_descriptor, None)):
             descs, labels, sources = [], [], []
             for m, lab in refs:
                 j = joints[m["id"]]
@@ -389,7 +393,7 @@ class PartJudge:
                 raise ShapeMoveError(f"{data}: no real {split or 'reference'} clip of a "
                                      f"{'locomotion or standing gesture' if describe is legs_descriptor else 'gesture'} "
                                      "with usable features; the part judge needs them")
-            knns.append(PartKNN(descs, labels, sources, describe, k))
+            knns.append(PartKNN(descs, labels, sources, describe, k, weights))
         count = lambda knn: {c: int((knn.labels == c).sum() // 2) for c in knn.classes}  # noqa: E731
         info = {"data": str(data), "split": split, "k": k, "max_per_class": max_per_class,
                 "legs_references": count(knns[0]), "arms_references": count(knns[1])}

@@ -1,0 +1,224 @@
+"""Left and right, and two things at once: held-out prompts judged by body part.
+
+    res = eval_parts("weights/default", data="data/built")
+    res["sides"]["named_side_moves_most"], res["two_things"]["both"], res["two_things"]["legs"], res["two_things"]["arms"]
+
+Two held-out prompt sets, written by hand and never used for training or tuning (no prompt is a
+training caption: ``tests/test_heldout_parts.py``):
+
+- ``configs/heldout_sides.json``: {"text", "side": "left"|"right", "part": "hand"|"foot", "action"}:
+  raise or wave a named hand, kick or lift a named foot. Right when the named side's hand (or foot)
+  moves most relative to the pelvis, in the body's own frame (``part_judge.side_of``).
+- ``configs/heldout_two_things.json``: {"text", "legs", "arms"}: a locomotion and a gesture at once,
+  only the pairs of ``compose_parts.HELD_OUT_PAIRS`` (never composed for training). Legs right when
+  the judged gait is the expected one ("walk in a circle": the path circles while the legs move),
+  arms right when the judged gesture is; both right when both are.
+
+One generated motion per prompt (seed ``seed + i`` for the i-th prompt of each set; the product's
+best-of-N TMA choice among token samples unless ``candidates`` says otherwise), judged by
+``part_judge.PartJudge`` built from the real training clips of the built dataset ``data``;
+``judge_real`` is the judge's own accuracy on the real test clips (``part_judge_accuracy``), the
+most a generator can be credited with. ``retrieval=False`` runs a model that reads retrieved clips
+(``ShapeMoveT5.memory``, ``memory_k`` > 0) with an empty memory: the prompt alone.
+Targets (issue #23): sides >= 90 %, both >= 70 %, legs and arms >= 85 % each.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+from ..errors import ShapeMoveError
+
+CONFIGS = Path(__file__).resolve().parents[2] / "configs"
+DEFAULT_SIDES = CONFIGS / "heldout_sides.json"
+DEFAULT_TWO_THINGS = CONFIGS / "heldout_two_things.json"
+MAX_PROMPTS_BYTES = 1 << 20
+TARGETS = {"sides": 0.90, "both": 0.70, "legs": 0.85, "arms": 0.85}
+SIDES, PARTS = ("left", "right"), ("hand", "foot")
+
+
+def _items(path: Path, what: str) -> list:
+    from ..io.limits import read_json
+
+    doc = read_json(path, what, MAX_PROMPTS_BYTES)
+    items = doc.get("prompts") if isinstance(doc, dict) else doc
+    if not isinstance(items, list) or not items:
+        raise ShapeMoveError(f"{path}: no prompts (expected {{\"prompts\": [...]}})")
+    return items
+
+
+def load_sides(path=None) -> list[dict]:
+    """The left/right prompts [{text, side, part, action}] of a JSON file."""
+    path = Path(path) if path else DEFAULT_SIDES
+    out = []
+    for i, it in enumerate(_items(path, "left/right prompt list")):
+        if not (isinstance(it, dict) and isinstance(it.get("text"), str) and it.get("side") in SIDES
+                and it.get("part") in PARTS):
+            raise ShapeMoveError(f"{path}: prompt {i} must be {{\"text\": ..., \"side\": \"left\"|\"right\", "
+                                 f"\"part\": \"hand\"|\"foot\"}}")
+        out.append({"text": it["text"], "side": it["side"], "part": it["part"], "action": str(it.get("action", ""))})
+    return out
+
+
+def load_two_things(path=None) -> list[dict]:
+    """The two-things prompts [{text, legs, arms}] of a JSON file; every (legs, arms) pair must be
+    one of ``HELD_OUT_PAIRS`` (pairs composed for training would not test anything new)."""
+    from ..data.compose_parts import HELD_OUT_PAIRS
+
+    path = Path(path) if path else DEFAULT_TWO_THINGS
+    out = []
+    for i, it in enumerate(_items(path, "two-things prompt list")):
+        if not (isinstance(it, dict) and isinstance(it.get("text"), str) and isinstance(it.get("legs"), str)
+                and isinstance(it.get("arms"), str)):
+            raise ShapeMoveError(f"{path}: prompt {i} must be {{\"text\": ..., \"legs\": ..., \"arms\": ...}}")
+        if (it["legs"], it["arms"]) not in HELD_OUT_PAIRS:
+            raise ShapeMoveError(f"{path}: prompt {i} pairs {it['legs']!r} with {it['arms']!r}, not one of the "
+                                 "held-out pairs of core/data/compose_parts.py (HELD_OUT_PAIRS)")
+        out.append({"text": it["text"], "legs": it["legs"], "arms": it["arms"]})
+    return out
+
+
+def _share(flags: list[bool]) -> float | None:
+    return sum(flags) / len(flags) if flags else None
+
+
+def _by(rows: list[dict], key: str, flags: tuple[str, ...]) -> dict:
+    out: dict = {}
+    for r in rows:
+        out.setdefault(str(r[key]), []).append(r)
+    return {k: {"n": len(v), **{f: _share([x[f] for x in v]) for f in flags}} for k, v in sorted(out.items())}
+
+
+def eval_parts(model_dir=None, data=None, sides=None, two_things=None, seed: int = 0, seconds: float = 4.0,
+               candidates: int | None = None, retrieval: bool = True, generator=None, judge=None,
+               judge_check: bool = True, progress=None, show_progress: bool = True) -> dict:
+    """Generate one motion per held-out prompt and judge it by part (module docstring). Returns
+    {"sides": {...}, "two_things": {...}, "judge_real", "targets", "settings", "rows": {...}}."""
+    from ..generation.generate import Generator, Request
+    from ..generation.sampling_params import DEFAULT_CANDIDATES
+    from .action_classifier import default_built_dir
+    from .part_judge import PartJudge, arms_right, legs_right
+    from .part_judge_accuracy import real_accuracy
+
+    side_items, two_items = load_sides(sides), load_two_things(two_things)
+    candidates = DEFAULT_CANDIDATES if candidates is None else candidates
+    if judge is None:
+        data = data if data is not None else default_built_dir()
+        if data is None:
+            raise ShapeMoveError("eval parts judges generated motions against real clips: pass --data BUILT, a "
+                                 "built dataset (or set SHAPEMOVE_BUILT; default data/built when it exists)")
+        judge = PartJudge.from_data(data, "train", progress=show_progress)
+    real = real_accuracy(judge, data, "test", progress=show_progress) if judge_check and data is not None else None
+    gen = generator if generator is not None else Generator(model_dir)
+    reads_memory = bool(getattr(gen, "reads_memory", False))
+    if reads_memory:
+        gen.set_retrieval(retrieval)
+    total, done = len(side_items) + len(two_items), 0
+
+    def generate(text: str, s: int):
+        nonlocal done
+        m = gen.generate_batch([Request(text, seconds=seconds, seed=s, candidates=candidates)])[0]
+        done += 1
+        if progress is not None:
+            progress(done / total, text)
+        return judge.judge([m.features])[0], bool(m.warnings)
+
+    side_rows, two_rows = [], []
+    for i, it in enumerate(side_items):
+        j, warned = generate(it["text"], seed + i)
+        side_rows.append({**it, "judged": j, "right": j[f"{it['part']}_side"] == it["side"], "warned": warned})
+    for i, it in enumerate(two_items):
+        j, warned = generate(it["text"], seed + i)
+        lr, ar = legs_right(it["legs"], j), arms_right(it["arms"], j)
+        two_rows.append({**it, "pair": f"{it['legs']} + {it['arms']}", "judged": j, "legs_right": lr,
+                         "arms_right": ar, "both_right": lr and ar, "warned": warned})
+    return {
+        "sides": {"named_side_moves_most": _share([r["right"] for r in side_rows]), "prompts": len(side_rows),
+                  "per_part": _by(side_rows, "part", ("right",)), "per_side": _by(side_rows, "side", ("right",))},
+        "two_things": {"both": _share([r["both_right"] for r in two_rows]),
+                       "legs": _share([r["legs_right"] for r in two_rows]),
+                       "arms": _share([r["arms_right"] for r in two_rows]), "prompts": len(two_rows),
+                       "per_pair": _by(two_rows, "pair", ("both_right", "legs_right", "arms_right"))},
+        "targets": TARGETS,
+        "judge_real": real,
+        "judge": dict(judge.info),
+        "settings": {"model": str(getattr(gen, "model_dir", model_dir)), "seed": seed, "seconds": seconds,
+                     "candidates": candidates, "samples_per_prompt": 1,
+                     "retrieval": ("on" if retrieval else "off") if reads_memory else "none (the model reads no memory)",
+                     "sides_file": str(Path(sides) if sides else DEFAULT_SIDES),
+                     "two_things_file": str(Path(two_things) if two_things else DEFAULT_TWO_THINGS)},
+        "rows": {"sides": side_rows, "two_things": two_rows},
+    }
+
+
+def _pct(v) -> str:
+    return "—" if v is None else f"{100 * v:.1f}%"
+
+
+def format_results(res: dict) -> str:
+    s, t, tg = res["sides"], res["two_things"], res["targets"]
+    lines = [f"Held-out left/right prompts ({s['prompts']}): the named side moves most {_pct(s['named_side_moves_most'])} "
+             f"(target {_pct(tg['sides'])}); " + ", ".join(f"{k} {_pct(v['right'])} of {v['n']}" for k, v in s["per_part"].items()),
+             f"Held-out two-things prompts ({t['prompts']}): both parts right {_pct(t['both'])} (target {_pct(tg['both'])}), "
+             f"legs {_pct(t['legs'])}, arms {_pct(t['arms'])} (target {_pct(tg['legs'])} each)"]
+    w = max([len(p) for p in t["per_pair"]] + [4])
+    lines.append(f"  {'pair'.ljust(w)}  {'n':>2}  {'both':>6}  {'legs':>6}  {'arms':>6}")
+    for p, v in t["per_pair"].items():
+        lines.append(f"  {p.ljust(w)}  {v['n']:>2}  {_pct(v['both_right']):>6}  {_pct(v['legs_right']):>6}  {_pct(v['arms_right']):>6}")
+    real = res.get("judge_real")
+    if real:
+        lines.append(f"the judge on real {real['split']} clips: legs {_pct(real['legs']['accuracy'])} of {real['legs']['n']}, "
+                     f"arms {_pct(real['arms']['accuracy'])} of {real['arms']['n']}, side {_pct(real['side']['accuracy'])} "
+                     f"of {real['side']['n']} (clips and their mirrors), circle path {_pct(real['path']['accuracy'])} "
+                     f"of {real['path']['n']}")
+    st = res["settings"]
+    lines.append(f"one motion per prompt (seed {st['seed']} + i, {st['seconds']} s, best of {st['candidates']} token "
+                 f"samples by the TMA), retrieval {st['retrieval']}")
+    return "\n".join(lines)
+
+
+def add_arguments(p) -> None:
+    """Options of `python -m shapemove eval parts`."""
+    p.add_argument("--model", type=Path, default=None, help="model folder (default: the embedded default model)")
+    p.add_argument("--data", type=Path, default=None,
+                   help="built dataset: its real training clips are the judge's references, its test clips check the "
+                        "judge (default $SHAPEMOVE_BUILT, else data/built)")
+    p.add_argument("--sides", type=Path, default=None, help="left/right prompts (default configs/heldout_sides.json)")
+    p.add_argument("--two-things", type=Path, default=None,
+                   help="two-things prompts (default configs/heldout_two_things.json)")
+    p.add_argument("--seconds", type=float, default=4.0, help="length of each generated motion")
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--candidates", type=int, default=None,
+                   help="token samples per prompt, the TMA keeps the closest (default: the product's, 8; 1 = none)")
+    p.add_argument("--no-retrieval", action="store_true",
+                   help="a model that reads retrieved clips gets none (an empty memory): the prompt alone")
+    p.add_argument("--no-judge-check", action="store_true", help="skip the judge's accuracy on the real test clips")
+    p.add_argument("--json", type=Path, default=None, help="write the results here")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+
+
+def from_cli(args) -> int:
+    from tqdm import tqdm
+
+    from ..atomic import atomic_write_json
+
+    if args.seconds is not None and not 0.5 <= args.seconds <= 60:
+        raise ShapeMoveError(f"--seconds must be between 0.5 and 60, got {args.seconds}")
+    bar = None
+
+    def progress(frac, msg):
+        nonlocal bar
+        if bar is None:
+            bar = tqdm(total=100, desc="eval parts", unit="%", disable=args.quiet)
+        bar.update(round(100 * frac) - bar.n)
+
+    try:
+        res = eval_parts(args.model, args.data, args.sides, args.two_things, args.seed, args.seconds, args.candidates,
+                         retrieval=not args.no_retrieval, judge_check=not args.no_judge_check, progress=progress,
+                         show_progress=not args.quiet)
+    finally:
+        if bar is not None:
+            bar.close()
+    print(format_results(res))
+    if args.json:
+        print(f"wrote {atomic_write_json(args.json, res, nan_to_null=True)}")
+    return 0
