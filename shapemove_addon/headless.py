@@ -10,7 +10,7 @@ import numpy as np
 
 from ..core.atomic import atomic_path
 from .preview_render import add_preview_stage, render_frame
-from .scene_build import build_rig
+from .animation_rig import build_animated_rig
 
 
 def save_blend(path: Path) -> Path:
@@ -48,11 +48,13 @@ def write_strip(frames: list[np.ndarray], path: Path) -> Path:
 
 
 def build_scene_file(motion, body, out_blend: Path, preview: Path | None = None, frames: int = 4,
-                     resolution=(320, 320), name: str = "ShapeMove") -> dict:
-    """New scene with the rig for ``motion``; saves ``out_blend``; with ``preview`` renders
-    ``frames`` evenly spaced frames into one PNG strip. Returns facts about what was built."""
+                     resolution=(320, 320), name: str = "ShapeMove", root_motion: str = "PELVIS") -> dict:
+    """New scene with the rig for ``motion`` (a loop cycles, a timeline gets NLA strips, the root
+    travel goes where ``root_motion`` says: ``animation_rig``); saves ``out_blend``; with
+    ``preview`` renders ``frames`` evenly spaced frames into one PNG strip. Returns facts about
+    what was built."""
     bpy.ops.wm.read_factory_settings(use_empty=True)
-    rig = build_rig(bpy.context, motion, body, name=name)
+    rig = build_animated_rig(bpy.context, motion, body, name=name, root_motion=root_motion)
     scene = bpy.context.scene
     info = {"armature": rig.armature.name, "vertices": len(rig.body.data.vertices),
             "bones": len(rig.armature.data.bones), "frame_start": scene.frame_start, "frame_end": scene.frame_end}
