@@ -85,8 +85,12 @@ def on_generated(name: str, msg: dict):
         return None
     r = msg["result"]
     rig = build_rig_from_file(r["path"], name, r.get("measurements"), r.get("physics"))
-    if rig is not None and r.get("warnings"):  # far from the training data: the panel names the closest actions
+    model = [str(w) for w in r.get("model_warnings") or []]  # what the model folder lacks (e.g. no TMA)
+    if rig is not None and [w for w in r.get("warnings") or [] if w not in model]:
+        # far from the training data: the panel names the closest actions
         rig["shapemove_nearest_actions"] = [str(a) for a in r.get("nearest_actions") or []][:3] or ["?"]
+    if rig is not None and model:
+        rig["shapemove_model_warnings"] = model
     return rig
 
 
@@ -155,6 +159,23 @@ class SHAPEMOVE_OT_build_from_motion(ReportingOperator, bpy.types.Operator, Impo
 
 
 # -- generate ------------------------------------------------------------------------------------
+def scene_prompt(context) -> str:
+    """The Generate panel's prompt, stripped; an empty one is a ShapeMoveError."""
+    prompt = context.scene.shapemove.prompt.strip()
+    if not prompt:
+        raise ShapeMoveError("the prompt is empty: describe a motion, e.g. 'a person jogs forward and waves'")
+    return prompt
+
+
+def generation_params(context, label: str) -> dict:
+    """The job parameters every generation shares: the Generate panel's shape text, seed and temperature,
+    the active model and body, and a new motion file named after ``label``."""
+    s = context.scene.shapemove
+    return {"shape_text": s.shape_text.strip() or None, "seed": s.seed, "temperature": s.temperature,
+            "model": setting("active_model") or None, "body": body_spec(context),
+            "out": str(paths.new_motion_path(label))}
+
+
 class SHAPEMOVE_OT_generate(JobOperator, bpy.types.Operator):
     """Generate a body shape and a motion from the prompt (runs in the background)"""
 
@@ -164,13 +185,9 @@ class SHAPEMOVE_OT_generate(JobOperator, bpy.types.Operator):
 
     def start(self, context):
         s = context.scene.shapemove
-        prompt = s.prompt.strip()
-        if not prompt:
-            raise ShapeMoveError("the prompt is empty: describe a motion, e.g. 'a person jogs forward and waves'")
-        params = {"prompt": prompt, "shape_text": s.shape_text.strip() or None, "seed": s.seed,
-                  "temperature": s.temperature, "seconds": s.seconds if s.use_seconds else None,
-                  "model": setting("active_model") or None, "body": body_spec(context),
-                  "out": str(paths.new_motion_path(prompt))}
+        prompt = scene_prompt(context)
+        params = {**generation_params(context, prompt), "prompt": prompt,
+                  "seconds": s.seconds if s.use_seconds else None}
         name = paths.slug(prompt, 24)
 
         job_submit.submit_job("generate", params, kind=self.job, label="generate",

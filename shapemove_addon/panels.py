@@ -129,12 +129,15 @@ def draw_result(layout, rig) -> None:
     physics = rig.get(PHYSICS_KEY) or {}
     m = rig.shapemove
     nearest = list(rig.get("shapemove_nearest_actions") or [])  # the prompt was far from the training data
-    if not physics and m.height_cm <= 0 and not nearest:
+    lacking = list(rig.get("shapemove_model_warnings") or [])   # a part the model folder lacks (no TMA)
+    if not physics and m.height_cm <= 0 and not nearest and not lacking:
         return
     box = layout.box()
     box.label(text=rig.name, icon="ARMATURE_DATA")
     if nearest:
         box.label(text="Prompt unlike the training data; closest: " + ", ".join(nearest), icon="ERROR")
+    for w in lacking:
+        box.label(text=w, icon="ERROR")
     if physics:
         grid = box.grid_flow(columns=2, align=True)
         for key, label, fmt in PHYSICS_FIGURES:

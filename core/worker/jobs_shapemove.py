@@ -16,7 +16,7 @@ import numpy as np
 
 from ..constants import FPS
 from ..errors import ShapeMoveError
-from ..generation.model_bundle import resolve_model_dir
+from ..generation.model_bundle import part_warnings, resolve_model_dir
 from ..io.mocap import Motion22
 from ..scene.motion_file import load_motion, save_motion
 from ..search.motion_search import check_query, index_library, search as _search
@@ -124,6 +124,7 @@ def generate(params, progress, cancel) -> dict:
     return {**_motion_facts(out, motions[0]), "measurements": _measurements(gen.body, motions[0].betas),
             "physics": phys, "ik_error_cm": float(motions[0].ik_error_cm or 0.0),
             "warnings": list(motions[0].warnings),
+            "model_warnings": [w for w in motions[0].warnings if w in part_warnings(gen.model_dir)],
             "nearest_actions": list(check.nearest_actions) if check is not None else []}
 
 
