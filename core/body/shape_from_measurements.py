@@ -30,8 +30,8 @@ import numpy as np
 
 from ..atomic import atomic_path
 from ..errors import ShapeMoveError
-from ..text.shape_words import PERSON_RANGES, SIZE_TARGETS, ShapeWords, parse_shape_words, word_conflict
-from .body_mass import DENSITY_KG_M3, bmi as bmi_of
+from ..text.shape_words import PERSON_RANGES, ShapeWords, parse_shape_words, size_targets, word_conflict
+from .body_mass import DENSITY_KG_M3, VolumePolynomial, bmi as bmi_of
 from .measure import MASS, MEASUREMENTS, measure_mesh
 from .skeleton import JOINT_INDEX as JI
 
@@ -46,6 +46,7 @@ REGRESSION_FILE = Path(__file__).resolve().parents[2] / "assets" / "girth_regres
 _regressions: dict = {}
 _keys: dict = {}     # id(body) -> (body, body_key): the key is computed once per body object
 _arrays: dict = {}   # id(body) -> (body, linear arrays of fast_measure)
+_volumes: dict = {}  # id(body) -> (body, VolumePolynomial)
 PLAUSIBLE_CM = {"height_cm": (50, 260), "chest_cm": (40, 200), "waist_cm": (30, 200), "hip_cm": (40, 200),
                 "arm_length_cm": (15, 110), "leg_length_cm": (30, 140),
                 "mass_kg": PERSON_RANGES["mass_kg"], "bmi": PERSON_RANGES["bmi"]}
@@ -164,14 +165,15 @@ def _linear_vertices(body) -> tuple:
 
 
 def fast_mass(body, betas: np.ndarray) -> np.ndarray:
-    """(B,10) betas -> (B,) mass in kg: the rest mesh's volume x ``body_mass.DENSITY_KG_M3`` (the
-    same number ``measure`` gives, without slicing the mesh)."""
-    from .body_mass import mass_kg
-
+    """(B,10) betas -> (B,) mass in kg: the rest mesh's volume x ``body_mass.DENSITY_KG_M3``, the
+    same number ``measure`` gives, from the volume's exact cubic in the betas (``VolumePolynomial``,
+    built once per body)."""
     b = np.asarray(betas, np.float64).reshape(-1, body.num_betas)
-    _, _, _, _, v0, vd = _linear_vertices(body)
-    verts = v0[None] + (b @ vd.T).reshape(len(b), *v0.shape)
-    return mass_kg(verts, body.faces, DENSITY_KG_M3)
+    entry = _volumes.get(id(body))
+    if entry is None or entry[0] is not body:
+        _, _, _, _, v0, vd = _linear_vertices(body)
+        entry = _volumes[id(body)] = (body, VolumePolynomial(v0, vd.reshape(*v0.shape, -1), body.faces))
+    return entry[1](b) * DENSITY_KG_M3
 
 
 def torch_no_grad():
@@ -334,19 +336,12 @@ def shape_words(text: str) -> ShapeWords:
         raise ShapeMoveError(f"the shape text {text!r}: {exc}") from None
 
 
-def _size_targets(d: ShapeWords) -> tuple[float | None, float | None]:
-    """(height cm, waist-to-height ratio) the size words aim at (their mean), None where none."""
-    hs = [SIZE_TARGETS[w][0] for w in d.size_words if SIZE_TARGETS[w][0] is not None]
-    rs = [SIZE_TARGETS[w][1] for w in d.size_words if SIZE_TARGETS[w][1] is not None]
-    return (sum(hs) / len(hs) if hs else None), (sum(rs) / len(rs) if rs else None)
-
-
 def _targets(d: ShapeWords, default_height) -> dict:
     """Target measurements of a parsed text: stated numbers win; size words give a height and a
     waist (ratio x height; ``default_height()`` when the text gives none); weight words that are no
     size word ("obese", "skinny") a BMI when no weight is stated."""
     out = d.measurements()
-    h_word, ratio = _size_targets(d)
+    h_word, ratio = size_targets(d)
     if "height_cm" not in out and h_word is not None:
         out["height_cm"] = h_word
     if d.mass_kg is not None:
@@ -467,7 +462,7 @@ def _fit_frame(body, targets: dict, base, A, mu, sigma, lo_b, hi_b, reg: float =
                 theta, m, r, cost, lam, improved = th_new, m_new, r_new, c_new, max(lam / 10, 1e-9), True
                 break
             lam *= 10
-        if not improved or np.abs((m - t) / unit).max() < 0.05:
+        if not improved or np.abs((m - t) / unit).max() < 0.02 or np.abs(step).max() < 1e-5:
             break
     return base + theta @ A
 

@@ -457,8 +457,11 @@ def _combine_age(age_hits: list[str], genders: list[str], out: ShapeWords) -> No
 
 
 def _combine_build(out: ShapeWords) -> None:
-    # heights: size words whose height bands do not overlap
+    # heights: height words whose bands do not overlap ("tall and stocky": the word that says only
+    # a height wins over the height a build word implies, see ``size_targets``)
     hwords = [w for w in out.size_words if ADJECTIVES[w][0] is not None and w not in ("average-sized",)]
+    if any(ADJECTIVES[w][1] is None for w in hwords):
+        hwords = [w for w in hwords if ADJECTIVES[w][1] is None]
     for a in hwords:
         for b in hwords:
             ra, rb = ADJECTIVES[a][0], ADJECTIVES[b][0]
@@ -509,6 +512,8 @@ def _check_numbers(out: ShapeWords) -> None:
                                  f"range [{lo}, {hi}] cm")
     if out.height_cm is not None:
         for w in out.size_words:
+            if ADJECTIVES[w][1] is not None and ADJECTIVES[w][0] is not None:
+                continue  # petite, lanky, stocky, big: mostly a build; a stated height decides the height
             rng = ADJECTIVES[w][0]
             if rng is not None and SIZE_TARGETS[w][0] is not None and not (
                     rng[0] - HEIGHT_MARGIN_CM <= out.height_cm < rng[1] + HEIGHT_MARGIN_CM):
@@ -527,6 +532,19 @@ def _check_numbers(out: ShapeWords) -> None:
         msg = word_conflict(out, bmi)
         if msg:
             raise ShapeMoveError(f"the shape text contradicts itself: BMI {bmi:.1f}" + msg)
+
+
+def size_targets(out: ShapeWords) -> tuple[float | None, float | None]:
+    """(height cm, waist-to-height ratio) the size words aim at, None where none: the mean over the
+    words that say it, a word that says only a height (or only a build) winning over one that says
+    both ("tall and stocky": 185 cm, the waist of "stocky")."""
+    def pick(i: int) -> float | None:
+        ws = [w for w in out.size_words if SIZE_TARGETS[w][i] is not None]
+        pure = [w for w in ws if ADJECTIVES[w][1 - i] is None]
+        ws = pure or ws
+        return sum(SIZE_TARGETS[w][i] for w in ws) / len(ws) if ws else None
+
+    return pick(0), pick(1)
 
 
 def stated_bmi(out: ShapeWords) -> float | None:
