@@ -53,6 +53,7 @@ EXAMPLES: dict[str, str] = {
     "eval paraphrase": P + "eval paraphrase --data data/built --prompts configs/heldout_paraphrases_blind.json "
                            "--json out/eval_paraphrase_blind.json",
     "eval shape": P + "eval shape --bodies 200 --json out/eval_shape.json",
+    "eval speed": P + "eval speed --data data/built --checkpoint weights/default/savae.pt --feet --json out/eval_speed.json",
     "retarget": P + 'retarget --motion walk.bvh --shape-text "A person standing 190 cm tall" --out tall_walk.npz',
     "retarget-rig": P + "retarget-rig --motion wave.npz --blend hero.blend --armature Hero --out hero_wave.blend "
                         "--preset mixamo",
