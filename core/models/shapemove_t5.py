@@ -159,6 +159,7 @@ class ShapeMoveT5(nn.Module):
         self.encoder_kind = encoder
         self.info: dict = {}
         self.memory = None  # motion_memory.MotionMemory the decoder reads, when it was trained with one
+        self.memory_enabled = True  # False: the decoder reads no retrieved clips (to measure without)
 
     @property
     def memory_k(self) -> int:
@@ -172,7 +173,7 @@ class ShapeMoveT5(nn.Module):
                                  "(motion_memory.json/.safetensors missing from its folder)")
         return self.memory.lookup(reader, motion_texts, self.memory_k, self.lm.config.memory_codes,
                                   self.vocab.first_code_id, exclude, rng,
-                                  empty=[t == NULL_PROMPT for t in motion_texts])
+                                  empty=[t == NULL_PROMPT or not self.memory_enabled for t in motion_texts])
 
     @property
     def d_model(self) -> int:

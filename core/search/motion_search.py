@@ -119,6 +119,31 @@ def load_motion_features(path: Path) -> tuple[np.ndarray, str]:
     raise ShapeMoveError(f"{path}: not a motion file (.npz, .bvh, .amc)")
 
 
+def library_clips(folder, progress=None, min_frames: int = 8) -> tuple[list[str], list[str], list[np.ndarray]]:
+    """(ids, captions, features (T,263)) of the library files that have a caption and at least
+    ``min_frames`` frames (what the retrieval memory can use); files without are left out."""
+    folder = Path(folder)
+    if not folder.is_dir():
+        raise ShapeMoveError(f"library folder not found: {folder}")
+    ids, captions, feats = [], [], []
+    entries = list_library(folder)
+    for i, (cid, path, _) in enumerate(entries):
+        try:
+            x, caption = load_motion_features(path)
+        except ShapeMoveError:
+            continue
+        if caption.strip() and len(x) >= min_frames and x.ndim == 2 and x.shape[1] == 263 and np.isfinite(x).all():
+            ids.append(cid)
+            captions.append(caption.strip())
+            feats.append(np.asarray(x, np.float32))
+        if progress is not None:
+            progress((i + 1) / max(1, len(entries)), cid)
+    if not ids:
+        raise ShapeMoveError(f"{folder}: no motion with a caption to add to the memory (a caption is the "
+                             "file's prompt or the first line of a same-name .txt)")
+    return ids, captions, feats
+
+
 def resolve_tma(tma):
     """(tma tuple, checkpoint file or None) from a path, a load_tma() tuple or None (the default model)."""
     from ..models.tma_embed import load_tma, tma_path
