@@ -214,7 +214,7 @@ def parse_amc(text: str, skel: Skeleton, source="AMC", angle_unit: str | None = 
     dofs["root"] = len(skel.root_order)
     chunks = {name: [] for name in dofs}
     seen = dict.fromkeys(dofs, 0)  # frame number in which each bone was last given
-    frames = 0
+    frames, frame_line, gap = 0, 0, None
     joints = 2 * len(skel.bones) + 1  # upper bound of bones + End Sites
     for line_no, raw in enumerate(text.splitlines(), 1):
         line = raw.strip()
@@ -229,7 +229,10 @@ def parse_amc(text: str, skel: Skeleton, source="AMC", angle_unit: str | None = 
             continue
         name, rest = (line.split(None, 1) + [""])[:2]
         if name.isdigit():
+            if frames and gap is None:
+                gap = _frame_gap(seen, frames, frame_line, dofs, source)
             frames += 1
+            frame_line = line_no
             if frames * joints > MAX_JOINT_FRAMES:  # stop before storing more lines than could ever be used
                 check_joint_frames(frames, joints, source, "AMC")
             continue
@@ -253,6 +256,9 @@ def parse_amc(text: str, skel: Skeleton, source="AMC", angle_unit: str | None = 
         chunks[name].append(rest)
     if frames == 0:
         raise ShapeMoveError(f"{source}: AMC has no frames")
+    gap = gap or _frame_gap(seen, frames, frame_line, dofs, source)
+    if gap is not None:  # raised after the loop: a frames x joints bomb is refused as such first
+        raise ShapeMoveError(gap)
     if angle_unit is not None:
         angle, declared = (1.0 if angle_unit == "rad" else np.pi / 180), None
     values = {}
@@ -270,6 +276,16 @@ def parse_amc(text: str, skel: Skeleton, source="AMC", angle_unit: str | None = 
     if declared is not None:
         _check_radians(skel, root, values, source, declared)
     return root, values, angle
+
+
+def _frame_gap(seen: dict, frame: int, line: int, dofs: dict, source) -> str | None:
+    """The error sentence when a bone with dof has no line in ``frame`` (``seen``: the frame each
+    bone was last given in), else None."""
+    for name in dofs:
+        if seen[name] != frame:
+            return (f"{source}: line {line}: AMC frame {frame} gives no lines for {name!r} (expected one line of "
+                    f"{dofs[name]} values): truncated file or wrong skeleton")
+    return None
 
 
 RADIANS_SHARE = 0.5  # share of frames with a rotation beyond +-2 pi that makes declared radians implausible

@@ -147,7 +147,8 @@ def redecode(params, progress, cancel) -> dict:
 
 def retarget(params, progress, cancel) -> dict:
     """params {"source" (BVH / ASF+AMC / AMASS .npz), "body", "betas" (10, optional: else the
-    source subject's own shape, fitted to its bone lengths), "method" ("auto" | "savae" | "naive";
+    source subject's own shape, fitted to its bone lengths), "source_fps" / "angle_unit" (optional
+    overrides of what the file declares: ``io.mocap.reader_options``), "method" ("auto" | "savae" | "naive";
     auto = through the SA-VAE when a model has one, else naive), "model", "out"} -> the motion on
     the body, written to ``out``."""
     from ..body.fit import bone_lengths, fit_betas_to_bone_lengths
@@ -165,7 +166,9 @@ def retarget(params, progress, cancel) -> dict:
     body = load_body_model(param(params, op, "body", str, None))
     progress(0.1, f"reading {source.name}")
     source = _library_clip(source)
-    joints, _ = source_joints(source, body)
+    read = {k: v for k, v in (("source_fps", param(params, op, "source_fps", (int, float), None)),
+                              ("angle_unit", param(params, op, "angle_unit", str, None))) if v is not None}
+    joints, _ = source_joints(source, body, read)
     betas = _betas(params, op)
     if betas is None:  # the subject's own proportions
         betas = fit_betas_to_bone_lengths(body, np.median(bone_lengths(joints), axis=0)).betas
@@ -179,7 +182,8 @@ def retarget(params, progress, cancel) -> dict:
     if cancel():
         raise JobCancelled
     progress(0.3, "retargeting" + (" through the SA-VAE" if vae is not None else " (naive: no SA-VAE model)"))
-    motion = savae_retarget(source, vae, body, betas) if vae is not None else naive_retarget(source, body, betas)
+    motion = (savae_retarget(source, vae, body, betas, read=read) if vae is not None
+              else naive_retarget(source, body, betas, read=read))
     motion.prompt = motion.prompt or (source.subject if not isinstance(source, Path) else source.stem)
     save_motion(out, motion)
     return {**_motion_facts(out, motion), "method": "savae" if vae is not None else "naive"}
