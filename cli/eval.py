@@ -97,6 +97,16 @@ def add_shape(sub):
     p.set_defaults(_run=shape_eval.from_cli)
 
 
+def add_shape_words(sub):
+    from ..core.eval import shape_words_eval
+
+    p = sub.add_parser("shape-words", help="bodies the text describes: gender, age, muscle, height and weight "
+                       "(issue #25), on the parser + fit path or the [BETA] head",
+                       description=shape_words_eval.__doc__.splitlines()[0])
+    shape_words_eval.add_arguments(p)
+    p.set_defaults(_run=shape_words_eval.from_cli)
+
+
 def add_paraphrase(sub):
     from ..core.eval import paraphrase_eval
 
@@ -175,7 +185,7 @@ def add_speed(sub):
     p.set_defaults(_run=speed_report.from_cli)
 
 
-KINDS = [add_recon, add_generate, add_paraphrase, add_parts, add_shape, add_retarget, add_speed]
+KINDS = [add_recon, add_generate, add_paraphrase, add_parts, add_shape, add_shape_words, add_retarget, add_speed]
 
 
 def add_arguments(p):

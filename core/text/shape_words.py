@@ -355,12 +355,14 @@ def _read_age(tx: _Text, out: ShapeWords) -> None:
     for m in tx.take(r"\bage(?:d)?\s*(?:of|is|:)?\s*" + _N):
         ages.append((_num(m.group(1)), m.group(0)))
     dec = "|".join(DECADES) + r"|\d0'?s"
-    for m in tx.take(r"\bin\s+(?:his|her|their|the)\s+(early|mid|late)?[\s-]*(" + dec + r")\b"):
-        word = m.group(2)
+    for m in tx.take(r"\bin\s+(his|her|their|the)\s+(early|mid|late)?[\s-]*(" + dec + r")\b"):
+        word = m.group(3)
         base = DECADES.get(word) if word in DECADES else int(word[:2])
         base = 13 if base == 10 else base
-        ages.append((base + {"early": 2, "mid": 5, "late": 8}.get(m.group(1) or "mid", 5)
+        ages.append((base + {"early": 2, "mid": 5, "late": 8}.get(m.group(2) or "mid", 5)
                      if base != 13 else 16, m.group(0)))
+        s, e = m.span(1)   # the pronoun stays for the gender words ("in her sixties")
+        tx.t = tx.t[:s] + m.group(1) + tx.t[e:]
     for v, said in ages:
         if out.age is not None and abs(out.age - v) > 2:
             raise ShapeMoveError(f"the shape text states two ages ({out.age:g} and {v:g}); keep one")
