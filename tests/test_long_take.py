@@ -1,5 +1,5 @@
 """Long takes in bounded memory (issue 28): a long take built here from a short real Bandai walk
-(``bench/long_take.py``). The windowed steps (joints without the mesh, the ground probe, the IK,
+(``bench/long_take_input.py``). The windowed steps (joints without the mesh, the ground probe, the IK,
 the SA-VAE encoder) give what one pass over the whole take gives, across window seams, and
 ``retarget --naive`` needs about the same memory for a 90 s take as for a 30 s one (it grew by
 ~2 GB a minute before: a 93 s take needed 3.6 GB). The 10-minute case is ``bench long_take``."""
@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 import torch
 
-from shapemove.bench.long_take import walk_path, write_long_take
+from shapemove.bench.long_take_input import walk_path, write_long_take
 
 pytestmark = pytest.mark.usefixtures("one_thread")
 

@@ -6,7 +6,8 @@ Bases: short real clips from the shared archives (Bandai BVH, CMU BVH, CMU and H
 Each case damages one base in one way a file really gets damaged (a value added to or lost from a
 row or bone line, a CHANNELS line lost or miscounted, the Frames count off, an absurd frame time,
 rows dropped/duplicated/joined/split, truncation, a garbage token, radians declared over degrees,
-a dof lost from the ASF, a frame number lost) and is read by ``load_smpl22`` in its OWN forked
+a dof lost from the ASF, a frame number lost), or changes it harmlessly (CRLF line ends, tabs,
+trailing spaces, blank or comment lines: it must load the same), and is read by ``load_smpl22`` in its OWN forked
 process limited to 30 s and 1 GB more address space. Outcomes:
 
   refused      ShapeMoveError (a sentence for the user)            -- fine
@@ -130,6 +131,17 @@ def mutate_bvh(text: str, kind: str, rng) -> str:
         toks = lines[r].split()
         toks[int(rng.integers(len(toks)))] = BAD_TOKENS[int(rng.integers(len(BAD_TOKENS)))]
         lines[r] = " ".join(toks)
+    elif kind == "harmless":  # what editors and exporters do to a good file: it must still load the same
+        how = int(rng.integers(4))
+        if how == 0:
+            return "\r\n".join(lines) + "\r\n"
+        if how == 1:
+            lines = [s.replace(" ", "\t") if i in set(rows) else s for i, s in enumerate(lines)]
+        elif how == 2:
+            lines = [s + "   " for s in lines]
+        else:
+            lines.insert(r, "")
+            lines.append("")
     return "\n".join(lines) + "\n"
 
 
@@ -175,14 +187,23 @@ def mutate_amc(files: dict, main: str, kind: str, rng) -> dict:
         toks = lines[r].split()
         toks[int(rng.integers(1, len(toks))) if len(toks) > 1 else 0] = BAD_TOKENS[int(rng.integers(len(BAD_TOKENS)))]
         lines[r] = " ".join(toks)
+    elif kind == "harmless":  # line endings, comments, spacing: still the same clip
+        how = int(rng.integers(3))
+        if how == 0:
+            out[main] = "\r\n".join(lines) + "\r\n"
+            return out
+        if how == 1:
+            lines.insert(r, "# a comment line")
+        else:
+            lines = [s.replace(" ", "  ") + " " for s in lines]
     out[main] = "\n".join(lines) + "\n"
     return out
 
 
 BVH_KINDS = ["row_plus", "row_minus", "del_channels", "channels_count", "frames_off", "frame_time", "drop_row",
-             "dup_row", "join_rows", "split_row", "truncate", "garbage"]
+             "dup_row", "join_rows", "split_row", "truncate", "garbage", "harmless"]
 AMC_KINDS = ["bone_plus", "bone_minus", "drop_bone_line", "dup_bone_line", "drop_frame_number", "amc_radians",
-             "asf_radians", "asf_dof_lost", "truncate", "garbage"]
+             "asf_radians", "asf_dof_lost", "truncate", "garbage", "harmless"]
 
 
 # -- one limited load ----------------------------------------------------------------------------
