@@ -11,6 +11,10 @@ mesh positions (tests/test_blender_export.py):
   importer adds one frame, so the keys are moved to frame 0 for the export and back afterwards).
 - BVH: ``bvh_writer`` (Y up, centimetres, world-aligned rest frames), not Blender's exporter,
   which writes Z-up armature axes.
+A rig animated by NLA strips only (a timeline of prompts, possibly re-timed) is baked frame by
+frame into a temporary action for the export (``_nla_baked``), removed afterwards. The root
+motion mode (pelvis, object, root bone, in place: ``animation_rig``) is in the rig's keys, so
+every format carries it (BVH: the armature's bones only, not the object's travel).
 The exporters see only the rig (selection overridden) and write to a temporary name first,
 renamed when complete (atomic). Selection, the active object and the mode are restored afterwards.
 """
@@ -77,6 +81,61 @@ def _action_from_frame_zero(rig, scene, start: int, end: int):
         scene.frame_set(saved[2])
 
 
+@contextlib.contextmanager
+def _nla_baked(rig, scene, start: int, end: int):
+    """While exporting: a rig played by NLA strips only gets a temporary action with its evaluated
+    pose (every bone's quaternion and location, the object's location) keyed on every frame."""
+    anim = rig.animation_data
+    if anim is None or anim.action is not None or not any(len(t.strips) for t in anim.nla_tracks):
+        yield
+        return
+    from .animation_rig import _curve_adder, _key_vectors
+    from .keyframes import FIRST_FRAME
+
+    names = [pb.name for pb in rig.pose.bones]
+    frames = list(range(start, end + 1))
+    quats = np.zeros((len(frames), len(names), 4))
+    locs = np.zeros((len(frames), len(names), 3))
+    obj_loc = np.zeros((len(frames), 3))
+    saved = scene.frame_current
+    for i, f in enumerate(frames):
+        scene.frame_set(f)
+        for j, n in enumerate(names):
+            pb = rig.pose.bones[n]
+            quats[i, j], locs[i, j] = pb.rotation_quaternion, pb.location
+        obj_loc[i] = rig.location
+    for j in range(len(names)):   # quaternion signs continuous over time
+        flip = np.cumsum(np.r_[0, (np.einsum("tc,tc->t", quats[1:, j], quats[:-1, j]) < 0)]) % 2 == 1
+        quats[flip, j] *= -1
+    action = bpy.data.actions.new(f"{rig.name}_baked")
+    try:
+        if bpy.app.version >= (4, 4, 0):
+            slot = action.slots.new(id_type="OBJECT", name=rig.name)
+            anim.action = action
+            if anim.action_slot != slot:
+                anim.action_slot = slot
+        else:
+            anim.action = action
+        new = _curve_adder(action, rig)
+        shift = start - FIRST_FRAME   # _key_vectors keys from FIRST_FRAME
+        for j, n in enumerate(names):
+            _key_vectors(new, f'pose.bones["{n}"].rotation_quaternion', quats[:, j])
+            _key_vectors(new, f'pose.bones["{n}"].location', locs[:, j])
+        _key_vectors(new, "location", obj_loc)
+        if shift:
+            for fc in action_fcurves(action, rig):
+                co = np.empty(2 * len(fc.keyframe_points), np.float32)
+                fc.keyframe_points.foreach_get("co", co)
+                co[0::2] += shift
+                fc.keyframe_points.foreach_set("co", co)
+                fc.update()
+        yield
+    finally:
+        anim.action = None
+        bpy.data.actions.remove(action)
+        scene.frame_set(saved)
+
+
 def _frame_range(rig, scene) -> tuple[int, int]:
     anim = rig.animation_data
     if anim is not None and anim.action is not None:
@@ -106,7 +165,7 @@ def export_rig(context, rig, filepath, fmt: str = "FBX") -> Path:
     try:
         with _only_selected(context, objects, rig):
             if fmt == "FBX":
-                with _action_from_frame_zero(rig, context.scene, start, end):
+                with _nla_baked(rig, context.scene, start, end), _action_from_frame_zero(rig, context.scene, start, end):
                     result = bpy.ops.export_scene.fbx(
                         filepath=str(tmp), use_selection=True, object_types={"ARMATURE", "MESH"},
                         add_leaf_bones=False, apply_unit_scale=True, apply_scale_options="FBX_SCALE_ALL",
@@ -115,12 +174,14 @@ def export_rig(context, rig, filepath, fmt: str = "FBX") -> Path:
                         bake_anim_force_startend_keying=True, bake_anim_simplify_factor=0.0,
                         use_armature_deform_only=True)
             elif fmt == "GLTF":
-                result = bpy.ops.export_scene.gltf(
-                    filepath=str(tmp), export_format="GLB", use_selection=True, export_animations=True,
-                    export_skins=True, export_all_influences=True, export_morph=True,
-                    export_animation_mode="ACTIVE_ACTIONS", export_force_sampling=True, export_frame_range=False)
+                with _nla_baked(rig, context.scene, start, end):
+                    result = bpy.ops.export_scene.gltf(
+                        filepath=str(tmp), export_format="GLB", use_selection=True, export_animations=True,
+                        export_skins=True, export_all_influences=True, export_morph=True,
+                        export_animation_mode="ACTIVE_ACTIONS", export_force_sampling=True, export_frame_range=False)
             else:
-                write_bvh(context.scene, rig, tmp, start, end)
+                with _nla_baked(rig, context.scene, start, end):
+                    write_bvh(context.scene, rig, tmp, start, end)
                 result = {"FINISHED"}
     except (RuntimeError, OSError) as exc:
         tmp.unlink(missing_ok=True)

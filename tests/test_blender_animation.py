@@ -1,0 +1,107 @@
+"""The animation rigs in real bpy (shapemove_addon/animation_rig.py): a loop cycles for ever with
+the root advancing per cycle, root motion on the pelvis / object / root bone / none gives the
+same world motion (or none), a timeline plays as NLA strips, and the FBX export carries it."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from shapemove.core.scene.motion_file import make_motion
+
+bpy = pytest.importorskip("bpy", reason="needs the bpy module (pip install bpy==5.0.1)")
+from bpy_readback import bone_heads_world  # noqa: E402
+pytestmark = pytest.mark.blender
+
+P = 16
+ADV = np.array([0.3, 0.0, 1.2])   # Y up: 1.24 m per cycle
+
+
+def _loop(body):
+    t = np.arange(P)[:, None, None]
+    rng = np.random.default_rng(1)
+    poses = 0.3 * rng.normal(size=(1, 24, 3)) * np.sin(2 * np.pi * t / P + rng.uniform(0, 6, (1, 24, 3)))
+    transl = np.arange(P)[:, None] * ADV[None] / P + [0.0, 0.9, 0.0] + [0.0, 0.02, 0.0] * np.sin(4 * np.pi * t[:, 0] / P)
+    return make_motion(body, poses, transl, np.zeros(10), fps=20, prompt="loop test", loop_advance=ADV.astype(np.float32))
+
+
+def _pelvis(arm, frame):
+    bpy.context.scene.frame_set(frame)
+    return bone_heads_world(arm, ["pelvis"])[0]
+
+
+@pytest.mark.parametrize("mode", ["PELVIS", "OBJECT", "ROOT_BONE", "NONE"])
+def test_loop_cycles_with_root_advance(openbody, mode):
+    from shapemove.shapemove_addon.animation_rig import build_animated_rig
+
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    m = _loop(openbody)
+    rig = build_animated_rig(bpy.context, m, openbody, name="Loop", root_motion=mode)
+    arm = rig.armature
+    adv_z_up = np.array([ADV[0], -ADV[2], ADV[1]])
+    for f in (1, 5, 12):   # one, two and three cycles later: the same pose, moved by the advance
+        a, b, c = _pelvis(arm, f), _pelvis(arm, f + P), _pelvis(arm, f + 2 * P)
+        want = adv_z_up if mode != "NONE" else np.zeros(3)
+        np.testing.assert_allclose(b - a, want, atol=1e-4)
+        np.testing.assert_allclose(c - b, want, atol=1e-4)
+    # the world pose of frame 5 is the motion's, whatever carries the travel
+    expect = m.joints[4, 0] if mode != "NONE" else m.joints[4, 0] - [m.joints[4, 0, 0] - m.joints[0, 0, 0], 0,
+                                                                   m.joints[4, 0, 2] - m.joints[0, 0, 2]]
+    np.testing.assert_allclose(_pelvis(arm, 5), [expect[0], -expect[2], expect[1]], atol=1e-4)
+    assert ("root" in arm.data.bones) == (mode == "ROOT_BONE")
+
+
+def test_timeline_nla_strips_play_the_segments(openbody):
+    from shapemove.shapemove_addon.animation_rig import TRACK_NAME, build_animated_rig
+
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    m = _loop(openbody)
+    m.loop_advance = None
+    m.segment_bounds, m.segment_prompts = np.array([[0, 6], [6, 16]]), ["walks", "waves"]
+    rig = build_animated_rig(bpy.context, m, openbody, name="Timeline")
+    strips = rig.armature.animation_data.nla_tracks[TRACK_NAME].strips
+    assert [(s.name, s.frame_start, s.frame_end) for s in strips] == [("walks", 1.0, 7.0), ("waves", 7.0, 17.0)]
+    assert rig.armature.animation_data.action is None
+    for f in (3, 9, 15):
+        j = m.joints[f - 1, 0]
+        np.testing.assert_allclose(_pelvis(rig.armature, f), [j[0], -j[2], j[1]], atol=1e-4)
+    strips[1].frame_start_ui = 30.0   # re-timed: the second segment now starts at frame 30
+    j = m.joints[8, 0]
+    np.testing.assert_allclose(_pelvis(rig.armature, 32), [j[0], -j[2], j[1]], atol=1e-4)
+
+
+@pytest.mark.parametrize("mode", ["OBJECT", "ROOT_BONE"])
+def test_fbx_carries_root_motion(openbody, tmp_path, mode):
+    from shapemove.shapemove_addon import export
+    from shapemove.shapemove_addon.animation_rig import build_animated_rig
+
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    m = _loop(openbody)
+    rig = build_animated_rig(bpy.context, m, openbody, name="Rig", root_motion=mode)
+    ref = {f: _pelvis(rig.armature, f) for f in (1, 8, P + 1)}
+    path = export.export_rig(bpy.context, rig.armature, tmp_path / "rig.fbx", "FBX")
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    bpy.ops.import_scene.fbx(filepath=str(path))
+    arm = next(o for o in bpy.data.objects if o.type == "ARMATURE")
+    assert ("root" in arm.data.bones) == (mode == "ROOT_BONE")
+    for f, want in ref.items():   # Blender's FBX importer puts the file's frame 0 at frame 1
+        np.testing.assert_allclose(_pelvis(arm, f), want, atol=2e-3)
+
+
+def test_fbx_of_a_timeline(openbody, tmp_path):
+    from shapemove.shapemove_addon import export
+    from shapemove.shapemove_addon.animation_rig import TRACK_NAME, build_animated_rig
+
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    m = _loop(openbody)
+    m.loop_advance = None
+    m.segment_bounds, m.segment_prompts = np.array([[0, 6], [6, 16]]), ["walks", "waves"]
+    rig = build_animated_rig(bpy.context, m, openbody, name="Timeline")
+    ref = {f: _pelvis(rig.armature, f) for f in (1, 4, 9, 16)}
+    path = export.export_rig(bpy.context, rig.armature, tmp_path / "timeline.fbx", "FBX")
+    strips = rig.armature.animation_data.nla_tracks[TRACK_NAME].strips
+    assert [s.frame_start for s in strips] == [1.0, 7.0]      # put back after the export
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    bpy.ops.import_scene.fbx(filepath=str(path))
+    arm = next(o for o in bpy.data.objects if o.type == "ARMATURE")
+    for f, want in ref.items():
+        np.testing.assert_allclose(_pelvis(arm, f), want, atol=2e-3)
