@@ -28,7 +28,7 @@ from .rig_state import PHYSICS_KEY, current_betas, rig_body_spec, rig_of
 from .animation_rig import ROOT_MOTION_ITEMS, build_animated_rig
 from .scene_build import SLIDER_RANGE
 
-MEASUREMENT_PROPS = ("height_cm", "chest_cm", "waist_cm", "hip_cm")
+MEASUREMENT_PROPS = ("height_cm", "chest_cm", "waist_cm", "hip_cm", "mass_kg", "bmi")
 
 
 def active_rig(context):

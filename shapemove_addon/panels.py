@@ -122,6 +122,7 @@ class SHAPEMOVE_PT_generate(_SubPanel, bpy.types.Panel):
 PHYSICS_FIGURES = (("penetrate_cm", "Penetrate", "{:.2f} cm"), ("float_cm", "Float", "{:.2f} cm"),
                    ("skate_pct", "Skate", "{:.1f} %"), ("dyn_stable_pct", "Stability", "{:.0f} %"))
 MEASUREMENTS = (("height_cm", "Height"), ("chest_cm", "Chest"), ("waist_cm", "Waist"), ("hip_cm", "Hips"))
+BODY_MASS = (("mass_kg", "Mass", "{:.1f} kg"), ("bmi", "BMI", "{:.1f}"))  # mesh volume x 985 kg/m^3; kg/m^2
 
 
 def draw_result(layout, rig) -> None:
@@ -147,6 +148,9 @@ def draw_result(layout, rig) -> None:
         grid = box.grid_flow(columns=2, align=True)
         for prop, label in MEASUREMENTS:
             grid.label(text=f"{label}: {getattr(m, prop):.1f} cm")
+        for prop, label, fmt in BODY_MASS:
+            if getattr(m, prop) > 0:
+                grid.label(text=f"{label}: {fmt.format(getattr(m, prop))}")
 
 
 class SHAPEMOVE_PT_shape(_RigPanel, bpy.types.Panel):
@@ -176,8 +180,9 @@ class SHAPEMOVE_PT_shape(_RigPanel, bpy.types.Panel):
         m = rig.shapemove
         if m.height_cm > 0:
             grid = box.grid_flow(columns=2, align=True)
-            for prop in ("height_cm", "chest_cm", "waist_cm", "hip_cm"):
-                grid.label(text=f"{m.bl_rna.properties[prop].name}: {getattr(m, prop):.1f}")
+            for prop in ("height_cm", "chest_cm", "waist_cm", "hip_cm", "mass_kg", "bmi"):
+                if prop in ("height_cm", "chest_cm", "waist_cm", "hip_cm") or getattr(m, prop) > 0:
+                    grid.label(text=f"{m.bl_rna.properties[prop].name}: {getattr(m, prop):.1f}")
         draw_job(box, "measure", "shapemove.measure", "Measure", icon="DRIVER_DISTANCE")
 
 

@@ -72,6 +72,9 @@ class ShapeMoveObjectProperties(bpy.types.PropertyGroup):
     chest_cm: FloatProperty(name="Chest (cm)", **_MEASURE)
     waist_cm: FloatProperty(name="Waist (cm)", **_MEASURE)
     hip_cm: FloatProperty(name="Hip (cm)", **_MEASURE)
+    mass_kg: FloatProperty(name="Mass (kg)", min=0.0, precision=1,
+                           description="Rest-pose mesh volume x 985 kg/m^3, a whole-body density (kg)")
+    bmi: FloatProperty(name="BMI", min=0.0, precision=1, description="Body-mass index: mass / height^2 (kg/m^2)")
 
 
 class ShapeMoveLibraryItem(bpy.types.PropertyGroup):

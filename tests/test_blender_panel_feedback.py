@@ -88,6 +88,7 @@ def test_generate_panel_shows_physics_and_measurements(addon, openbody, tmp_path
     assert f"Stability: {physics['dyn_stable_pct']:.0f} %" in shown
     for prop, label in (("height_cm", "Height"), ("chest_cm", "Chest"), ("waist_cm", "Waist"), ("hip_cm", "Hips")):
         assert f"{label}: {measurements[prop]:.1f} cm" in shown
+    assert f"Mass: {measurements['mass_kg']:.1f} kg" in shown and f"BMI: {measurements['bmi']:.1f}" in shown
     assert rig.name in shown
 
     # a cancelled job builds nothing
