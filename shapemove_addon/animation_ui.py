@@ -21,9 +21,8 @@ from ..core.errors import ShapeMoveError
 from ..core.scene.axes import points_to_y_up
 from . import job_submit, paths
 from .animation_rig import ROOT_MOTION_ITEMS, SEGMENTS_KEY, TRACK_NAME
-from .operators import ReportingOperator, JobOperator, build_rig_from_file
+from .operators import JobOperator, ReportingOperator, build_rig_from_file, generation_params, scene_prompt
 from .panels import _SettingsPanel, draw_job, draw_optional
-from .preferences import body_spec, setting
 from .redecode import MOTION_FILE_KEY
 from .rig_state import rig_of
 
@@ -97,13 +96,6 @@ def _chain(edges: np.ndarray, n: int) -> np.ndarray:
     return np.asarray(order)
 
 
-def _base_params(context, label: str) -> dict:
-    s = context.scene.shapemove
-    return {"shape_text": s.shape_text.strip() or None, "seed": s.seed, "temperature": s.temperature,
-            "model": setting("active_model") or None, "body": body_spec(context),
-            "out": str(paths.new_motion_path(label))}
-
-
 def _on_built(name: str, root_motion: str, replace=None, keep_strips=None):
     def done(msg):
         if msg.get("cancelled"):
@@ -159,10 +151,9 @@ class SHAPEMOVE_OT_animate(JobOperator, bpy.types.Operator):
 
     def start(self, context):
         s, a = context.scene.shapemove, context.scene.shapemove_animation
-        prompt = s.prompt.strip()
-        if not prompt:
-            raise ShapeMoveError("the prompt is empty: describe a motion, e.g. 'a person walks forward'")
-        params = {**_base_params(context, prompt), "prompt": prompt, "seconds": s.seconds if s.use_seconds else None,
+        prompt = scene_prompt(context)
+        params = {**generation_params(context, prompt), "prompt": prompt,
+                  "seconds": s.seconds if s.use_seconds else None,
                   "loop": a.loop, "in_place": a.root_motion == "NONE",
                   "speed": a.speed if abs(a.speed - 1.0) > 1e-6 else None,
                   "stretch": a.stretch if a.use_stretch else None}
@@ -221,7 +212,7 @@ class SHAPEMOVE_OT_sequence(JobOperator, bpy.types.Operator):
         empty = [i + 1 for i, sg in enumerate(segs) if not sg["prompt"]]
         if empty:
             raise ShapeMoveError(f"timeline prompt {empty[0]} is empty")
-        params = {**_base_params(context, "timeline"), "segments": segs}
+        params = {**generation_params(context, "timeline"), "segments": segs}
         job_submit.submit_job("sequence", params, kind=self.job, label="timeline",
                               on_result=_on_built("Timeline", a.root_motion))
         return f"generating a timeline of {len(segs)} prompts..."
@@ -249,7 +240,7 @@ class SHAPEMOVE_OT_regenerate_strip(ReportingOperator, bpy.types.Operator):
         if not source:
             raise ShapeMoveError("this rig does not know its motion file; generate the timeline again")
         timing = {i: t for i, t in enumerate(strip_timing(rig)) if i != k}
-        params = {**_base_params(context, "timeline"), "regenerate": k, "motion": str(source),
+        params = {**generation_params(context, "timeline"), "regenerate": k, "motion": str(source),
                   "seed": int(context.scene.shapemove.seed) + 1000 + k}
         context.scene.shapemove.seed += 1   # the next press samples another one
         job_submit.submit_job("sequence", params, kind="sequence", label="regenerate strip",
