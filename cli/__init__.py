@@ -40,6 +40,8 @@ EXAMPLES: dict[str, str] = {
     "data": P + "data build --source ../shared/data/*.tar.xz --out data/built",
     "data build": P + "data build --source ../shared/data/*.tar.xz --out data/built",
     "data compose": P + "data compose --data data/built --count 800 --seed 0",
+    "data compose-parts": P + "data compose-parts --data data/built --count 800 --seed 0",
+    "data mirror": P + "data mirror --data data/built",
     "train": P + "train vae --data data/built --config configs/default_vae.json --out runs/vae",
     "train vae": P + "train vae --data data/built --config configs/default_vae.json --out runs/vae",
     "train tma": P + "train tma --data data/built --config configs/default_tma.json --out runs/tma",

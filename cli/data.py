@@ -37,6 +37,16 @@ def add_arguments(p):
     m = sub.add_parser("mirror", help="add the mirror image (left <-> right, captions too) of every training clip")
     m.add_argument("--data", type=Path, required=True, help="a dataset folder made by `data build`")
     m.add_argument("--body-model", default=None, help="openbody (default) or a path to SMPL model files")
+    m.add_argument("--shard", default="0/1", help="i/n: mirror every n-th clip starting at i (n processes on one --data)")
+
+
+def _shard(text: str) -> tuple[int, int]:
+    try:
+        shard = tuple(int(v) for v in text.split("/"))
+        assert len(shard) == 2
+    except (ValueError, AssertionError):
+        raise ShapeMoveError(f"--shard must look like 0/2, got {text!r}") from None
+    return shard
 
 
 def run(args) -> int:
@@ -51,7 +61,7 @@ def run(args) -> int:
         from ..core.body.load import load_body_model
         from ..core.data.mirror import mirror_dataset
 
-        ids = mirror_dataset(args.data, body=load_body_model(args.body_model))
+        ids = mirror_dataset(args.data, body=load_body_model(args.body_model), shard=_shard(args.shard))
         print(f"mirrored clips written: {len(ids)} (training split); split lists and Mean/Std refreshed")
         return 0
     if args.action == "compose":
@@ -62,11 +72,7 @@ def run(args) -> int:
         return 0
     from ..core.body.load import load_body_model
 
-    try:
-        shard = tuple(int(v) for v in args.shard.split("/"))
-        assert len(shard) == 2
-    except (ValueError, AssertionError):
-        raise ShapeMoveError(f"--shard must look like 0/2, got {args.shard!r}") from None
+    shard = _shard(args.shard)
     body = load_body_model(args.body_model)
     report = build_dataset(args.source, args.out, body=body,
                            augment_share=AUGMENT_SHARE if args.augment_share is None else args.augment_share,

@@ -130,9 +130,11 @@ def mirror_labels(labels: dict) -> dict:
     return sw(labels or {})
 
 
-def mirror_dataset(data, body=None, verbose: bool = True, progress=None, cancel=None) -> list[str]:
+def mirror_dataset(data, body=None, verbose: bool = True, progress=None, cancel=None,
+                   shard: tuple[int, int] = (0, 1)) -> list[str]:
     """Add the mirror image of every training clip (not mirrors themselves) of built dataset
-    ``data``; resumable (a clip whose meta exists is skipped). Returns the ids written."""
+    ``data``; resumable (a clip whose meta exists is skipped). ``shard`` (i, n): only every n-th
+    clip from the i-th (n processes can share the work). Returns the ids written."""
     from tqdm import tqdm
 
     data = Path(data)
@@ -140,6 +142,10 @@ def mirror_dataset(data, body=None, verbose: bool = True, progress=None, cancel=
         raise ShapeMoveError(f"{data}: not a built dataset (no meta/ folder); run `data build` first")
     metas = [json.loads(p.read_text(encoding="utf-8")) for p in sorted((data / "meta").glob("*.json"))]
     todo = [m for m in metas if m.get("split") == "train" and not m.get("mirror_of")]
+    index, count = shard
+    if not 0 <= index < count:
+        raise ShapeMoveError(f"shard must be i/n with 0 <= i < n, got {index}/{count}")
+    todo = todo[index::count]
     proc = ClipProcessor(body)
     written = []
     for i, m in enumerate(tqdm(todo, desc="mirroring", unit="clip", disable=not verbose)):
