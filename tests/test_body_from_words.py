@@ -93,3 +93,14 @@ def test_the_issue_targets_on_generated_texts():
     assert r["age"]["in_band_pct"] >= 90 and r["muscle"]["at_least_0.7_pct"] >= 90
     assert r["numeric"]["both_met_pct"] >= 97 and r["numeric"]["height_err_cm_max"] < 1 and r["numeric"]["mass_err_kg_max"] < 2
     assert r["left_to_head"] == 0 and r["refused_total"] <= 1
+
+
+def test_cli_body_shape_prints_the_words_sliders_and_body(capsys):
+    from shapemove.cli import main
+
+    assert main(["body", "shape", "an elderly woman, 1.58 m, 71 kg"]) == 0
+    out = capsys.readouterr().out
+    assert "read:    71 kg, 1.58 m, woman, elderly" in out and "gender 1.00, age 75" in out
+    assert "height 158 cm" in out and "mass 71 kg, BMI 28.4" in out
+    assert main(["body", "shape", "an obese 2 m, 40 kg man"]) == 2
+    assert '"obese" means BMI >= 29' in capsys.readouterr().err
