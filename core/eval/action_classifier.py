@@ -68,9 +68,13 @@ def clip_actions(data, ids: list[str]) -> dict[str, list[str]]:
 
 
 def _actions_of(meta) -> list[str]:
-    """labels.actions of a clip's meta; [] for a composed "A, then B" clip (labels.sequence)."""
+    """labels.actions of a clip's meta; [] for a composed clip ("A, then B": labels.sequence; legs
+    of one clip and arms of another: composed_from) and for a mirror image (the judge's references
+    are real captured clips as they were captured)."""
     labels = meta.get("labels") if isinstance(meta, dict) else None
     if isinstance(labels, dict) and labels.get("sequence"):
+        return []
+    if isinstance(meta, dict) and (meta.get("composed_from") or meta.get("mirror_of")):
         return []
     acts = labels.get("actions") if isinstance(labels, dict) else None
     return [a for a in acts if isinstance(a, str)] if isinstance(acts, list) else []
