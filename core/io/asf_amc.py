@@ -14,6 +14,7 @@ joint, ``ltibia`` the knee, ``ltoes`` the ball of the foot); leaf bones get an E
 from __future__ import annotations
 
 import re
+from array import array
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -22,8 +23,8 @@ import numpy as np
 from ..errors import ShapeMoveError
 from ..geometry.fk import forward_kinematics, joints_from_offsets
 from ..geometry.rotations import euler_matrix
-from .limits import (MAX_FRAME_TIME, MAX_HIERARCHY_BYTES, MAX_JOINT_FRAMES, MIN_FRAME_TIME, check_joint_frames,
-                     parse_floats, read_text)
+from .limits import (MAX_AMC_BYTES, MAX_FRAME_TIME, MAX_HIERARCHY_BYTES, MAX_JOINT_FRAMES, MIN_FRAME_TIME,
+                     check_file_size, check_joint_frames, read_text)
 from .mocap_clip import Mocap, finish_mocap
 from .rig_map import find_rig
 
@@ -206,17 +207,23 @@ def parse_amc(text: str, skel: Skeleton, source="AMC", angle_unit: str | None = 
     naming the line). Angles in radians (``angle rad`` in the ASF or ``:RADIANS``) whose values go
     beyond +-2 pi on most frames are refused as degrees in disguise; ``angle_unit`` ('deg' or
     'rad') overrides what the files declare (and that check)."""
+    return _parse_amc(iter(text.splitlines()), skel, source, angle_unit)
+
+
+def _parse_amc(lines, skel: Skeleton, source, angle_unit: str | None):
+    """``parse_amc`` of an iterator over the AMC's lines: values are kept as float64 as they are
+    read (8 bytes a value, whatever the text's size)."""
     if angle_unit not in (None, "deg", "rad"):
         raise ShapeMoveError(f"angle unit must be 'deg' or 'rad', got {angle_unit!r}")
     angle = skel.angle_scale
     declared = "the ASF (angle rad)" if angle == 1.0 else None
     dofs = {name: len(b.dof) for name, b in skel.bones.items() if b.dof}
     dofs["root"] = len(skel.root_order)
-    chunks = {name: [] for name in dofs}
+    chunks = {name: array("d") for name in dofs}
     seen = dict.fromkeys(dofs, 0)  # frame number in which each bone was last given
     frames, frame_line, gap = 0, 0, None
     joints = 2 * len(skel.bones) + 1  # upper bound of bones + End Sites
-    for line_no, raw in enumerate(text.splitlines(), 1):
+    for line_no, raw in enumerate(lines, 1):
         line = raw.strip()
         if not line or line[0] == "#":
             continue
@@ -245,7 +252,8 @@ def parse_amc(text: str, skel: Skeleton, source="AMC", angle_unit: str | None = 
                                          "dof in the ASF")
                 continue
             raise ShapeMoveError(f"{source}: line {line_no}: AMC names bone {name[:40]!r}, which the ASF does not define")
-        n = len(rest.split())
+        toks = rest.split()
+        n = len(toks)
         if n != dofs[name]:
             raise ShapeMoveError(f"{source}: line {line_no}: AMC gives {n} values for {name!r}, expected {dofs[name]} "
                                  f"per frame (its ASF dof: {' '.join(skel.bones[name].dof) if name in skel.bones else ' '.join(skel.root_order).lower()}): "
@@ -253,7 +261,12 @@ def parse_amc(text: str, skel: Skeleton, source="AMC", angle_unit: str | None = 
         if seen[name] == frames:
             raise ShapeMoveError(f"{source}: line {line_no}: AMC gives {name!r} twice in frame {frames}")
         seen[name] = frames
-        chunks[name].append(rest)
+        try:
+            chunks[name].extend(map(float, toks))
+        except ValueError:
+            bad = next(t for t in toks if not _is_number(t))
+            raise ShapeMoveError(f"{source}: line {line_no}: AMC values for {name!r} contain something that is not a "
+                                 f"number: {bad[:40]!r}") from None
     if frames == 0:
         raise ShapeMoveError(f"{source}: AMC has no frames")
     gap = gap or _frame_gap(seen, frames, frame_line, dofs, source)
@@ -262,12 +275,9 @@ def parse_amc(text: str, skel: Skeleton, source="AMC", angle_unit: str | None = 
     if angle_unit is not None:
         angle, declared = (1.0 if angle_unit == "rad" else np.pi / 180), None
     values = {}
-    for name, lines in chunks.items():
-        if len(lines) != frames:
-            raise ShapeMoveError(f"{source}: AMC has {len(lines)} lines for {name!r} in {frames} frames "
-                                 "(truncated file or wrong skeleton)")
-        arr = parse_floats(" ".join(lines), frames * dofs[name] + 1, source, f"AMC values for {name!r}")
-        if arr.size != frames * dofs[name]:
+    for name in list(chunks):
+        arr = np.frombuffer(chunks.pop(name), dtype=np.float64)
+        if arr.size != frames * dofs[name]:  # every frame was checked to hold each bone once: cannot happen
             raise ShapeMoveError(f"{source}: AMC has {arr.size} values for {name!r}, expected {dofs[name]} per frame")
         if not np.all(np.isfinite(arr)) or (arr.size and np.abs(arr).max() > MAX_VALUE):
             raise ShapeMoveError(f"{source}: AMC values for {name!r} are NaN, inf or absurdly large")
@@ -286,6 +296,14 @@ def _frame_gap(seen: dict, frame: int, line: int, dofs: dict, source) -> str | N
             return (f"{source}: line {line}: AMC frame {frame} gives no lines for {name!r} (expected one line of "
                     f"{dofs[name]} values): truncated file or wrong skeleton")
     return None
+
+
+def _is_number(t: str) -> bool:
+    try:
+        float(t)
+        return True
+    except ValueError:
+        return False
 
 
 RADIANS_SHARE = 0.5  # share of frames with a rotation beyond +-2 pi that makes declared radians implausible
@@ -363,6 +381,21 @@ def _read_text(path: Path, what: str) -> str:
     return read_text(path, what, MAX_HIERARCHY_BYTES if what == "ASF" else None)
 
 
+def _file_lines(path: Path):
+    """The decoded lines of an AMC file, one at a time (at most ``MAX_AMC_BYTES``; binary refused)."""
+    check_file_size(path, MAX_AMC_BYTES, "AMC", "split the clip")
+    try:
+        fh = open(path, "rb")
+    except OSError as exc:
+        raise ShapeMoveError(f"cannot read AMC {path}: {exc.strerror or exc}") from None
+    with fh:
+        if b"\0" in fh.read(4096):
+            raise ShapeMoveError(f"{path}: binary data, not an AMC text file")
+        fh.seek(0)
+        for raw in fh:
+            yield raw.decode("utf-8", errors="replace")
+
+
 def load_asf(path) -> Skeleton:
     path = Path(path)
     return parse_asf(_read_text(path, "ASF"), path)
@@ -410,7 +443,7 @@ def load_amc(path, asf=None, fps: float | None = None, up_axis: str | None = Non
         skel.angle_scale = scale
     elif skel.angle_scale == 1.0:
         _check_asf_radians(skel, asf_path)
-    root, values, angle = parse_amc(_read_text(path, "AMC"), skel, path, angle_unit)
+    root, values, angle = _parse_amc(_file_lines(path), skel, path, angle_unit)
     names, parents, offsets, positions, rots = amc_to_positions(skel, root, values, angle)
     subject = asf_path.stem[4:] if asf_path.stem.startswith("HDM_") else asf_path.stem
     if up_axis is None and find_rig(names) is None:

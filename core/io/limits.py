@@ -20,6 +20,7 @@ from ..errors import ShapeMoveError
 
 MAX_TEXT_BYTES = 64 * 2**20  # a motion text file larger than this is refused (largest real: ~10 MB)
 MAX_BVH_BYTES = 256 * 2**20  # a BVH (streamed row by row): a 10-minute 120 fps take of a 48-joint rig is ~150 MB
+MAX_AMC_BYTES = 256 * 2**20  # an AMC (streamed line by line): a 10-minute 120 fps HDM05 take is ~90 MB
 MIN_FRAME_TIME = 1e-4  # s (10,000 fps): a shorter frame time is a broken header
 MAX_FRAME_TIME = 1.0   # s (1 fps): a longer one too (a 2 s frame time turned an 8-minute take into gigabytes)
 MAX_JOINT_FRAMES = 2_000_000  # frames x joints of one clip, before and after resampling
