@@ -143,3 +143,14 @@ def test_cli_refuses_bad_animation_input(tmp_path, args, message):
     assert res.returncode == 2, res.stderr
     lines = res.stderr.strip().splitlines()
     assert len(lines) == 1 and message in lines[0], res.stderr
+
+
+def test_timeline_segments_are_the_actions_asked(gen):
+    """The model's TMA names each segment's own prompt as the closest of the timeline's prompts
+    (the action classifier in core/eval needs a built dataset; this judge needs only the model)."""
+    from shapemove.core.generation.sequence import generate_sequence, segment_scores
+
+    segs = [("a person walks forward", 4.0), ("a person sits down", 3.0), ("a person waves", 3.0)]
+    m = generate_sequence(gen, segs, seed=0)
+    s = segment_scores(gen, m)
+    assert (s.argmax(0) == np.arange(3)).all(), np.round(s, 2)

@@ -184,3 +184,15 @@ def boundary_report(motion: Motion) -> dict:
     p99 = np.percentile(step[inside], 99, axis=0)
     ratios = [float((step[s - 1] / np.maximum(p99, 1e-6)).max()) for s in starts]
     return {"boundaries": [int(s) for s in starts], "ratios": ratios, "jump_ratio": max(ratios, default=0.0)}
+
+
+def segment_scores(gen, motion: Motion) -> np.ndarray:
+    """(S prompts, S segments) TMA cosine similarity of each segment's features to each of the
+    timeline's prompts: a segment is "the action asked" when its own prompt scores highest
+    (the model's TMA; biased upward when the TMA also picked the candidates, see ``rerank``)."""
+    if gen.picker is None:
+        raise ShapeMoveError(f"{gen.model_dir} has no tma/ model to judge the segments with")
+    if motion.features is None or len(motion.features) != motion.num_frames or motion.segment_bounds is None:
+        raise ShapeMoveError("judging segments needs a timeline with its decoder features")
+    feats = [np.asarray(motion.features[s:e]) for s, e in motion.segment_bounds]
+    return np.stack([gen.picker.scores(p, feats) for p in motion.segment_prompts])
