@@ -12,7 +12,7 @@ import sys
 
 # name -> (module in this package, one-line help)
 COMMANDS: dict[str, tuple[str, str]] = {
-    "body": ("body", "body model facts: `body info`"),
+    "body": ("body", "body model facts and the bodies shape texts describe: `body info|shape|render`"),
     "data": ("data", "build a training dataset from motion capture: `data build`"),
     "train": ("train", "train a model: `train vae|t5|tma`"),
     "eval": ("eval", "evaluate: `eval recon|generate`"),
@@ -37,6 +37,8 @@ P = "python -m shapemove "
 EXAMPLES: dict[str, str] = {
     "body": P + "body info",
     "body info": P + "body info",
+    "body shape": P + 'body shape "a muscular 188 cm man, 92 kg"',
+    "body render": P + 'body render "a tall, heavy-set man" "a slim teenage girl" --out bodies.png',
     "data": P + "data build --source ../shared/data/*.tar.xz --out data/built",
     "data build": P + "data build --source ../shared/data/*.tar.xz --out data/built",
     "data compose": P + "data compose --data data/built --count 800 --seed 0",
@@ -55,6 +57,7 @@ EXAMPLES: dict[str, str] = {
     "eval paraphrase": P + "eval paraphrase --data data/built --prompts configs/heldout_paraphrases_blind.json "
                            "--json out/eval_paraphrase_blind.json",
     "eval shape": P + "eval shape --bodies 200 --json out/eval_shape.json",
+    "eval shape-words": P + "eval shape-words --path auto --json out/eval_shape_words.json",
     "eval speed": P + "eval speed --data data/built --checkpoint weights/default/savae.pt --feet --json out/eval_speed.json",
     "retarget": P + 'retarget --motion walk.bvh --shape-text "A person standing 190 cm tall" --out tall_walk.npz',
     "retarget-rig": P + "retarget-rig --motion wave.npz --blend hero.blend --armature Hero --out hero_wave.blend "
