@@ -105,3 +105,24 @@ def test_fbx_of_a_timeline(openbody, tmp_path):
     arm = next(o for o in bpy.data.objects if o.type == "ARMATURE")
     for f, want in ref.items():
         np.testing.assert_allclose(_pelvis(arm, f), want, atol=2e-3)
+
+
+def test_curve_object_to_path():
+    from shapemove.shapemove_addon.animation_ui import curve_path
+
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    cu = bpy.data.curves.new("path", "CURVE")
+    cu.dimensions = "3D"
+    sp = cu.splines.new("POLY")
+    pts = [(0, 0, 0), (0.5, 1.0, 0), (0, 2.0, 0), (-0.5, 3.0, 0)]   # Blender: forward is +Y, Z up
+    sp.points.add(len(pts) - 1)
+    for p, co in zip(sp.points, pts):
+        p.co = (*co, 1.0)
+    obj = bpy.data.objects.new("path", cu)
+    bpy.context.scene.collection.objects.link(obj)
+    obj.location = (1.0, 0.0, 0.0)
+    path = np.array(curve_path(obj, bpy.context))
+    # Y up, [x, z]: Blender (X, Y) -> (x, z) = (X, -Y); first point first, world transform applied
+    np.testing.assert_allclose(path[0], [1.0, 0.0], atol=1e-6)
+    np.testing.assert_allclose(path[-1], [0.5, -3.0], atol=1e-6)
+    assert len(path) == 4
