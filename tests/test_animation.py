@@ -154,3 +154,27 @@ def test_timeline_segments_are_the_actions_asked(gen):
     m = generate_sequence(gen, segs, seed=0)
     s = segment_scores(gen, m)
     assert (s.argmax(0) == np.arange(3)).all(), np.round(s, 2)
+
+
+def test_worker_ops_animate_and_sequence(tmp_path, gen):
+    from shapemove.core.scene.motion_file import load_motion
+    from shapemove.core.worker import jobs_animation, jobs_shapemove
+    from shapemove.core.worker.ops import default_jobs
+
+    assert {"animate", "sequence"} <= set(default_jobs())
+    jobs_shapemove._GENERATORS.clear()
+    never = lambda: False   # noqa: E731
+    out = jobs_animation.animate({"prompt": "a person walks forward", "seconds": 2, "speed": 2.0, "in_place": True,
+                                  "out": str(tmp_path / "a.npz")}, lambda f, m: None, never)
+    m = load_motion(out["path"])
+    assert out["frames"] == m.num_frames == 20
+    assert np.abs(m.joints[:, 0, [0, 2]] - m.joints[0, 0, [0, 2]]).max() <= 0.01
+    seq = jobs_animation.sequence({"segments": [{"prompt": "a person walks forward", "seconds": 1.2},
+                                                {"prompt": "a person waves", "seconds": 1.2}],
+                                   "out": str(tmp_path / "s.npz")}, lambda f, m: None, never)
+    assert [s["prompt"] for s in seq["segments"]] == ["a person walks forward", "a person waves"]
+    again = jobs_animation.sequence({"regenerate": 1, "motion": seq["path"], "seed": 4, "out": str(tmp_path / "t.npz")},
+                                    lambda f, m: None, never)
+    assert again["segments"] == seq["segments"] and again["path"].endswith("t.npz")
+    with pytest.raises(ShapeMoveError, match="segments"):
+        jobs_animation.sequence({"segments": [{"prompt": "x"}], "out": str(tmp_path / "u.npz")}, lambda f, m: None, never)
