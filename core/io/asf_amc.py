@@ -24,7 +24,7 @@ from ..errors import ShapeMoveError
 from ..geometry.fk import forward_kinematics, joints_from_offsets
 from ..geometry.rotations import euler_matrix
 from .limits import (MAX_AMC_BYTES, MAX_FRAME_TIME, MAX_HIERARCHY_BYTES, MAX_JOINT_FRAMES, MIN_FRAME_TIME,
-                     check_file_size, check_joint_frames, read_text)
+                     check_file_size, check_joint_frames, is_number, read_text)
 from .mocap_clip import Mocap, finish_mocap
 from .rig_map import find_rig
 
@@ -264,7 +264,7 @@ def _parse_amc(lines, skel: Skeleton, source, angle_unit: str | None):
         try:
             chunks[name].extend(map(float, toks))
         except ValueError:
-            bad = next(t for t in toks if not _is_number(t))
+            bad = next(t for t in toks if not is_number(t))
             raise ShapeMoveError(f"{source}: line {line_no}: AMC values for {name!r} contain something that is not a "
                                  f"number: {bad[:40]!r}") from None
     if frames == 0:
@@ -296,14 +296,6 @@ def _frame_gap(seen: dict, frame: int, line: int, dofs: dict, source) -> str | N
             return (f"{source}: line {line}: AMC frame {frame} gives no lines for {name!r} (expected one line of "
                     f"{dofs[name]} values): truncated file or wrong skeleton")
     return None
-
-
-def _is_number(t: str) -> bool:
-    try:
-        float(t)
-        return True
-    except ValueError:
-        return False
 
 
 RADIANS_SHARE = 0.5  # share of frames with a rotation beyond +-2 pi that makes declared radians implausible

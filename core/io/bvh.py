@@ -15,7 +15,7 @@ from ..errors import ShapeMoveError
 from ..geometry.fk import forward_kinematics, joints_from_offsets
 from ..geometry.rotations import axis_rotation
 from .limits import (MAX_BVH_BYTES, MAX_FRAME_TIME, MAX_HIERARCHY_BYTES, MAX_SECONDS, MIN_FRAME_TIME, check_file_size,
-                     check_joint_frames)
+                     check_joint_frames, is_number)
 from .mocap_clip import Mocap, finish_mocap
 from .units_axes import UNITS
 
@@ -255,7 +255,7 @@ def _parse(head: str, lines, source, frame_time: float | None, data_bytes: int):
         try:
             data[row] = np.array(toks, dtype=np.float64)
         except ValueError:
-            bad = next(t for t in toks if not _is_float(t))
+            bad = next(t for t in toks if not is_number(t))
             raise ShapeMoveError(f"{source}: line {line_no - 1}: BVH motion data contains something that is not a "
                                  f"number: {bad[:40]!r}") from None
         row += 1
@@ -265,14 +265,6 @@ def _parse(head: str, lines, source, frame_time: float | None, data_bytes: int):
     if not np.all(np.isfinite(data)) or np.abs(data).max() > MAX_VALUE:
         raise ShapeMoveError(f"{source}: BVH motion data holds NaN, inf or absurdly large values")
     return names, parents, offsets, channels, data, step
-
-
-def _is_float(t: str) -> bool:
-    try:
-        float(t)
-        return True
-    except ValueError:
-        return False
 
 
 def _file_lines(fh, first: bytes):

@@ -132,14 +132,15 @@ def parse_floats(text: str, count: int, source, what: str) -> np.ndarray:
         try:
             vals = np.array(toks, dtype=np.float64)
         except ValueError:
-            bad = next(t for t in toks if not _is_float(t))
+            bad = next(t for t in toks if not is_number(t))
             raise ShapeMoveError(f"{source}: {what} contains something that is not a number: {bad[:40]!r}") from None
         out[n: n + len(vals)] = vals
         n += len(vals)
     return out[:n]
 
 
-def _is_float(t: str) -> bool:
+def is_number(t: str) -> bool:
+    """Whether the token ``t`` reads as a float (the readers name the first one that does not)."""
     try:
         float(t)
         return True
