@@ -488,6 +488,8 @@ def _combine_build(out: ShapeWords) -> None:
             raise ShapeMoveError(f"the shape text's build words disagree: '{hi}' and '{lo}'")
         out.muscle = max(vals) if min(vals) >= 0.5 else sum(vals) / len(vals)
     weights = [(w, BUILD_WORDS[w].weight) for w in out.build_words if BUILD_WORDS[w].weight is not None]
+    pure = [(w, v) for w, v in weights if (BUILD_WORDS[w].muscle or 0.0) < 0.7]
+    weights = pure or weights   # "a skinny bodybuilder": the weight word says the weight, the sport the muscle
     if weights:
         hi = max(weights, key=lambda x: x[1])
         lo = min(weights, key=lambda x: x[1])
