@@ -23,6 +23,7 @@ CHANNELS = {"xposition": ("p", 0), "yposition": ("p", 1), "zposition": ("p", 2),
             "xrotation": ("r", "x"), "yrotation": ("r", "y"), "zrotation": ("r", "z")}
 MAX_JOINTS = 2000
 MAX_VALUE = 1e7  # any channel value beyond this is corrupt (cm, degrees)
+FK_WINDOW = 4096  # frames posed at once when reading (memory: the take's positions and rotations, no more)
 
 
 class _Tokens:
@@ -332,8 +333,13 @@ def load_bvh(path, unit: str | None = None, up_axis: str | None = None, fps: flo
         raise ShapeMoveError(f"source frame rate {fps} must lie between {1 / MAX_FRAME_TIME:g} and "
                              f"{1 / MIN_FRAME_TIME:g} fps")
     names, parents, offsets, channels, data, dt = read_bvh(path, None if fps is None else 1.0 / fps)
-    trans, rots = bvh_local_transforms(offsets, channels, data)
-    positions = forward_kinematics(rots, joints_from_offsets(trans, parents), parents)[0]
+    T, J = len(data), len(names)
+    positions, rots = np.empty((T, J, 3)), np.empty((T, J, 3, 3))
+    for s in range(0, T, FK_WINDOW):  # per frame: the same numbers, without whole-take temporaries
+        trans, rots[s:s + FK_WINDOW] = bvh_local_transforms(offsets, channels, data[s:s + FK_WINDOW])
+        positions[s:s + FK_WINDOW] = forward_kinematics(rots[s:s + FK_WINDOW], joints_from_offsets(trans, parents),
+                                                        parents)[0]
+    del data
     scale = None
     if unit is not None:
         if unit not in UNITS:
