@@ -26,7 +26,6 @@ from pathlib import Path
 
 import numpy as np
 
-from ..atomic import atomic_write_json
 from ..constants import FPS
 from ..errors import ShapeMoveError
 from ..generation.generate import Generator, Request
@@ -35,7 +34,7 @@ from ..geometry.rotations import axis_angle_to_matrix
 from ..train.motion_dataset import read_split
 from ..train.t5_dataset import read_lines
 from .evaluate import evaluate_motion
-from .report import aggregate
+from .report import aggregate, show_result
 from .tma_embed import embed_motions, embed_texts, load_tma
 
 KEYS = ("r_precision_top1", "r_precision_top3", "matching_score", "fid", "penetrate_cm", "float_cm", "skate_pct",
@@ -209,7 +208,5 @@ def from_cli(args) -> int:
                             candidates=getattr(args, "candidates", 1))
     finally:
         bar.close()
-    print(format_results(res, f"Text-to-motion evaluation, {split} split"))
-    if getattr(args, "json", None):
-        print(f"wrote {atomic_write_json(args.json, res, nan_to_null=True)}")
-    return 0
+    return show_result(format_results(res, f"Text-to-motion evaluation, {split} split"), res,
+                       getattr(args, "json", None))

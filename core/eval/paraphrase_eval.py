@@ -35,7 +35,6 @@ from pathlib import Path
 
 import numpy as np
 
-from ..atomic import atomic_write_json
 from ..errors import ShapeMoveError
 
 DEFAULT_PROMPTS = Path(__file__).resolve().parents[2] / "configs" / "heldout_paraphrases.json"
@@ -241,23 +240,12 @@ def add_arguments(p) -> None:
 
 
 def from_cli(args) -> int:
-    from tqdm import tqdm
+    from .report import PercentBar, show_result
 
-    bar = None  # opened at the first prompt, after the classifier's own progress bars
-
-    def progress(frac, msg):
-        nonlocal bar
-        if bar is None:
-            bar = tqdm(total=100, desc="eval paraphrase", unit="%", disable=args.quiet)
-        bar.update(round(100 * frac) - bar.n)
-
+    progress = PercentBar("eval paraphrase", args.quiet)  # opened at the first prompt, after the classifier's bars
     try:
         res = eval_paraphrase(args.model, args.prompts, args.tma, args.seed, args.seconds, progress, data=args.data,
                               show_progress=not args.quiet, candidates=args.candidates)
     finally:
-        if bar is not None:
-            bar.close()
-    print(format_results(res))
-    if args.json:
-        print(f"wrote {atomic_write_json(args.json, res, nan_to_null=True)}")
-    return 0
+        progress.close()
+    return show_result(format_results(res), res, args.json)

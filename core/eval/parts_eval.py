@@ -197,28 +197,15 @@ def add_arguments(p) -> None:
 
 
 def from_cli(args) -> int:
-    from tqdm import tqdm
-
-    from ..atomic import atomic_write_json
+    from .report import PercentBar, show_result
 
     if args.seconds is not None and not 0.5 <= args.seconds <= 60:
         raise ShapeMoveError(f"--seconds must be between 0.5 and 60, got {args.seconds}")
-    bar = None
-
-    def progress(frac, msg):
-        nonlocal bar
-        if bar is None:
-            bar = tqdm(total=100, desc="eval parts", unit="%", disable=args.quiet)
-        bar.update(round(100 * frac) - bar.n)
-
+    progress = PercentBar("eval parts", args.quiet)
     try:
         res = eval_parts(args.model, args.data, args.sides, args.two_things, args.seed, args.seconds, args.candidates,
                          retrieval=not args.no_retrieval, judge_check=not args.no_judge_check, progress=progress,
                          show_progress=not args.quiet)
     finally:
-        if bar is not None:
-            bar.close()
-    print(format_results(res))
-    if args.json:
-        print(f"wrote {atomic_write_json(args.json, res, nan_to_null=True)}")
-    return 0
+        progress.close()
+    return show_result(format_results(res), res, args.json)

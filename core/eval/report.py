@@ -78,3 +78,35 @@ def format_table(metrics: dict, ground_truth: dict | None = None, title: str = "
 
 def print_table(metrics: dict, ground_truth: dict | None = None, **kwargs) -> None:
     print(format_table(metrics, ground_truth, **kwargs))
+
+
+class PercentBar:
+    """A ``progress(fraction, message)`` callback drawing a 0-100 % bar, opened at its first call (so
+    after the bars the work opens before it, e.g. a classifier's); ``close()`` when the work is done."""
+
+    def __init__(self, desc: str, quiet: bool = False):
+        self.desc, self.quiet, self.bar = desc, quiet, None
+
+    def __call__(self, fraction: float, message: str = "") -> None:
+        if self.bar is None:
+            from tqdm import tqdm
+
+            self.bar = tqdm(total=100, desc=self.desc, unit="%", disable=self.quiet)
+        self.bar.update(round(100 * fraction) - self.bar.n)
+
+    def close(self) -> None:
+        if self.bar is not None:
+            self.bar.close()
+
+
+def show_result(table: str, result: dict, json_path=None) -> int:
+    """An evaluation command's ending: print its table, write ``result`` as JSON to ``json_path`` when
+    given (NaN as null, atomically) and say where; the exit code 0."""
+    print(table)
+    if json_path:
+        from pathlib import Path
+
+        from ..atomic import atomic_write_json
+
+        print(f"wrote {atomic_write_json(Path(json_path), result, nan_to_null=True)}")
+    return 0

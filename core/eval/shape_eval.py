@@ -25,9 +25,9 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from ..atomic import atomic_write_json
 from ..data.shape_text import ADJECTIVES, in_range, numeric_shape_text, shape_sentence
 from ..errors import ShapeMoveError
+from .report import show_result
 
 CAPTIONS = ("a person walks forward.", "someone waves with the right hand.", "a person jumps in place.")
 FORMS = ("sentence", "centimetres", "metres", "feet and inches")
@@ -142,7 +142,4 @@ def add_arguments(p) -> None:
 
 def from_cli(args) -> int:
     res = eval_shape(args.model, args.bodies, args.seed, progress=not args.quiet)
-    print(format_results(res))
-    if args.json:
-        print(f"wrote {atomic_write_json(args.json, res, nan_to_null=True)}")
-    return 0
+    return show_result(format_results(res), res, args.json)

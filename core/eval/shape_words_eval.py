@@ -29,9 +29,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ..atomic import atomic_write_json
 from ..errors import ShapeMoveError
 from ..text.shape_words import AGE_WORDS, BUILD_WORDS, INCH, LB, ST
+from .report import show_result
 
 MOTION = ("a person walks forward.", "someone waves with the right hand.", "a person jumps in place.")
 NO_SHAPE_PROMPTS = ("a person nods", "someone walks forward", "a person waves with both hands", "someone sits down",
@@ -450,7 +450,4 @@ def add_arguments(p) -> None:
 
 def from_cli(args) -> int:
     res = eval_shape_words(args.path, args.texts, args.seed, args.model, seeds=args.seeds)
-    print(format_results(res))
-    if args.json:
-        print(f"wrote {atomic_write_json(Path(args.json), res, nan_to_null=True)}")
-    return 0
+    return show_result(format_results(res), res, args.json)
