@@ -172,3 +172,17 @@ def test_feature_embedder_normalizes_pools_and_separates():
     manual = np.concatenate([x.mean(0), x.std(0)] + [x[10 * i:10 * (i + 1)].mean(0) for i in range(4)])
     assert np.allclose(e[0], manual / np.linalg.norm(manual), atol=1e-5)
     assert not np.allclose(e[0], e[1])
+
+
+def test_a_copied_reference_is_judged_without_its_own_source():
+    import numpy as np
+
+    from shapemove.core.eval.action_classifier import ActionClassifier
+
+    e = np.eye(4, dtype=np.float32)
+    emb = np.stack([e[0], e[0] * 0.99 + e[1] * 0.01, e[1], e[1] * 0.9 + e[0] * 0.1, e[2]])
+    clf = ActionClassifier(emb, ["kick", "kick", "walk", "walk", "wave"], k=1,
+                           sources=["a", "a", "b", "c", "d"])
+    # clip 0's nearest other reference is clip 1 (same source "a": left out), then clip 3 (walk)
+    assert clf.classify_references([0]) == ["walk"]
+    assert clf.classify_embeddings(emb[:1]) == ["kick"]

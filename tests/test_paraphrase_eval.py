@@ -42,6 +42,13 @@ def test_paraphrase_eval_on_a_tiny_model(tiny_bundle, tmp_path, capsys):  # noqa
         assert res[kind]["accuracy_lenient"] == pytest.approx(lenient / len(rows))
         assert all(r[f"{pred}_pred"] in known for r in rows)
     assert "overall" in out and "Held-out paraphrases" in out
+    # the no-generation baseline: the nearest training caption's real clip, judged without itself
+    assert all(r["nearest_caption_pred"] in labelled for r in rows)
+    near = sum(r["nearest_caption_pred"] == r["action"] for r in rows)
+    assert res["nearest_caption"]["accuracy"] == pytest.approx(near / len(rows))
+    counts = {a: labelled.count(a) for a in set(labelled)}
+    assert res["frequent"]["actions"] == sorted({r["action"] for r in rows if counts.get(r["action"], 0) >= 20})
+    assert "nearest caption (MiniLM) copied" in out
 
 
 def test_bad_prompt_files(tmp_path):

@@ -250,10 +250,13 @@ class ActionClassifier:
         main = [a[0] for a in labels]
         gone = set(skipped)
         sources = [source_of(cid) for cid, _ in clips if cid not in gone]
+        ids = [cid for cid, _ in clips if cid not in gone]
         info = {"kind": f"{k}-nearest training clips in TMA motion space", "k": k, "data": str(data),
                 "split": split, "clips": len(main), "skipped_without_features": len(skipped),
                 "actions_without_clips": sorted(set(actions) - set(main))}
-        return cls(emb, main, embed, k, info, actions, sources)
+        out = cls(emb, main, embed, k, info, actions, sources)
+        out.ids = ids  # the reference clips' ids (their captions: the nearest-caption baseline)
+        return out
 
     def classify_embeddings(self, emb: np.ndarray, chunk: int = 1024) -> list[str]:
         emb = np.asarray(emb, np.float32)
@@ -281,6 +284,16 @@ class ActionClassifier:
             d["n"] += 1
             d["right"] += p == a
         return {a: {"n": d["n"], "accuracy": d["right"] / d["n"]} for a, d in sorted(out.items())}
+
+    def classify_references(self, index: list[int]) -> list[str]:
+        """Action of reference clips ``index`` each judged among the others without its own source
+        (as ``reachable`` does): how a copied real clip is judged, without finding itself."""
+        src = np.asarray(self.sources)
+        if not len(index):
+            return []
+        sims = self.embeddings[index] @ self.embeddings.T
+        sims[src[index][:, None] == src[None, :]] = -np.inf
+        return knn_vote(np.where(np.isfinite(sims), sims, -1e9), self.labels, self.k)
 
     def classify(self, feats: list) -> list[str]:
         """Action of each raw (T, 263) feature array."""

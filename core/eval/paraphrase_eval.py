@@ -97,7 +97,8 @@ def _tally(rows: list[dict], key: str) -> dict:
 
 def eval_paraphrase(model_dir=None, prompts=None, tma=None, seed: int = 0, seconds: float | None = 4.0,
                     progress=None, generator=None, data=None, classifier=None, ceiling_clips: int | None = None,
-                    show_progress: bool = True, candidates: int | None = None, feature_classifier=None) -> dict:
+                    show_progress: bool = True, candidates: int | None = None, feature_classifier=None,
+                    retrieval: bool = True, frequent: int = 20) -> dict:
     """Generate a motion per held-out prompt and classify it (module docstring). ``data``: the built
     dataset whose training clips the kNN classifier reads (default ``default_built_dir()``);
     ``classifier``: an ``ActionClassifier`` to use instead (``feature_classifier`` likewise for the
@@ -119,6 +120,7 @@ def eval_paraphrase(model_dir=None, prompts=None, tma=None, seed: int = 0, secon
                                  "pass --data BUILT, the built dataset the model was trained on "
                                  "(or set SHAPEMOVE_BUILT; default data/built when it exists)")
     gen = generator if generator is not None else Generator(model_dir)
+    gen.set_retrieval(retrieval)
     actions = gen.known_actions
     if not actions:
         raise ShapeMoveError(f"{gen.model_dir}: its T5 lists no known actions (trained before known_texts.json); "
@@ -158,12 +160,22 @@ def eval_paraphrase(model_dir=None, prompts=None, tma=None, seed: int = 0, secon
     text_emb = embed_texts(model, tok, [r["text"] for r in rows]) if rows else np.zeros((0, A.shape[1]))
     for r, t in zip(rows, text_emb):
         r["text_pred"] = actions[int(np.argmax(A @ t))]
+    nearest = nearest_caption_baseline(classifier, data, rows, gen) if data is not None and rows else None
+    counts: dict = {}
+    for a in classifier.labels:
+        counts[a] = counts.get(a, 0) + 1
+    often = [r for r in rows if counts.get(r["action"], 0) >= frequent]
     clfs = {"motion": classifier, "motion_features": feature_classifier}
     reach = {k: _reachable(c, rows) for k, c in clfs.items() if c is not None}
     return {"motion": _tally(rows, "motion_pred"), "text": _tally(rows, "text_pred"),
             "motion_vs_text_prototypes": _tally(rows, "motion_proto_pred"),
             **({"motion_features": _tally(rows, "motion_features_pred")} if feature_classifier is not None else {}),
             "reachable": reach,
+            **({"nearest_caption": _tally(rows, "nearest_caption_pred")} if nearest else {}),
+            "frequent": {"min_clips": frequent, "actions": sorted({r["action"] for r in often}),
+                         "motion": _tally(often, "motion_pred"),
+                         **({"nearest_caption": _tally(often, "nearest_caption_pred")} if nearest else {})},
+            "retrieval": bool(retrieval and gen.reads_memory),
             "candidates": candidates,
             "classifier": {**classifier.info, "ceiling": ceiling},
             "feature_classifier": dict(feature_classifier.info) if feature_classifier is not None else None,
@@ -171,6 +183,33 @@ def eval_paraphrase(model_dir=None, prompts=None, tma=None, seed: int = 0, secon
             "unknown_prompts": len(items) - len(known), "warned": sum(r["warned"] for r in rows),
             "prompts_file": str(Path(prompts) if prompts else DEFAULT_PROMPTS),
             "actions": actions, "rows": rows}
+
+
+def nearest_caption_baseline(classifier, data, rows: list[dict], gen) -> bool:
+    """No generation at all: copy the real training clip (a reference of ``classifier``) whose
+    caption is nearest to the prompt by MiniLM cosine, and judge it among the other references
+    without its own source. Sets ``row["nearest_caption_pred"]``; False when it cannot run."""
+    from ..models.motion_memory import sentence_vectors
+
+    ids = getattr(classifier, "ids", None)
+    if not ids:
+        return False
+    caps, owner = [], []
+    for i, cid in enumerate(ids):
+        path = Path(data) / "texts" / f"{cid}.txt"
+        for c in (path.read_text(encoding="utf-8").splitlines() if path.is_file() else []):
+            if c.strip():
+                caps.append(c.strip())
+                owner.append(i)
+    if not caps:
+        return False
+    reader = gen._text_encoder()
+    V = sentence_vectors(reader, caps)
+    Q = sentence_vectors(reader, [r["text"] for r in rows])
+    best = [owner[int(j)] for j in (Q @ V.T).argmax(1)]
+    for r, p in zip(rows, classifier.classify_references(best)):
+        r["nearest_caption_pred"] = p
+    return True
 
 
 def _reachable(classifier, rows: list[dict]) -> float | None:
@@ -214,6 +253,15 @@ def format_results(res: dict) -> str:
     if reach:
         lines.append("reachable (a perfect generator, each prompt's action judged by leave-one-source-out on the "
                      "training clips): " + ", ".join(f"{k} {_pct(v)}" for k, v in reach.items()))
+    if res.get("nearest_caption"):
+        lines.append(f"no generation, the real clip with the nearest caption (MiniLM) copied and judged the same "
+                     f"way: {_pct(res['nearest_caption']['accuracy'])} ({_pct(res['nearest_caption']['accuracy_lenient'])} lenient)")
+    fr = res.get("frequent") or {}
+    if fr.get("motion"):
+        lines.append(f"actions with >= {fr['min_clips']} real training clips ({fr['motion']['prompts']} prompts): motion "
+                     f"{_pct(fr['motion']['accuracy'])} ({_pct(fr['motion']['accuracy_lenient'])} lenient)"
+                     + (f", nearest caption {_pct(fr['nearest_caption']['accuracy'])}" if fr.get("nearest_caption") else ""))
+    lines.append(f"retrieved clips read by the decoder: {'yes' if res.get('retrieval') else 'no'}")
     lines.append(f"best of {res.get('candidates', 1)} samples per prompt (TMA choice)")
     if ceil:
         info = res["classifier"]
@@ -237,6 +285,7 @@ def add_arguments(p) -> None:
                    help="token samples per prompt, the TMA keeps the closest (default: the product's, 8; 1 = none)")
     p.add_argument("--json", type=Path, default=None, help="write the results here")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.add_argument("--no-retrieval", action="store_true", help="the decoder reads no retrieved clips (to compare)")
 
 
 def from_cli(args) -> int:
@@ -245,7 +294,8 @@ def from_cli(args) -> int:
     progress = PercentBar("eval paraphrase", args.quiet)  # opened at the first prompt, after the classifier's bars
     try:
         res = eval_paraphrase(args.model, args.prompts, args.tma, args.seed, args.seconds, progress, data=args.data,
-                              show_progress=not args.quiet, candidates=args.candidates)
+                              show_progress=not args.quiet, candidates=args.candidates,
+                              retrieval=not args.no_retrieval)
     finally:
         progress.close()
     return show_result(format_results(res), res, args.json)
