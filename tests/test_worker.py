@@ -180,7 +180,8 @@ def test_measure_op_reports_the_bodys_own_lengths(shared):
     betas = [1.5, -0.5, 0, 0, 0.3, 0, 0, 0, 0, -1.0]
     got = shared.call("measure", {"betas": betas}, timeout=90)
     want = _openbody_lengths_cm(betas)
-    assert set(got) == {"height_cm", "chest_cm", "waist_cm", "hip_cm", "arm_length_cm", "leg_length_cm"}
+    assert set(got) == {"height_cm", "chest_cm", "waist_cm", "hip_cm", "arm_length_cm", "leg_length_cm", "mass_kg", "bmi"}
+    assert got["bmi"] == pytest.approx(got["mass_kg"] / (got["height_cm"] / 100) ** 2, rel=1e-5)
     for k, v in want.items():  # float32 in the worker: 0.01 mm
         assert got[k] == pytest.approx(v, abs=1e-3)
     # the betas reached the body: the mean shape is measurably different

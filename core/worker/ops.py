@@ -47,7 +47,7 @@ def body_info(params, progress, cancel) -> dict:
 
 def measure(params, progress, cancel) -> dict:
     """params {"betas": 10 numbers (default zeros) or B lists of 10, "body"} -> measurements in cm
-    (core.body.measure): numbers, or lists of B numbers."""
+    (core.body.measure; mass_kg in kg from the mesh volume, bmi in kg/m^2): numbers, or lists of B numbers."""
     from ..body.load import load_body_model
     from ..body.measure import measure as _measure
 
