@@ -58,6 +58,23 @@ def test_panels_register_and_draw_in_the_factory_scene(installed):
     assert prefs == ["body_model", "python_env", "models_dir", "active_model", "device"]
 
 
+def test_animation_panel_draws_and_lists_the_timeline(installed):
+    from ui_support import PanelSelf, RnaLayout
+
+    panel = ext("shapemove_addon.animation_ui").SHAPEMOVE_PT_animation
+    assert hasattr(bpy.types, panel.bl_idname)
+    assert bpy.ops.shapemove.timeline_add() == {"FINISHED"} and bpy.ops.shapemove.timeline_add() == {"FINISHED"}
+    settings = bpy.context.scene.shapemove_animation
+    settings.timeline[1].prompt, settings.timeline[1].seconds = "a person waves", 2.5
+    log: list = []
+    panel.draw(PanelSelf(panel, RnaLayout(log)), bpy.context)
+    ops = [d["op"] for d in log if d["kind"] == "operator"]
+    assert ops == ["shapemove.animate", "shapemove.timeline_add", "shapemove.timeline_remove", "shapemove.sequence"]
+    rows = [d["value"] for d in log if d["kind"] == "prop" and d["data"] == "ShapeMoveTimelineItem"]
+    assert rows[2:] == ["a person waves", 2.5] and [d["rows"] for d in log if d["kind"] == "list"] == [2]
+    assert bpy.ops.shapemove.timeline_remove() == {"FINISHED"} and len(settings.timeline) == 1
+
+
 def test_rig_from_a_motion_file_without_torch(rig):
     r = rig["rig"]
     assert rig["result"] == ["FINISHED"] and rig["new_objects"] == 2
