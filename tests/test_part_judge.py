@@ -1,0 +1,101 @@
+"""The part judge (core/eval/part_judge.py) on real captured clips of the tiny dataset: the side that
+moves, the gait of the legs, the path, the arms, and its refusals."""
+import json
+
+import numpy as np
+import pytest
+
+from shapemove.core.data.mirror import mirror_joints
+from shapemove.core.errors import ShapeMoveError
+from shapemove.core.eval.part_judge import (CIRCLE, NO_GESTURE, STRAIGHT, PartJudge, arms_label, joints_of, legs_label,
+                                            legs_right, load_joints, path_of, side_activity, side_of)
+from shapemove.core.eval.part_judge_accuracy import leave_one_out, named_side, real_accuracy
+
+WAVE_LEFT = "dataset-2_wave-left-hand_elderly_001"
+KICK_LEFT = "HDM_bd_kickLFront1Reps_001_120"
+WALKS = ["dataset-1_walk_feminine_001", "dataset-2_walk_masculine_003"]
+RUNS = ["dataset-1_run_happy_001", "dataset-2_run_elderly_001"]
+
+
+def metas(data):
+    return [json.loads(ln) for ln in (data / "meta.jsonl").read_text().splitlines() if ln.strip()]
+
+
+@pytest.fixture(scope="module")
+def judge(tiny_dataset):
+    real = [m for m in metas(tiny_dataset) if not m.get("augmented_from") and not m["id"].endswith("_aug")]
+    return PartJudge.from_metas(tiny_dataset, real, progress=False)
+
+
+def test_side_of_a_left_hand_wave_and_its_mirror(tiny_dataset):
+    j = load_joints(tiny_dataset, WAVE_LEFT)
+    left, right = side_activity(j, "hand")
+    assert left > 2 * right                                    # the waving hand travels far more
+    assert side_of(j, "hand") == "left"
+    m = mirror_joints(j)
+    assert side_activity(m, "hand") == pytest.approx((right, left), rel=1e-6)   # the mirror swaps them exactly
+    assert side_of(m, "hand") == "right"
+
+
+def test_side_of_a_left_kick_and_its_mirror(tiny_dataset):
+    j = load_joints(tiny_dataset, KICK_LEFT)
+    left, right = side_activity(j, "foot")
+    assert left > 1.5 * right
+    assert side_of(j, "foot") == "left" and side_of(mirror_joints(j), "foot") == "right"
+
+
+def test_legs_tell_walks_from_runs_without_their_own_clip(judge, tiny_dataset):
+    for cid, want in [(c, "walk") for c in WALKS] + [(c, "run") for c in RUNS]:
+        j = load_joints(tiny_dataset, cid)
+        assert judge.legs.classify(j, exclude_source=cid) == want, cid
+        assert judge.legs.classify(mirror_joints(j), exclude_source=cid) == want, cid   # side-invariant
+
+
+def test_arms_of_locomotion_are_no_gesture_and_a_wave_is_not(judge, tiny_dataset):
+    for cid in WALKS + RUNS:
+        assert judge.arms.classify(load_joints(tiny_dataset, cid), exclude_source=cid) == NO_GESTURE, cid
+    wave = load_joints(tiny_dataset, WAVE_LEFT)
+    assert judge.judge_joints(mirror_joints(wave[10:]))["arms"] == "wave"     # a part of it, mirrored
+    assert judge.judge_joints(wave)["legs"] == "stand"
+
+
+def test_path_circles_for_a_jog_in_a_circle_only(tiny_dataset):
+    assert path_of(load_joints(tiny_dataset, "HDM_bk_jogLeftCircle4StepsRstart_003_120")) == CIRCLE
+    for cid in WALKS + RUNS:
+        assert path_of(load_joints(tiny_dataset, cid)) == STRAIGHT, cid
+    assert legs_right(CIRCLE, {"legs": "jog", "path": CIRCLE}) and not legs_right(CIRCLE, {"legs": "jog", "path": STRAIGHT})
+    assert not legs_right(CIRCLE, {"legs": "stand", "path": CIRCLE}) and legs_right("jog", {"legs": "jog", "path": CIRCLE})
+
+
+def test_labels_and_named_sides():
+    assert legs_label(["jog", "walk in a circle"]) == "jog" and legs_label(["walk in a circle"]) == "walk"
+    assert legs_label(["wave"]) == "stand" and arms_label(["wave goodbye"]) == "wave"
+    assert arms_label(["walk"]) == NO_GESTURE and arms_label(["walk", "wave"]) is None and legs_label(["kick"]) is None
+    assert named_side({"dataset": "bandai", "labels": {"content": "raise-up-right-hand"}}) == ("right", "hand")
+    assert named_side({"dataset": "bandai", "labels": {"content": "wave-both-hands"}}) is None
+    assert named_side({"dataset": "hdm05", "labels": {"class": "kickLFront1Reps"}}) == ("left", "foot")
+    assert named_side({"dataset": "hdm05", "labels": {"class": "grabHighR"}}) == ("right", "hand")
+
+
+def test_real_accuracy_counts_each_named_side_and_its_mirror(judge, tiny_dataset):
+    real = [m for m in metas(tiny_dataset) if not m["id"].endswith("_aug")]
+    res = real_accuracy(judge, tiny_dataset, metas=real, progress=False)
+    named = [m for m in real if named_side(m)]
+    assert {m["id"] for m in named} >= {WAVE_LEFT, KICK_LEFT}
+    assert res["side"]["n"] == 2 * len(named) and res["side"]["accuracy"] == 1.0
+    assert res["side"]["confusion"] == {"left": {"left": len(named)}, "right": {"right": len(named)}}
+    loo = leave_one_out(judge)
+    assert loo["legs"]["per_class"]["run"]["accuracy"] == 1.0 and loo["legs"]["per_class"]["walk"]["n"] >= 2
+
+
+def test_bad_input_is_refused(tiny_dataset):
+    with pytest.raises(ShapeMoveError, match="features must be"):
+        joints_of(np.zeros((20, 100)))
+    with pytest.raises(ShapeMoveError, match="at least 10 frames"):
+        side_of(np.zeros((3, 22, 3)), "hand")
+    with pytest.raises(ShapeMoveError, match="NaN"):
+        joints_of(np.full((20, 263), np.nan))
+    with pytest.raises(ShapeMoveError, match="part must be one of"):
+        side_of(load_joints(tiny_dataset, WAVE_LEFT), "elbow")
+    with pytest.raises(ShapeMoveError, match="not a built dataset"):
+        PartJudge.from_data(tiny_dataset / "meta")
