@@ -16,9 +16,19 @@ on mesh measurements of sampled bodies (the tests check it against ``measure``),
 costs a few milliseconds; other bodies use the mesh. The prior keeps the directions the targets
 don't constrain near 0, so "190 cm tall" changes height without inventing a belly.
 
-``targets_from_shape_text`` reads a numeric shape sentence ("A person standing 190 cm tall, with
-a waist circumference of 100 cm ...", ``data.shape_text.parse_shape_sentence``) or, failing that,
-the adjectives of ``data.shape_text`` ("a tall, heavy-set man") mapped to the middle of their bands.
+Mass (kg) and BMI are measurements too: the closed mesh's volume x 985 kg/m^3 (``body_mass``),
+an exact cubic in the betas (``fast_mass``).
+
+Shape text -> body (``betas_for_shape_text``): ``text.shape_words`` reads the words and numbers
+("a muscular 188 cm man, 92 kg", "an elderly woman", "6 ft 4, 250 lb"). On OpenBody the words set
+the phenotype sliders through the shipped map (gender, age and muscle held exactly, weight, height
+and proportions as a prior) and the stated numbers (height, girths, mass or BMI; size words' bands)
+are then met on the mesh by Levenberg-Marquardt over the free sliders and the four beta directions
+the sliders cannot see (``_phenotype_frame``), so the sliders read back from the betas are the
+words' own. A stated height or weight the body cannot reach, or a result whose BMI a weight word
+excludes, is a ShapeMoveError; so is every contradiction the reader finds. Bodies without a
+phenotype map (the SMPL family) fit the numbers alone. ``shape_targets`` /
+``targets_from_shape_text`` give the measurement targets of a text.
 """
 from __future__ import annotations
 
