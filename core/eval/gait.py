@@ -9,6 +9,8 @@ All take (T,22,3) joints in metres, Y up, at ``fps`` frames per second (20 after
 - ``cycle_frequency``: gait cycles (strides, two steps) per second: the dominant frequency of the
   ankles' fore-aft separation (left ankle minus right, along the body's facing direction); it swings
   once per cycle whatever the root does, so it does not depend on the root's travel;
+- ``swing`` : the ankles' fore-aft separation's amplitude (sqrt(2) x its standard deviation, m):
+  how far the feet reach apart, ahead and behind, whatever the root does;
 - ``cadence`` = 2 x ``cycle_frequency`` (steps per second);
 - ``stride_length`` = ``mean_speed`` / ``cycle_frequency`` (metres per cycle);
 - ``leg_length(body, betas)``: the rest pelvis height above the lowest foot joint, the leg
@@ -60,6 +62,12 @@ def ankle_separation(joints) -> np.ndarray:
     fwd = facing_directions(j)[:, [0, 2]]
     fwd /= np.linalg.norm(fwd, axis=-1, keepdims=True).clip(1e-9)
     return ((j[:, 7, [0, 2]] - j[:, 8, [0, 2]]) * fwd).sum(-1)
+
+
+def swing(joints) -> float:
+    """Amplitude of the ankles' fore-aft separation (m): sqrt(2) x its standard deviation (the
+    amplitude of a sine), a step length's measure that does not look at the root."""
+    return float(np.sqrt(2.0) * ankle_separation(joints).std())
 
 
 def min_cycle_frames(fps: float = FPS) -> int:

@@ -9,7 +9,9 @@
     the decoder's contacts planted, IK onto the body, grounded on the soles). Per action: mean
     speeds, their ratio (total decoded distance / total original distance, i.e. frame-weighted;
     target ``TARGET`` = 0.95), the mean of the per-clip ratios, and the per-frame correlation of
-    the root's horizontal velocity (``gait.velocity_correlation``, frame-weighted mean over clips).
+    the root's horizontal velocity (``gait.velocity_correlation``, frame-weighted mean over clips),
+    and the legs' swing ratio (``gait.swing``, decoded / original: < 1 when the legs step short,
+    which no root fix can give back).
     ``feet=True`` adds the fallback of ``motion.root_from_feet`` (the root's travel re-derived
     from the decoded feet planted by the decoder's contacts): ``feet`` (decoded joints moved) and
     ``feet_final`` (those joints planted and IK'd, ``generation.decode.motion_from_joints``).
@@ -40,7 +42,7 @@ from ..generation.retarget import encode_windowed, load_vae
 from ..motion.features import joints_from_features
 from ..motion.root_from_feet import root_from_feet
 from ..train.motion_dataset import read_split
-from .gait import cadence, leg_length, mean_speed, min_cycle_frames, stride_length, velocity_correlation
+from .gait import cadence, leg_length, mean_speed, min_cycle_frames, stride_length, swing, velocity_correlation
 
 LOCOMOTION = ("walk", "jog", "run", "sprint")
 TARGET = 0.95          # decoded / original mean root speed (issue #24)
@@ -100,7 +102,8 @@ def _decoded_joints(codes, vae, betas) -> tuple[np.ndarray, np.ndarray]:
 
 def clip_speeds(vae, body, norm_feats, shape_feats, betas, feet: bool = False, ik_refine_iters: int = 10) -> dict:
     """One real clip through the codec on its own betas -> {"frames", "orig_mps", and for each of
-    "decoded", "final" (and with ``feet`` "feet", "feet_final"): "<kind>_mps", "<kind>_corr"}."""
+    "decoded", "final" (and with ``feet`` "feet", "feet_final"): "<kind>_mps", "<kind>_corr",
+    "<kind>_swing_m"} (``gait.swing``: how far the feet reach apart; "orig_swing_m" the clip's)."""
     codes = encode_clip(vae, norm_feats)
     joints, feats = _decoded_joints(codes, vae, betas)
     n = len(joints)
@@ -112,10 +115,11 @@ def clip_speeds(vae, body, norm_feats, shape_feats, betas, feet: bool = False, i
         motions["feet"] = moved
         motions["feet_final"] = motion_from_joints(body, betas, moved.astype(np.float32), contacts,
                                                    ik_refine_iters).joints
-    out = {"frames": n, "orig_mps": mean_speed(orig)}
+    out = {"frames": n, "orig_mps": mean_speed(orig), "orig_swing_m": swing(orig)}
     for kind, j in motions.items():
         out[f"{kind}_mps"] = mean_speed(j)
         out[f"{kind}_corr"] = velocity_correlation(j, orig)
+        out[f"{kind}_swing_m"] = swing(j)
     return out
 
 
@@ -123,8 +127,10 @@ def _summary(rows: list[dict], kinds) -> dict:
     """Per-clip rows -> frame-weighted speeds, their ratios, the mean per-clip ratio, correlations."""
     w = np.array([r["frames"] - 1 for r in rows], np.float64)
     mean = lambda key: float((w * np.array([r[key] for r in rows])).sum() / w.sum())  # noqa: E731
-    out = {"clips": len(rows), "frames": int(sum(r["frames"] for r in rows)), "orig_mps": mean("orig_mps")}
+    out = {"clips": len(rows), "frames": int(sum(r["frames"] for r in rows)), "orig_mps": mean("orig_mps"),
+           "orig_swing_m": mean("orig_swing_m")}
     for k in kinds:
+        out[f"{k}_swing_ratio"] = mean(f"{k}_swing_m") / out["orig_swing_m"]
         out[f"{k}_mps"] = mean(f"{k}_mps")
         out[f"{k}_ratio"] = out[f"{k}_mps"] / out["orig_mps"]
         out[f"{k}_ratio_clip_mean"] = float(np.mean([r[f"{k}_mps"] / r["orig_mps"] for r in rows]))

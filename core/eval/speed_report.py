@@ -41,10 +41,12 @@ def print_speed(result: dict) -> None:
     print(f"root speed, {result['split']} split: decoded / original (target >= {TARGET:.2f}x), "
           "velocity correlation per frame")
     head = f"{'action':<8}{'clips':>6}{'orig m/s':>10}" + "".join(f"{k + ' x':>14}{'corr':>7}" for k in kinds)
-    print(head)
+    print(head + f"{'leg swing x':>13}")
     for name, s in [*result["actions"].items(), ("all", result["all"])]:
         print(f"{name:<8}{s['clips']:>6}{s['orig_mps']:>10.2f}"
-              + "".join(f"{_f(s[k + '_ratio']):>14}{_f(s[k + '_corr'], '{:.2f}'):>7}" for k in kinds))
+              + "".join(f"{_f(s[k + '_ratio']):>14}{_f(s[k + '_corr'], '{:.2f}'):>7}" for k in kinds)
+              + f"{_f(s['decoded_swing_ratio']):>13}")
+    print("leg swing x: how far the decoded feet reach apart fore and aft / the clip's (< 1: the legs step short)")
     sh = result.get("shape")
     if sh:
         print(f"shape: {len(sh['clips'])} walks on a short and a tall body (leg {sh['leg_short_m']:.3f} -> "
