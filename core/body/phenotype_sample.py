@@ -4,7 +4,8 @@ plus the part of the betas the sliders do not explain (a residual scaled by ``1 
 
 Used by the dataset builder's shape augmentation and by the `[BETA]` head's pool of new bodies, so
 that the bodies the model learns from span men and women, young and old, lean and heavy, and each
-comes with the phenotype that describes it in words (``core.text.shape_words.phenotype_words``).
+comes with the phenotype that describes it in words (``core.data.phenotype_captions.phenotype_texts``;
+``core.text.shape_words`` reads such words back).
 """
 from __future__ import annotations
 

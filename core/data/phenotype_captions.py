@@ -50,18 +50,21 @@ def _age_words(age: float) -> list[str]:
 
 def _build_words(muscle: float, weight: float, height_cm: float | None, g: float) -> list[str]:
     out = []
+    lean_only = muscle >= 0.6  # a muscular body is "lean", never "skinny" or "scrawny"
     if muscle >= 0.75:
         out += ["muscular", "ripped", "very muscular", "brawny", "bodybuilder-like"]
     elif muscle >= 0.6:
         out += ["athletic", "fit", "toned", "sporty"]
     elif muscle <= 0.15:
-        out += ["untoned", "soft-bodied"]
+        out += ["untoned"]
     if weight >= 0.85:
         out += ["obese", "very heavy", "very overweight"]
     elif weight >= 0.68:
         out += ["overweight", "heavy-set", "chubby", "stocky", "plump", "heavy"]
-    elif weight <= 0.15:
+    elif weight <= 0.15 and not lean_only:
         out += ["skinny", "very thin", "scrawny"]
+    elif weight <= 0.15:
+        out += ["lean", "slim"]
     elif weight <= 0.32:
         out += ["slim", "thin", "slender", "lean"]
     if height_cm is not None:
@@ -108,7 +111,7 @@ def phenotype_texts(phenotype: dict, measures: dict | None, key: str, n: int = 4
     """``n`` descriptions of a body with ``phenotype`` (slider name -> value) and ``measures``
     (``body.measure`` names: height_cm, and mass_kg when available)."""
     rng = random.Random(f"phenotype/{key}")
-    g, age = float(phenotype.get("gender", 0.5)), float(phenotype.get("age", 40.0))
+    g, age = float(phenotype.get("gender", 0.5)), float(int(phenotype.get("age", 40.0)))  # whole years, as people say
     muscle, weight = float(phenotype.get("muscle", 0.4)), float(phenotype.get("weight", 0.5))
     measures = measures or {}
     h = measures.get("height_cm")

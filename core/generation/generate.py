@@ -62,6 +62,32 @@ def parse_betas(text: str) -> np.ndarray:
 
 
 
+def body_from_prompt(body, prompt: str) -> tuple[np.ndarray, str]:
+    """(betas, source) when a request has no shape text: the person words of the motion prompt
+    ("a man throws a jab", "an old woman sits down": gender, age and build words, never its numbers,
+    which describe the motion) set the body; a prompt without them gets the average adult body
+    (betas 0, the same for every seed)."""
+    from ..body.shape_from_measurements import betas_for_shape_words
+    from ..text.shape_words import ShapeWords, parse_shape_words
+
+    import re
+
+    words_only = re.sub(r"\d+(?:[.,]\d+)?(?:\s*(?:[a-z]+\.?|'|\"))?", " ", str(prompt).lower())  # "10 m", "5 seconds"
+    try:
+        said = parse_shape_words(words_only)
+    except ShapeMoveError:  # a prompt is no shape text: what does not read as one is ignored
+        return np.zeros(body.num_betas, np.float32), "average adult"
+    words = ShapeWords(text=prompt, gender=said.gender, age=said.age, age_implied=said.age_implied,
+                       muscle=said.muscle, weight=said.weight,
+                       build_words=list(said.build_words), size_words=list(said.size_words), words=[w for w in said.words if not any(c.isdigit() for c in w)])
+    if not (words.phenotype() or words.size_words or words.build_words):
+        return np.zeros(body.num_betas, np.float32), "average adult"
+    try:
+        return np.asarray(betas_for_shape_words(body, words), np.float32), "prompt words"
+    except ShapeMoveError:
+        return np.zeros(body.num_betas, np.float32), "average adult"
+
+
 class Generator:
     def __init__(self, model_dir=None, body=None, ik_refine_iters: int = 10):
         self.model_dir = resolve_model_dir(model_dir)
@@ -238,6 +264,8 @@ class Generator:
             betas = betas_for_shape_text(self.body, r.shape_text)  # None: free text, the model's reading of it
             if betas is not None:  # shape words (phenotype sliders) and stated numbers met on the mesh
                 return np.asarray(betas, np.float32), "measurements"
+        if not (r.shape_text and r.shape_text.strip()) and r.shape_from == "auto":
+            return body_from_prompt(self.body, r.prompt)
         return np.asarray(predicted, np.float32), "[BETA] head"
 
     def redecode(self, motion: Motion, betas) -> Motion:
