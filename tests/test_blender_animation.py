@@ -126,3 +126,24 @@ def test_curve_object_to_path():
     np.testing.assert_allclose(path[0], [1.0, 0.0], atol=1e-6)
     np.testing.assert_allclose(path[-1], [0.5, -3.0], atol=1e-6)
     assert len(path) == 4
+
+
+def test_regenerated_timeline_keeps_the_other_strips_timing(openbody):
+    """What Regenerate Strip does with the new rig: the other strips get the timing the user gave them."""
+    from shapemove.shapemove_addon.animation_rig import build_animated_rig
+    from shapemove.shapemove_addon.animation_ui import retime_strips, strip_timing
+
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    m = _loop(openbody)
+    m.loop_advance = None
+    m.segment_bounds, m.segment_prompts = np.array([[0, 5], [5, 10], [10, 16]]), ["a", "b", "c"]
+    old = build_animated_rig(bpy.context, m, openbody, name="Old")
+    strips = old.armature.animation_data.nla_tracks[0].strips
+    strips[2].frame_start_ui = 40.0          # moved by the user
+    strips[0].scale = 2.0                    # and slowed down
+    timing = {i: t for i, t in enumerate(strip_timing(old.armature)) if i != 1}
+    new = build_animated_rig(bpy.context, m, openbody, name="New")
+    retime_strips(new.armature, timing)
+    got = strip_timing(new.armature)
+    assert got[0] == timing[0] and got[2] == timing[2]
+    assert got[0][2] == 2.0 and got[2][0] >= 40.0 and got[1] == (6.0, 11.0, 1.0)   # not the fresh 11.0
