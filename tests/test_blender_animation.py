@@ -146,4 +146,5 @@ def test_regenerated_timeline_keeps_the_other_strips_timing(openbody):
     retime_strips(new.armature, timing)
     got = strip_timing(new.armature)
     assert got[0] == timing[0] and got[2] == timing[2]
-    assert got[0][2] == 2.0 and got[2][0] >= 40.0 and got[1] == (6.0, 11.0, 1.0)   # not the fresh 11.0
+    assert got[0][2] == 2.0 and got[2][0] >= 40.0                       # not the fresh 1.0 / 11.0
+    assert got[1][2] == 1.0 and got[1][0] == got[0][1]                   # the new strip follows the slowed first
