@@ -32,6 +32,12 @@ LOOP_KEY = "shapemove_loop_frames"
 SEGMENTS_KEY = "shapemove_segments"
 TRACK_NAME = "ShapeMove timeline"
 PREVIEW_CYCLES = 2   # a loop's scene range shows this many cycles
+ROOT_MOTION_ITEMS = (
+    ("PELVIS", "Pelvis", "The pelvis bone carries the travel (as generated)"),
+    ("OBJECT", "Object", "The armature object carries the horizontal travel; the pelvis stays over the start"),
+    ("ROOT_BONE", "Root Bone", "A 'root' bone at the origin, the pelvis's parent, carries the horizontal travel"),
+    ("NONE", "In Place", "No horizontal travel (facing and height kept)"),
+)
 
 
 def _curve_adder(action, obj):
