@@ -1,17 +1,18 @@
 """The root's horizontal travel derived from what the legs do: planted feet do not move.
 
-A decoded motion's legs can step further than its root travels (issue #24: the SA-VAE shrinks
-root travel to 0.80-0.88x while the strides stay full size, so planted feet skate backward). This
-module re-derives the root's horizontal path from the feet alone:
+Issue #24's fallback: if a decoded motion's legs stepped further than its root travels (planted
+feet skating backward), the feet would give the travel back. This module re-derives the root's
+horizontal path from the feet alone (measured in docs/codec.md: on the shipped SA-VAE the decoded
+feet agree with the decoded root, so it gives the same short travel; the codec must carry it):
 
 - between frames t and t+1, every contact joint (heels = ankles 7, 8, toes = ball joints 10, 11,
   ``motion.contacts.CONTACT_IDS``) in contact at both frames is taken to stay fixed in the world,
   so the root moves by minus the change of that joint's horizontal offset from the root
   (``foot - root``, in world axes: the body's own turning is kept); several planted joints are
   averaged, the joints lowest above the floor weighted most (``planted_steps``);
-- steps with no planted joint (a run's flight, a missed contact) take a velocity interpolated
-  linearly between the nearest planted steps on either side (horizontal velocity is constant in
-  flight), held at the clip's ends;
+- steps with no planted joint (a run's flight, a missed contact) keep the motion's own root step
+  (``flight="keep"``, the default: on real runs the travel then comes out 1.00x, against 0.97x)
+  or take a velocity interpolated between the nearest planted steps (``flight="interpolate"``);
 - the root's height and every joint's offset from the root are unchanged: the whole frame moves
   horizontally, so the pose, the turning and the vertical motion are the decoder's.
 
@@ -80,22 +81,31 @@ def fill_steps(step: np.ndarray, known: np.ndarray) -> np.ndarray:
     return np.stack([np.interp(t, t[known], step[known, d]) for d in range(2)], axis=-1)
 
 
-def feet_root_path(joints, contacts, height_scale: float = HEIGHT_SCALE) -> np.ndarray:
+FLIGHT = ("keep", "interpolate")
+
+
+def feet_root_path(joints, contacts, height_scale: float = HEIGHT_SCALE, flight: str = "keep") -> np.ndarray:
     """(T,22,3) joints, (T,4) contacts -> (T,2) the root's horizontal path (x, z) from the planted
-    feet, starting at the clip's own first root position."""
+    feet, starting at the clip's own first root position. ``flight``: what the steps without a
+    planted joint do, "keep" the joints' own root step or "interpolate" (``fill_steps``)."""
+    if flight not in FLIGHT:
+        raise ShapeMoveError(f"flight must be one of {', '.join(FLIGHT)}, got {flight!r}")
     j, _ = _check(joints, contacts)
     step, known = planted_steps(j, contacts, height_scale)
     steps = fill_steps(step, known)
+    if flight == "keep":
+        steps[~known] = np.diff(j[:, 0, [0, 2]], axis=0)[~known]
     return j[0, 0, [0, 2]] + np.concatenate([np.zeros((1, 2)), np.cumsum(steps, axis=0)])
 
 
-def root_from_feet(joints, contacts, height_scale: float = HEIGHT_SCALE) -> np.ndarray:
+def root_from_feet(joints, contacts, height_scale: float = HEIGHT_SCALE, flight: str = "keep") -> np.ndarray:
     """(T,22,3) joints (metres, Y up, e.g. ``joints_from_features`` of decoded features) and (T,4)
     contacts of joints 7, 8, 10, 11 (the decoder's channels, ``body.plant.contacts_from_features``,
     or ``motion.contacts.detect_contacts``) -> (T,22,3) float64 joints, each frame moved
-    horizontally so the root follows ``feet_root_path``: planted feet stay where they are."""
+    horizontally so the root follows ``feet_root_path`` (``flight``: see there): planted feet stay
+    where they are."""
     j, _ = _check(joints, contacts)
-    path = feet_root_path(j, contacts, height_scale)
+    path = feet_root_path(j, contacts, height_scale, flight)
     out = j.copy()
     out[..., [0, 2]] += (path - j[:, 0, [0, 2]])[:, None]
     return out
