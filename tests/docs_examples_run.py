@@ -5,8 +5,8 @@ the whole page runs in about a minute.
     python tests/docs_examples_run.py PLAN.json RESULT.json
 
 PLAN: {"cwd": folder, "examples": [{"line": text, "argv": [...]}, ...]}. The folder gets what the
-examples read that no earlier example writes (links to weights/ and configs/, prompts.txt, a BVH
-clip, a .blend with a Mixamo-named armature "Hero", a two-prompt paraphrase file). RESULT: one
+examples read that no earlier example writes (links to weights/ and configs/, prompts.txt, a path
+s_curve.json, a BVH clip, a .blend with a Mixamo-named armature "Hero", a two-prompt paraphrase file). RESULT: one
 {"line", "rc", "seconds", "error"} per example, written after each one (a crash leaves the ones so far).
 """
 from __future__ import annotations
@@ -70,6 +70,7 @@ def prepare(cwd: Path) -> None:
         if not (cwd / name).exists():
             (cwd / name).symlink_to(ROOT / name, target_is_directory=True)
     (cwd / "prompts.txt").write_text("a person walks forward\n")
+    (cwd / "s_curve.json").write_text(json.dumps([[0, 0], [0.5, 1], [0, 2], [-0.5, 3], [0, 4]]))
     (cwd / "tiny_prompts.json").write_text(json.dumps({"prompts": [
         {"text": "a person walks forward", "action": "walk"}, {"text": "someone kicks", "action": "kick"}]}))
     walk_bvh(cwd / "walk.bvh")

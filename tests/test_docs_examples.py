@@ -43,10 +43,15 @@ FAST = [
 ]
 
 
+def joined_lines(text: str) -> list[str]:
+    """The text's lines, stripped, a line ending in a backslash joined with the next (as a shell does)."""
+    return [ln.strip() for ln in re.sub(r"\\\n\s*", "", text).splitlines()]
+
+
 def page_examples(path: Path = PAGE) -> list[str]:
-    """The `python -m shapemove ...` lines of the page's ```sh blocks, in order."""
+    """The `python -m shapemove ...` commands of the page's ```sh blocks, in order."""
     blocks = re.findall(r"```sh\n(.*?)```", path.read_text(encoding="utf-8"), re.S)
-    return [ln.strip() for b in blocks for ln in b.splitlines() if ln.strip().startswith(PREFIX)]
+    return [ln for b in blocks for ln in joined_lines(b) if ln.startswith(PREFIX)]
 
 
 def argv_of(line: str, mocap) -> list[str]:
@@ -66,12 +71,13 @@ def test_every_command_has_an_example_on_the_page():
 
 
 def test_examples_elsewhere_are_the_pages():
-    """The README's and the other pages' examples are copies of the tested ones."""
+    """The README's and the other pages' examples are copies of the tested ones (a synopsis with
+    `[--option]` or a trailing `...` is not an example)."""
     tested = set(page_examples())
     for md in [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]:
-        for ln in md.read_text(encoding="utf-8").splitlines():
-            ln = ln.strip().lstrip("$ ").strip()
-            if ln.startswith(PREFIX) and not ln.endswith("..."):
+        for ln in joined_lines(md.read_text(encoding="utf-8")):
+            ln = ln.lstrip("$ ").strip()
+            if ln.startswith(PREFIX) and not ln.endswith("...") and " [--" not in ln:  # not a synopsis
                 cmd = ln.split("  #")[0].strip()
                 assert cmd in tested, f"{md.name}: {cmd!r} is not an example of docs/command-line.md"
 
