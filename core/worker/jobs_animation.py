@@ -8,6 +8,8 @@
 """
 from __future__ import annotations
 
+from contextlib import contextmanager
+
 from ..errors import ShapeMoveError
 from ..scene.motion_file import load_motion, save_motion
 from .jobs_shapemove import _betas, _generator, _measurements, _motion_facts, _out_path
@@ -23,6 +25,24 @@ def _facts(out, motion, body) -> dict:
         facts["segments"] = [{"prompt": p, "start": int(s), "end": int(e)}
                              for p, (s, e) in zip(motion.segment_prompts, motion.segment_bounds)]
     return facts
+
+
+@contextmanager
+def _cancellable(cancel):
+    """A ShapeMoveError that the job's own cancel() caused ends the job as cancelled, not as an error."""
+    try:
+        yield
+    except ShapeMoveError as exc:
+        if cancel() and "cancelled" in str(exc):
+            raise JobCancelled from None
+        raise
+
+
+def _saved(out, motion, body, progress) -> dict:
+    """Write the motion file, report the job done, and return its facts."""
+    save_motion(out, motion)
+    progress(1.0, "done")
+    return _facts(out, motion, body)
 
 
 def animate(params, progress, cancel) -> dict:
@@ -41,15 +61,9 @@ def animate(params, progress, cancel) -> dict:
     gen = _generator(param(params, op, "model", str, None), param(params, op, "body", str, None))
     if cancel():
         raise JobCancelled
-    try:
+    with _cancellable(cancel):
         motion = _animate(gen, req, options, progress=lambda f, m: progress(0.1 + 0.8 * f, m), cancel=cancel)
-    except ShapeMoveError as exc:
-        if cancel() and "cancelled" in str(exc):
-            raise JobCancelled from None
-        raise
-    save_motion(out, motion)
-    progress(1.0, "done")
-    return _facts(out, motion, gen.body)
+    return _saved(out, motion, gen.body, progress)
 
 
 def sequence(params, progress, cancel) -> dict:
@@ -69,17 +83,11 @@ def sequence(params, progress, cancel) -> dict:
         segs = param(params, op, "segments", list)
         if not all(isinstance(s, dict) and "prompt" in s and "seconds" in s for s in segs):
             raise ShapeMoveError("op 'sequence': 'segments' must be a list of {\"prompt\", \"seconds\"} objects")
-        try:
+        with _cancellable(cancel):
             motion = generate_sequence(gen, [(s["prompt"], s["seconds"]) for s in segs],
                                        param(params, op, "shape_text", str, None) or None, _betas(params, op), seed,
                                        progress=lambda f, m: progress(0.1 + 0.85 * f, m), cancel=cancel)
-        except ShapeMoveError as exc:
-            if cancel() and "cancelled" in str(exc):
-                raise JobCancelled from None
-            raise
-    save_motion(out, motion)
-    progress(1.0, "done")
-    return _facts(out, motion, gen.body)
+    return _saved(out, motion, gen.body, progress)
 
 
 OPS = {"animate": animate, "sequence": sequence}
