@@ -4,7 +4,10 @@ The model makes the loop where it can: ``generate_loop`` samples several token s
 prompt (``token_sampling``), and in each decoded joint track ``best_cut`` looks for two frames a < b,
 at least ``MIN_PERIOD`` s apart, where the body's pose relative to its root and heading, and the
 joints' velocities in that frame, are most alike. The candidate and cut with the smallest seam
-win; frames a..b-1 are the cycle. ``make_cycle`` then removes what is left:
+win; frames a..b-1 are the cycle (the best ``PLANTED_TRIES`` cuts are planted in order until
+one's planted seam, ``seam_report``, is within ``GOOD_SEAM``, else the best of them is kept:
+planting moves joints the decoder barely moves, legs under a wave, by more than their own steps).
+``make_cycle`` then removes what is left:
 - the heading turns by the small angle between a and b, spread over the cycle, so every cycle
   travels the same way (a straight walk stays straight; Blender's Cycles modifier repeats it with
   an offset, never a rotation);
@@ -33,6 +36,8 @@ BLEND = 6              # frames over which the seam's last offset is blended in
 VELOCITY_WEIGHT = 4.0  # a velocity mismatch of 1 cm/frame costs as much as 4 cm of pose
 SEAM_SPEED = 1.0       # x its mean step: a joint faster than this at the seam frame is penalised
 FAST_WEIGHT = 0.2      # m of cost per unit of speed ratio above SEAM_SPEED
+PLANTED_TRIES = 3      # the best cuts planted until one's seam is good (``seam_report``)
+GOOD_SEAM = 1.5        # worst joint's wrap jump over its mean step that ends the search (the target)
 EDGE = 2               # frames at each end of a decoded clip that a cut avoids
 LOOP_MIN_SECONDS = 4.0  # candidates are at least this long, so a cycle has room
 
@@ -174,23 +179,33 @@ def generate_loop(gen, req, progress=None, cancel=None) -> Motion:
     cands, pred = sample_codes(gen, req.prompt, req.shape_text, n, lo, hi, req.seed, req.temperature, req.top_k,
                                req.guidance)
     betas, source = body_for(gen, req.prompt, req.shape_text, req.betas, pred)
-    best = None
+    found = []
     for codes in cands:
         if cancel is not None and cancel():
             raise ShapeMoveError("cancelled")
         track, _ = decoded_track(codes, gen.vae, betas)
         try:
-            cut = best_cut(track.joints, FPS, period)
+            found.append((track, best_cut(track.joints, FPS, period)))
         except ShapeMoveError:
             continue
-        if best is None or cut.cost < best[1].cost:
-            best = (track, cut)
-    if best is None:
+    if not found:
         raise ShapeMoveError(f"none of the {len(cands)} samples of {req.prompt!r} holds a loop; try --seconds or another seed")
-    if progress is not None:
-        progress(0.5, "planting the cycle")
-    cycle, adv = make_cycle(*best)
-    m = plant_loop(gen.body, betas, cycle, adv, gen.ik_refine_iters, prompt=req.prompt)
+    found.sort(key=lambda f: f[1].cost)
+    m, best = None, None
+    for i, (track, cut) in enumerate(found[:PLANTED_TRIES]):
+        # the seam is judged again once planted: the IK and grounding move joints that the
+        # decoder barely moves (legs under a wave) by more than their own steps
+        if cancel is not None and cancel():
+            raise ShapeMoveError("cancelled")
+        if progress is not None:
+            progress(0.5 + 0.4 * i / PLANTED_TRIES, "planting the cycle")
+        cycle, adv = make_cycle(track, cut)
+        planted = plant_loop(gen.body, betas, cycle, adv, gen.ik_refine_iters, prompt=req.prompt)
+        ratio = seam_report(planted)["jump_ratio"]
+        if m is None or ratio < best[0]:
+            m, best = planted, (ratio, cut)
+        if ratio <= GOOD_SEAM:
+            break
     m.shape_source = source
     m.warnings = [check.warning] if check is not None and check.warning else []
     m.prompt_check = check
