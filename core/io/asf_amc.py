@@ -24,7 +24,7 @@ from ..errors import ShapeMoveError
 from ..geometry.fk import forward_kinematics, joints_from_offsets
 from ..geometry.rotations import euler_matrix
 from .limits import (MAX_AMC_BYTES, MAX_FRAME_TIME, MAX_HIERARCHY_BYTES, MAX_JOINT_FRAMES, MIN_FRAME_TIME,
-                     check_file_size, check_joint_frames, is_number, read_text)
+                     check_joint_frames, is_number, open_bounded, read_text)
 from .mocap_clip import Mocap, finish_mocap
 from .rig_map import find_rig
 
@@ -375,12 +375,7 @@ def _read_text(path: Path, what: str) -> str:
 
 def _file_lines(path: Path):
     """The decoded lines of an AMC file, one at a time (at most ``MAX_AMC_BYTES``; binary refused)."""
-    check_file_size(path, MAX_AMC_BYTES, "AMC", "split the clip")
-    try:
-        fh = open(path, "rb")
-    except OSError as exc:
-        raise ShapeMoveError(f"cannot read AMC {path}: {exc.strerror or exc}") from None
-    with fh:
+    with open_bounded(path, MAX_AMC_BYTES, "AMC", "split the clip") as fh:
         if b"\0" in fh.read(4096):
             raise ShapeMoveError(f"{path}: binary data, not an AMC text file")
         fh.seek(0)

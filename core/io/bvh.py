@@ -14,8 +14,8 @@ import numpy as np
 from ..errors import ShapeMoveError
 from ..geometry.fk import forward_kinematics, joints_from_offsets
 from ..geometry.rotations import axis_rotation
-from .limits import (MAX_BVH_BYTES, MAX_FRAME_TIME, MAX_HIERARCHY_BYTES, MAX_SECONDS, MIN_FRAME_TIME, check_file_size,
-                     check_joint_frames, is_number)
+from .limits import (MAX_BVH_BYTES, MAX_FRAME_TIME, MAX_HIERARCHY_BYTES, MAX_SECONDS, MIN_FRAME_TIME,
+                     check_joint_frames, is_number, open_bounded)
 from .mocap_clip import Mocap, finish_mocap
 from .units_axes import UNITS
 
@@ -280,12 +280,7 @@ def read_bvh(path, frame_time: float | None = None):
     is read whole, the data rows one line at a time, so the file's size (at most ``MAX_BVH_BYTES``)
     never sits in memory, only the (T,C) values."""
     path = Path(path)
-    check_file_size(path, MAX_BVH_BYTES, "BVH", "split the clip")
-    try:
-        fh = open(path, "rb")
-    except OSError as exc:
-        raise ShapeMoveError(f"cannot read BVH {path}: {exc.strerror or exc}") from None
-    with fh:
+    with open_bounded(path, MAX_BVH_BYTES, "BVH", "split the clip") as fh:
         start = fh.read(4096)
         if b"\0" in start:
             raise ShapeMoveError(f"{path}: binary data, not an BVH text file")

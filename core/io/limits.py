@@ -52,6 +52,17 @@ def check_file_size(path, max_bytes: int, what: str, advice: str = "") -> int:
     return size
 
 
+def open_bounded(path, max_bytes: int, what: str, advice: str = ""):
+    """The user's file ``path`` opened for binary reading, its size checked first (``check_file_size``);
+    a file that cannot be opened is 'cannot read WHAT PATH: ...'. For readers that stream the file."""
+    path = Path(path)
+    check_file_size(path, max_bytes, what, advice)
+    try:
+        return open(path, "rb")
+    except OSError as exc:
+        raise ShapeMoveError(f"cannot read {what} {path}: {exc.strerror or exc}") from None
+
+
 def read_bounded(path, max_bytes: int, what: str, advice: str = "") -> bytes:
     """The bytes of the user's file ``path``, at most ``max_bytes``: the size is checked before
     reading (``check_file_size``) and at most ``max_bytes + 1`` bytes are read, so a file whose
