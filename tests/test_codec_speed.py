@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from shapemove.core.errors import ShapeMoveError
-from shapemove.core.eval.gait import cadence, leg_length, mean_speed, stride_length, velocity_correlation
+from shapemove.core.eval.gait import cadence, leg_length, mean_speed, stride_length, swing, velocity_correlation
 from shapemove.core.motion.contacts import detect_contacts, runs
 from shapemove.core.motion.features import joints_from_features
 from shapemove.core.motion.root_from_feet import feet_root_path, root_from_feet
@@ -42,6 +42,21 @@ def test_feet_reproduce_a_real_walks_travel(walk):
     assert 0.97 < _travel(derived) / real < 1.03                             # within a few %
     # the end point too: the path goes where the walk went, not just as far
     assert np.linalg.norm(derived[-1] - j[-1, 0, [0, 2]]) < 0.05 * real
+
+
+def test_feet_reproduce_a_real_runs_travel(tiny_dataset):
+    """A run has flights (no foot down): by default they keep the run's own root step; interpolated
+    between the plants instead, the travel comes out short (the stance's braking is averaged in)."""
+    j = joints_from_features(np.load(tiny_dataset / "new_joint_vecs" / "dataset-1_run_happy_001.npy").astype(np.float64))
+    c = detect_contacts(j)
+    assert (c.sum(1) == 0).mean() > 0.2                                      # airborne a fifth of the time
+    real = _travel(j[:, 0, [0, 2]])
+    keep = _travel(feet_root_path(j, c)) / real
+    interpolated = _travel(feet_root_path(j, c, flight="interpolate")) / real
+    assert 0.97 < keep < 1.03
+    assert interpolated < keep - 0.03
+    with pytest.raises(ShapeMoveError, match="flight"):
+        feet_root_path(j, c, flight="glide")
 
 
 def test_feet_restore_a_shrunk_root(walk):
@@ -86,6 +101,10 @@ def test_gait_measures_on_a_real_walk(walk):
     assert cadence(j) == pytest.approx(counted, rel=0.15)
     assert 1.4 < cadence(j) < 2.4                                            # steps per second
     assert stride_length(j) == pytest.approx(speed / (cadence(j) / 2))
+    assert 0.3 < swing(j) < 0.9                                              # feet ~0.5 m apart at full reach
+    half = j.copy()
+    half[:, [7, 8], 2] = 0.5 * (j[:, [7, 8], 2] - j[:, :1, 2]) + j[:, :1, 2]  # ankles half as far from the root
+    assert swing(half) == pytest.approx(0.5 * swing(j), rel=0.15)           # (the walk is along z)
     assert velocity_correlation(j, j) == pytest.approx(1.0)
     assert velocity_correlation(j, 0.5 * j) == pytest.approx(1.0)            # a scaled copy: same surges
     shifted = np.roll(j, 5, axis=0)                                          # a quarter step late: disagrees
@@ -110,6 +129,7 @@ def test_decoded_walk_speed_is_measured_on_both_roots(walk, codec, openbody):
     for kind in ("decoded", "final", "feet", "feet_final"):
         assert 0.5 < r[f"{kind}_mps"] / r["orig_mps"] < 1.2
         assert -1 <= r[f"{kind}_corr"] <= 1
+        assert 0.5 < r[f"{kind}_swing_m"] / r["orig_swing_m"] < 1.2
     # planting and IK move the feet, not the travel: the final root keeps the decoded speed
     assert r["final_mps"] == pytest.approx(r["decoded_mps"], rel=0.03)
 
