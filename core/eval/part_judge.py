@@ -8,8 +8,8 @@ No learned model: hand-made descriptors of the joints (``joints_from_features`` 
 HumanML3D features, 20 fps) and the nearest real clips, so the generator's TMA, which picks among
 its samples (``generation/rerank.py``), cannot flatter it (as ``action_classifier.FeatureEmbedder``).
 
-- **legs** (``LEGS``, legs and root only): root velocity in the body's own frame (forward,
-  sideways, up and down), turning rate, pelvis height, the hips, knees, ankles and feet relative to
+- **legs** (legs and root only): root velocity in the body's own frame (forward, sideways, up
+  and down) and its direction, turning rate, pelvis height, the hips, knees, ankles and feet relative to
   the pelvis in the body's frame (mean and spread over time), foot speeds, the share of frames with
   both feet off the floor and the stride frequency; every length in leg lengths, so bodies of any
   size compare. Classes: the gaits of ``compose_parts.LEGS_ACTIONS`` ("walk in a circle" is a
@@ -66,7 +66,7 @@ ARM_JOINTS = [13, 14, 16, 17, 18, 19, 20, 21]
 CHEST = 9
 SIDE_JOINTS = {"hand": ([18, 20], [19, 21]), "foot": ([7, 10], [8, 11])}   # (left, right)
 FEATURES = "new_joint_vecs"
-LEGS_WEIGHTS = {"root": 2.0}  # where the pelvis goes (forward, back, sideways, how fast) counts double
+LEGS_WEIGHTS = {"root": 2.0}  # how fast and which way the pelvis goes counts double
 
 
 # -- the body's own frame -----------------------------------------------------------------------
@@ -151,6 +151,7 @@ def legs_descriptor(joints) -> dict[str, np.ndarray]:
     stride, stride_share = dominant_frequency(legs[:, 4, 2] - legs[:, 5, 2])
     return {
         "root": np.array([step[:, 2].mean(), step[:, 0].mean(), hspeed.mean(), hspeed.std(), step[:, 1].std()]),
+        "direction": np.array([step[:, 2].mean(), step[:, 0].mean()]) / (np.hypot(step[:, 2].mean(), step[:, 0].mean()) + 0.3),
         "turn": np.array([abs(omega.mean()), np.abs(omega).mean()]),
         "height": np.array([local[:, 0, 1].mean(), local[:, 0, 1].std()]),
         "pose": legs.mean(0).ravel(),
