@@ -20,24 +20,23 @@ MIN_SPEED, MAX_SPEED = 0.5, 2.0
 MIN_SECONDS, MAX_SECONDS = 0.4, 120.0
 
 
-def check_speed(speed) -> float:
+def _number_in(value, what: str, lo: float, hi: float, kind: str = "a number", unit: str = "") -> float:
+    """``value`` as a float within [lo, hi]; otherwise a ShapeMoveError naming ``what``."""
     try:
-        s = float(speed)
+        s = float(value)
     except (TypeError, ValueError):
-        raise ShapeMoveError(f"--speed must be a number, got {speed!r}") from None
-    if not MIN_SPEED <= s <= MAX_SPEED:
-        raise ShapeMoveError(f"--speed must be between {MIN_SPEED} and {MAX_SPEED}, got {speed}")
+        raise ShapeMoveError(f"{what} must be {kind}, got {value!r}") from None
+    if not lo <= s <= hi:
+        raise ShapeMoveError(f"{what} must be between {lo} and {hi}{unit}, got {value}")
     return s
+
+
+def check_speed(speed) -> float:
+    return _number_in(speed, "--speed", MIN_SPEED, MAX_SPEED)
 
 
 def check_seconds(seconds, what: str = "--stretch") -> float:
-    try:
-        s = float(seconds)
-    except (TypeError, ValueError):
-        raise ShapeMoveError(f"{what} must be a number of seconds, got {seconds!r}") from None
-    if not MIN_SECONDS <= s <= MAX_SECONDS:
-        raise ShapeMoveError(f"{what} must be between {MIN_SECONDS} and {MAX_SECONDS} s, got {seconds}")
-    return s
+    return _number_in(seconds, what, MIN_SECONDS, MAX_SECONDS, "a number of seconds", " s")
 
 
 def warped_length(num_frames: int, speed: float | None = None, seconds: float | None = None,
