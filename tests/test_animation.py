@@ -57,6 +57,16 @@ def test_loop_seam_and_advance(gen):
     assert _slide(m) <= 0.5
 
 
+def test_loop_of_a_motion_in_place(gen):
+    """A wave's legs barely move: the seam is judged again once planted (the first cut's planted
+    seam jumps 2x their mean step; a later cut's does not)."""
+    from shapemove.core.generation.generate import Request
+    from shapemove.core.generation.loop import generate_loop, seam_report
+
+    r = seam_report(generate_loop(gen, Request("a person waves", seed=0)))
+    assert r["jump_ratio"] <= 1.5 and r["advance_m"] < 0.05, r
+
+
 def test_in_place_no_drift_feet_alternate(walk):
     from shapemove.core.generation.in_place import in_place, root_drift
 
