@@ -80,23 +80,13 @@ def _build_words(muscle: float, weight: float, height_cm: float | None, g: float
 
 
 def _height(cm: float, rng: random.Random) -> str:
-    kind = rng.randrange(4)
-    if kind == 0:
-        return f"{cm:.0f} cm"
-    if kind == 1:
-        return f"{cm / 100:.2f} m"
     inches = round(cm / 2.54)
     ft, inch = divmod(inches, 12)
-    return f"{ft} ft {inch}" if kind == 2 else f"{ft}'{inch}\""
+    return rng.choice([f"{cm:.0f} cm", f"{cm / 100:.2f} m", f"{ft} ft {inch}", f"{ft}'{inch}\""])
 
 
 def _mass(kg: float, rng: random.Random) -> str:
-    kind = rng.randrange(3)
-    if kind == 0:
-        return f"{kg:.0f} kg"
-    if kind == 1:
-        return f"{kg * 2.20462:.0f} lb"
-    return f"{kg:.0f} kilos"
+    return rng.choice([f"{kg:.0f} kg", f"{kg * 2.20462:.0f} lb", f"{kg:.0f} kilos"])
 
 
 def _has_age(noun: str) -> bool:
