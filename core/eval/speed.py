@@ -223,9 +223,9 @@ def speed_check(data, checkpoint, split: str = "test", model_dir=None, feet: boo
         raise ShapeMoveError("--max-clips must be at least 1")
     if shape_clips < 0:
         raise ShapeMoveError("--shape-clips must be 0 or more")
+    by_action = locomotion_clips(root, split)   # a wrong folder or split is refused before any model loads
     body = body if body is not None and not isinstance(body, str) else load_body_model(body)
     vae = load_vae(checkpoint, body)
-    by_action = locomotion_clips(root, split)
     rng = np.random.default_rng(0)
     for a, ids in by_action.items():
         if max_clips and len(ids) > max_clips:
