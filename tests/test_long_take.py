@@ -24,7 +24,9 @@ try:
     runpy.run_module("shapemove", run_name="__main__")
 except SystemExit as exc:
     code = exc.code or 0
-print("PEAK_KB", resource.getrusage(resource.RUSAGE_SELF).ru_maxrss, file=sys.stderr)
+# VmHWM: this program's own peak (ru_maxrss would carry the forking pytest process's size over exec)
+hwm = [ln.split()[1] for ln in open("/proc/self/status") if ln.startswith("VmHWM:")]
+print("PEAK_KB", hwm[0] if hwm else resource.getrusage(resource.RUSAGE_SELF).ru_maxrss, file=sys.stderr)
 sys.exit(code)
 """
 

@@ -50,7 +50,7 @@ def test_far_prompt_warns_and_names_the_closest_actions(gen, tiny_bundle):  # no
 def test_unreadable_text_and_impossible_numbers_are_refused(gen):
     with pytest.raises(ShapeMoveError, match="mostly characters the text encoder does not know"):
         gen.generate("\u0e1c\u0e39\u0e49\u0e0a\u0e32\u0e22\u0e40\u0e14\u0e34\u0e19 \u26bd", seconds=1.0)  # Thai + emoji
-    for shape, match in (("5000 cm tall", "outside the plausible range"), ("waist 0 cm", "outside"),
+    for shape, match in (("5000 cm tall", "no person is 5000 cm tall"), ("waist 0 cm", "outside"),
                          ("-170 cm tall", "negative")):
         with pytest.raises(ShapeMoveError, match=match):
             gen.generate("a person walks", shape_text=shape, seconds=1.0)
