@@ -34,7 +34,9 @@ try:
 except SystemExit as exc:
     code = exc.code or 0
 u = resource.getrusage(resource.RUSAGE_SELF)
-print("PEAK_KB", u.ru_maxrss, "CPU_S", u.ru_utime + u.ru_stime, file=sys.stderr)
+# VmHWM: this program's own peak (ru_maxrss would carry a large parent's size over fork + exec)
+hwm = [ln.split()[1] for ln in open("/proc/self/status") if ln.startswith("VmHWM:")]
+print("PEAK_KB", hwm[0] if hwm else u.ru_maxrss, "CPU_S", u.ru_utime + u.ru_stime, file=sys.stderr)
 sys.exit(code)
 """
 

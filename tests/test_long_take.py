@@ -16,19 +16,7 @@ from shapemove.bench.long_take_input import walk_path, write_long_take
 
 pytestmark = pytest.mark.usefixtures("one_thread")
 
-RUN_WITH_PEAK = """
-import resource, runpy, sys
-sys.argv = ["shapemove"] + sys.argv[1:]
-code = 0
-try:
-    runpy.run_module("shapemove", run_name="__main__")
-except SystemExit as exc:
-    code = exc.code or 0
-# VmHWM: this program's own peak (ru_maxrss would carry the forking pytest process's size over exec)
-hwm = [ln.split()[1] for ln in open("/proc/self/status") if ln.startswith("VmHWM:")]
-print("PEAK_KB", hwm[0] if hwm else resource.getrusage(resource.RUSAGE_SELF).ru_maxrss, file=sys.stderr)
-sys.exit(code)
-"""
+from shapemove.bench.long_take import PEAK_WRAPPER as RUN_WITH_PEAK  # noqa: E402  (prints PEAK_KB, the run's VmHWM)
 
 
 @pytest.fixture(scope="module")
