@@ -145,21 +145,32 @@ def join(a: Part, b: Part, scale_b: float, blend: int = BLEND_FRAMES):
     return rot.astype(np.float32), root.astype(np.float32), contacts
 
 
-def compose_arrays(proc, a: Part, b: Part) -> dict:
-    """The arrays ``build._write_clip`` writes, for A then B on A's body (ClipProcessor FK/grounding/features)."""
+def posed_arrays(proc, rot: np.ndarray, root: np.ndarray, betas: np.ndarray, contacts: np.ndarray, rest=None) -> dict:
+    """The arrays ``build._write_clip`` writes for local rotations ``rot`` (T,24,3,3) and world root
+    path ``root`` (T,3) on the body ``betas`` (its rest joints ``rest`` when known): FK and grounding
+    on the mesh for that body and for the canonical one (stride scaled with leg length), and the
+    features of both (``ClipProcessor``)."""
     import torch
 
-    rest_a = proc.body.rest_joints(torch.as_tensor(a.betas)[None])[0].numpy()
-    rest_b = proc.body.rest_joints(torch.as_tensor(b.betas)[None])[0].numpy()
-    rot, root, contacts = join(a, b, proc.stride_scale(rest_b, a.betas))
-    shaped = proc.pose_on(rot, root, a.betas, 1.0, contacts)
-    normal = proc.pose_on(rot, root, np.zeros(10, np.float32), proc.stride_scale(rest_a, None), contacts)
+    if rest is None:
+        rest = proc.body.rest_joints(torch.as_tensor(betas)[None])[0].numpy()
+    shaped = proc.pose_on(rot, root, betas, 1.0, contacts)
+    normal = proc.pose_on(rot, root, np.zeros(10, np.float32), proc.stride_scale(rest, None), contacts)
     return {
         "new_joints": shaped, "new_joint_vecs": proc.features(shaped, rot, contacts),
         "norm_joints": normal, "norm_joint_vecs": proc.features(normal, rot, contacts),
-        "betas": a.betas, "contacts": contacts, "poses": matrix_to_axis_angle(rot).astype(np.float32),
-        "transl": shaped[:, 0] - rest_a[0], "ik_error_cm": 0.0, "measure": proc.measure(a.betas),
+        "betas": betas, "contacts": contacts, "poses": matrix_to_axis_angle(rot).astype(np.float32),
+        "transl": shaped[:, 0] - rest[0], "ik_error_cm": 0.0, "measure": proc.measure(betas),
     }
+
+
+def compose_arrays(proc, a: Part, b: Part) -> dict:
+    """The arrays ``build._write_clip`` writes, for A then B on A's body (``posed_arrays``)."""
+    import torch
+
+    rest_b = proc.body.rest_joints(torch.as_tensor(b.betas)[None])[0].numpy()
+    rot, root, contacts = join(a, b, proc.stride_scale(rest_b, a.betas))
+    return posed_arrays(proc, rot, root, a.betas, contacts)
 
 
 def upright(data: Path, meta: dict, end: bool) -> bool:

@@ -24,10 +24,10 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ShapeMoveError
-from ..geometry.rotations import axis_angle_to_matrix, matrix_to_axis_angle
+from ..geometry.rotations import axis_angle_to_matrix
 from .build import ClipProcessor, _write_clip, finalize
 from .captions import _pick, _tidy, progressive
-from .compose import ComposedSource, verb_phrase
+from .compose import ComposedSource, _read_lines, posed_arrays, verb_phrase
 
 LEGS_ACTIONS = ("walk", "jog", "run", "march", "sneak", "walk backward", "sidestep", "walk in a circle", "limp")
 ARMS_ACTIONS = ("wave", "wave goodbye", "raise hand", "beckon", "guide", "punch", "throw", "reach up",
@@ -53,10 +53,6 @@ def parts_captions(cid: str, x: str, y: str, n: int = 6) -> list[str]:
             options += [f"{s} {y} as {pron} {x}.", f"while {pron} {x}, {s} {y}."]
     first = f"a person {x} while {y_ing}."
     return [_tidy(s) for s in [first] + _pick(cid, [o for o in options if o != first], n - 1)]
-
-
-def _read_lines(path: Path) -> list[str]:
-    return [ln.strip() for ln in path.read_text(encoding="utf-8").splitlines() if ln.strip()] if path.is_file() else []
 
 
 def _pools(data: Path) -> tuple[dict, dict]:
@@ -88,14 +84,7 @@ def part_arrays(proc: ClipProcessor, data: Path, a: str, b: str, arms_action: st
     rot[:, joints] = axis_angle_to_matrix(pb[sb:sb + n])[:, joints]
     root = (np.load(data / "transl" / f"{a}.npy") + rest_a[0])[sa:sa + n]
     contacts = np.load(data / "contacts" / f"{a}.npy")[sa:sa + n].astype(np.uint8)
-    shaped = proc.pose_on(rot, root, betas, 1.0, contacts)
-    normal = proc.pose_on(rot, root, np.zeros(10, np.float32), proc.stride_scale(rest_a, None), contacts)
-    return {
-        "new_joints": shaped, "new_joint_vecs": proc.features(shaped, rot, contacts),
-        "norm_joints": normal, "norm_joint_vecs": proc.features(normal, rot, contacts),
-        "betas": betas, "contacts": contacts, "poses": matrix_to_axis_angle(rot).astype(np.float32),
-        "transl": shaped[:, 0] - rest_a[0], "ik_error_cm": 0.0, "measure": proc.measure(betas),
-    }
+    return posed_arrays(proc, rot, root, betas, contacts, rest_a)
 
 
 def compose_parts_dataset(data, count: int, seed: int = 0, body=None, verbose: bool = True) -> list[str]:

@@ -26,6 +26,7 @@ import numpy as np
 
 from ..errors import ShapeMoveError
 from .build import ClipProcessor, _write_clip, finalize
+from .compose import _read_lines
 from .sources import ClipSource
 
 SUFFIX = "_mirror"
@@ -167,7 +168,3 @@ def mirror_dataset(data, body=None, verbose: bool = True, progress=None, cancel=
             progress((i + 1) / len(todo), cid)
     finalize(data)
     return written
-
-
-def _read_lines(path: Path) -> list[str]:
-    return [ln.strip() for ln in path.read_text(encoding="utf-8").splitlines() if ln.strip()] if path.is_file() else []
