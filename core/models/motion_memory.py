@@ -163,7 +163,8 @@ class MotionMemory:
         todo = [b for b in range(len(texts)) if not (empty and empty[b]) and str(texts[b]).strip()]
         if not todo or k <= 0:
             return ids, sims
-        vec = sentence_vectors(reader, [texts[b] for b in todo])
+        row = {t: i for i, t in enumerate(dict.fromkeys(texts[b] for b in todo))}  # best-of-N repeats a prompt N times
+        vec = sentence_vectors(reader, list(row))[[row[texts[b]] for b in todo]]
         found = self.nearest(vec, k, [exclude[b] for b in todo] if exclude is not None else None, rng)
         for b, near in zip(todo, found):
             for j, (c, s) in enumerate(near):
