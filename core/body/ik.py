@@ -54,7 +54,7 @@ SPINE_BLEND = {3: 1.0 / 3.0, 6: 2.0 / 3.0}  # share of the chest's left-right ax
 _LIMB_OF = {l[0]: l for l in LIMBS}   # limb root -> its limb
 _HINGE_OF = {l[1]: l for l in LIMBS}  # knee/elbow -> its limb
 _EPS = 1e-9
-IK_WINDOW = 1024  # frames per batch in ``solve_ik``: ~50 s at 20 fps, ~120 MB of Jacobians at most
+IK_WINDOW = 512  # frames per batch in ``solve_ik``: ~25 s at 20 fps, ~60 MB of Jacobians at most
 
 
 @dataclass

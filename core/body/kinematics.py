@@ -13,7 +13,7 @@ import torch
 
 from ..geometry.torch_ops import axis_angle_to_matrix, forward_kinematics
 
-WINDOW = 1024  # frames posed at once by the windowed steps (a few MB each, whatever the take's length)
+WINDOW = 256  # frames posed at once by the windowed steps (a few MB each, whatever the take's length)
 
 
 def as_rotation_matrices(rotations: torch.Tensor) -> torch.Tensor:

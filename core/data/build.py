@@ -122,12 +122,12 @@ class ClipProcessor:
         reproduces the result."""
         import torch
 
-        from ..geometry.torch_ops import forward_kinematics
+        from ..body.kinematics import posed_joints
 
         rest = self.body.rest_joints(torch.as_tensor(betas)[None])  # (1,24,3)
-        R = torch.as_tensor(rotations, dtype=torch.float32)
-        joints, _ = forward_kinematics(R, rest.expand(R.shape[0], -1, -1), self.body.parents)
-        joints = joints[:, :22].numpy() - rest[0, 0].numpy() + (root * scale)[:, None, :]
+        with torch.no_grad():  # window by window: memory does not grow with the take
+            joints = posed_joints(self.body, betas, rotations)[:, :22].numpy()
+        joints = joints - rest[0, 0].numpy() + (root * scale)[:, None, :]
         per_foot, _, low_all = self.probe(betas).lowest(rotations, joints[:, 0] - rest[0, 0].numpy())
         c = np.zeros((len(joints), 4), np.uint8) if contacts is None else contacts
         joints[..., 1] += ground_shift(per_foot, low_all, c)[:, None]
