@@ -35,6 +35,9 @@ def add_arguments(p):
                    help="a folder of your own captioned motions added to the retrieval memory (no retraining)")
     p.add_argument("--no-retrieval", action="store_true",
                    help="the decoder reads the prompt alone, without the retrieved training clips")
+    p.add_argument("--retrieval-prefix", type=int, default=None, metavar="CODES",
+                   help="half the candidates continue the first CODES codes (4 frames each) of the nearest "
+                        "clips by caption (default 2; 0 = none)")
     add_animation_arguments(p)
 
 
@@ -69,9 +72,11 @@ def run(args) -> int:
     if args.out.suffix.lower() != ".npz":
         raise ShapeMoveError(f"--out must end in .npz, got {args.out}")
     check_sampling(args.seed, args.temperature, args.top_k)  # before loading any model
-    from ..core.generation.sampling_params import DEFAULT_CANDIDATES, check_candidates, check_guidance
+    from ..core.generation.sampling_params import (DEFAULT_CANDIDATES, DEFAULT_RETRIEVAL_PREFIX, check_candidates,
+                                                   check_guidance, check_retrieval_prefix)
 
     candidates = check_candidates(DEFAULT_CANDIDATES if args.candidates is None else args.candidates)
+    prefix = check_retrieval_prefix(DEFAULT_RETRIEVAL_PREFIX if args.retrieval_prefix is None else args.retrieval_prefix)
     guidance = check_guidance(args.guidance)
     ensure_parent(args.out)  # a parent that is a file, or no permission: said now, not after generating
     betas = parse_betas(args.betas) if args.betas else None
@@ -84,7 +89,7 @@ def run(args) -> int:
     from ..core.generation.generate import Request
 
     motion = animate(gen, Request(args.prompt, args.shape_text, betas, args.seconds, args.seed, args.temperature,
-                                  args.top_k, args.shape_from, candidates, guidance), animation)
+                                  args.top_k, args.shape_from, candidates, guidance, prefix), animation)
     save_motion(args.out, motion)
     import sys
 

@@ -85,3 +85,33 @@ def test_decoder_reads_the_memory_and_empty_memory_is_text_only():
         le = model.lm.step(*model.lm.encode(states, mask, seg, empty, sims), dec)[0]
         lt = model.lm.step(*model.lm.encode(states, mask, seg), dec)[0]
         assert torch.allclose(le, lt, atol=1e-5)                               # no memory = text only
+
+
+def test_retrieval_seeds_are_the_starts_of_the_nearest_clips(memory):
+    from shapemove.core.generation.retrieval_seeds import seed_prefixes, seeded_count
+
+    mem, reader = memory
+    rows = seed_prefixes(mem, reader, "a fighter throws a jab", count=2, prefix=3)
+    assert rows[0] == mem.clip_tokens[mem.clip_ids.index("punch_1")][:3].tolist() == [0, 1, 2]
+    assert len(rows) == 2 and all(len(r) == 3 for r in rows) and rows[1] != rows[0]
+    assert seed_prefixes(mem, reader, "a fighter throws a jab", count=2, prefix=6) == []  # clips of 6 codes: none longer
+    assert seed_prefixes(None, reader, "a jab", 2, 2) == [] and seed_prefixes(mem, reader, "a jab", 0, 2) == []
+    assert [seeded_count(n) for n in (1, 2, 8)] == [0, 1, 4]
+
+
+def test_per_row_prefixes_decode_as_each_prefix_alone():
+    from shapemove.core.models.constrained_decoding import decode
+
+    torch.manual_seed(0)
+    size = T5Size(d_model=32, d_ff=64, num_layers=1, num_decoder_layers=1, num_heads=2, d_kv=16, dropout_rate=0.0)
+    model = ShapeMoveT5.build_minilm(10, size).eval()
+    states, mask, seg = torch.randn(2, 5, 384), torch.ones(2, 5, dtype=torch.bool), torch.ones(2, 5, dtype=torch.long)
+    states[1] = states[0]
+    with torch.no_grad():
+        both = decode(model, (states, mask, seg), 4, 4, temperature=0, prefix_codes=[[1, 2], [7, 3]])
+        a = decode(model, (states[:1], mask[:1], seg[:1]), 4, 4, temperature=0, prefix_codes=[1, 2])
+        b = decode(model, (states[:1], mask[:1], seg[:1]), 4, 4, temperature=0, prefix_codes=[7, 3])
+    assert both.codes == [a.codes[0], b.codes[0]] and both.codes[0] != both.codes[1]
+    assert torch.allclose(both.betas[0], both.betas[1], atol=1e-6)  # [BETA] precedes the codes
+    with pytest.raises(ValueError, match="one length"):
+        decode(model, (states, mask, seg), 4, 4, temperature=0, prefix_codes=[[1, 2], [3]])

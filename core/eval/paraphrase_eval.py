@@ -98,21 +98,24 @@ def _tally(rows: list[dict], key: str) -> dict:
 def eval_paraphrase(model_dir=None, prompts=None, tma=None, seed: int = 0, seconds: float | None = 4.0,
                     progress=None, generator=None, data=None, classifier=None, ceiling_clips: int | None = None,
                     show_progress: bool = True, candidates: int | None = None, feature_classifier=None,
-                    retrieval: bool = True, frequent: int = 20) -> dict:
+                    retrieval: bool = True, frequent: int = 20, retrieval_prefix: int | None = None) -> dict:
     """Generate a motion per held-out prompt and classify it (module docstring). ``data``: the built
     dataset whose training clips the kNN classifier reads (default ``default_built_dir()``);
     ``classifier``: an ``ActionClassifier`` to use instead (``feature_classifier`` likewise for the
-    TMA-free one); ``candidates``: best-of-N samples per prompt (default: the product's). Returns
+    TMA-free one); ``candidates``: best-of-N samples per prompt (default: the product's);
+    ``retrieval_prefix``: codes of a retrieved clip the seeded candidates start from (default: the
+    product's; 0 none, ``retrieval_seeds.py``). Returns
     {"motion", "text", "motion_vs_text_prototypes", "motion_features", "reachable", "classifier",
     "unknown_action", "actions", "rows", ...}."""
     from ..generation.generate import Generator, Request
     from ..generation.model_bundle import model_files
-    from ..generation.sampling_params import DEFAULT_CANDIDATES
+    from ..generation.sampling_params import DEFAULT_CANDIDATES, DEFAULT_RETRIEVAL_PREFIX
     from .action_classifier import ActionClassifier, FeatureEmbedder, default_built_dir
     from .tma_embed import embed_motions, embed_texts, load_tma
 
     items = load_prompts(prompts)
     candidates = DEFAULT_CANDIDATES if candidates is None else candidates
+    retrieval_prefix = DEFAULT_RETRIEVAL_PREFIX if retrieval_prefix is None else retrieval_prefix
     if classifier is None:
         data = data if data is not None else default_built_dir()
         if data is None:
@@ -144,7 +147,8 @@ def eval_paraphrase(model_dir=None, prompts=None, tma=None, seed: int = 0, secon
     known = [it for it in items if it["action"] in actions]
     rows, embs, feats = [], [], []
     for i, it in enumerate(known):
-        m = gen.generate_batch([Request(it["text"], seconds=seconds, seed=seed + i, candidates=candidates)])[0]
+        m = gen.generate_batch([Request(it["text"], seconds=seconds, seed=seed + i, candidates=candidates,
+                                        retrieval_prefix=retrieval_prefix)])[0]
         motion_emb = embed_motions(model, [m.features], mean, std)[0]
         embs.append(motion_emb)
         feats.append(m.features)
@@ -177,6 +181,7 @@ def eval_paraphrase(model_dir=None, prompts=None, tma=None, seed: int = 0, secon
                          **({"nearest_caption": _tally(often, "nearest_caption_pred")} if nearest else {})},
             "retrieval": bool(retrieval and gen.reads_memory),
             "candidates": candidates,
+            "retrieval_prefix": retrieval_prefix if retrieval and gen.reads_memory else 0,
             "classifier": {**classifier.info, "ceiling": ceiling},
             "feature_classifier": dict(feature_classifier.info) if feature_classifier is not None else None,
             "unknown_action": sorted({it["action"] for it in items if it["action"] not in actions}),
@@ -262,7 +267,9 @@ def format_results(res: dict) -> str:
                      f"{_pct(fr['motion']['accuracy'])} ({_pct(fr['motion']['accuracy_lenient'])} lenient)"
                      + (f", nearest caption {_pct(fr['nearest_caption']['accuracy'])}" if fr.get("nearest_caption") else ""))
     lines.append(f"retrieved clips read by the decoder: {'yes' if res.get('retrieval') else 'no'}")
-    lines.append(f"best of {res.get('candidates', 1)} samples per prompt (TMA choice)")
+    seeded = res.get("retrieval_prefix") or 0
+    lines.append(f"best of {res.get('candidates', 1)} samples per prompt (TMA choice)"
+                 + (f", half of them continuing the first {seeded} codes of a retrieved clip" if seeded else ""))
     if ceil:
         info = res["classifier"]
         lines.append(f"the classifier ({info.get('k')}-NN over {info.get('clips')} {info.get('split')} clips) names real "
@@ -286,6 +293,8 @@ def add_arguments(p) -> None:
     p.add_argument("--json", type=Path, default=None, help="write the results here")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.add_argument("--no-retrieval", action="store_true", help="the decoder reads no retrieved clips (to compare)")
+    p.add_argument("--retrieval-prefix", type=int, default=None, metavar="CODES",
+                   help="codes of a retrieved clip half the candidates start from (default: the product's; 0: none)")
 
 
 def from_cli(args) -> int:
@@ -295,7 +304,7 @@ def from_cli(args) -> int:
     try:
         res = eval_paraphrase(args.model, args.prompts, args.tma, args.seed, args.seconds, progress, data=args.data,
                               show_progress=not args.quiet, candidates=args.candidates,
-                              retrieval=not args.no_retrieval)
+                              retrieval=not args.no_retrieval, retrieval_prefix=args.retrieval_prefix)
     finally:
         progress.close()
     return show_result(format_results(res), res, args.json)

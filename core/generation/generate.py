@@ -30,7 +30,9 @@ from .decode import decode_features, decode_tokens, redecode
 from .model_bundle import model_files, part_warnings, resolve_model_dir
 from .prompts import check_prompt
 from .rerank import CandidatePicker
-from .sampling_params import DEFAULT_CANDIDATES, DEFAULT_GUIDANCE, check_candidates, check_guidance, check_sampling
+from .retrieval_seeds import seed_prefixes, seeded_count
+from .sampling_params import (DEFAULT_CANDIDATES, DEFAULT_GUIDANCE, DEFAULT_RETRIEVAL_PREFIX, check_candidates,
+                              check_guidance, check_retrieval_prefix, check_sampling)
 
 
 @dataclass
@@ -45,6 +47,7 @@ class Request:
     shape_from: str = "auto"  # "auto": measurements stated in the shape text win; "head": the [BETA] head only
     candidates: int = DEFAULT_CANDIDATES  # token samples drawn; the TMA keeps the one closest to the prompt
     guidance: float | None = None  # classifier-free guidance scale; None: the model's default (0 without a null prompt)
+    retrieval_prefix: int = DEFAULT_RETRIEVAL_PREFIX  # codes of a retrieved clip half the candidates start from (0: none)
 
 
 def parse_betas(text: str) -> np.ndarray:
@@ -133,18 +136,32 @@ class Generator:
                 g = torch.Generator().manual_seed(int(r.seed))
                 lo, hi = self._length(r.seconds)
                 n = r.candidates if r.temperature > 0 and self.picker is not None else 1
-                inputs = self.t5.inputs_for(self.tok, [r.prompt] * n, [r.shape_text] * n)
+                seeds = self._retrieval_seeds(r, n)
                 s = self.default_guidance if r.guidance is None else r.guidance
-                null = self.t5.inputs_for(self.tok, [NULL_PROMPT] * n, [r.shape_text] * n) if s > 0 else None
-                out = decode(self.t5, inputs, lo, hi, temperature=r.temperature, top_k=r.top_k, generator=g,
-                             guidance=s, null_inputs=null)
+                cands, beta = [], None
+                for rows, prefix in ((n - len(seeds), None), (len(seeds), seeds)):
+                    if rows == 0:
+                        continue
+                    inputs = self.t5.inputs_for(self.tok, [r.prompt] * rows, [r.shape_text] * rows)
+                    null = self.t5.inputs_for(self.tok, [NULL_PROMPT] * rows, [r.shape_text] * rows) if s > 0 else None
+                    out = decode(self.t5, inputs, lo, hi, temperature=r.temperature, top_k=r.top_k, generator=g,
+                                 guidance=s, null_inputs=null, prefix_codes=prefix)
+                    cands += out.codes
+                    beta = out.betas[0] if beta is None else beta  # [BETA] precedes the codes: one body for all
                 best = 0
-                if n > 1:  # the [BETA] state does not depend on the sampled tokens: one body for all
-                    feats = [decode_features(c, self.vae, out.betas[0].numpy()).numpy() for c in out.codes]
+                if n > 1:
+                    feats = [decode_features(c, self.vae, beta.numpy()).numpy() for c in cands]
                     best = self.picker.pick(r.prompt, feats)
-                codes.append(out.codes[best])
-                betas.append(out.betas[best])
+                codes.append(cands[best])
+                betas.append(beta)
         return codes, torch.stack(betas)
+
+    def _retrieval_seeds(self, r: Request, n: int) -> list[list[int]]:
+        """Prefixes for the seeded share of ``n`` candidates (``retrieval_seeds.py``): only for a model
+        that reads retrieved clips, with retrieval on, and a best-of-N to choose among them."""
+        if n < 2 or not r.retrieval_prefix or not self.reads_memory or not self.t5.memory_enabled:
+            return []
+        return seed_prefixes(self.t5.memory, self.tok, r.prompt, seeded_count(n), r.retrieval_prefix)
 
     # -- what the model knows ----------------------------------------------------------------
     @property
@@ -223,6 +240,7 @@ class Generator:
             r.seed, r.temperature, r.top_k = check_sampling(r.seed, r.temperature, r.top_k)
             r.candidates = check_candidates(r.candidates)
             r.guidance = check_guidance(r.guidance)
+            r.retrieval_prefix = check_retrieval_prefix(r.retrieval_prefix)
         checks = []
         for r in reqs:  # every text checked before any generation
             with one_torch_thread():

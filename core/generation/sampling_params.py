@@ -13,6 +13,8 @@ DEFAULT_CANDIDATES = 8   # best-of-N token samples (generation/rerank.py)
 MAX_CANDIDATES = 64
 DEFAULT_GUIDANCE = 2.0    # classifier-free guidance of models trained with null_share (constrained_decoding.py)
 MAX_GUIDANCE = 20.0
+DEFAULT_RETRIEVAL_PREFIX = 2  # codes of a retrieved clip a seeded candidate starts from (retrieval_seeds.py)
+MAX_RETRIEVAL_PREFIX = 12
 
 
 def _integer(value, name: str) -> int:
@@ -67,3 +69,13 @@ def check_guidance(s) -> float | None:
     if isinstance(s, bool) or not isinstance(s, (int, float)) or not math.isfinite(float(s)) or not 0 <= s <= MAX_GUIDANCE:
         raise ShapeMoveError(f"guidance must be a number from 0 (none) to {MAX_GUIDANCE:g}, got {str(s)[:40]!r}")
     return float(s)
+
+
+def check_retrieval_prefix(n) -> int:
+    """Codes of a retrieved clip that seeded candidates start from (``retrieval_seeds.py``): 0 (no
+    seeding) to ``MAX_RETRIEVAL_PREFIX``."""
+    n = _integer(n, "retrieval prefix")
+    if not 0 <= n <= MAX_RETRIEVAL_PREFIX:
+        raise ShapeMoveError(f"retrieval prefix must be between 0 and {MAX_RETRIEVAL_PREFIX} codes, "
+                             f"got {n if abs(n) < 10**9 else 'a huge number'}")
+    return n

@@ -35,22 +35,34 @@ def motion_mask(vocab, vocab_size: int, allow_end: bool) -> torch.Tensor:
 
 
 @torch.no_grad()
+def _prefix_rows(prefix_codes, rows: int, num_codes: int) -> list[list[int]]:
+    """One list of prefix codes per row: a flat list shared by all rows, or a list per row."""
+    p = list(prefix_codes or [])
+    per_row = bool(p) and isinstance(p[0], (list, tuple))
+    out = [[int(c) for c in r] for r in p] if per_row else [[int(c) for c in p]] * rows
+    if len(out) != rows or len({len(r) for r in out}) > 1:
+        raise ValueError(f"per-row prefix codes: {rows} rows of one length needed")
+    if any(not 0 <= c < num_codes for r in out for c in r):
+        raise ValueError(f"prefix codes must lie in 0..{num_codes - 1}")
+    return out
+
+
 def decode(model, inputs: tuple, min_codes: int, max_codes: int, temperature: float = 1.0,
            top_k: int | None = None, generator: torch.Generator | None = None, guidance: float = 0.0,
            null_inputs: tuple | None = None, prefix_codes: list[int] | None = None) -> Decoded:
     """``inputs``: ``model.inputs_for(...)`` (token ids + mask for a T5, states + mask + segments
     for MiniLM); ``null_inputs`` the same for the empty motion text, needed when ``guidance`` > 0.
     ``prefix_codes``: motion codes (0..NUM_CODES-1) already written after ``[SOM]`` for every row
-    (e.g. the last tokens of the previous segment of a timeline): the decoder continues from them;
+    (e.g. the last tokens of the previous segment of a timeline), or one list per row, all of one
+    length (the starts of retrieved clips, ``retrieval_seeds``): the decoder continues from them;
     ``codes`` holds only the new ones and ``min_codes``/``max_codes`` count only those."""
     vocab = model.vocab
     enc, enc_mask = model.encode(*inputs)
     B = enc.shape[0]
     start = vocab.pad_id  # decoder_start_token_id of every ShapeMove decoder
-    prefix = [vocab.first_code_id + int(c) for c in (prefix_codes or [])]
-    if any(not 0 <= int(c) < vocab.num_codes for c in (prefix_codes or [])):
-        raise ValueError(f"prefix codes must lie in 0..{vocab.num_codes - 1}")
-    seq = torch.tensor([[start, vocab.beta_id, vocab.som_id] + prefix] * B, dtype=torch.long)
+    rows = _prefix_rows(prefix_codes, B, vocab.num_codes)
+    seq = torch.tensor([[start, vocab.beta_id, vocab.som_id] + [vocab.first_code_id + c for c in r] for r in rows],
+                       dtype=torch.long)
     # the state whose input is [BETA] (position 1) gives the betas
     logits, hidden, past = model.step(enc, enc_mask, seq, use_cache=True)
     betas = model.beta_head(hidden[:, 1])
