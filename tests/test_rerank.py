@@ -6,7 +6,7 @@ import torch
 from tiny_models import tiny_bundle  # noqa: F401  (session fixture)
 
 from shapemove.core.errors import ShapeMoveError
-from shapemove.core.generation.sampling_params import check_candidates
+from shapemove.core.generation.sampling_params import check_candidates, check_retrieval_prefix
 
 
 @pytest.mark.parametrize("bad,match", [(0, "between 1 and 64"), (65, "between 1 and 64"), (2.5, "whole number"),
@@ -15,6 +15,13 @@ def test_candidates_are_checked(bad, match):
     with pytest.raises(ShapeMoveError, match=match):
         check_candidates(bad)
     assert check_candidates(8.0) == 8
+
+
+@pytest.mark.parametrize("bad,match", [(-1, "between 0 and 12"), (13, "between 0 and 12"), (1.5, "whole number")])
+def test_retrieval_prefix_is_checked(bad, match):
+    with pytest.raises(ShapeMoveError, match=match):
+        check_retrieval_prefix(bad)
+    assert check_retrieval_prefix(0) == 0 and check_retrieval_prefix(2.0) == 2
 
 
 def test_generator_keeps_the_candidate_closest_to_the_prompt(tiny_bundle):  # noqa: F811
