@@ -309,9 +309,9 @@ class SHAPEMOVE_OT_redecode(ReportingOperator, _RigOperator, bpy.types.Operator)
 
 
 # -- retarget ------------------------------------------------------------------------------------
-def _retarget_job(context, source: str, target_rig, name: str) -> None:
+def _retarget_job(context, source: str, target_rig, name: str, read: dict | None = None) -> None:
     params = {"source": source, "body": rig_body_spec(target_rig), "model": setting("active_model") or None,
-              "out": str(paths.new_motion_path(name))}
+              "out": str(paths.new_motion_path(name)), **(read or {})}
     if target_rig is not None:
         params["betas"] = current_betas(target_rig).tolist()
 
@@ -320,6 +320,16 @@ def _retarget_job(context, source: str, target_rig, name: str) -> None:
             build_rig_from_file(msg["result"]["path"], name)
 
     job_submit.submit_job("retarget", params, kind="retarget", label=f"retarget {Path(source).name}", on_result=done)
+
+
+def reader_overrides(s) -> dict:
+    """The panel's overrides of what a mocap file declares (the CLI's --source-fps / --angle-unit)."""
+    out = {}
+    if s.retarget_source_fps > 0:
+        out["source_fps"] = float(s.retarget_source_fps)
+    if s.retarget_angle_unit != "FILE":
+        out["angle_unit"] = s.retarget_angle_unit.lower()
+    return out
 
 
 class SHAPEMOVE_OT_retarget(JobOperator, bpy.types.Operator):
@@ -336,8 +346,10 @@ class SHAPEMOVE_OT_retarget(JobOperator, bpy.types.Operator):
     def start(self, context):
         s = context.scene.shapemove
         target = s.retarget_target or active_rig(context)
+        read = {}
         if s.retarget_source == "FILE":
             source = existing_path(s.retarget_path, "motion file")
+            read = reader_overrides(s)
             name = Path(source).stem
         else:
             arm = context.active_object
@@ -349,7 +361,7 @@ class SHAPEMOVE_OT_retarget(JobOperator, bpy.types.Operator):
             _export_plain_bvh(context, arm, source)
             name = arm.name
             target = s.retarget_target
-        _retarget_job(context, source, target, name)
+        _retarget_job(context, source, target, name, read)
         return f"retargeting {Path(source).name}..."
 
 

@@ -207,6 +207,9 @@ class SHAPEMOVE_PT_retarget(_SettingsPanel, bpy.types.Panel):
         col.row().prop(s, "retarget_source", expand=True)
         if s.retarget_source == "FILE":
             col.prop(s, "retarget_path", text="")
+            row = col.row(align=True)
+            row.prop(s, "retarget_source_fps")
+            row.prop(s, "retarget_angle_unit", text="")
         else:
             obj = context.active_object
             col.label(text=f"Source: {obj.name}" if obj is not None and obj.type == "ARMATURE" else

@@ -113,6 +113,14 @@ class ShapeMoveSceneSettings(bpy.types.PropertyGroup):
         items=[("FILE", "File", "A BVH, ASF/AMC or AMASS .npz file"),
                ("ACTION", "Active armature", "The action of the active (non-ShapeMove) armature")])
     retarget_path: StringProperty(name="Motion file", subtype="FILE_PATH", default="")
+    retarget_source_fps: FloatProperty(name="Source fps", default=0.0, min=0.0, max=10000.0,
+                                       description="The file's frame rate when its own is wrong (BVH Frame Time, "
+                                                   "AMC rate); 0 = as the file says")
+    retarget_angle_unit: EnumProperty(
+        name="Angles", default="FILE",
+        items=[("FILE", "As declared", "Degrees or radians as the ASF/AMC declares"),
+               ("DEG", "Degrees", "The ASF/AMC's angles are degrees, whatever it declares"),
+               ("RAD", "Radians", "The ASF/AMC's angles are radians, whatever it declares")])
     retarget_target: PointerProperty(name="Target rig", type=bpy.types.Object, poll=_is_rig,
                                      description="ShapeMove rig whose body receives the motion (empty: fit a body)")
     # library

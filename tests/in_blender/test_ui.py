@@ -203,6 +203,17 @@ def test_bad_input_is_reported_and_changes_nothing(rig):
     assert counts() == before
 
 
+def test_retarget_file_overrides_reach_the_job_parameters():
+    s = bpy.context.scene.shapemove
+    overrides = ext("shapemove_addon.operators").reader_overrides
+    assert overrides(s) == {}                                   # as the file declares
+    s.retarget_source_fps, s.retarget_angle_unit = 30.0, "RAD"
+    try:
+        assert overrides(s) == {"source_fps": 30.0, "angle_unit": "rad"}
+    finally:
+        s.retarget_source_fps, s.retarget_angle_unit = 0.0, "FILE"
+
+
 # -- torch imports from here on: jobs in this process ------------------------------------------------
 @pytest.fixture(scope="module")
 def in_process(rig):
