@@ -12,12 +12,14 @@ process limited to 30 s and 1 GB more address space. Outcomes:
 
   refused      ShapeMoveError (a sentence for the user)            -- fine
   same         loaded, every joint within 1 cm of the intact clip  -- fine (the damage was harmless)
+  shorter      loaded fewer frames, each within 1 cm of the intact clip's -- fine: a file cut between
+               two frames is a valid shorter file (AMC files carry no frame count)
   silent-wrong loaded, but some joint is >= 1 cm off the intact clip (or the length differs)
   traceback    any other exception
   hang         killed by the 30 s alarm
   over-memory  MemoryError, or killed past the 1 GB limit
 
-Prints the counts and one line per finding; exit status 1 when anything but refused/same occurs.
+Prints the counts and one line per finding; exit status 1 when anything but refused/same/shorter occurs.
 """
 from __future__ import annotations
 
@@ -232,7 +234,11 @@ def run_case(path: Path, intact: np.ndarray | None) -> dict:
 
         try:
             j = _load_joints(path)
-            if intact is None or j.shape != intact.shape:
+            if intact is not None and 0 < j.shape[0] < intact.shape[0] and j.shape[1:] == intact.shape[1:] \
+                    and float(np.linalg.norm(j - intact[:len(j)], axis=-1).max()) < TOLERANCE_M:
+                out = {"outcome": "shorter", "message": f"a valid shorter file: {j.shape[0]} frames of "
+                                                        f"{intact.shape[0]}, each within 1 cm of the intact clip's"}
+            elif intact is None or j.shape != intact.shape:
                 out = {"outcome": "silent-wrong", "message": f"{j.shape[0]} frames, the intact clip "
                                                              f"{None if intact is None else intact.shape[0]}"}
             else:
@@ -305,14 +311,15 @@ def main(argv=None) -> int:
             by_kind.setdefault(kind, {}).setdefault(res["outcome"], 0)
             by_kind[kind][res["outcome"]] += 1
             example.setdefault(kind, f"{b['name']}: {res['message']}")
-            if res["outcome"] not in ("refused", "same"):
+            if res["outcome"] not in ("refused", "same", "shorter"):
                 findings.append({"case": i, "base": b["name"], "kind": kind, **res})
             for n in files:
                 (d / n).unlink()
             d.rmdir()
     total = sum(counts.values())
     print(f"{total} damaged real files ({len(base)} bases): " + ", ".join(
-        f"{k} {counts.get(k, 0)}" for k in ("refused", "same", "silent-wrong", "traceback", "hang", "over-memory")))
+        f"{k} {counts.get(k, 0)}" for k in ("refused", "same", "shorter", "silent-wrong", "traceback", "hang",
+                                            "over-memory")))
     for k, v in sorted(by_kind.items()):
         print(f"  {k:18s} " + ", ".join(f"{o} {n}" for o, n in sorted(v.items())))
         if args.verbose:
