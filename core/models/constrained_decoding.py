@@ -34,7 +34,6 @@ def motion_mask(vocab, vocab_size: int, allow_end: bool) -> torch.Tensor:
     return mask
 
 
-@torch.no_grad()
 def _prefix_rows(prefix_codes, rows: int, num_codes: int) -> list[list[int]]:
     """One list of prefix codes per row: a flat list shared by all rows, or a list per row."""
     p = list(prefix_codes or [])
@@ -47,6 +46,7 @@ def _prefix_rows(prefix_codes, rows: int, num_codes: int) -> list[list[int]]:
     return out
 
 
+@torch.no_grad()
 def decode(model, inputs: tuple, min_codes: int, max_codes: int, temperature: float = 1.0,
            top_k: int | None = None, generator: torch.Generator | None = None, guidance: float = 0.0,
            null_inputs: tuple | None = None, prefix_codes: list[int] | None = None) -> Decoded:
