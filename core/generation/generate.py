@@ -50,6 +50,11 @@ class Request:
     retrieval_prefix: int = DEFAULT_RETRIEVAL_PREFIX  # codes of a retrieved clip half the candidates start from (0: none)
 
 
+def _rows(inputs: tuple | None, a: int, b: int) -> tuple | None:
+    """Rows a..b-1 of batch-first encoder inputs (rows of one prompt are alike: read once, sliced)."""
+    return None if inputs is None else tuple(x[a:b] for x in inputs)
+
+
 def parse_betas(text: str) -> np.ndarray:
     """'b0,b1,…' (up to 10 numbers; missing ones are 0) -> (10,)"""
     try:
@@ -138,14 +143,14 @@ class Generator:
                 n = r.candidates if r.temperature > 0 and self.picker is not None else 1
                 seeds = self._retrieval_seeds(r, n)
                 s = self.default_guidance if r.guidance is None else r.guidance
+                inputs = self.t5.inputs_for(self.tok, [r.prompt] * n, [r.shape_text] * n)  # read once for all rows
+                null = self.t5.inputs_for(self.tok, [NULL_PROMPT] * n, [r.shape_text] * n) if s > 0 else None
                 cands, beta = [], None
-                for rows, prefix in ((n - len(seeds), None), (len(seeds), seeds)):
-                    if rows == 0:
+                for a, b, prefix in ((0, n - len(seeds), None), (n - len(seeds), n, seeds)):
+                    if a == b:
                         continue
-                    inputs = self.t5.inputs_for(self.tok, [r.prompt] * rows, [r.shape_text] * rows)
-                    null = self.t5.inputs_for(self.tok, [NULL_PROMPT] * rows, [r.shape_text] * rows) if s > 0 else None
-                    out = decode(self.t5, inputs, lo, hi, temperature=r.temperature, top_k=r.top_k, generator=g,
-                                 guidance=s, null_inputs=null, prefix_codes=prefix)
+                    out = decode(self.t5, _rows(inputs, a, b), lo, hi, temperature=r.temperature, top_k=r.top_k,
+                                 generator=g, guidance=s, null_inputs=_rows(null, a, b), prefix_codes=prefix)
                     cands += out.codes
                     beta = out.betas[0] if beta is None else beta  # [BETA] precedes the codes: one body for all
                 best = 0

@@ -67,7 +67,6 @@ class MotionMemory:
         self.clip_ids, self.clip_tokens = list(clip_ids), [np.asarray(t, dtype=np.int64) for t in clip_tokens]
         self.clip_family = clip_family or [frozenset([c]) for c in clip_ids]
         self._index = {t: i for i, t in enumerate(self.texts)}
-        self._cache: dict[str, tuple] = {}
 
     def __len__(self) -> int:
         return len(self.clip_ids)
@@ -114,7 +113,6 @@ class MotionMemory:
         self.clip_family += list(families) if families is not None else [frozenset([c]) for c in clip_ids]
         if new_texts:
             self.vectors = torch.cat([self.vectors, sentence_vectors(reader, new_texts)])
-        self._cache.clear()
 
     # -- lookup ---------------------------------------------------------------------------------
     def nearest(self, vectors: torch.Tensor, k: int, exclude: list | None = None,
