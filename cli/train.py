@@ -42,6 +42,10 @@ def add_arguments(p):
         s.add_argument("--device", choices=["cpu", "cuda"], help="default: cuda when available")
         s.add_argument("--body", help="body model: openbody (default) or an SMPL-family file")
         s.add_argument("--quiet", action="store_true", help="no progress bar")
+        if kind == "vae":
+            s.add_argument("--init-from", type=Path, default=None,
+                           help="fine-tune this trained savae.pt (sets the config's train.init_from; "
+                                "train.freeze names the parts kept as they are)")
         if kind == "t5":
             s.add_argument("--vae", type=Path, required=True, help="trained SA-VAE (savae.pt) that tokenizes the motions")
             s.add_argument("--base-model", type=Path, default=None,

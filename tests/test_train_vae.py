@@ -1,6 +1,7 @@
 """SA-VAE training: dataset crops, schedule, checkpoints, exact resume, DDP under torchrun, CLI."""
 import json
 import os
+import shutil
 import subprocess
 import sys
 import time
@@ -193,6 +194,43 @@ def test_training_reduces_loss(data_dir, body, tmp_path):
     train_vae(data_dir, tmp_path / "r", cfg, body=body, device="cpu", verbose=False)
     recon = [json.loads(line)["train"]["recon"] for line in (tmp_path / "r" / "log.jsonl").read_text().splitlines()]
     assert len(recon) == 40 and np.mean(recon[-5:]) < 0.9 * np.mean(recon[:5])
+
+
+def test_decoder_fine_tune_keeps_every_token(data_dir, body, tmp_path):
+    """Fine-tuning from a trained codec with the encoder and quantizer frozen: the encoder's weights,
+    the normalization and so every clip's tokens stay exactly as they were, while the decoder and
+    shape embedding learn (here the root-travel loss, off in the source run)."""
+    train_vae(data_dir, tmp_path / "src", tiny_config(), body=body, device="cpu", verbose=False)
+    src = load_savae(tmp_path / "src" / "savae.pt")
+    # the fine-tune reads data with another normalization: the source's must win
+    moved_stats = Path(shutil.copytree(data_dir, tmp_path / "data"))
+    np.save(moved_stats / "Mean.npy", np.load(data_dir / "Mean.npy") + 0.5)
+    cfg = tiny_config(steps=4, lr=1e-2, init_from=str(tmp_path / "src" / "savae.pt"), freeze=("encoder", "quantizer"))
+    cfg.loss.root = 1.0
+    train_vae(moved_stats, tmp_path / "ft", cfg, body=body, device="cpu", verbose=False)
+    ft = load_savae(tmp_path / "ft" / "savae.pt")
+    assert torch.equal(ft.mean, src.mean) and torch.equal(ft.std, src.std)
+    for name, v in src.encoder.state_dict().items():
+        assert torch.equal(v, ft.encoder.state_dict()[name]), name
+    moved = [name for name, v in src.decoder.state_dict().items() if not torch.equal(v, ft.decoder.state_dict()[name])]
+    assert moved and any(not torch.equal(v, ft.shape_embedding.state_dict()[k])
+                         for k, v in src.shape_embedding.state_dict().items())
+    clips = MotionClips(data_dir, "train", 64)
+    x = src.normalize(torch.from_numpy(np.load(data_dir / "norm_joint_vecs" / f"{clips.ids[0]}.npy")[None, :64]))
+    with torch.no_grad():
+        assert torch.equal(src.encode(x)[1], ft.encode(x)[1])
+        assert not torch.allclose(src.decode(*src.encode(x)[:1], torch.zeros(1, 10)),
+                                  ft.decode(*ft.encode(x)[:1], torch.zeros(1, 10)))
+    # another network, a missing source, or freezing without a source are refused by name
+    with pytest.raises(ShapeMoveError, match="another network.*width"):
+        train_vae(data_dir, tmp_path / "w", SAVAEConfig(width=24, depth=1, shape_hidden=16, train=TrainSettings(
+            steps=1, batch_size=4, init_from=str(tmp_path / "src" / "savae.pt"))), body=body, device="cpu", verbose=False)
+    with pytest.raises(ShapeMoveError, match="not found"):
+        train_vae(data_dir, tmp_path / "m", tiny_config(init_from=str(tmp_path / "nope.pt")), body=body, device="cpu", verbose=False)
+    with pytest.raises(ShapeMoveError, match="freeze needs train.init_from"):
+        tiny_config(freeze=("encoder",)).validate()
+    with pytest.raises(ShapeMoveError, match="unknown part.*'encodr'"):
+        tiny_config(init_from="x.pt", freeze=("encodr",)).validate()
 
 
 def test_cli_train_vae(data_dir, tmp_path):

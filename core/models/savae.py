@@ -57,6 +57,11 @@ class TrainSettings:
     log_every: int = 50
     seed: int = 0
     num_workers: int = 0
+    init_from: str = ""          # start from this trained savae.pt (its weights and its Mean/Std)
+    freeze: tuple = ()           # parts left as they are: "encoder", "quantizer", "shape_embedding", "decoder"
+
+
+PARTS = ("encoder", "quantizer", "shape_embedding", "decoder")  # the SAVAE's sub-modules, by attribute name
 
 
 @dataclass
@@ -142,6 +147,13 @@ class SAVAEConfig:
             raise ShapeMoveError(f"train.window must be a multiple of {self.downsample}")
         if self.train.decay not in ("step", "cosine", "none"):
             raise ShapeMoveError("train.decay must be 'step', 'cosine' or 'none'")
+        unknown = [p for p in self.train.freeze if p not in PARTS]
+        if unknown:
+            raise ShapeMoveError(f"train.freeze: unknown part(s) {', '.join(map(repr, unknown))}; parts are {', '.join(PARTS)}")
+        if self.train.freeze and not self.train.init_from:
+            raise ShapeMoveError("train.freeze needs train.init_from: freezing untrained weights keeps them random")
+        if set(self.train.freeze) >= {"encoder", "shape_embedding", "decoder"}:
+            raise ShapeMoveError("train.freeze leaves nothing to train")
 
 
 class SAVAE(nn.Module):

@@ -47,15 +47,22 @@ def read_split(root, split: str) -> list[str]:
 class MotionClips(Dataset):
     """Item ``(index, epoch)`` (or ``index``, epoch 0) -> dict of float32 tensors:
     x (window, D) normalized canonical features, y (window, D) normalized shape-aware features
-    (same frames), betas (10,). Clips shorter than ``window`` are left out (``self.skipped``)."""
+    (same frames), betas (10,). Clips shorter than ``window`` are left out (``self.skipped``).
+    ``stats``: (mean, std) to normalize with instead of the folder's Mean/Std (a model fine-tuned
+    from a checkpoint keeps the normalization it was trained with)."""
 
-    def __init__(self, root, split: str = "train", window: int = 64, seed: int = 0):
+    def __init__(self, root, split: str = "train", window: int = 64, seed: int = 0, stats=None):
         self.root = Path(root)
         if not self.root.is_dir():
             raise ShapeMoveError(f"dataset folder not found: {self.root}")
         self.window, self.seed = window, seed
         self.has_contacts = (self.root / "contacts").is_dir()
         self.mean, self.std = load_stats(self.root)
+        if stats is not None:
+            mean, std = (np.asarray(a, dtype=np.float32).reshape(-1) for a in stats)
+            if mean.shape != self.mean.shape or std.shape != self.std.shape:
+                raise ShapeMoveError(f"{self.root}: the model's Mean/Std have {mean.shape[0]} values, the dataset's features {self.mean.shape[0]}")
+            self.mean, self.std = mean, std
         self.ids, self.lengths, self.skipped = [], [], []
         for cid in read_split(self.root, split):
             try:

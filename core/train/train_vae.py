@@ -24,7 +24,7 @@ from ..body.load import load_body_model
 from ..body.soles import sole_offsets
 from ..errors import ShapeMoveError
 from ..models.fsq import codebook_usage
-from ..models.savae import SAVAE, SAVAEConfig, TrainSettings
+from ..models.savae import SAVAE, SAVAEConfig, TrainSettings, load_savae
 from ..models.vae_losses import bone_lengths, vae_losses
 from . import distributed
 from .checkpoint_cadence import finish, save_if_due
@@ -78,6 +78,26 @@ def batch_losses(model_out: dict, b: dict, model, cfg, body) -> dict:
                       body_soles(body, b["betas"]), b.get("contacts"))
 
 
+def start_from(cfg: SAVAEConfig, body_name: str) -> SAVAE:
+    """The trained SA-VAE ``cfg.train.init_from`` that a run starts from (fine-tuning), checked to
+    have the same network as ``cfg``: only losses and training settings may differ."""
+    src = load_savae(cfg.train.init_from, body=body_name)
+    mine = {k: v for k, v in cfg.to_dict().items() if k not in ("loss", "train")}
+    theirs = {k: v for k, v in src.cfg.to_dict().items() if k not in ("loss", "train")}
+    diff = [f"{k}: {theirs[k]!r} there, {mine[k]!r} here" for k in mine if mine[k] != theirs.get(k)]
+    if diff:
+        raise ShapeMoveError(f"train.init_from {cfg.train.init_from}: another network ({'; '.join(diff)})")
+    return src
+
+
+def freeze(model: SAVAE, parts) -> None:
+    """Leave ``parts`` (names of ``savae.PARTS``) as they are: no gradients, so the optimizer skips them.
+    With the encoder and quantizer frozen every clip keeps its tokens, so a T5 trained on the
+    starting codec's tokens works with the fine-tuned decoder."""
+    for name in parts:
+        getattr(model, name).requires_grad_(False)
+
+
 def _to(batch: dict, device) -> dict:
     return {k: v.to(device, non_blocking=True) for k, v in batch.items()}
 
@@ -106,7 +126,8 @@ def evaluate(model: SAVAE, dataset: MotionClips, cfg: SAVAEConfig, device, body=
 
 
 def train_vae(data, out, config: SAVAEConfig | None = None, steps: int | None = None, resume: bool = False,
-              body=None, device: str | None = None, progress=None, cancel=None, verbose: bool = True) -> dict:
+              body=None, device: str | None = None, progress=None, cancel=None, verbose: bool = True,
+              init_from=None) -> dict:
     """Train (or resume) an SA-VAE on the dataset folder ``data``; returns the last metrics.
 
     progress(fraction, message) is called on rank 0 every ``log_every`` steps; when cancel()
@@ -115,6 +136,8 @@ def train_vae(data, out, config: SAVAEConfig | None = None, steps: int | None = 
     cfg = copy.deepcopy(config) if config is not None else SAVAEConfig.small()
     if steps is not None:
         cfg.train.steps = int(steps)
+    if init_from is not None:
+        cfg.train.init_from = str(init_from)
     cfg.validate()
     t = cfg.train
     out = Path(out)
@@ -128,16 +151,23 @@ def train_vae(data, out, config: SAVAEConfig | None = None, steps: int | None = 
 def _train(data, out, cfg, t, resume, body, dist, progress, cancel, verbose) -> dict:
     if t.batch_size % dist.world_size:
         raise ShapeMoveError(f"batch_size {t.batch_size} must be divisible by the number of processes ({dist.world_size})")
-    # -- data ----------------------------------------------------------------------------------
-    train_set = MotionClips(data, "train", t.window, seed=t.seed)
-    val_set = MotionClips(data, "val", t.window, seed=t.seed + 1)
-    mean, std = train_set.mean, train_set.std
-    # -- model, body, optimizer, schedule ----------------------------------------------------
-    torch.manual_seed(t.seed)  # same initial weights on every rank
-    model = SAVAE(cfg, mean, std).to(dist.device)
     body = resolve_body(body)
     body_name = body.name
-    optimizer = torch.optim.AdamW(model.parameters(), lr=t.lr, betas=tuple(t.adam_betas), weight_decay=t.weight_decay)
+    source = start_from(cfg, body_name) if t.init_from else None
+    # -- data (normalized as the starting model was, when there is one) ----------------------
+    stats = (source.mean.numpy(), source.std.numpy()) if source is not None else None
+    train_set = MotionClips(data, "train", t.window, seed=t.seed, stats=stats)
+    val_set = MotionClips(data, "val", t.window, seed=t.seed + 1, stats=stats)
+    mean, std = train_set.mean, train_set.std
+    # -- model, optimizer, schedule ----------------------------------------------------------
+    torch.manual_seed(t.seed)  # same initial weights on every rank
+    model = SAVAE(cfg, mean, std)
+    if source is not None:
+        model.load_state_dict(source.state_dict())
+    freeze(model, t.freeze)
+    model = model.to(dist.device)
+    trained = [p for p in model.parameters() if p.requires_grad]
+    optimizer = torch.optim.AdamW(trained, lr=t.lr, betas=tuple(t.adam_betas), weight_decay=t.weight_decay)
     scheduler = torch.optim.lr_scheduler.LambdaLR(optimizer, lambda s: lr_factor(s, t, t.steps))
     step = 0
     last = out / "last.pt"
@@ -175,7 +205,7 @@ def _train(data, out, cfg, t, resume, body, dist, progress, cancel, verbose) -> 
         b = _to(next(batch_iter), dist.device)
         result = model(b["x"], b["betas"])
         losses = batch_losses(result, b, raw, cfg, body)
-        optimizer_step(losses["total"], optimizer, scheduler, raw.parameters(), t.grad_clip)
+        optimizer_step(losses["total"], optimizer, scheduler, trained, t.grad_clip)
         step += 1
         log.bar.update(1)
         done = step == t.steps
@@ -191,4 +221,4 @@ def _train(data, out, cfg, t, resume, body, dist, progress, cancel, verbose) -> 
 def from_cli(args) -> dict:
     """Entry point of `python -m shapemove train vae` (see cli/train.py)."""
     return train_vae(args.data, args.out, SAVAEConfig.load(args.config), steps=args.steps, resume=args.resume,
-                     body=args.body, device=args.device, verbose=not args.quiet)
+                     body=args.body, device=args.device, verbose=not args.quiet, init_from=args.init_from)
