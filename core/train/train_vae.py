@@ -29,7 +29,7 @@ from ..models.vae_losses import bone_lengths, vae_losses
 from . import distributed
 from .checkpoint_cadence import finish, save_if_due
 from .run_log import StepLog
-from .checkpoint import load_checkpoint, make_metadata, save_checkpoint, stats_hash
+from .checkpoint import config_differences, load_checkpoint, make_metadata, save_checkpoint, stats_hash
 from .motion_dataset import BatchStream, MotionClips
 from .optimizer_step import optimizer_step
 from .resume import restore, rng_state
@@ -82,11 +82,11 @@ def start_from(cfg: SAVAEConfig, body_name: str) -> SAVAE:
     """The trained SA-VAE ``cfg.train.init_from`` that a run starts from (fine-tuning), checked to
     have the same network as ``cfg``: only losses and training settings may differ."""
     src = load_savae(cfg.train.init_from, body=body_name)
-    mine = {k: v for k, v in cfg.to_dict().items() if k not in ("loss", "train")}
-    theirs = {k: v for k, v in src.cfg.to_dict().items() if k not in ("loss", "train")}
-    diff = [f"{k}: {theirs[k]!r} there, {mine[k]!r} here" for k in mine if mine[k] != theirs.get(k)]
+    theirs, mine = src.cfg.to_dict(), cfg.to_dict()
+    diff = config_differences(theirs, mine, ignore=("loss", "train"))
     if diff:
-        raise ShapeMoveError(f"train.init_from {cfg.train.init_from}: another network ({'; '.join(diff)})")
+        shown = "; ".join(f"{k}: {theirs.get(k)!r} there, {mine.get(k)!r} here" for k in diff)
+        raise ShapeMoveError(f"train.init_from {cfg.train.init_from}: another network ({shown})")
     return src
 
 
