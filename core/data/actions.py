@@ -151,25 +151,27 @@ def specific(acts: list[str]) -> list[str]:
     return [a for a in acts if a not in drop]
 
 
-def find_actions(text: str) -> list[str]:
-    """The canonical actions a text names, in order of appearance (longer overlapping match wins),
-    except that a specific action comes before the generic one it implies ("walks with a limp":
-    limp, walk)."""
+def action_spans(text: str) -> list[tuple[int, int, str]]:
+    """(start, end, action) of every action named in ``split_words(text)``, in order of appearance;
+    where two patterns overlap, the longer match wins ("jumping jacks" over "jump")."""
     text = split_words(text)
     hits = []  # (start, -length, name, end)
     for name, rx in _COMPILED:
         for m in rx.finditer(text):
             hits.append((m.start(), -(m.end() - m.start()), name, m.end()))
-    hits.sort()
-    taken: list[tuple[int, int]] = []
-    found: list[tuple[int, str]] = []
+    taken: list[tuple[int, int, str]] = []
     for start, neg, name, end in sorted(hits, key=lambda h: (h[1], h[0])):  # longest first
-        if any(start < e and end > s for s, e in taken):
-            continue
-        taken.append((start, end))
-        found.append((start, name))
+        if not any(start < e and end > s for s, e, _ in taken):
+            taken.append((start, end, name))
+    return sorted(taken)
+
+
+def find_actions(text: str) -> list[str]:
+    """The canonical actions a text names, in order of appearance (longer overlapping match wins),
+    except that a specific action comes before the generic one it implies ("walks with a limp":
+    limp, walk)."""
     out: list[str] = []
-    for _, name in sorted(found):
+    for _, _, name in action_spans(text):
         if name not in out:
             out.append(name)
     first = specific(out)

@@ -176,6 +176,13 @@ def source_of(cid: str) -> str:
     return cid[:-4] if cid.endswith("_aug") else cid
 
 
+def take_of(cid: str) -> str:
+    """The captured take a built clip shows: ``X``, ``X_aug`` and ``X_mirror`` are all ``X``."""
+    while cid.endswith(("_aug", "_mirror")):
+        cid = cid.rsplit("_", 1)[0]
+    return cid
+
+
 class FeatureEmbedder:
     """Unit vectors of raw (T, 263) features without any learned model: the features normalized
     with the dataset's Mean/Std, then their mean and std over time and the means of the four
@@ -258,14 +265,23 @@ class ActionClassifier:
         out.ids = ids  # the reference clips' ids (their captions: the nearest-caption baseline)
         return out
 
-    def classify_embeddings(self, emb: np.ndarray, chunk: int = 1024) -> list[str]:
+    def classify_embeddings(self, emb: np.ndarray, chunk: int = 1024, exclude: list | None = None) -> list[str]:
+        """Action of each embedding. ``exclude[i]``: a clip id whose captured take (the clip, its
+        mirror image and shape-augmented copies) row i must not find among the references (a
+        motion that IS a retrieved training clip, judged without itself), or None."""
         emb = np.asarray(emb, np.float32)
         if emb.ndim != 2 or emb.shape[1] != self.embeddings.shape[1]:
             raise ShapeMoveError(f"ActionClassifier: embeddings of shape {emb.shape}, expected (N, {self.embeddings.shape[1]})")
         emb = emb / np.linalg.norm(emb, axis=1, keepdims=True).clip(1e-8)
+        roots = np.asarray([take_of(c) for c in self.sources]) if exclude is not None else None
         out: list[str] = []
         for s in range(0, len(emb), chunk):  # (chunk, M) similarities at a time
-            out += knn_vote(emb[s:s + chunk] @ self.embeddings.T, self.labels, self.k)
+            sims = emb[s:s + chunk] @ self.embeddings.T
+            if roots is not None:
+                for i, cid in enumerate(exclude[s:s + chunk]):
+                    if cid is not None:
+                        sims[i, roots == take_of(cid)] = -1e9
+            out += knn_vote(sims, self.labels, self.k)
         return out
 
     def reachable(self, chunk: int = 512) -> dict:
@@ -295,11 +311,11 @@ class ActionClassifier:
         sims[src[index][:, None] == src[None, :]] = -np.inf
         return knn_vote(np.where(np.isfinite(sims), sims, -1e9), self.labels, self.k)
 
-    def classify(self, feats: list) -> list[str]:
-        """Action of each raw (T, 263) feature array."""
+    def classify(self, feats: list, exclude: list | None = None) -> list[str]:
+        """Action of each raw (T, 263) feature array (``exclude``: as ``classify_embeddings``)."""
         if self.embed is None:
             raise ShapeMoveError("ActionClassifier: built from embeddings only; it cannot embed motions")
-        return self.classify_embeddings(self.embed(feats)) if len(feats) else []
+        return self.classify_embeddings(self.embed(feats), exclude=exclude) if len(feats) else []
 
     def ceiling(self, data, split: str = "test", max_clips: int | None = None, seed: int = 0,
                 progress: bool = True) -> dict:

@@ -98,7 +98,8 @@ def _tally(rows: list[dict], key: str) -> dict:
 def eval_paraphrase(model_dir=None, prompts=None, tma=None, seed: int = 0, seconds: float | None = 4.0,
                     progress=None, generator=None, data=None, classifier=None, ceiling_clips: int | None = None,
                     show_progress: bool = True, candidates: int | None = None, feature_classifier=None,
-                    retrieval: bool = True, frequent: int = 20, retrieval_prefix: int | None = None) -> dict:
+                    retrieval: bool = True, frequent: int = 20, retrieval_prefix: int | None = None,
+                    retrieved: int | None = None, retrieval_first: float | None = None) -> dict:
     """Generate a motion per held-out prompt and classify it (module docstring). ``data``: the built
     dataset whose training clips the kNN classifier reads (default ``default_built_dir()``);
     ``classifier``: an ``ActionClassifier`` to use instead (``feature_classifier`` likewise for the
@@ -109,13 +110,16 @@ def eval_paraphrase(model_dir=None, prompts=None, tma=None, seed: int = 0, secon
     "unknown_action", "actions", "rows", ...}."""
     from ..generation.generate import Generator, Request
     from ..generation.model_bundle import model_files
-    from ..generation.sampling_params import DEFAULT_CANDIDATES, DEFAULT_RETRIEVAL_PREFIX
+    from ..generation.sampling_params import (DEFAULT_CANDIDATES, DEFAULT_RETRIEVAL_FIRST, DEFAULT_RETRIEVAL_PREFIX,
+                                              DEFAULT_RETRIEVED)
     from .action_classifier import ActionClassifier, FeatureEmbedder, default_built_dir
     from .tma_embed import embed_motions, embed_texts, load_tma
 
     items = load_prompts(prompts)
     candidates = DEFAULT_CANDIDATES if candidates is None else candidates
     retrieval_prefix = DEFAULT_RETRIEVAL_PREFIX if retrieval_prefix is None else retrieval_prefix
+    retrieved = DEFAULT_RETRIEVED if retrieved is None else retrieved
+    retrieval_first = DEFAULT_RETRIEVAL_FIRST if retrieval_first is None else retrieval_first
     if classifier is None:
         data = data if data is not None else default_built_dir()
         if data is None:
@@ -148,18 +152,20 @@ def eval_paraphrase(model_dir=None, prompts=None, tma=None, seed: int = 0, secon
     rows, embs, feats = [], [], []
     for i, it in enumerate(known):
         m = gen.generate_batch([Request(it["text"], seconds=seconds, seed=seed + i, candidates=candidates,
-                                        retrieval_prefix=retrieval_prefix)])[0]
+                                        retrieval_prefix=retrieval_prefix, retrieved=retrieved if retrieval else 0,
+                                        retrieval_first=retrieval_first)])[0]
         motion_emb = embed_motions(model, [m.features], mean, std)[0]
         embs.append(motion_emb)
         feats.append(m.features)
         rows.append({**it, "motion_proto_pred": actions[int(np.argmax(A @ motion_emb))],
-                     "warned": bool(m.warnings)})
+                     "warned": bool(m.warnings), "kept_clip": (gen.last_sources or [None])[0]})
         if progress is not None:
             progress((i + 1) / len(known), it["text"])
-    for r, p in zip(rows, classifier.classify_embeddings(np.stack(embs)) if embs else []):
+    kept = [r["kept_clip"] for r in rows]  # a retrieved clip is judged without its own take
+    for r, p in zip(rows, classifier.classify_embeddings(np.stack(embs), exclude=kept) if embs else []):
         r["motion_pred"] = p
     if feature_classifier is not None:
-        for r, p in zip(rows, feature_classifier.classify(feats)):
+        for r, p in zip(rows, feature_classifier.classify(feats, exclude=kept)):
             r["motion_features_pred"] = p
     text_emb = embed_texts(model, tok, [r["text"] for r in rows]) if rows else np.zeros((0, A.shape[1]))
     for r, t in zip(rows, text_emb):
@@ -182,6 +188,8 @@ def eval_paraphrase(model_dir=None, prompts=None, tma=None, seed: int = 0, secon
             "retrieval": bool(retrieval and gen.reads_memory),
             "candidates": candidates,
             "retrieval_prefix": retrieval_prefix if retrieval and gen.reads_memory else 0,
+            "retrieved": retrieved if retrieval else 0, "retrieval_first": retrieval_first,
+            "kept_retrieved": sum(r["kept_clip"] is not None for r in rows),
             "classifier": {**classifier.info, "ceiling": ceiling},
             "feature_classifier": dict(feature_classifier.info) if feature_classifier is not None else None,
             "unknown_action": sorted({it["action"] for it in items if it["action"] not in actions}),
@@ -266,7 +274,10 @@ def format_results(res: dict) -> str:
         lines.append(f"actions with >= {fr['min_clips']} real training clips ({fr['motion']['prompts']} prompts): motion "
                      f"{_pct(fr['motion']['accuracy'])} ({_pct(fr['motion']['accuracy_lenient'])} lenient)"
                      + (f", nearest caption {_pct(fr['nearest_caption']['accuracy'])}" if fr.get("nearest_caption") else ""))
-    lines.append(f"retrieved clips read by the decoder: {'yes' if res.get('retrieval') else 'no'}")
+    lines.append(f"retrieved clips read by the decoder: {'yes' if res.get('retrieval') else 'no'}; real clips "
+                 f"retrieved as candidates: {res.get('retrieved', 0)} per prompt"
+                 + (f", alone from caption similarity {res['retrieval_first']:g}" if res.get("retrieval_first") else "")
+                 + f"; kept a retrieved clip for {res.get('kept_retrieved', 0)} prompts (judged without its own take)")
     seeded = res.get("retrieval_prefix") or 0
     lines.append(f"best of {res.get('candidates', 1)} samples per prompt (TMA choice)"
                  + (f", half of them continuing the first {seeded} codes of a retrieved clip" if seeded else ""))
@@ -295,6 +306,10 @@ def add_arguments(p) -> None:
     p.add_argument("--no-retrieval", action="store_true", help="the decoder reads no retrieved clips (to compare)")
     p.add_argument("--retrieval-prefix", type=int, default=None, metavar="CODES",
                    help="codes of a retrieved clip half the candidates start from (default: the product's; 0: none)")
+    p.add_argument("--retrieved", type=int, default=None, metavar="CLIPS",
+                   help="real clips nearest by caption added to the candidates (default: the product's; 0: none)")
+    p.add_argument("--retrieval-first", type=float, default=None, metavar="SIM",
+                   help="caption similarity from which only retrieved clips compete (default: the product's)")
 
 
 def from_cli(args) -> int:
@@ -304,7 +319,8 @@ def from_cli(args) -> int:
     try:
         res = eval_paraphrase(args.model, args.prompts, args.tma, args.seed, args.seconds, progress, data=args.data,
                               show_progress=not args.quiet, candidates=args.candidates,
-                              retrieval=not args.no_retrieval, retrieval_prefix=args.retrieval_prefix)
+                              retrieval=not args.no_retrieval, retrieval_prefix=args.retrieval_prefix,
+                              retrieved=args.retrieved, retrieval_first=args.retrieval_first)
     finally:
         progress.close()
     return show_result(format_results(res), res, args.json)

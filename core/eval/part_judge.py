@@ -254,8 +254,9 @@ class PartKNN:
     def scores_of(self, x: np.ndarray, exclude_source: str | None = None) -> dict[str, float]:
         """``scores`` of a descriptor already normalized (a row of ``self.X``)."""
         d = np.linalg.norm(self.X - x[None], axis=1)
-        if exclude_source is not None:
-            d = np.where(self.sources == exclude_source, np.inf, d)
+        if exclude_source is not None:  # one source id, or several
+            ex = [exclude_source] if isinstance(exclude_source, str) else list(exclude_source)
+            d = np.where(np.isin(self.sources, ex), np.inf, d)
         out = {}
         for c in self.classes:
             dc = np.sort(d[self.labels == c])
@@ -409,9 +410,12 @@ class PartJudge:
                 "foot_side": "left" if foot[0] > foot[1] else "right",
                 "hand_activity_m": [round(v, 3) for v in hand], "foot_activity_m": [round(v, 3) for v in foot]}
 
-    def judge(self, features_list: list) -> list[dict]:
-        """One judgement per (T, 263) features array: legs (gait), path, arms, hand_side, foot_side."""
-        return [self.judge_joints(joints_of(f)) for f in features_list]
+    def judge(self, features_list: list, exclude: list | None = None) -> list[dict]:
+        """One judgement per (T, 263) features array: legs (gait), path, arms, hand_side, foot_side.
+        ``exclude[i]``: reference clip ids motion i must not find (the training clips it was
+        retrieved from: a copy is judged without itself), or None."""
+        ex = exclude if exclude is not None else [None] * len(features_list)
+        return [self.judge_joints(joints_of(f), e or None) for f, e in zip(features_list, ex)]
 
 
 def legs_right(expected: str, judged: dict) -> bool:

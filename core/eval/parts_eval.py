@@ -90,17 +90,20 @@ def _by(rows: list[dict], key: str, flags: tuple[str, ...]) -> dict:
 
 def eval_parts(model_dir=None, data=None, sides=None, two_things=None, seed: int = 0, seconds: float = 4.0,
                candidates: int | None = None, retrieval: bool = True, generator=None, judge=None,
-               judge_check: bool = True, progress=None, show_progress: bool = True) -> dict:
+               judge_check: bool = True, progress=None, show_progress: bool = True, by_parts: bool = True,
+               retrieved: int | None = None, retrieval_first: float | None = None) -> dict:
     """Generate one motion per held-out prompt and judge it by part (module docstring). Returns
     {"sides": {...}, "two_things": {...}, "judge_real", "targets", "settings", "rows": {...}}."""
     from ..generation.generate import Generator, Request
-    from ..generation.sampling_params import DEFAULT_CANDIDATES
-    from .action_classifier import default_built_dir
+    from ..generation.sampling_params import DEFAULT_CANDIDATES, DEFAULT_RETRIEVAL_FIRST, DEFAULT_RETRIEVED
+    from .action_classifier import default_built_dir, take_of
     from .part_judge import PartJudge, arms_right, legs_right
     from .part_judge_accuracy import real_accuracy
 
     side_items, two_items = load_sides(sides), load_two_things(two_things)
     candidates = DEFAULT_CANDIDATES if candidates is None else candidates
+    retrieved = DEFAULT_RETRIEVED if retrieved is None else retrieved
+    retrieval_first = DEFAULT_RETRIEVAL_FIRST if retrieval_first is None else retrieval_first
     if judge is None:
         data = data if data is not None else default_built_dir()
         if data is None:
@@ -116,21 +119,24 @@ def eval_parts(model_dir=None, data=None, sides=None, two_things=None, seed: int
 
     def generate(text: str, s: int):
         nonlocal done
-        m = gen.generate_batch([Request(text, seconds=seconds, seed=s, candidates=candidates)])[0]
+        m = gen.generate_batch([Request(text, seconds=seconds, seed=s, candidates=candidates, by_parts=by_parts,
+                                        retrieved=retrieved if retrieval else 0, retrieval_first=retrieval_first)])[0]
         done += 1
         if progress is not None:
             progress(done / total, text)
-        return judge.judge([m.features])[0], bool(m.warnings)
+        how = {"part_prompts": list(m.part_prompts) if m.part_prompts else None,
+               "mirrored": bool(m.mirrored or m.arms_mirrored), "retrieved_clips": list(m.retrieved_clips)}
+        return judge.judge([m.features], [{take_of(c) for c in m.retrieved_clips}])[0], bool(m.warnings), how
 
     side_rows, two_rows = [], []
     for i, it in enumerate(side_items):
-        j, warned = generate(it["text"], seed + i)
-        side_rows.append({**it, "judged": j, "right": j[f"{it['part']}_side"] == it["side"], "warned": warned})
+        j, warned, how = generate(it["text"], seed + i)
+        side_rows.append({**it, "judged": j, "right": j[f"{it['part']}_side"] == it["side"], "warned": warned, **how})
     for i, it in enumerate(two_items):
-        j, warned = generate(it["text"], seed + i)
+        j, warned, how = generate(it["text"], seed + i)
         lr, ar = legs_right(it["legs"], j), arms_right(it["arms"], j)
         two_rows.append({**it, "pair": f"{it['legs']} + {it['arms']}", "judged": j, "legs_right": lr,
-                         "arms_right": ar, "both_right": lr and ar, "warned": warned})
+                         "arms_right": ar, "both_right": lr and ar, "warned": warned, **how})
     return {
         "sides": {"named_side_moves_most": _share([r["right"] for r in side_rows]), "prompts": len(side_rows),
                   "per_part": _by(side_rows, "part", ("right",)), "per_side": _by(side_rows, "side", ("right",))},
@@ -142,7 +148,8 @@ def eval_parts(model_dir=None, data=None, sides=None, two_things=None, seed: int
         "judge_real": real,
         "judge": dict(judge.info),
         "settings": {"model": str(getattr(gen, "model_dir", model_dir)), "seed": seed, "seconds": seconds,
-                     "candidates": candidates, "samples_per_prompt": 1,
+                     "candidates": candidates, "samples_per_prompt": 1, "by_parts": by_parts,
+                     "retrieved": retrieved if retrieval else 0, "retrieval_first": retrieval_first,
                      "retrieval": ("on" if retrieval else "off") if reads_memory else "none (the model reads no memory)",
                      "sides_file": str(Path(sides) if sides else DEFAULT_SIDES),
                      "two_things_file": str(Path(two_things) if two_things else DEFAULT_TWO_THINGS)},
@@ -173,6 +180,11 @@ def format_results(res: dict) -> str:
     st = res["settings"]
     lines.append(f"one motion per prompt (seed {st['seed']} + i, {st['seconds']} s, best of {st['candidates']} token "
                  f"samples by the TMA), retrieval {st['retrieval']}")
+    rows = res["rows"]["sides"] + res["rows"]["two_things"]
+    lines.append(f"by body part: {'on' if st.get('by_parts', True) else 'off'}; composed {sum(bool(r.get('part_prompts')) for r in rows)}, "
+                 f"mirrored {sum(bool(r.get('mirrored')) for r in rows)}, a retrieved clip kept for "
+                 f"{sum(bool(r.get('retrieved_clips')) for r in rows)} of {len(rows)} prompts "
+                 f"({st.get('retrieved', 0)} clips offered per prompt; judged without their own takes)")
     return "\n".join(lines)
 
 
@@ -191,6 +203,12 @@ def add_arguments(p) -> None:
                    help="token samples per prompt, the TMA keeps the closest (default: the product's, 8; 1 = none)")
     p.add_argument("--no-retrieval", action="store_true",
                    help="a model that reads retrieved clips gets none (an empty memory): the prompt alone")
+    p.add_argument("--no-parts", action="store_true",
+                   help="generate each prompt whole: no composition by body part, no mirroring to the named side")
+    p.add_argument("--retrieved", type=int, default=None, metavar="CLIPS",
+                   help="real clips nearest by caption added to the candidates (default: the product's; 0: none)")
+    p.add_argument("--retrieval-first", type=float, default=None, metavar="SIM",
+                   help="caption similarity from which only retrieved clips compete (default: the product's)")
     p.add_argument("--no-judge-check", action="store_true", help="skip the judge's accuracy on the real test clips")
     p.add_argument("--json", type=Path, default=None, help="write the results here")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
@@ -205,7 +223,8 @@ def from_cli(args) -> int:
     try:
         res = eval_parts(args.model, args.data, args.sides, args.two_things, args.seed, args.seconds, args.candidates,
                          retrieval=not args.no_retrieval, judge_check=not args.no_judge_check, progress=progress,
-                         show_progress=not args.quiet)
+                         show_progress=not args.quiet, by_parts=not args.no_parts, retrieved=args.retrieved,
+                         retrieval_first=args.retrieval_first)
     finally:
         progress.close()
     return show_result(format_results(res), res, args.json)

@@ -28,11 +28,14 @@ from ..scene.motion_file import Motion
 from ..torch_threads import one_torch_thread
 from .decode import decode_features, decode_tokens, redecode
 from .model_bundle import model_files, part_warnings, resolve_model_dir
+from .parts import generate_by_parts
 from .prompts import check_prompt
 from .rerank import CandidatePicker
 from .retrieval_seeds import seed_prefixes, seeded_count
-from .sampling_params import (DEFAULT_CANDIDATES, DEFAULT_GUIDANCE, DEFAULT_RETRIEVAL_PREFIX, check_candidates,
-                              check_guidance, check_retrieval_prefix, check_sampling)
+from .retrieved_candidates import retrieved_codes
+from .sampling_params import (DEFAULT_CANDIDATES, DEFAULT_GUIDANCE, DEFAULT_RETRIEVAL_FIRST, DEFAULT_RETRIEVAL_PREFIX,
+                              DEFAULT_RETRIEVED, check_candidates, check_guidance, check_retrieval_first,
+                              check_retrieval_prefix, check_retrieved, check_sampling)
 
 
 @dataclass
@@ -48,6 +51,9 @@ class Request:
     candidates: int = DEFAULT_CANDIDATES  # token samples drawn; the TMA keeps the one closest to the prompt
     guidance: float | None = None  # classifier-free guidance scale; None: the model's default (0 without a null prompt)
     retrieval_prefix: int = DEFAULT_RETRIEVAL_PREFIX  # codes of a retrieved clip half the candidates start from (0: none)
+    retrieved: int = DEFAULT_RETRIEVED  # real clips nearest by caption added to the candidates (0: none)
+    retrieval_first: float | None = DEFAULT_RETRIEVAL_FIRST  # caption similarity from which only retrieved clips compete
+    by_parts: bool = True  # two things at once composed by body part, a named side mirrored (parts.py)
 
 
 def _rows(inputs: tuple | None, a: int, b: int) -> tuple | None:
@@ -111,6 +117,7 @@ class Generator:
         self.default_guidance = DEFAULT_GUIDANCE if trained_null > 0 else 0.0  # a model without a null prompt: none
         self._tma_file = files.get("tma")
         self._picker = None
+        self.last_sources: list[str | None] = []  # tokens_for: the retrieved clip each request kept, or None
 
     @property
     def picker(self) -> CandidatePicker | None:
@@ -136,6 +143,7 @@ class Generator:
         if self.t5 is None:
             raise ShapeMoveError(f"{self.model_dir} has no t5/ model: text-to-motion needs one (train t5)")
         codes, betas = [], []
+        self.last_sources = []  # per request: the memory clip whose tokens were kept, None for a sample
         with one_torch_thread():
             for r in reqs:  # one at a time: each has its own seed, length and temperature
                 g = torch.Generator().manual_seed(int(r.seed))
@@ -153,13 +161,29 @@ class Generator:
                                  generator=g, guidance=s, null_inputs=_rows(null, a, b), prefix_codes=prefix)
                     cands += out.codes
                     beta = out.betas[0] if beta is None else beta  # [BETA] precedes the codes: one body for all
+                sources = [None] * len(cands)
+                if n > 1:  # real clips nearest by caption compete with the samples, or replace them
+                    found = self._retrieved(r, lo, hi)
+                    if found and r.retrieval_first is not None and found[0][1] >= r.retrieval_first:
+                        cands, sources = [], []
+                    for cid, _, c in found:
+                        cands.append(c)
+                        sources.append(cid)
                 best = 0
-                if n > 1:
+                if len(cands) > 1:
                     feats = [decode_features(c, self.vae, beta.numpy()).numpy() for c in cands]
                     best = self.picker.pick(r.prompt, feats)
                 codes.append(cands[best])
                 betas.append(beta)
+                self.last_sources.append(sources[best])
         return codes, torch.stack(betas)
+
+    def _retrieved(self, r: Request, lo: int, hi: int) -> list[tuple[str, float, list[int]]]:
+        """(clip id, caption similarity, codes) of the memory's clips nearest to the prompt (``retrieved_candidates.py``),
+        when the model folder has a memory and retrieval is on."""
+        if not r.retrieved or self.t5.memory is None or not self.t5.memory_enabled:
+            return []
+        return retrieved_codes(self.t5.memory, self._text_encoder(), r.prompt, r.retrieved, lo, hi)
 
     def _retrieval_seeds(self, r: Request, n: int) -> list[list[int]]:
         """Prefixes for the seeded share of ``n`` candidates (``retrieval_seeds.py``): only for a model
@@ -246,6 +270,8 @@ class Generator:
             r.candidates = check_candidates(r.candidates)
             r.guidance = check_guidance(r.guidance)
             r.retrieval_prefix = check_retrieval_prefix(r.retrieval_prefix)
+            r.retrieved = check_retrieved(r.retrieved)
+            r.retrieval_first = check_retrieval_first(r.retrieval_first)
         checks = []
         for r in reqs:  # every text checked before any generation
             with one_torch_thread():
@@ -260,10 +286,13 @@ class Generator:
         for i, (r, check) in enumerate(zip(reqs, checks)):
             if cancel is not None and cancel():
                 break
-            codes, pred = self.tokens_for([r])
-            betas, source = self.body_shape(r, pred[0].numpy())
-            motion = self.decode_motion(codes[0], betas, prompt=r.prompt)
-            motion.shape_source = source
+            motion = generate_by_parts(self, r) if r.by_parts else None
+            if motion is None:  # one action, no side named: the motion as the model writes it
+                codes, pred = self.tokens_for([r])
+                betas, source = self.body_shape(r, pred[0].numpy())
+                motion = self.decode_motion(codes[0], betas, prompt=r.prompt)
+                motion.shape_source = source
+                motion.retrieved_clips = [c for c in self.last_sources if c]
             motion.warnings = [check.warning] if check is not None and check.warning else []
             if r.candidates > 1 and r.temperature > 0:  # best-of-N wanted: say when the model cannot pick
                 motion.warnings += part_warnings(self.model_dir)

@@ -15,6 +15,9 @@ DEFAULT_GUIDANCE = 2.0    # classifier-free guidance of models trained with null
 MAX_GUIDANCE = 20.0
 DEFAULT_RETRIEVAL_PREFIX = 2  # codes of a retrieved clip a seeded candidate starts from (retrieval_seeds.py)
 MAX_RETRIEVAL_PREFIX = 12
+DEFAULT_RETRIEVED = 2  # real clips nearest by caption added to best-of-N's candidates (retrieved_candidates.py)
+MAX_RETRIEVED = 16
+DEFAULT_RETRIEVAL_FIRST = None  # caption similarity from which only retrieved clips compete (None: never)
 
 
 def _integer(value, name: str) -> int:
@@ -79,3 +82,21 @@ def check_retrieval_prefix(n) -> int:
         raise ShapeMoveError(f"retrieval prefix must be between 0 and {MAX_RETRIEVAL_PREFIX} codes, "
                              f"got {n if abs(n) < 10**9 else 'a huge number'}")
     return n
+
+
+def check_retrieved(n) -> int:
+    """Real clips retrieved as extra candidates (``retrieved_candidates.py``): 0 (none) to ``MAX_RETRIEVED``."""
+    n = _integer(n, "retrieved clips")
+    if not 0 <= n <= MAX_RETRIEVED:
+        raise ShapeMoveError(f"retrieved clips must be between 0 and {MAX_RETRIEVED}, "
+                             f"got {n if abs(n) < 10**9 else 'a huge number'}")
+    return n
+
+
+def check_retrieval_first(s) -> float | None:
+    """None (retrieved clips only compete with the samples) or a caption similarity in [0, 1]."""
+    if s is None:
+        return None
+    if isinstance(s, bool) or not isinstance(s, (int, float)) or not math.isfinite(float(s)) or not 0 <= s <= 1:
+        raise ShapeMoveError(f"retrieval-first similarity must be a number from 0 to 1, got {str(s)[:40]!r}")
+    return float(s)

@@ -1,0 +1,124 @@
+"""What a prompt asks of each body part: two things at once, and a named side.
+
+    plan = plan_parts("a woman jogs along, waving her left hand")
+    plan.legs_prompt   -> "a woman jogs along"
+    plan.arms_prompt   -> "a person waving her left hand"
+    plan.arms_side     -> ("left", "hand")
+    named_side("kick with your right foot")  -> ("right", "foot")
+
+Actions are found by the dataset's own action patterns (``data/actions.py``: one vocabulary for
+captions, labels and prompts). A prompt is **two things at once** when it names a locomotion
+(``LEGS``: walk, jog, run, march, sneak, limp, sidestep, walk backward, in a circle, ...) and an
+arm gesture (``ARMS``: wave, punch, throw, raise a hand, beckon, reach up, arm circles, ...) and
+no order between them ("then", "after", "before": a sequence is the timeline's job,
+``sequence.py``). The text is cut between the two at the connector that joins them (",", "while",
+"as", "and", "with", ...; else where the second action starts); each clause becomes its own
+prompt, the one without a subject getting "a person".
+
+A **named side** is "left" or "right" with a body part ("left hand", "his right leg", "the left
+one"...) or with an action of one part ("kicks left" is a foot, "punches with the right" a hand).
+"Turns left", "to the right", "walks left" name a direction, not a side, and are not read.
+"""
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+
+from ..data.actions import action_spans, split_words
+from ..data.compose_parts import ARMS_ACTIONS, LEGS_ACTIONS
+
+LEGS = frozenset(LEGS_ACTIONS) | {"sprint", "walk in a figure eight", "zombie walk"}
+ARMS = frozenset(ARMS_ACTIONS)
+FOOT_ACTIONS = frozenset({"kick", "spin kick", "kick ball", "hop"})
+SEQUENCE = re.compile(r"\b(then|after|afterwards|before|followed by|next|finally|later)\b")
+CONNECTOR = re.compile(r",|;|\b(?:while|whilst|as|and|with|at the same time|all the while|meanwhile|"
+                       r"simultaneously)\b")
+SUBJECT = re.compile(r"^(?:(?:a|an|the|this|that|one|some|my|our|his|her|their|your)\s+)?(?:\w+\s+){0,3}?"
+                     r"(?:person|man|woman|boy|girl|guy|lady|kid|child|someone|somebody|he|she|they|people|"
+                     r"soldier|dancer|athlete|figure|character|actor|player|runner|walker|human|i|you|we)\b")
+HAND_WORDS = r"hand|hands|arm|arms|fist|fists|palm|elbow|shoulder|wrist|finger|fingers"
+FOOT_WORDS = r"foot|feet|leg|legs|knee|knees|heel|toe|toes|shin|ankle|thigh"
+SIDE = re.compile(r"\b(left|right)\b(?:(?:-|\s+)(?:(?:hand(?:ed)?|arm(?:ed)?|foot(?:ed)?|leg(?:ged)?)\b|"
+                  r"(?:\w+\s+){0,1}?(" + HAND_WORDS + "|" + FOOT_WORDS + r")\b))?")
+DIRECTION = re.compile(r"\b(?:to|towards?|on) (?:the|his|her|their|your|its) (?:left|right)\b|"
+                       r"\b(?:turn|turns|turning|turned|veer|veers|steer|steers|bear|bears|head|heads|go|goes|"
+                       r"walk|walks|step|steps|move|moves|look|looks|curve|curves|spin|spins|rotate|rotates)"
+                       r"\s+(?:to\s+)?(?:left|right)\b")
+
+
+@dataclass(frozen=True)
+class PartPlan:
+    legs_prompt: str
+    arms_prompt: str
+    legs_action: str
+    arms_action: str
+    arms_side: tuple[str, str] | None   # ("left" | "right", "hand"), when the arms clause names a side
+
+
+def _part_of(word: str | None) -> str | None:
+    if not word:
+        return None
+    w = word.lower()
+    if re.fullmatch(HAND_WORDS, w) or w.startswith(("hand", "arm")):
+        return "hand"
+    if re.fullmatch(FOOT_WORDS, w) or w.startswith(("foot", "leg")):
+        return "foot"
+    return None
+
+
+def named_side(text: str) -> tuple[str, str] | None:
+    """("left" | "right", "hand" | "foot") when the text names one side of the body, else None
+    (no side, both sides, or only a direction such as "turns left")."""
+    t = DIRECTION.sub(" ", split_words(text))
+    found = set()
+    for m in SIDE.finditer(t):
+        word = m.group(2) or re.sub(r"^(left|right)[-\s]+", "", m.group(0)).strip() or None
+        part = _part_of(word)
+        if part is None:  # "the left one", "with the right": the part the action moves
+            acts = [a for _, _, a in action_spans(t)]
+            if any(a in FOOT_ACTIONS for a in acts):
+                part = "foot"
+            elif any(a in ARMS or a in ("punch", "slash") for a in acts):
+                part = "hand"
+        if part is not None:
+            found.add((m.group(1), part))
+    sides = {s for s, _ in found}
+    if len(sides) != 1:
+        return None
+    parts = {p for _, p in found}
+    return (sides.pop(), parts.pop()) if len(parts) == 1 else None
+
+
+def _tidy(clause: str) -> str:
+    c = CONNECTOR.sub(lambda m: m.group(0) if m.group(0).isalpha() else " ", clause)
+    c = re.sub(r"^\W*(?:(?:while|whilst|as|and|with|at the same time|all the while|meanwhile|simultaneously)\b\W*)+",
+               "", c.strip())
+    c = re.sub(r"\W*\b(?:at the same time|simultaneously|meanwhile)\W*$", "", c)
+    return re.sub(r"\s+", " ", c).strip(" ,.;")
+
+
+def _with_subject(clause: str) -> str:
+    return clause if SUBJECT.match(clause) else f"a person {clause}"
+
+
+def plan_parts(text: str) -> PartPlan | None:
+    """The legs and arms prompts of a two-things-at-once prompt (module docstring), or None."""
+    t = split_words(text).strip()
+    if SEQUENCE.search(t):
+        return None
+    spans = action_spans(t)
+    legs = next((s for s in spans if s[2] in LEGS), None)
+    arms = next((s for s in spans if s[2] in ARMS), None)
+    if legs is None or arms is None:
+        return None
+    first, second = sorted([legs, arms])
+    cuts = [m.start() for m in CONNECTOR.finditer(t, first[1], second[0])]
+    cut = cuts[0] if cuts else second[0]
+    a, b = _tidy(t[:cut]), _tidy(t[cut:])
+    if not a or not b:
+        return None
+    legs_clause, arms_clause = (a, b) if first is legs else (b, a)
+    arms_prompt = _with_subject(arms_clause)
+    side = named_side(arms_prompt)
+    return PartPlan(_with_subject(legs_clause), arms_prompt, legs[2], arms[2],
+                    side if side is not None and side[1] == "hand" else None)

@@ -1,0 +1,58 @@
+"""What a prompt asks of each body part (core/generation/part_prompts.py): two things at once split
+into a legs prompt and an arms prompt; a named side read, a direction not mistaken for one."""
+from __future__ import annotations
+
+import pytest
+
+from shapemove.core.generation.part_prompts import named_side, plan_parts
+
+
+@pytest.mark.parametrize("text, legs, arms, acts", [
+    ("a woman jogs along, waving her left hand", "a woman jogs along", "a person waving her left hand", ("jog", "wave")),
+    ("She waves as she walks.", "she walks", "she waves", ("walk", "wave")),
+    ("he sprints and punches the air", "he sprints", "a person punches the air", ("sprint", "punch")),
+    ("a person walks backwards beckoning", "a person walks backwards", "a person beckoning", ("walk backward", "beckon")),
+    ("a man marches while throwing a ball", "a man marches", "a person throwing a ball", ("march", "throw")),
+])
+def test_two_things_split_into_a_legs_and_an_arms_prompt(text, legs, arms, acts):
+    plan = plan_parts(text)
+    assert plan is not None
+    assert (plan.legs_prompt, plan.arms_prompt) == (legs, arms)
+    assert (plan.legs_action, plan.arms_action) == acts
+
+
+def test_the_arms_clause_carries_its_side():
+    assert plan_parts("a woman jogs along, waving her left hand").arms_side == ("left", "hand")
+    assert plan_parts("someone walks and waves the right arm").arms_side == ("right", "hand")
+    assert plan_parts("a person jogs forward and waves").arms_side is None
+
+
+@pytest.mark.parametrize("text", [
+    "a person walks forward",             # one action
+    "a person waves",                     # one action
+    "a person walks and then waves",      # a sequence is the timeline's job
+    "someone waves, after that he runs",
+    "a person runs and jumps",            # two locomotions: no arms gesture
+    "a person kicks and punches",         # no locomotion
+])
+def test_not_two_things_at_once(text):
+    assert plan_parts(text) is None
+
+
+@pytest.mark.parametrize("text, side", [
+    ("raise your left hand", ("left", "hand")),
+    ("kick with the right foot", ("right", "foot")),
+    ("a man kicks left", ("left", "foot")),
+    ("punches with the left", ("left", "hand")),
+    ("a left-handed throw", ("left", "hand")),
+    ("lifts the right knee high", ("right", "foot")),
+    ("the person raises their right arm", ("right", "hand")),
+    ("steps right with the left foot", ("left", "foot")),
+    ("turns left and waves", None),
+    ("walks to the right", None),
+    ("a person turns right", None),
+    ("waves with both the left and right hands", None),
+    ("a person waves", None),
+])
+def test_named_side(text, side):
+    assert named_side(text) == side

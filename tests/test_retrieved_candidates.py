@@ -1,0 +1,92 @@
+"""Real clips retrieved by caption as best-of-N candidates (core/generation/retrieved_candidates.py)
+and the judges that must not find a retrieved clip's own take (eval/action_classifier.py)."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from shapemove.core.errors import ShapeMoveError
+from shapemove.core.generation.retrieved_candidates import retrieved_codes, windows
+
+pytestmark = pytest.mark.usefixtures("one_thread")
+
+
+def test_windows_cut_a_clip_to_the_requested_length():
+    c = list(range(30))
+    assert windows(c, 5, 40) == [c]                      # fits: the whole clip
+    assert windows(c, 31, 40) == []                     # shorter than the least asked for
+    w = windows(c, 10, 10)
+    assert w == [c[0:10], c[10:20], c[20:30]]           # start, middle, end
+    assert windows(list(range(11)), 10, 10) == [list(range(10)), list(range(1, 11))]
+
+
+@pytest.fixture(scope="module")
+def gen():
+    from shapemove.core.generation.generate import Generator
+
+    return Generator(None)
+
+
+@pytest.fixture()
+def memory(gen):
+    """A memory of three clips of the default model's own tokens: a walk and two punches."""
+    from shapemove.core.generation.generate import Request
+    from shapemove.core.models.motion_memory import MotionMemory
+
+    walk = gen.tokens_for([Request("a person walks forward", seconds=4, seed=0, candidates=1)])[0][0]
+    punch = gen.tokens_for([Request("a person throws punches", seconds=6, seed=0, candidates=1)])[0][0]
+    mem = MotionMemory([], __import__("torch").zeros(0, 384), [], [], [])
+    mem.add_clips(["walk_1", "punch_1", "punch_1_mirror"],
+                  [["a person walks forward."], ["a person throws punches."], ["a person throws punches."]],
+                  [walk, punch, punch[:12]], gen._text_encoder())
+    return mem
+
+
+def test_retrieved_codes_are_the_nearest_captions_clips(gen, memory):
+    rows = retrieved_codes(memory, gen._text_encoder(), "somebody punches", 1, 20, 20)
+    assert [r[0] for r in rows] == ["punch_1"] * 3      # a 30-code clip gives three 20-code windows
+    assert rows[0][1] > 0.7 and rows[0][2] == [int(x) for x in memory.clip_tokens[1][:20]]
+    rows = retrieved_codes(memory, gen._text_encoder(), "somebody punches", 2, 4, 50)
+    assert [r[0] for r in rows] == ["punch_1", "walk_1"]  # one clip per caption, then the next caption's
+    assert retrieved_codes(None, gen._text_encoder(), "x", 2, 4, 50) == []
+
+
+def test_generation_keeps_a_retrieved_clip_only_when_it_wins(gen, memory):
+    from shapemove.core.generation.generate import Request
+
+    old = gen.t5.memory
+    gen.t5.memory = memory
+    try:
+        # retrieval first from similarity 0: only the retrieved windows compete
+        m = gen.generate_batch([Request("a man throws punches", seconds=4, seed=0, retrieval_first=0.0)])[0]
+        assert m.retrieved_clips == ["punch_1"]
+        assert any(list(m.tokens) == w for w in windows(memory.clip_tokens[1], 20, 20))
+        # no clips offered: the samples alone
+        m = gen.generate_batch([Request("a man throws punches", seconds=4, seed=0, retrieved=0)])[0]
+        assert m.retrieved_clips == []
+        # retrieval off turns the candidates off too
+        gen.set_retrieval(False)
+        m = gen.generate_batch([Request("a man throws punches", seconds=4, seed=0, retrieval_first=0.0)])[0]
+        assert m.retrieved_clips == []
+    finally:
+        gen.t5.memory = old
+        gen.set_retrieval(True)
+    with pytest.raises(ShapeMoveError, match="retrieved clips"):
+        gen.generate_batch([Request("a man throws punches", retrieved=-1)])
+    with pytest.raises(ShapeMoveError, match="retrieval-first"):
+        gen.generate_batch([Request("a man throws punches", retrieval_first=1.5)])
+
+
+def test_a_judge_does_not_find_the_retrieved_take_itself():
+    from shapemove.core.eval.action_classifier import ActionClassifier, take_of
+
+    assert take_of("clip_7_mirror_aug") == take_of("clip_7") == "clip_7"
+    e = np.eye(8, dtype=np.float32)[[0, 0, 0, 1, 1, 1, 2, 2]] + 0.01
+    labels = ["kick"] * 3 + ["walk"] * 3 + ["wave"] * 2
+    sources = ["k", "k_mirror", "k_aug", "w1", "w2", "w3", "v1", "v2"]
+    clf = ActionClassifier(e, labels, None, 3, {}, None, sources)
+    q = np.eye(8, dtype=np.float32)[[0]] + 0.02
+    assert clf.classify_embeddings(q) == ["kick"]
+    # the query IS take "k": without its three copies, the kick is no longer its own neighbour
+    assert clf.classify_embeddings(q, exclude=["k_mirror"]) != ["kick"]
+    assert clf.classify_embeddings(q, exclude=[None]) == ["kick"]
