@@ -47,6 +47,8 @@ def run(args) -> int:
     print(f"shape text:  {args.shape_text}  (body from: {motion.shape_source or '[BETA] head'})")
     print(f"motion:      {motion.num_frames} frames at {motion.fps:g} fps ({motion.num_frames / motion.fps:.1f} s), "
           f"{len(motion.tokens)} tokens, generated in {t1 - t0:.1f} s")
+    if motion.part_prompts:
+        print(f"by part:     legs {motion.part_prompts[0]!r}, arms {motion.part_prompts[1]!r}")
     print(f"body:        {shape_adjectives(m)}: " + format_body(m))
     print(f"scene:       {(args.out / 'shapemove.blend').resolve()}  ({info['vertices']} vertices, {info['bones']} bones, "
           f"frames {info['frame_start']}-{info['frame_end']})")

@@ -38,6 +38,14 @@ def add_arguments(p):
     p.add_argument("--retrieval-prefix", type=int, default=None, metavar="CODES",
                    help="half the candidates continue the first CODES codes (4 frames each) of the nearest "
                         "clips by caption (default 2; 0 = none)")
+    p.add_argument("--retrieved", type=int, default=None, metavar="CLIPS",
+                   help="real clips of the model's memory nearest by caption compete with the samples "
+                        "(default 2; 0 = none)")
+    p.add_argument("--retrieval-first", type=float, default=None, metavar="SIM",
+                   help="from this caption similarity (0-1) only the retrieved clips compete (default: never)")
+    p.add_argument("--no-parts", action="store_true",
+                   help="generate the prompt whole: no legs + arms composition of two things at once, no mirroring "
+                        "to a named left or right")
     add_animation_arguments(p)
 
 
@@ -72,10 +80,13 @@ def run(args) -> int:
     if args.out.suffix.lower() != ".npz":
         raise ShapeMoveError(f"--out must end in .npz, got {args.out}")
     check_sampling(args.seed, args.temperature, args.top_k)  # before loading any model
-    from ..core.generation.sampling_params import (DEFAULT_CANDIDATES, DEFAULT_RETRIEVAL_PREFIX, check_candidates,
-                                                   check_guidance, check_retrieval_prefix)
+    from ..core.generation.sampling_params import (DEFAULT_CANDIDATES, DEFAULT_RETRIEVAL_FIRST, DEFAULT_RETRIEVAL_PREFIX,
+                                                   DEFAULT_RETRIEVED, check_candidates, check_guidance,
+                                                   check_retrieval_first, check_retrieval_prefix, check_retrieved)
 
     candidates = check_candidates(DEFAULT_CANDIDATES if args.candidates is None else args.candidates)
+    retrieved = check_retrieved(DEFAULT_RETRIEVED if args.retrieved is None else args.retrieved)
+    first = check_retrieval_first(DEFAULT_RETRIEVAL_FIRST if args.retrieval_first is None else args.retrieval_first)
     prefix = check_retrieval_prefix(DEFAULT_RETRIEVAL_PREFIX if args.retrieval_prefix is None else args.retrieval_prefix)
     guidance = check_guidance(args.guidance)
     ensure_parent(args.out)  # a parent that is a file, or no permission: said now, not after generating
@@ -89,7 +100,8 @@ def run(args) -> int:
     from ..core.generation.generate import Request
 
     motion = animate(gen, Request(args.prompt, args.shape_text, betas, args.seconds, args.seed, args.temperature,
-                                  args.top_k, args.shape_from, candidates, guidance, prefix), animation)
+                                  args.top_k, args.shape_from, candidates, guidance, prefix, retrieved, first,
+                                  not args.no_parts), animation)
     save_motion(args.out, motion)
     import sys
 
@@ -98,6 +110,13 @@ def run(args) -> int:
     m = measure(gen.body, motion.betas)
     print(f"wrote {args.out}: {motion.num_frames} frames ({motion.num_frames / motion.fps:.1f} s), "
           f"{len(motion.tokens) if motion.tokens is not None else 0} tokens, IK error {motion.ik_error_cm:.2f} cm")
+    if motion.part_prompts:
+        print(f"two things at once: legs {motion.part_prompts[0]!r}, arms {motion.part_prompts[1]!r}"
+              + (" (arms mirrored to the named side)" if motion.arms_mirrored else ""))
+    elif motion.mirrored:
+        print("mirrored: the named side now moves most")
+    if motion.retrieved_clips:
+        print(f"kept a retrieved training clip: {', '.join(motion.retrieved_clips)}")
     if motion.loop_advance is not None:
         print(f"loop: the root advances {float(np.linalg.norm(motion.loop_advance[[0, 2]])):.2f} m per cycle")
     print(f"body ({motion.shape_source or '[BETA] head'}): " + format_body(m))

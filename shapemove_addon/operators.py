@@ -91,6 +91,8 @@ def on_generated(name: str, msg: dict):
         rig["shapemove_nearest_actions"] = [str(a) for a in r.get("nearest_actions") or []][:3] or ["?"]
     if rig is not None and model:
         rig["shapemove_model_warnings"] = model
+    if rig is not None and r.get("parts"):
+        rig["shapemove_parts"] = [str(p) for p in r["parts"]][:2]  # two things at once, a side mirrored
     return rig
 
 

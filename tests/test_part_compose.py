@@ -136,3 +136,21 @@ def test_bad_by_parts_fields_are_refused(gen, tmp_path):
     np.savez(tmp_path / "bad2.npz", **data)
     with pytest.raises(ShapeMoveError, match="mirrored"):
         load_motion(tmp_path / "bad2.npz")
+
+
+def test_clauses_the_patterns_miss_are_named_by_the_nearest_caption(gen):
+    from shapemove.core.generation.part_prompts import clauses, plan_parts
+    from shapemove.core.generation.parts import plan_of
+
+    text = "a man marches with his right arm raised"
+    assert clauses(text) == ["a man marches", "his right arm raised"]
+    assert plan_parts(text) is None                  # "arm raised" is none of the action patterns
+    plan, side = plan_of(text, gen)
+    assert (plan.legs_prompt, plan.arms_prompt) == ("a man marches", "a man his right arm raised")
+    assert (plan.legs_action, plan.arms_action) == ("march", "raise hand") and side is None
+    assert plan.arms_side == ("right", "hand")
+    # single actions stay whole: no part named by the patterns, a subject alone, "as fast as"
+    for single in ("a man tiptoes and circles his arms", "A person walking with a hurt right leg",
+                   "A man running as fast as he can", "he walks to the door and opens it",
+                   "A zombie shambling toward the camera, arms out"):
+        assert plan_of(single, gen)[0] is None, single

@@ -35,7 +35,7 @@ def memory(gen):
 
     walk = gen.tokens_for([Request("a person walks forward", seconds=4, seed=0, candidates=1)])[0][0]
     punch = gen.tokens_for([Request("a person throws punches", seconds=6, seed=0, candidates=1)])[0][0]
-    mem = MotionMemory([], __import__("torch").zeros(0, 384), [], [], [])
+    mem = MotionMemory.empty()
     mem.add_clips(["walk_1", "punch_1", "punch_1_mirror"],
                   [["a person walks forward."], ["a person throws punches."], ["a person throws punches."]],
                   [walk, punch, punch[:12]], gen._text_encoder())
@@ -90,3 +90,23 @@ def test_a_judge_does_not_find_the_retrieved_take_itself():
     # the query IS take "k": without its three copies, the kick is no longer its own neighbour
     assert clf.classify_embeddings(q, exclude=["k_mirror"]) != ["kick"]
     assert clf.classify_embeddings(q, exclude=[None]) == ["kick"]
+
+
+def test_a_users_library_becomes_retrieved_candidates(gen, tmp_path):
+    """A model folder without a memory (the default) gets one from ``add_library``: the user's
+    captioned motion is then a candidate that wins when only retrieved clips compete."""
+    from shapemove.core.generation.generate import Generator, Request
+    from shapemove.core.scene.motion_file import save_motion
+
+    lib = tmp_path / "library"
+    lib.mkdir()
+    m = gen.generate_batch([Request("a person does jumping jacks", seconds=5, seed=0, by_parts=False)])[0]
+    save_motion(lib / "jacks.npz", m)
+    own = Generator(None)
+    assert own.t5.memory is None
+    assert own.add_library(lib) == 1
+    out = own.generate_batch([Request("someone does jumping jacks", seconds=4, seed=0, retrieval_first=0.0)])[0]
+    assert out.retrieved_clips and out.retrieved_clips[0].startswith("library:")
+    (tmp_path / "empty").mkdir()
+    with pytest.raises(ShapeMoveError, match="no motion with a caption"):
+        own.add_library(tmp_path / "empty")

@@ -99,7 +99,7 @@ def eval_paraphrase(model_dir=None, prompts=None, tma=None, seed: int = 0, secon
                     progress=None, generator=None, data=None, classifier=None, ceiling_clips: int | None = None,
                     show_progress: bool = True, candidates: int | None = None, feature_classifier=None,
                     retrieval: bool = True, frequent: int = 20, retrieval_prefix: int | None = None,
-                    retrieved: int | None = None, retrieval_first: float | None = None) -> dict:
+                    retrieved: int | None = None, retrieval_first: float | None = None, by_parts: bool = True) -> dict:
     """Generate a motion per held-out prompt and classify it (module docstring). ``data``: the built
     dataset whose training clips the kNN classifier reads (default ``default_built_dir()``);
     ``classifier``: an ``ActionClassifier`` to use instead (``feature_classifier`` likewise for the
@@ -153,12 +153,14 @@ def eval_paraphrase(model_dir=None, prompts=None, tma=None, seed: int = 0, secon
     for i, it in enumerate(known):
         m = gen.generate_batch([Request(it["text"], seconds=seconds, seed=seed + i, candidates=candidates,
                                         retrieval_prefix=retrieval_prefix, retrieved=retrieved if retrieval else 0,
-                                        retrieval_first=retrieval_first)])[0]
+                                        retrieval_first=retrieval_first, by_parts=by_parts)])[0]
         motion_emb = embed_motions(model, [m.features], mean, std)[0]
         embs.append(motion_emb)
         feats.append(m.features)
         rows.append({**it, "motion_proto_pred": actions[int(np.argmax(A @ motion_emb))],
-                     "warned": bool(m.warnings), "kept_clip": (gen.last_sources or [None])[0]})
+                     "warned": bool(m.warnings), "kept_clip": (gen.last_sources or [None])[0],
+                     "parts": list(m.part_prompts) if m.part_prompts else None,
+                     "mirrored": bool(m.mirrored or m.arms_mirrored)})
         if progress is not None:
             progress((i + 1) / len(known), it["text"])
     kept = [r["kept_clip"] for r in rows]  # a retrieved clip is judged without its own take
@@ -189,7 +191,8 @@ def eval_paraphrase(model_dir=None, prompts=None, tma=None, seed: int = 0, secon
             "candidates": candidates,
             "retrieval_prefix": retrieval_prefix if retrieval and gen.reads_memory else 0,
             "retrieved": retrieved if retrieval else 0, "retrieval_first": retrieval_first,
-            "kept_retrieved": sum(r["kept_clip"] is not None for r in rows),
+            "kept_retrieved": sum(r["kept_clip"] is not None for r in rows), "by_parts": by_parts,
+            "composed": sum(bool(r["parts"]) for r in rows), "mirrored": sum(r["mirrored"] for r in rows),
             "classifier": {**classifier.info, "ceiling": ceiling},
             "feature_classifier": dict(feature_classifier.info) if feature_classifier is not None else None,
             "unknown_action": sorted({it["action"] for it in items if it["action"] not in actions}),
@@ -278,6 +281,8 @@ def format_results(res: dict) -> str:
                  f"retrieved as candidates: {res.get('retrieved', 0)} per prompt"
                  + (f", alone from caption similarity {res['retrieval_first']:g}" if res.get("retrieval_first") else "")
                  + f"; kept a retrieved clip for {res.get('kept_retrieved', 0)} prompts (judged without its own take)")
+    lines.append(f"by body part: {'on' if res.get('by_parts', True) else 'off'}; two things composed for "
+                 f"{res.get('composed', 0)} prompts, mirrored to a named side for {res.get('mirrored', 0)}")
     seeded = res.get("retrieval_prefix") or 0
     lines.append(f"best of {res.get('candidates', 1)} samples per prompt (TMA choice)"
                  + (f", half of them continuing the first {seeded} codes of a retrieved clip" if seeded else ""))
@@ -310,6 +315,8 @@ def add_arguments(p) -> None:
                    help="real clips nearest by caption added to the candidates (default: the product's; 0: none)")
     p.add_argument("--retrieval-first", type=float, default=None, metavar="SIM",
                    help="caption similarity from which only retrieved clips compete (default: the product's)")
+    p.add_argument("--no-parts", action="store_true",
+                   help="generate each prompt whole: no composition by body part, no mirroring to a named side")
 
 
 def from_cli(args) -> int:
@@ -320,7 +327,8 @@ def from_cli(args) -> int:
         res = eval_paraphrase(args.model, args.prompts, args.tma, args.seed, args.seconds, progress, data=args.data,
                               show_progress=not args.quiet, candidates=args.candidates,
                               retrieval=not args.no_retrieval, retrieval_prefix=args.retrieval_prefix,
-                              retrieved=args.retrieved, retrieval_first=args.retrieval_first)
+                              retrieved=args.retrieved, retrieval_first=args.retrieval_first,
+                              by_parts=not args.no_parts)
     finally:
         progress.close()
     return show_result(format_results(res), res, args.json)

@@ -212,12 +212,16 @@ class Generator:
     def add_library(self, folder, progress=None) -> int:
         """Add a folder of the user's own motions (the Library panel's folder: motion .npz, BVH/AMC
         or a built dataset, each with a caption) to the retrieval memory, without retraining: their
-        SA-VAE tokens become clips the decoder can read. Returns the number of clips added."""
+        SA-VAE tokens become clips the decoder can read (a model with ``memory_k``) and candidates
+        retrieved by caption (``retrieved_candidates.py``). Returns the number of clips added."""
         from ..search.motion_search import library_clips
 
-        if not self.reads_memory:
-            raise ShapeMoveError(f"{self.model_dir}: this model does not read retrieved clips; "
-                                 "a motion library cannot be added to it (retrain with memory_k > 0)")
+        if self.t5 is None:
+            raise ShapeMoveError(f"{self.model_dir} has no t5/ model: a motion library is retrieved by the text model")
+        if self.t5.memory is None:  # a model without a memory: the library alone is retrieved
+            from ..models.motion_memory import MotionMemory
+
+            self.t5.memory = MotionMemory.empty()
         ids, captions, feats = library_clips(folder, progress=progress)
         tokens = []
         down = self.vae.cfg.downsample

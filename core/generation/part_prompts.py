@@ -27,13 +27,13 @@ from dataclasses import dataclass
 from ..data.actions import action_spans, split_words
 from ..data.compose_parts import ARMS_ACTIONS, LEGS_ACTIONS
 
-LEGS = frozenset(LEGS_ACTIONS) | {"sprint", "walk in a figure eight", "zombie walk"}
+LEGS = frozenset(LEGS_ACTIONS) | {"sprint", "walk in a figure eight"}   # not "zombie walk": its arms are the action
 ARMS = frozenset(ARMS_ACTIONS)
 FOOT_ACTIONS = frozenset({"kick", "spin kick", "kick ball", "hop"})
 SEQUENCE = re.compile(r"\b(then|after|afterwards|before|followed by|next|finally|later)\b")
 CONNECTOR = re.compile(r",|;|\b(?:while|whilst|as|and|with|at the same time|all the while|meanwhile|"
                        r"simultaneously)\b")
-SUBJECT = re.compile(r"^(?:(?:a|an|the|this|that|one|some|my|our|his|her|their|your)\s+)?(?:\w+\s+){0,3}?"
+SUBJECT = re.compile(r"^(?:(?:a|an|the|this|that|one|some|my|our|his|her|their|your)\s+(?:[\w-]+,?\s+){0,3}?)?"
                      r"(?:person|man|woman|boy|girl|guy|lady|kid|child|someone|somebody|he|she|they|people|"
                      r"soldier|dancer|athlete|figure|character|actor|player|runner|walker|human|i|you|we)\b")
 HAND_WORDS = r"hand|hands|arm|arms|fist|fists|palm|elbow|shoulder|wrist|finger|fingers"
@@ -101,8 +101,32 @@ def _with_subject(clause: str) -> str:
     return clause if SUBJECT.match(clause) else f"a person {clause}"
 
 
-def plan_parts(text: str) -> PartPlan | None:
-    """The legs and arms prompts of a two-things-at-once prompt (module docstring), or None."""
+def clauses(text: str) -> list[str]:
+    """The clauses of a prompt: cut at its connectors and before a participle that follows a verb
+    ("jogs along waving" -> "jogs along", "waving"), each tidied, empty ones dropped."""
+    t = split_words(text).strip()
+    as_as = [m.span() for m in re.finditer(r"\bas\s+\w+(?:\s+\w+)?\s+as\b", t)]  # "as fast as he can"
+    cuts = {m.start() for m in CONNECTOR.finditer(t) if not any(a <= m.start() < b for a, b in as_as)}
+    words = list(re.finditer(r"[a-z'-]+", t))
+    for prev, w in zip(words[1:], words[2:]):  # a participle after a verb: "jogs along waving"
+        start = max([c for c in cuts if c < w.start()], default=0)
+        before = _tidy(t[start:w.start()])
+        if (w.group(0).endswith("ing") and len(w.group(0)) > 4 and not CONNECTOR.fullmatch(prev.group(0))
+                and len(before.split()) >= 2 and not SUBJECT.fullmatch(before)):
+            cuts.add(w.start())
+    bounds = [0] + sorted(cuts) + [len(t)]
+    return [c for c in (_tidy(t[a:b]) for a, b in zip(bounds, bounds[1:])) if c]
+
+
+def _subject(t: str) -> str:
+    m = SUBJECT.match(t)
+    return m.group(0) if m else "a person"
+
+
+def plan_parts(text: str, classify=None) -> PartPlan | None:
+    """The legs and arms prompts of a two-things-at-once prompt (module docstring), or None.
+    ``classify(clauses) -> actions`` (an action name or None each) names the action of clauses the
+    action patterns do not recognise (``parts.clause_classifier``: the nearest training caption)."""
     t = split_words(text).strip()
     if SEQUENCE.search(t):
         return None
@@ -110,7 +134,7 @@ def plan_parts(text: str) -> PartPlan | None:
     legs = next((s for s in spans if s[2] in LEGS), None)
     arms = next((s for s in spans if s[2] in ARMS), None)
     if legs is None or arms is None:
-        return None
+        return _plan_by_clauses(t, classify) if classify is not None else None
     first, second = sorted([legs, arms])
     cuts = [m.start() for m in CONNECTOR.finditer(t, first[1], second[0])]
     cut = cuts[0] if cuts else second[0]
@@ -121,4 +145,38 @@ def plan_parts(text: str) -> PartPlan | None:
     arms_prompt = _with_subject(arms_clause)
     side = named_side(arms_prompt)
     return PartPlan(_with_subject(legs_clause), arms_prompt, legs[2], arms[2],
+                    side if side is not None and side[1] == "hand" else None)
+
+
+STOP = frozenset("a an the this that his her their its my your our one some is are was be being been it he she they "
+                 "him them who while as and with of to in on at for from by".split())
+
+
+def _content(clause: str) -> list[str]:
+    """The clause's words that are not its subject or small words."""
+    m = SUBJECT.match(clause)
+    rest = clause[m.end():] if m else clause
+    return [w for w in re.findall(r"[a-z'-]+", rest) if w not in STOP]
+
+
+def _plan_by_clauses(t: str, classify) -> PartPlan | None:
+    """Two things at once read clause by clause, ``classify`` naming what the patterns do not."""
+    cs = clauses(t)
+    if len(cs) < 2:
+        return None
+    acts = [next((a for _, _, a in action_spans(c) if a in LEGS or a in ARMS), None) for c in cs]
+    if not any(acts):  # one part at least must be named in words the action patterns know
+        return None
+    todo = [i for i, a in enumerate(acts) if a is None and len(_content(cs[i])) >= 2]
+    for i, a in zip(todo, classify([cs[i] for i in todo]) if todo else []):
+        acts[i] = a
+    li = next((i for i, a in enumerate(acts) if a in LEGS), None)
+    ai = next((i for i, a in enumerate(acts) if a in ARMS and i != li), None)
+    if li is None or ai is None:
+        return None
+    subject = _subject(t)
+    with_subject = lambda c: c if SUBJECT.match(c) else f"{subject} {c}"  # noqa: E731
+    arms_prompt = with_subject(cs[ai])
+    side = named_side(arms_prompt)
+    return PartPlan(with_subject(cs[li]), arms_prompt, acts[li], acts[ai],
                     side if side is not None and side[1] == "hand" else None)

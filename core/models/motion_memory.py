@@ -71,6 +71,13 @@ class MotionMemory:
     def __len__(self) -> int:
         return len(self.clip_ids)
 
+    @classmethod
+    def empty(cls) -> "MotionMemory":
+        """A memory with no clips (a user's library is added to it)."""
+        from .text_encoder import HIDDEN
+
+        return cls([], torch.zeros(0, HIDDEN), [], [], [])
+
     # -- building -------------------------------------------------------------------------------
     @classmethod
     def from_dataset(cls, root, ids: list[str], tokens: dict, reader) -> "MotionMemory":
@@ -79,7 +86,7 @@ class MotionMemory:
         from ..data.built_meta import clip_meta
 
         root = Path(root)
-        mem = cls([], torch.zeros(0, 384), [], [], [])
+        mem = cls.empty()
         clips, captions, fams = [], [], []
         for cid in ids:
             if cid not in tokens or not len(tokens[cid]):

@@ -93,8 +93,9 @@ def _motion_facts(path: Path, motion) -> dict:
 # -- ops ---------------------------------------------------------------------------------------
 def generate(params, progress, cancel) -> dict:
     """params {"prompt", "shape_text", "betas" (10, optional), "seconds" (optional), "seed",
-    "temperature", "top_k", "model" (folder, optional), "body", "out" (.npz)} -> the motion file
-    written, its facts and the body's measurements (cm)."""
+    "temperature", "top_k", "by_parts" (optional, default true), "model" (folder, optional), "body",
+    "out" (.npz)} -> the motion file written, its facts, the body's measurements (cm) and what
+    generation by body part did ("parts")."""
     from ..generation.generate import Request
 
     op = "generate"
@@ -108,6 +109,8 @@ def generate(params, progress, cancel) -> dict:
         req.candidates = param(params, op, "candidates", int)
     if params.get("guidance") is not None:
         req.guidance = float(param(params, op, "guidance", (int, float)))
+    if params.get("by_parts") is not None:
+        req.by_parts = bool(param(params, op, "by_parts", bool))
     progress(0.05, "loading models")
     gen = _generator(param(params, op, "model", str, None), param(params, op, "body", str, None))
     if cancel():
@@ -125,7 +128,18 @@ def generate(params, progress, cancel) -> dict:
             "physics": phys, "ik_error_cm": float(motions[0].ik_error_cm or 0.0),
             "warnings": list(motions[0].warnings),
             "model_warnings": [w for w in motions[0].warnings if w in part_warnings(gen.model_dir)],
-            "nearest_actions": list(check.nearest_actions) if check is not None else []}
+            "nearest_actions": list(check.nearest_actions) if check is not None else [],
+            "parts": _parts(motions[0])}
+
+
+def _parts(motion) -> list[str]:
+    """What generation by body part did, in a line each ([] when the prompt was generated whole)."""
+    out = []
+    if motion.part_prompts:
+        out.append(f"Two things at once: legs '{motion.part_prompts[0]}', arms '{motion.part_prompts[1]}'")
+    if motion.mirrored or motion.arms_mirrored:
+        out.append("Mirrored so the side you named moves most")
+    return out
 
 
 def redecode(params, progress, cancel) -> dict:
