@@ -174,7 +174,7 @@ def generation_params(context, label: str) -> dict:
     the active model and body, and a new motion file named after ``label``."""
     s = context.scene.shapemove
     return {"shape_text": s.shape_text.strip() or None, "seed": s.seed, "temperature": s.temperature,
-            "model": setting("active_model") or None, "body": body_spec(context),
+            "by_parts": bool(s.by_parts), "model": setting("active_model") or None, "body": body_spec(context),
             "out": str(paths.new_motion_path(label))}
 
 

@@ -112,6 +112,7 @@ class SHAPEMOVE_PT_generate(_SubPanel, bpy.types.Panel):
         row = col.row(align=True)
         row.prop(s, "seed")
         row.prop(s, "temperature")
+        col.prop(s, "by_parts")
         draw_job(col, "generate", "shapemove.generate", "Generate")
         rig = rig_of(context.active_object)
         if rig is not None:

@@ -99,6 +99,9 @@ class ShapeMoveSceneSettings(bpy.types.PropertyGroup):
     seed: IntProperty(name="Seed", default=0, min=0)
     temperature: FloatProperty(name="Temperature", default=1.0, min=0.0, max=3.0,
                                description="Sampling temperature (0 = always the most likely motion)")
+    by_parts: BoolProperty(name="By body part", default=True,
+                           description="Two things at once ('jogs, waving') are generated as legs and arms and put "
+                                       "together; a named left or right is made the side that moves most")
     # shape
     shape_from_text: StringProperty(name="Shape text", default="",
                                     description="e.g. 'a man with a height of 185 cm and a waist circumference of 90 cm'")

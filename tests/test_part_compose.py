@@ -154,3 +154,21 @@ def test_clauses_the_patterns_miss_are_named_by_the_nearest_caption(gen):
                    "A man running as fast as he can", "he walks to the door and opens it",
                    "A zombie shambling toward the camera, arms out"):
         assert plan_of(single, gen)[0] is None, single
+
+
+def test_the_generate_job_says_what_was_composed(tmp_path):
+    from shapemove.core.worker import jobs_shapemove
+    from shapemove.core.worker.client import InProcessRunner
+
+    runner = InProcessRunner(jobs_shapemove.register({}))
+    try:
+        text = "a person walks forward while waving the left hand"
+        r = runner.call("generate", {"prompt": text, "seconds": 2, "out": str(tmp_path / "a.npz")})
+        assert r["parts"][0] == ("Two things at once: legs 'a person walks forward', "
+                                 "arms 'a person waving the left hand'")
+        r = runner.call("generate", {"prompt": text, "seconds": 2, "by_parts": False, "out": str(tmp_path / "b.npz")})
+        assert r["parts"] == []
+        with pytest.raises(ShapeMoveError, match="'by_parts' must be bool"):
+            runner.call("generate", {"prompt": text, "by_parts": "yes", "out": str(tmp_path / "c.npz")})
+    finally:
+        runner.stop()

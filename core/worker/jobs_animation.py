@@ -56,7 +56,7 @@ def animate(params, progress, cancel) -> dict:
                   betas=_betas(params, op), seconds=param(params, op, "seconds", (int, float), None),
                   seed=int(param(params, op, "seed", int, 0)),
                   temperature=float(param(params, op, "temperature", (int, float), 1.0)),
-                  top_k=param(params, op, "top_k", int, 50))
+                  top_k=param(params, op, "top_k", int, 50), by_parts=bool(param(params, op, "by_parts", bool, True)))
     progress(0.05, "loading models")
     gen = _generator(param(params, op, "model", str, None), param(params, op, "body", str, None))
     if cancel():

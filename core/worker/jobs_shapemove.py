@@ -109,8 +109,7 @@ def generate(params, progress, cancel) -> dict:
         req.candidates = param(params, op, "candidates", int)
     if params.get("guidance") is not None:
         req.guidance = float(param(params, op, "guidance", (int, float)))
-    if params.get("by_parts") is not None:
-        req.by_parts = bool(param(params, op, "by_parts", bool))
+    req.by_parts = bool(param(params, op, "by_parts", bool, True))
     progress(0.05, "loading models")
     gen = _generator(param(params, op, "model", str, None), param(params, op, "body", str, None))
     if cancel():
