@@ -62,10 +62,6 @@ def redecode(motion: Motion, vae, body, betas, ik_refine_iters: int = 10) -> Mot
     (``contacts_measured``); a generated one plants what the decoder predicts for the new body."""
     if motion.tokens is None or len(motion.tokens) == 0:
         raise ShapeMoveError("this motion has no tokens to re-decode (it was not generated or retargeted)")
-    from .parts import is_by_parts, redecode_parts
-
-    if is_by_parts(motion):  # two things at once, or a side mirrored: the same composition again
-        return redecode_parts(motion, vae, body, betas, ik_refine_iters)
     known = motion.contacts if motion.contacts_measured else None
     return decode_tokens([int(t) for t in motion.tokens], vae, body, betas, ik_refine_iters, prompt=motion.prompt,
                          contacts=known)

@@ -28,7 +28,7 @@ from ..scene.motion_file import Motion
 from ..torch_threads import one_torch_thread
 from .decode import decode_features, decode_tokens, redecode
 from .model_bundle import model_files, part_warnings, resolve_model_dir
-from .parts import generate_by_parts
+from .parts import generate_by_parts, is_by_parts, redecode_parts
 from .prompts import check_prompt
 from .rerank import CandidatePicker
 from .retrieval_seeds import seed_prefixes, seeded_count
@@ -325,5 +325,8 @@ class Generator:
         return np.asarray(predicted, np.float32), "[BETA] head"
 
     def redecode(self, motion: Motion, betas) -> Motion:
-        """The same tokens on another body (``decode.redecode``)."""
+        """The same tokens on another body (``decode.redecode``; a motion made by body part is
+        composed and mirrored again, ``parts.redecode_parts``)."""
+        if is_by_parts(motion):
+            return redecode_parts(motion, self.vae, self.body, betas, self.ik_refine_iters)
         return redecode(motion, self.vae, self.body, betas, self.ik_refine_iters)
