@@ -110,3 +110,31 @@ def test_a_users_library_becomes_retrieved_candidates(gen, tmp_path):
     (tmp_path / "empty").mkdir()
     with pytest.raises(ShapeMoveError, match="no motion with a caption"):
         own.add_library(tmp_path / "empty")
+
+
+def test_a_model_folder_with_a_memory_retrieves_from_it(gen, tmp_path):
+    """A memory written beside a T5 that does not read one (tools/build_motion_memory.py does this
+    for a trained model) is loaded and retrieved from; one with codes the model lacks is refused."""
+    import shutil
+
+    from shapemove.core.generation.generate import Generator, Request
+    from shapemove.core.model_files import write_manifest
+    from shapemove.core.models.motion_memory import MotionMemory
+
+    model = tmp_path / "model"
+    shutil.copytree(gen.model_dir, model)
+    codes = gen.tokens_for([Request("a person throws punches", seconds=5, seed=0, candidates=1)])[0][0]
+    mem = MotionMemory.empty()
+    mem.add_clips(["punch_9"], [["a person throws punches."]], [codes], gen._text_encoder())
+    mem.save(model / "t5")
+    write_manifest(model)
+    own = Generator(model)
+    assert own.t5.memory_k == 0 and own.t5.memory.clip_ids == ["punch_9"]
+    m = own.generate_batch([Request("someone punches", seconds=4, seed=0, retrieval_first=0.0)])[0]
+    assert m.retrieved_clips == ["punch_9"]
+    bad = MotionMemory.empty()
+    bad.add_clips(["x"], [["a person waves."]], [[5000, 1]], gen._text_encoder())
+    bad.save(model / "t5")
+    write_manifest(model)
+    with pytest.raises(ShapeMoveError, match="codes outside"):
+        Generator(model)
