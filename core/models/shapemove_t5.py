@@ -385,13 +385,13 @@ class ShapeMoveT5(nn.Module):
             head.load_state_dict({k: v.float() for k, v in load_file(str(directory / "beta_head.safetensors")).items()})
         model = cls(lm, head, vocab, info.get("beta_weight", 1.0), encoder)
         model.info = info
-        if model.memory_k:
-            from .motion_memory import MEMORY_JSON, MEMORY_TENSORS, MotionMemory
+        from .motion_memory import MEMORY_JSON, MEMORY_TENSORS, MotionMemory
 
-            model.memory = MotionMemory.load(directory)
-            if model.memory is None:
-                raise ShapeMoveError(f"{directory}: this model reads retrieved clips but {MEMORY_JSON} and "
-                                     f"{MEMORY_TENSORS} are missing; copy the whole model folder again")
+        model.memory = MotionMemory.load(directory)  # a model that does not read it still retrieves candidates
+        if model.memory is None and model.memory_k:
+            raise ShapeMoveError(f"{directory}: this model reads retrieved clips but {MEMORY_JSON} and "
+                                 f"{MEMORY_TENSORS} are missing; copy the whole model folder again")
+        if model.memory is not None:
             bad = [c for c, t in zip(model.memory.clip_ids, model.memory.clip_tokens)
                    if len(t) and (t.min() < 0 or t.max() >= vocab.num_codes)]
             if bad:
