@@ -52,6 +52,8 @@ train-default: setup
 	$(PY) -m shapemove train t5 --data $(BUILT) --config configs/default_t5.json --vae $(RUNS)/vae/savae.pt \
 		--out $(RUNS)/t5 --resume $(if $(BASE_T5),--base-model $(BASE_T5),)
 	$(PY) tools/export_default.py --vae $(RUNS)/vae --t5 $(RUNS)/t5 --tma $(RUNS)/tma --out weights/default --card configs/model_card.json
+	$(PY) -m shapemove train head --model weights/default --data $(BUILT) --out $(RUNS)/head --resume
+	rm -rf weights/default && cp -r $(RUNS)/head/model weights/default
 
 # Evaluation tables of docs/evaluation.md (needs $(BUILT) from train-default); the 1-step SA-VAE is the untrained baseline.
 eval: setup

@@ -47,6 +47,7 @@ EXAMPLES: dict[str, str] = {
     "train": P + "train vae --data data/built --config configs/default_vae.json --out runs/vae",
     "train vae": P + "train vae --data data/built --config configs/default_vae.json --out runs/vae",
     "train tma": P + "train tma --data data/built --config configs/default_tma.json --out runs/tma",
+    "train head": P + "train head --data data/built --out runs/head",
     "train t5": P + "train t5 --data data/built --config configs/default_t5.json --vae runs/vae/savae.pt --out runs/t5",
     "eval": P + "eval shape --bodies 200 --json out/eval_shape.json",
     "eval recon": P + "eval recon --data data/built --split test --checkpoint weights/default/savae.pt --max-clips 40 "

@@ -1,6 +1,7 @@
 """`python -m shapemove train KIND --data DIR --config small|paper|PATH.json --out RUN [--steps N] [--resume|--force]`.
 
-KIND is vae (SA-VAE), t5 or tma. Each kind lives in ``core/train/train_KIND.py`` and defines
+KIND is vae (SA-VAE), t5, tma or head (a new [BETA] head for ``--model DIR``, the T5 frozen). Each kind
+lives in ``core/train/train_KIND.py`` and defines
 ``from_cli(args) -> dict`` (the final metrics) reading the common arguments below (add a kind to
 ``KINDS``). Several processes: ``torchrun --nproc_per_node N -m
 shapemove train vae ...`` (DistributedDataParallel; gloo on CPU, nccl on GPU).
@@ -16,7 +17,8 @@ from ..core.errors import ShapeMoveError
 from ..core.train.run_guard import check_run_folder
 
 KINDS = {"vae": "the shape-aware VAE (stage 1)", "t5": "text -> motion tokens + [BETA] head (stage 2)",
-         "tma": "the text-motion retrieval model (TMA)"}
+         "tma": "the text-motion retrieval model (TMA)",
+         "head": "a new [BETA] head for an exported model, its T5 frozen (reads the shape words)"}
 
 
 def _module(kind: str):
@@ -46,6 +48,10 @@ def add_arguments(p):
             s.add_argument("--init-from", type=Path, default=None,
                            help="fine-tune this trained savae.pt (sets the config's train.init_from; "
                                 "train.freeze names the parts kept as they are)")
+        if kind == "head":
+            s.add_argument("--model", type=Path, default=None,
+                           help="exported model folder whose T5 stays as it is (default: the shipped model, "
+                                "weights/default); RUN/model/ is that folder with the new head")
         if kind == "t5":
             s.add_argument("--vae", type=Path, required=True, help="trained SA-VAE (savae.pt) that tokenizes the motions")
             s.add_argument("--base-model", type=Path, default=None,

@@ -152,7 +152,9 @@ def test_clauses_the_patterns_miss_are_named_by_the_nearest_caption(gen):
     # single actions stay whole: no part named by the patterns, a subject alone, "as fast as"
     for single in ("a man tiptoes and circles his arms", "A person walking with a hurt right leg",
                    "A man running as fast as he can", "he walks to the door and opens it",
-                   "A zombie shambling toward the camera, arms out"):
+                   "A zombie shambling toward the camera, arms out",
+                   "A person raises the left hand slowly, like an elderly person.",   # a style, not a walk
+                   "A woman is raising both hands energetically, with youthful vigour."):
         assert plan_of(single, gen)[0] is None, single
 
 

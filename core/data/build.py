@@ -29,7 +29,7 @@ from ..constants import FPS
 from ..errors import ShapeMoveError
 from ..geometry.rotations import matrix_to_axis_angle
 from ..io.mocap import load_smpl22
-from ..motion.contacts import detect_contacts, to_feature_order
+from ..motion.contacts import detect_contacts
 from .shape_text import shape_texts
 from .sources import ClipSource, discover, open_source
 from .splits import split_of
@@ -138,11 +138,9 @@ class ClipProcessor:
         """(T-1,263) HumanML3D features of (T,22,3) joints grounded on the mesh (``pose_on``: heights
         kept as they are) with local ``rotations`` (T,>=22,3,3); the 4 foot-contact channels hold
         ``contacts`` (T,4) of joints 7, 8, 10, 11."""
-        from ..motion.features import feature_slices, features_from_joints
+        from ..motion.features import posed_features
 
-        f = features_from_joints(joints, rotations[:, :22], keep_height=True)
-        f[:, feature_slices["contacts"]] = to_feature_order(contacts[:-1]).astype(np.float32)
-        return f
+        return posed_features(joints, rotations, contacts)
 
     def solve(self, joints: np.ndarray) -> dict:
         """The subject's side of a clip (22 joints at 20 fps): contacts detected on the mocap, betas

@@ -159,6 +159,16 @@ def _content(clause: str) -> list[str]:
     return [w for w in re.findall(r"[a-z'-]+", rest) if w not in STOP]
 
 
+def _has_verb(clause: str) -> bool:
+    """Whether a clause says what someone does (a verb of the caption tables, or a participle):
+    "like an elderly person" or "with youthful vigour" say how, and are left alone."""
+    from ..data.captions import _verbs
+
+    verbs = _verbs()
+    return any(w in verbs or w + "s" in verbs or (len(w) > 4 and w.endswith(("ing", "ed")))
+               for w in _content(clause))
+
+
 def _plan_by_clauses(t: str, classify) -> PartPlan | None:
     """Two things at once read clause by clause, ``classify`` naming what the patterns do not."""
     cs = clauses(t)
@@ -167,7 +177,7 @@ def _plan_by_clauses(t: str, classify) -> PartPlan | None:
     acts = [next((a for _, _, a in action_spans(c) if a in LEGS or a in ARMS), None) for c in cs]
     if not any(acts):  # one part at least must be named in words the action patterns know
         return None
-    todo = [i for i, a in enumerate(acts) if a is None and len(_content(cs[i])) >= 2]
+    todo = [i for i, a in enumerate(acts) if a is None and len(_content(cs[i])) >= 2 and _has_verb(cs[i])]
     for i, a in zip(todo, classify([cs[i] for i in todo]) if todo else []):
         acts[i] = a
     li = next((i for i, a in enumerate(acts) if a in LEGS), None)

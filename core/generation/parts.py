@@ -12,9 +12,9 @@ track's foot contacts (``decode.motion_from_joints``). A single action naming a 
 the left foot") is generated as usual and mirrored when the other side moves most.
 
 The Motion keeps what re-decoding needs: ``tokens`` (the legs, or the whole motion), ``arms_tokens``
-and the two mirror flags; ``features`` are those of the planted composition's joints
-(``motion.features.features_from_joints``), so every later reader of the features (the part judge,
-the TMA) sees what the rig plays.
+and the two mirror flags; ``features`` are those of the planted motion, computed as the dataset builder computes a clip's
+(``motion.features.posed_features``: the posed joints, their IK rotations, the planted contacts),
+so every later reader of the features (the part judge, the TMA) sees what the rig plays.
 """
 from __future__ import annotations
 
@@ -23,7 +23,8 @@ import dataclasses
 import numpy as np
 
 from ..constants import FPS
-from ..motion.features import features_from_joints
+from ..geometry.rotations import axis_angle_to_matrix
+from ..motion.features import posed_features
 from ..scene.motion_file import Motion
 from .decode import motion_from_joints
 from .part_compose import compose_arms, mirror_track, needs_mirror
@@ -48,8 +49,9 @@ def assemble(body, betas, legs: Track, arms: Track | None, prompt: str | None, i
              **extra) -> Motion:
     """The planted Motion of a legs track (and the arms of an arms track, when given)."""
     joints = compose_arms(legs.joints, arms.joints) if arms is not None else legs.joints
-    return motion_from_joints(body, betas, joints, legs.contacts, ik_refine_iters, prompt=prompt,
-                              features=features_from_joints(joints, keep_height=True), **extra)
+    m = motion_from_joints(body, betas, joints, legs.contacts, ik_refine_iters, prompt=prompt, **extra)
+    m.features = posed_features(m.joints, axis_angle_to_matrix(m.poses), m.contacts)  # as the builder's clips
+    return m
 
 
 CLAUSE_NEAR = 0.6   # MiniLM cosine from which a clause takes the action of its nearest training caption
@@ -89,8 +91,9 @@ def generate_by_parts(gen, r, on_tokens=None) -> Motion | None:
         codes, pred = gen.tokens_for([r])
         betas, source = gen.body_shape(r, pred[0].numpy())
         track, mirrored = _side_fixed(codes[0], gen.vae, betas, side)
-        m = assemble(gen.body, betas, track, None, r.prompt, gen.ik_refine_iters,
-                     tokens=np.asarray(codes[0], np.int16), mirrored=mirrored)
+        m = (assemble(gen.body, betas, track, None, r.prompt, gen.ik_refine_iters,
+                      tokens=np.asarray(codes[0], np.int16), mirrored=True) if mirrored
+             else gen.decode_motion(codes[0], betas, prompt=r.prompt))  # the named side already moves most
         m.shape_source = source
         m.retrieved_clips = [c for c in gen.last_sources if c]
         return m

@@ -65,7 +65,7 @@ def decode(model, inputs: tuple, min_codes: int, max_codes: int, temperature: fl
                        dtype=torch.long)
     # the state whose input is [BETA] (position 1) gives the betas
     logits, hidden, past = model.step(enc, enc_mask, seq, use_cache=True)
-    betas = model.beta_head(hidden[:, 1])
+    betas = model.betas_at(hidden[:, 1], inputs)
     guided = guidance > 0
     if guided:
         if null_inputs is None:

@@ -31,7 +31,7 @@ from torch import nn
 
 from ..errors import ShapeMoveError
 from ..model_files import damaged_model_errors, sha256_file, verify_manifest, write_manifest
-from .beta_head import BetaHead
+from .beta_head import BetaHead, build_head
 
 FORMAT_V1 = "shapemove-t5/1"  # T5 + sentencepiece tokenizer (the default model until it is retrained)
 FORMAT = "shapemove-t5/2"
@@ -254,9 +254,25 @@ class ShapeMoveT5(nn.Module):
         _, hidden, _ = self.step(enc, mask, seq)
         return hidden[:, 1]
 
+    def head_text(self, inputs) -> tuple:
+        """What a head that reads the words (``beta_head.reads_text``) gets beside the `[BETA]` state:
+        the MiniLM token states of ``inputs_for`` inputs and the mask of the shape text's tokens
+        (segment 0, which leads each row); (None, None) for a head that does not read them."""
+        if not getattr(self.beta_head, "reads_text", False):
+            return None, None
+        if self.encoder_kind != "minilm":
+            raise ShapeMoveError("a [BETA] head that reads the words needs the MiniLM encoder")
+        states, mask, segments = inputs[:3]
+        return states, mask & (segments == 0)
+
+    def betas_at(self, hidden_at_beta: torch.Tensor, inputs) -> torch.Tensor:
+        """(B, 10) betas from the `[BETA]` states of ``inputs_for`` inputs (the head's one entry point:
+        ``predict_betas`` and ``constrained_decoding.decode`` read betas through it)."""
+        return self.beta_head(hidden_at_beta, *self.head_text(inputs))
+
     def predict_betas(self, inputs) -> torch.Tensor:
         """(B, 10) betas of the `[BETA]` head for ``inputs_for`` inputs."""
-        return self.beta_head(self.beta_state(inputs))
+        return self.betas_at(self.beta_state(inputs), inputs)
 
     # -- training -----------------------------------------------------------------------------
     def forward(self, inputs_a, inputs_b, labels, betas=None, segments=None, memory=None):
@@ -283,7 +299,8 @@ class ShapeMoveT5(nn.Module):
             pos = is_beta.float().argmax(1) + 1
             pos = pos.clamp(max=hidden.shape[1] - 1)
             h = hidden[torch.arange(hidden.shape[0]), pos][has_beta]
-            pred = self.beta_head(h)
+            text, text_mask = self.head_text((inputs_a, inputs_b, segments))
+            pred = self.beta_head(h, *((text[has_beta], text_mask[has_beta]) if text is not None else ()))
             if betas is not None:
                 l1 = (pred - betas[has_beta]).abs().mean()
         return {"loss": ce + self.beta_weight * l1, "ce": ce.detach(), "l1": l1.detach(), "betas_pred": pred}
@@ -301,7 +318,8 @@ class ShapeMoveT5(nn.Module):
         tmp = directory.with_name(directory.name + ".tmp")
         shutil.rmtree(tmp, ignore_errors=True)
         info = {"format": FORMAT, "encoder": self.encoder_kind, "beta_weight": self.beta_weight,
-                "d_model": self.d_model, "num_codes": self.vocab.num_codes, **(meta or {})}
+                "d_model": self.d_model, "num_codes": self.vocab.num_codes, **(meta or {}),
+                "beta_head": self.beta_head.config()}
         if self.encoder_kind == "minilm":
             from .text_encoder import fingerprint
 
@@ -381,7 +399,10 @@ class ShapeMoveT5(nn.Module):
                 if lm.config.vocab_size < vocab.vocab_size:
                     raise ShapeMoveError(f"{directory}: the tokenizer has {vocab.vocab_size} tokens, the model "
                                          f"only {lm.config.vocab_size}: tokenizer and model do not match")
-            head = BetaHead(lm.config.d_model)
+            head = build_head(info.get("beta_head"), lm.config.d_model)  # no entry: the first (MLP) head
+            if head.reads_text and encoder != "minilm":
+                raise ShapeMoveError(f"{directory}: its [BETA] head reads MiniLM states, but the model's "
+                                     f"encoder is {encoder}")
             head.load_state_dict({k: v.float() for k, v in load_file(str(directory / "beta_head.safetensors")).items()})
         model = cls(lm, head, vocab, info.get("beta_weight", 1.0), encoder)
         model.info = info

@@ -7,7 +7,7 @@ from pathlib import Path
 
 from ..errors import ShapeMoveError
 
-FINISHED = {"vae": "savae.pt", "t5": "t5/shapemove.json", "tma": "tma.pt"}
+FINISHED = {"vae": "savae.pt", "t5": "t5/shapemove.json", "tma": "tma.pt", "head": "model/manifest.json"}
 
 
 def check_run_folder(out, kind: str, resume: bool = False, force: bool = False) -> None:
