@@ -78,7 +78,8 @@ def test_generation_keeps_a_retrieved_clip_only_when_it_wins(gen, memory):
 
 
 def test_a_judge_does_not_find_the_retrieved_take_itself():
-    from shapemove.core.eval.action_classifier import ActionClassifier, take_of
+    from shapemove.core.eval.action_classifier import ActionClassifier
+    from shapemove.core.models.motion_memory import family, take_of
 
     assert take_of("clip_7_mirror_aug") == take_of("clip_7") == "clip_7"
     e = np.eye(8, dtype=np.float32)[[0, 0, 0, 1, 1, 1, 2, 2]] + 0.01
@@ -90,6 +91,8 @@ def test_a_judge_does_not_find_the_retrieved_take_itself():
     # the query IS take "k": without its three copies, the kick is no longer its own neighbour
     assert clf.classify_embeddings(q, exclude=["k_mirror"]) != ["kick"]
     assert clf.classify_embeddings(q, exclude=[None]) == ["kick"]
+    assert clf.classify_embeddings(q, exclude=[["w1", "k"]]) != ["kick"]   # a motion made of two retrieved clips
+    assert family("clip_7_mirror", {"composed_from": ["a_aug", "b"]}) == {"clip_7", "a", "b"}
 
 
 def test_a_users_library_becomes_retrieved_candidates(gen, tmp_path):

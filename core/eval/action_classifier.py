@@ -176,13 +176,6 @@ def source_of(cid: str) -> str:
     return cid[:-4] if cid.endswith("_aug") else cid
 
 
-def take_of(cid: str) -> str:
-    """The captured take a built clip shows: ``X``, ``X_aug`` and ``X_mirror`` are all ``X``."""
-    while cid.endswith(("_aug", "_mirror")):
-        cid = cid.rsplit("_", 1)[0]
-    return cid
-
-
 class FeatureEmbedder:
     """Unit vectors of raw (T, 263) features without any learned model: the features normalized
     with the dataset's Mean/Std, then their mean and std over time and the means of the four
@@ -266,9 +259,11 @@ class ActionClassifier:
         return out
 
     def classify_embeddings(self, emb: np.ndarray, chunk: int = 1024, exclude: list | None = None) -> list[str]:
-        """Action of each embedding. ``exclude[i]``: a clip id whose captured take (the clip, its
+        """Action of each embedding. ``exclude[i]``: a clip id or clip ids whose captured takes (each clip, its
         mirror image and shape-augmented copies) row i must not find among the references (a
-        motion that IS a retrieved training clip, judged without itself), or None."""
+        motion made of retrieved training clips, judged without them), or None / empty."""
+        from ..models.motion_memory import take_of
+
         emb = np.asarray(emb, np.float32)
         if emb.ndim != 2 or emb.shape[1] != self.embeddings.shape[1]:
             raise ShapeMoveError(f"ActionClassifier: embeddings of shape {emb.shape}, expected (N, {self.embeddings.shape[1]})")
@@ -278,9 +273,10 @@ class ActionClassifier:
         for s in range(0, len(emb), chunk):  # (chunk, M) similarities at a time
             sims = emb[s:s + chunk] @ self.embeddings.T
             if roots is not None:
-                for i, cid in enumerate(exclude[s:s + chunk]):
-                    if cid is not None:
-                        sims[i, roots == take_of(cid)] = -1e9
+                for i, cids in enumerate(exclude[s:s + chunk]):
+                    if cids:  # one clip id, or several
+                        cids = [cids] if isinstance(cids, str) else cids
+                        sims[i, np.isin(roots, [take_of(c) for c in cids])] = -1e9
             out += knn_vote(sims, self.labels, self.k)
         return out
 

@@ -158,12 +158,12 @@ def eval_paraphrase(model_dir=None, prompts=None, tma=None, seed: int = 0, secon
         embs.append(motion_emb)
         feats.append(m.features)
         rows.append({**it, "motion_proto_pred": actions[int(np.argmax(A @ motion_emb))],
-                     "warned": bool(m.warnings), "kept_clip": (gen.last_sources or [None])[0],
+                     "warned": bool(m.warnings), "kept_clips": list(m.retrieved_clips),
                      "parts": list(m.part_prompts) if m.part_prompts else None,
                      "mirrored": bool(m.mirrored or m.arms_mirrored)})
         if progress is not None:
             progress((i + 1) / len(known), it["text"])
-    kept = [r["kept_clip"] for r in rows]  # a retrieved clip is judged without its own take
+    kept = [r["kept_clips"] for r in rows]  # retrieved clips are judged without their own takes
     for r, p in zip(rows, classifier.classify_embeddings(np.stack(embs), exclude=kept) if embs else []):
         r["motion_pred"] = p
     if feature_classifier is not None:
@@ -191,7 +191,7 @@ def eval_paraphrase(model_dir=None, prompts=None, tma=None, seed: int = 0, secon
             "candidates": candidates,
             "retrieval_prefix": retrieval_prefix if retrieval and gen.reads_memory else 0,
             "retrieved": retrieved if retrieval else 0, "retrieval_first": retrieval_first,
-            "kept_retrieved": sum(r["kept_clip"] is not None for r in rows), "by_parts": by_parts,
+            "kept_retrieved": sum(bool(r["kept_clips"]) for r in rows), "by_parts": by_parts,
             "composed": sum(bool(r["parts"]) for r in rows), "mirrored": sum(r["mirrored"] for r in rows),
             "classifier": {**classifier.info, "ceiling": ceiling},
             "feature_classifier": dict(feature_classifier.info) if feature_classifier is not None else None,

@@ -96,7 +96,8 @@ def eval_parts(model_dir=None, data=None, sides=None, two_things=None, seed: int
     {"sides": {...}, "two_things": {...}, "judge_real", "targets", "settings", "rows": {...}}."""
     from ..generation.generate import Generator, Request
     from ..generation.sampling_params import DEFAULT_CANDIDATES, DEFAULT_RETRIEVAL_FIRST, DEFAULT_RETRIEVED
-    from .action_classifier import default_built_dir, take_of
+    from ..models.motion_memory import take_of
+    from .action_classifier import default_built_dir
     from .part_judge import PartJudge, arms_right, legs_right
     from .part_judge_accuracy import real_accuracy
 

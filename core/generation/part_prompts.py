@@ -97,8 +97,15 @@ def _tidy(clause: str) -> str:
     return re.sub(r"\s+", " ", c).strip(" ,.;")
 
 
-def _with_subject(clause: str) -> str:
-    return clause if SUBJECT.match(clause) else f"a person {clause}"
+def _with_subject(clause: str, subject: str = "a person") -> str:
+    return clause if SUBJECT.match(clause) else f"{subject} {clause}"
+
+
+def _plan(legs_prompt: str, arms_prompt: str, legs_action: str, arms_action: str) -> PartPlan:
+    """The plan, with the side the arms prompt names when it names a hand."""
+    side = named_side(arms_prompt)
+    return PartPlan(legs_prompt, arms_prompt, legs_action, arms_action,
+                    side if side is not None and side[1] == "hand" else None)
 
 
 def clauses(text: str) -> list[str]:
@@ -142,10 +149,7 @@ def plan_parts(text: str, classify=None) -> PartPlan | None:
     if not a or not b:
         return None
     legs_clause, arms_clause = (a, b) if first is legs else (b, a)
-    arms_prompt = _with_subject(arms_clause)
-    side = named_side(arms_prompt)
-    return PartPlan(_with_subject(legs_clause), arms_prompt, legs[2], arms[2],
-                    side if side is not None and side[1] == "hand" else None)
+    return _plan(_with_subject(legs_clause), _with_subject(arms_clause), legs[2], arms[2])
 
 
 STOP = frozenset("a an the this that his her their its my your our one some is are was be being been it he she they "
@@ -185,8 +189,4 @@ def _plan_by_clauses(t: str, classify) -> PartPlan | None:
     if li is None or ai is None:
         return None
     subject = _subject(t)
-    with_subject = lambda c: c if SUBJECT.match(c) else f"{subject} {c}"  # noqa: E731
-    arms_prompt = with_subject(cs[ai])
-    side = named_side(arms_prompt)
-    return PartPlan(with_subject(cs[li]), arms_prompt, acts[li], acts[ai],
-                    side if side is not None and side[1] == "hand" else None)
+    return _plan(_with_subject(cs[li], subject), _with_subject(cs[ai], subject), acts[li], acts[ai])

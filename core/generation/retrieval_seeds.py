@@ -13,8 +13,6 @@ picks among these and the unseeded samples (``rerank.CandidatePicker``).
 """
 from __future__ import annotations
 
-from ..models.motion_memory import sentence_vectors
-
 SEEDED_SHARE = 0.5   # share of best-of-N's candidates that start from a retrieved clip
 
 
@@ -24,16 +22,8 @@ def seed_prefixes(memory, reader, prompt: str, count: int, prefix: int) -> list[
     are skipped. [] without a memory, for ``count`` or ``prefix`` 0, or an empty memory."""
     if memory is None or count <= 0 or prefix <= 0 or not len(memory):
         return []
-    vec = sentence_vectors(reader, [prompt])
-    near = memory.nearest(vec, 2 * count)[0]  # room for skipping clips too short to continue
-    out = []
-    for c, _ in near:
-        codes = memory.clip_tokens[c]
-        if len(codes) > prefix:
-            out.append([int(x) for x in codes[:prefix]])
-            if len(out) == count:
-                break
-    return out
+    near = memory.nearest_long(reader, prompt, count, prefix + 1, 2 * count)  # room for skipping short clips
+    return [[int(x) for x in memory.clip_tokens[c][:prefix]] for c, _ in near]
 
 
 def seeded_count(candidates: int) -> int:

@@ -19,9 +19,6 @@ and its feet are planted as for any sample. A clip shorter than the requested le
 """
 from __future__ import annotations
 
-from ..models.motion_memory import sentence_vectors
-
-
 WINDOWS = 3   # windows of a clip longer than the requested length: its start, middle and end
 
 
@@ -45,13 +42,7 @@ def retrieved_codes(memory, reader, prompt: str, count: int, min_codes: int,
     a memory or for ``count`` 0."""
     if memory is None or count <= 0 or not len(memory):
         return []
-    near = memory.nearest(sentence_vectors(reader, [prompt]), 4 * count)[0]  # room for skipping short clips
-    out, used = [], 0
-    for c, sim in near:
-        w = windows(memory.clip_tokens[c], min_codes, max_codes)
-        if w:
-            out += [(memory.clip_ids[c], float(sim), x) for x in w]
-            used += 1
-            if used == count:
-                break
+    out = []
+    for c, sim in memory.nearest_long(reader, prompt, count, min_codes, 4 * count):  # room for skipping short clips
+        out += [(memory.clip_ids[c], float(sim), w) for w in windows(memory.clip_tokens[c], min_codes, max_codes)]
     return out

@@ -37,6 +37,25 @@ def _integer(value, name: str) -> int:
     return value
 
 
+def _count(value, name: str, lo: int, hi: int, unit: str = "") -> int:
+    """A whole number in [lo, hi]; the refusal names ``name`` and the range (in ``unit``)."""
+    n = _integer(value, name)
+    if not lo <= n <= hi:
+        raise ShapeMoveError(f"{name} must be between {lo} and {hi}{' ' + unit if unit else ''}, "
+                             f"got {n if abs(n) < 10**9 else 'a huge number'}")
+    return n
+
+
+def _number_or_none(value, what: str, hi: float, lo_text: str = "0") -> float | None:
+    """None, or a finite number in [0, hi]; the refusal says "``what`` must be a number from ``lo_text`` to hi"."""
+    if value is None:
+        return None
+    if (isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(float(value))
+            or not 0 <= value <= hi):
+        raise ShapeMoveError(f"{what} must be a number from {lo_text} to {hi:g}, got {str(value)[:40]!r}")
+    return float(value)
+
+
 def check_sampling(seed, temperature, top_k) -> tuple[int, float, int | None]:
     """(seed, temperature, top_k) validated: seed 0..2**63-1, temperature finite in [0, 100]
     (0 = greedy), top_k None/0 (no limit) or a positive whole number."""
@@ -59,44 +78,25 @@ def check_sampling(seed, temperature, top_k) -> tuple[int, float, int | None]:
 def check_candidates(n) -> int:
     """Number of token samples for best-of-N (``rerank.py``): a whole number from 1 (no choice) to
     ``MAX_CANDIDATES``."""
-    n = _integer(n, "candidates")
-    if not 1 <= n <= MAX_CANDIDATES:
-        raise ShapeMoveError(f"candidates must be between 1 and {MAX_CANDIDATES}, got {n if abs(n) < 10**9 else 'a huge number'}")
-    return n
+    return _count(n, "candidates", 1, MAX_CANDIDATES)
 
 
 def check_guidance(s) -> float | None:
     """Classifier-free guidance scale: None (the model's default) or a finite number in [0, MAX_GUIDANCE]."""
-    if s is None:
-        return None
-    if isinstance(s, bool) or not isinstance(s, (int, float)) or not math.isfinite(float(s)) or not 0 <= s <= MAX_GUIDANCE:
-        raise ShapeMoveError(f"guidance must be a number from 0 (none) to {MAX_GUIDANCE:g}, got {str(s)[:40]!r}")
-    return float(s)
+    return _number_or_none(s, "guidance", MAX_GUIDANCE, "0 (none)")
 
 
 def check_retrieval_prefix(n) -> int:
     """Codes of a retrieved clip that seeded candidates start from (``retrieval_seeds.py``): 0 (no
     seeding) to ``MAX_RETRIEVAL_PREFIX``."""
-    n = _integer(n, "retrieval prefix")
-    if not 0 <= n <= MAX_RETRIEVAL_PREFIX:
-        raise ShapeMoveError(f"retrieval prefix must be between 0 and {MAX_RETRIEVAL_PREFIX} codes, "
-                             f"got {n if abs(n) < 10**9 else 'a huge number'}")
-    return n
+    return _count(n, "retrieval prefix", 0, MAX_RETRIEVAL_PREFIX, "codes")
 
 
 def check_retrieved(n) -> int:
     """Real clips retrieved as extra candidates (``retrieved_candidates.py``): 0 (none) to ``MAX_RETRIEVED``."""
-    n = _integer(n, "retrieved clips")
-    if not 0 <= n <= MAX_RETRIEVED:
-        raise ShapeMoveError(f"retrieved clips must be between 0 and {MAX_RETRIEVED}, "
-                             f"got {n if abs(n) < 10**9 else 'a huge number'}")
-    return n
+    return _count(n, "retrieved clips", 0, MAX_RETRIEVED)
 
 
 def check_retrieval_first(s) -> float | None:
     """None (retrieved clips only compete with the samples) or a caption similarity in [0, 1]."""
-    if s is None:
-        return None
-    if isinstance(s, bool) or not isinstance(s, (int, float)) or not math.isfinite(float(s)) or not 0 <= s <= 1:
-        raise ShapeMoveError(f"retrieval-first similarity must be a number from 0 to 1, got {str(s)[:40]!r}")
-    return float(s)
+    return _number_or_none(s, "retrieval-first similarity", 1.0)

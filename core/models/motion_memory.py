@@ -35,14 +35,17 @@ MAX_MEMORY_BYTES = 64 << 20
 def family(cid: str, meta: dict | None = None) -> frozenset:
     """Root ids a clip derives from: its own id without the mirror/augmentation suffixes, and those
     of the clips it was composed from."""
-    def root(c: str) -> str:
-        while c.endswith(("_mirror", "_aug")):
-            c = c.rsplit("_", 1)[0]
-        return c
     meta = meta or {}
-    parts = [root(c) for c in meta.get("composed_from") or []]
+    parts = [take_of(c) for c in meta.get("composed_from") or []]
     base = meta.get("mirror_of") or cid
-    return frozenset([root(base)] + parts)
+    return frozenset([take_of(base)] + parts)
+
+
+def take_of(cid: str) -> str:
+    """The captured take a built clip shows: ``X``, ``X_aug`` and ``X_mirror`` are all ``X``."""
+    while cid.endswith(("_mirror", "_aug")):
+        cid = cid.rsplit("_", 1)[0]
+    return cid
 
 
 def sentence_vectors(reader, texts: list[str], batch: int = 256) -> torch.Tensor:
@@ -146,6 +149,13 @@ class MotionMemory:
                     break
             out.append(chosen)
         return out
+
+    def nearest_long(self, reader, prompt: str, count: int, min_codes: int, room: int) -> list[tuple[int, float]]:
+        """Up to ``count`` (clip index, similarity) of the distinct clips nearest to ``prompt`` by
+        caption that have at least ``min_codes`` codes, looked for among the ``room`` nearest
+        (generation's retrieved candidates and seeded prefixes)."""
+        near = self.nearest(sentence_vectors(reader, [prompt]), room)[0]
+        return [(c, s) for c, s in near if len(self.clip_tokens[c]) >= min_codes][:count]
 
     def _pick(self, clips: list[int], taken: set, fam: frozenset, rng: random.Random | None) -> int | None:
         """A clip of ``clips`` not taken and outside ``fam``: with ``rng`` a few random draws (a
