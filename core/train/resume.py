@@ -20,11 +20,12 @@ def rng_state() -> dict:
 
 
 def set_rng_state(s: dict) -> None:
-    torch.set_rng_state(s["torch"])
+    """RNG states are CPU byte tensors, also in a checkpoint loaded with ``map_location="cuda"``."""
+    torch.set_rng_state(s["torch"].cpu())
     random.setstate((3, tuple(s["python"]), s["python_gauss"]))
-    np.random.set_state(("MT19937", s["numpy"].numpy().astype(np.uint32), s["numpy_pos"], *s["numpy_gauss"]))
+    np.random.set_state(("MT19937", s["numpy"].cpu().numpy().astype(np.uint32), s["numpy_pos"], *s["numpy_gauss"]))
     if s["cuda"] and torch.cuda.is_available():
-        torch.cuda.set_rng_state_all(s["cuda"])
+        torch.cuda.set_rng_state_all([t.cpu() for t in s["cuda"]])
 
 
 def restore(ckpt: dict, model, optimizer, scheduler) -> int:

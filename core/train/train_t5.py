@@ -266,6 +266,7 @@ def _train(data, vae_path, out, c, base_model, resume, dist, progress, cancel, v
                     {"ce": ("train", "ce"), "l1": ("train", "l1")})
         save_if_due(save, step, c.ckpt_every, total, dist)
     # -- 4. the [BETA] head alone on heights and waists (beta_head_refit.py) -------------------
+    total = c.steps + c.head_steps  # c.steps may have been shortened while training (tools/gpu_t5.py)
     if c.steps <= step < total:
         from .beta_head_refit import HeadExamples, head_loss
 
