@@ -1,13 +1,14 @@
 """Train ShapeMove's T5 on a lent GPU machine that holds no ShapeMove data, in three steps.
 
-    python tools/gpu_t5.py pack --data data/built --run runs/default --out .gpu       # here
+    python tools/gpu_t5.py pack --data data/built --vae weights/default/savae.pt --tokens runs/t5/tokens.npz --out .gpu
     python tools/gpu_t5.py train --pack .gpu --configs A.json B.json --minutes 7 --out $OUT   # there
-    python tools/gpu_t5.py unpack --state $OUT/A --data data/built --out runs/gpu_a   # here
+    python tools/gpu_t5.py unpack --state $OUT/A --tokens runs/t5/tokens.npz --out runs/gpu_a   # here
 
 Only 64 MiB travel to the GPU machine, the repository included, so ``pack`` writes what
 ``train_t5`` reads and nothing else: the training split's captions, shape texts, betas and clip meta
-(a tar), the SA-VAE and the FSQ tokens it gave every clip (``RUN/vae/savae.pt``,
-``RUN/t5/tokens.npz``), and the frozen MiniLM in float16 with only the rows of its word-piece
+(a tar), the SA-VAE and the FSQ tokens it gave every clip (``tokens.npz`` of a ``train t5`` run,
+refused unless it was made by that very VAE file: a T5 trained on another codec's tokens writes
+motions the shipped decoder reads as noise), and the frozen MiniLM in float16 with only the rows of its word-piece
 table that the training texts use (the bank's sentences sampled exhaustively): about 24 MB instead of
 the 83 MB package. Its token states differ from the float32 encoder's by float16 rounding, the same
 rounding ``StateCache`` applies to every state it keeps.
@@ -77,9 +78,12 @@ def pack(args) -> None:
                 f = data / d / f"{c}.{'npy' if d == 'betas' else 'json' if d == 'meta' else 'txt'}"
                 if f.is_file():
                     tar.add(f, f"{d}/{f.name}")
-    z = np.load(args.run / "t5" / "tokens.npz", allow_pickle=False)
+    z = np.load(args.tokens, allow_pickle=False)
+    stamp = f"{args.vae.resolve()}:{args.vae.stat().st_mtime_ns}"
+    if str(z["__vae__"]) != stamp:
+        raise SystemExit(f"{args.tokens} holds the tokens of {str(z['__vae__']).rsplit(':', 1)[0]}, not of {args.vae}")
     np.savez_compressed(out / "tokens.npz", **{k: z[k] for k in z.files if k != "__vae__"})
-    (out / "savae.pt").write_bytes((args.run / "vae" / "savae.pt").read_bytes())
+    (out / "savae.pt").write_bytes(args.vae.read_bytes())
     enc = load_text_encoder()
     used = {0, 100, 101, 102, 103}
     texts = _training_texts(data, ids)
@@ -204,7 +208,7 @@ def unpack(args) -> None:
     from shapemove.core.models.shapemove_t5 import ShapeMoveT5, size_from_dict
     from shapemove.core.models.text_encoder import StateCache, load_text_encoder
     from shapemove.core.train.motion_dataset import read_split
-    from shapemove.core.train.train_t5 import T5TrainConfig
+    from shapemove.core.train.train_t5 import T5TrainConfig, load_vae
 
     parts = sorted(args.state.parent.glob(args.state.name + ".*.safetensors"))
     if not parts:
@@ -212,7 +216,8 @@ def unpack(args) -> None:
     with safe_open(str(parts[0]), "pt") as f:
         meta = f.metadata()
     c = T5TrainConfig(**json.loads(meta["config"]))
-    model = ShapeMoveT5.build_minilm(1000, size_from_dict(c.size), beta_weight=c.beta_weight)
+    vae = load_vae(args.vae)
+    model = ShapeMoveT5.build_minilm(int(vae.quantizer.codebook_size), size_from_dict(c.size), beta_weight=c.beta_weight)
     state = {k: v.float() if v.is_floating_point() else v for p in parts for k, v in load_file(str(p)).items()}
     model.load_state_dict(state)
     model.eval()
@@ -222,11 +227,11 @@ def unpack(args) -> None:
     if model.memory_k:
         from shapemove.core.models.motion_memory import MotionMemory
 
-        z = np.load(args.run / "t5" / "tokens.npz", allow_pickle=False)
+        z = np.load(args.tokens, allow_pickle=False)
         tokens = {k: z[k] for k in z.files if k != "__vae__"}
         states.add([t for c_ in train_ids for t in (args.data / "texts" / f"{c_}.txt").read_text().splitlines() if t.strip()])
         memory = MotionMemory.from_dataset(args.data, train_ids, tokens, states)
-    info = {"vae": str(args.run / "vae" / "savae.pt"), "config": c.__dict__, "downsample": 4,
+    info = {"vae": str(args.vae), "config": c.__dict__, "downsample": vae.cfg.downsample,
             "max_codes": c.max_codes, "data": str(args.data), "base_model": None, "step": int(meta["step"]),
             "trained_on": "GPU (tools/gpu_t5.py)"}
     model.save(args.out / "t5", None, info, known=build_known(args.data, train_ids, states), memory=memory)
@@ -238,7 +243,8 @@ def main() -> int:
     sub = ap.add_subparsers(dest="cmd", required=True)
     a = sub.add_parser("pack")
     a.add_argument("--data", type=Path, default=Path("data/built"))
-    a.add_argument("--run", type=Path, default=Path("runs/default"))
+    a.add_argument("--vae", type=Path, default=Path("weights/default/savae.pt"))
+    a.add_argument("--tokens", type=Path, required=True, help="tokens.npz of a train t5 run on that VAE")
     a.add_argument("--out", type=Path, default=Path(".gpu"))
     a = sub.add_parser("train")
     a.add_argument("--pack", type=Path, default=Path(".gpu"))
@@ -262,7 +268,8 @@ def main() -> int:
     a = sub.add_parser("unpack")
     a.add_argument("--state", type=Path, required=True)
     a.add_argument("--data", type=Path, default=Path("data/built"))
-    a.add_argument("--run", type=Path, default=Path("runs/default"))
+    a.add_argument("--vae", type=Path, default=Path("weights/default/savae.pt"))
+    a.add_argument("--tokens", type=Path, required=True, help="the tokens.npz that was packed")
     a.add_argument("--out", type=Path, required=True)
     args = ap.parse_args()
     {"pack": pack, "train": train, "train-one": train_one, "unpack": unpack}[args.cmd](args)
