@@ -67,6 +67,22 @@ def test_loop_of_a_motion_in_place(gen):
     assert r["jump_ratio"] <= 1.5 and r["advance_m"] < 0.05, r
 
 
+def test_loop_of_two_things_is_made_by_part(gen):
+    """A two-things prompt loops the by-part motion: the legs walk, the waving hand stays up."""
+    from shapemove.core.generation.generate import Request
+    from shapemove.core.generation.loop import generate_loop, seam_report
+
+    m = generate_loop(gen, Request("a person walks forward and waves", seed=0))
+    assert m.part_prompts == ("a person walks forward", "a person waves")
+    r = seam_report(m)
+    assert r["jump_ratio"] <= 1.5 and r["advance_m"] > 1.0, r
+    up = max(float((m.joints[:, w, 1] > m.joints[:, s, 1]).mean()) for w, s in ((20, 16), (21, 17)))
+    assert up >= 0.9  # a wrist above its shoulder all through the cycle
+    assert _slide(m) <= 0.5
+    whole = generate_loop(gen, Request("a person walks forward and waves", seed=0, by_parts=False))
+    assert whole.part_prompts is None
+
+
 def test_in_place_no_drift_feet_alternate(walk):
     from shapemove.core.generation.in_place import in_place, root_drift
 

@@ -40,6 +40,8 @@ PLANTED_TRIES = 3      # the best cuts planted until one's seam is good (``seam_
 GOOD_SEAM = 1.5        # worst joint's wrap jump over its mean step that ends the search (the target)
 EDGE = 2               # frames at each end of a decoded clip that a cut avoids
 LOOP_MIN_SECONDS = 4.0  # candidates are at least this long, so a cycle has room
+PART_SECONDS = 6.0     # a by-part motion's length when the loop's length is not asked for
+PART_TRIES = 3         # by-part motions (seeds seed, seed + 2, ...) whose best cuts compete
 
 
 @dataclass
@@ -165,6 +167,7 @@ def generate_loop(gen, req, progress=None, cancel=None) -> Motion:
     n = check_candidates(req.candidates or DEFAULT_CANDIDATES)
     check = gen.check_text(req.prompt)
     down = gen.vae.cfg.downsample
+    no_part_loop = False
     if req.seconds is not None:
         if not 0.4 <= req.seconds <= 30:
             raise ShapeMoveError(f"a loop's --seconds must be between 0.4 and 30, got {req.seconds}")
@@ -174,6 +177,16 @@ def generate_loop(gen, req, progress=None, cancel=None) -> Motion:
     else:
         lo, hi = int(round(LOOP_MIN_SECONDS * FPS / down)), max(gen.max_codes, int(round(LOOP_MIN_SECONDS * FPS / down)))
         period = None
+    if req.by_parts:  # two things at once or a named side: the by-part motion, looped
+        if progress is not None:
+            progress(0.1, "generating by body part")
+        m = _loop_by_parts(gen, req, lo * down / FPS if req.seconds is not None else PART_SECONDS, period, cancel)
+        if m is not False:
+            if m is not None:
+                m.warnings = [check.warning] if check is not None and check.warning else []
+                m.prompt_check = check
+                return m
+            no_part_loop = True
     if progress is not None:
         progress(0.1, "sampling loop candidates")
     cands, pred = sample_codes(gen, req.prompt, req.shape_text, n, lo, hi, req.seed, req.temperature, req.top_k,
@@ -208,9 +221,44 @@ def generate_loop(gen, req, progress=None, cancel=None) -> Motion:
             break
     m.shape_source = source
     m.warnings = [check.warning] if check is not None and check.warning else []
+    if req.by_parts and no_part_loop:
+        m.warnings.append("no loop was found in the motion made by body part: the prompt was generated whole")
     m.prompt_check = check
     m.seam_cost = best[1].cost
     return m
+
+
+def _loop_by_parts(gen, req, seconds: float, period, cancel=None):
+    """A loop of the by-part motion (``parts.generate_by_parts``) of ``req``: ``PART_TRIES`` of them
+    (seeds 2 apart: a by-part motion uses its seed + 1 for the arms), each cut where it loops best
+    and planted, the best planted seam kept. False when the prompt is one action with no named side
+    (the caller loops it whole), None when no motion holds a loop."""
+    import dataclasses
+
+    from .parts import generate_by_parts
+
+    best = None
+    for k in range(PART_TRIES):
+        if cancel is not None and cancel():
+            raise ShapeMoveError("cancelled")
+        made = generate_by_parts(gen, dataclasses.replace(req, seconds=seconds, seed=req.seed + 2 * k))
+        if made is None:
+            return False
+        track = track_of(made)
+        try:
+            cut = best_cut(track.joints, made.fps, period)
+        except ShapeMoveError:
+            continue
+        cycle, adv = make_cycle(track, cut)
+        m = plant_loop(gen.body, made.betas, cycle, adv, gen.ik_refine_iters, prompt=req.prompt)
+        ratio = seam_report(m)["jump_ratio"]
+        if best is None or ratio < best[0]:
+            m.shape_source, m.part_prompts, m.retrieved_clips = made.shape_source, made.part_prompts, made.retrieved_clips
+            m.seam_cost = cut.cost
+            best = (ratio, m)
+        if ratio <= GOOD_SEAM:
+            break
+    return None if best is None else best[1]
 
 
 def seam_report(motion: Motion) -> dict:
