@@ -24,6 +24,8 @@ def add_arguments(p):
     p.add_argument("--regenerate", type=int, default=None, metavar="K",
                    help="re-generate segment K (1-based) of --motion with --seed; the other segments are kept")
     p.add_argument("--motion", type=Path, default=None, help="the timeline to change with --regenerate")
+    p.add_argument("--no-parts", action="store_true",
+                   help="generate segments of two things at once whole, not by body part")
     p.add_argument("--in-place", action="store_true", help="remove the root's horizontal travel")
     p.add_argument("--model", type=Path, default=None)
     p.add_argument("--body-model", default=None)
@@ -56,14 +58,14 @@ def run(args) -> int:
     ensure_parent(args.out)
     from ..core.generation.generate import Generator, parse_betas
     from ..core.generation.in_place import in_place
-    from ..core.generation.sequence import generate_sequence, regenerate_segment
+    from ..core.generation.sequence import generate_sequence, regenerate_segment, segment_codes
 
     betas = parse_betas(args.betas) if args.betas else None
     gen = Generator(args.model, body=args.body_model)
     if args.regenerate is not None:
         motion = regenerate_segment(gen, base, args.regenerate - 1, args.seed, args.prompt[0] if args.prompt else None,
                                     args.seconds[0] if args.seconds else None, args.temperature, args.top_k,
-                                    candidates, guidance)
+                                    candidates, guidance, by_parts=not args.no_parts)
     else:
         from tqdm import tqdm
 
@@ -74,7 +76,7 @@ def run(args) -> int:
                 bar.refresh()
 
             motion = generate_sequence(gen, segments, args.shape_text, betas, args.seed, args.temperature, args.top_k,
-                                       candidates, guidance, progress=progress)
+                                       candidates, guidance, progress=progress, by_parts=not args.no_parts)
     if args.in_place:
         motion = in_place(motion)
     save_motion(args.out, motion)
@@ -84,6 +86,7 @@ def run(args) -> int:
         print(f"warning: {w}", file=sys.stderr)
     print(f"wrote {args.out}: {motion.num_frames} frames ({motion.num_frames / motion.fps:.1f} s), "
           f"{len(motion.segment_bounds)} segments, IK error {motion.ik_error_cm:.2f} cm")
-    for (s, e), p in zip(motion.segment_bounds, motion.segment_prompts):
-        print(f"  frames {int(s):4d}-{int(e) - 1:4d}  {p}")
+    own_arms = segment_codes(motion, arms=True)
+    for (s, e), p, a in zip(motion.segment_bounds, motion.segment_prompts, own_arms):
+        print(f"  frames {int(s):4d}-{int(e) - 1:4d}  {p}{'  (by body part)' if a is not None else ''}")
     return 0

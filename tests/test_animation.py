@@ -171,6 +171,30 @@ def test_cli_refuses_bad_animation_input(tmp_path, args, message):
     assert len(lines) == 1 and message in lines[0], res.stderr
 
 
+def test_timeline_segment_of_two_things_is_made_by_part(gen):
+    """A "walks and waves" segment: its legs walk on from the timeline, its hand is up while the
+    segments around it keep their arms down; the arms' codes are kept, a regenerated neighbour
+    keeps them."""
+    from shapemove.core.generation.sequence import boundary_report, generate_sequence, regenerate_segment, segment_codes
+
+    segs = [("a person walks forward", 3.0), ("a person walks forward and waves", 4.0), ("a person sits down", 3.0)]
+
+    def hand_up(m, k):
+        s, e = m.segment_bounds[k]
+        return max(float((m.joints[s:e, w, 1] > m.joints[s:e, sh, 1]).mean()) for w, sh in ((20, 16), (21, 17)))
+
+    m = generate_sequence(gen, segs, seed=0)
+    own = segment_codes(m, arms=True)
+    assert own[0] is None and own[2] is None and len(own[1]) == len(segment_codes(m)[1]) == 20
+    assert hand_up(m, 1) >= 0.9 and hand_up(m, 0) <= 0.1 and hand_up(m, 2) <= 0.1
+    assert boundary_report(m)["jump_ratio"] <= 2.0
+    whole = generate_sequence(gen, segs, seed=0, by_parts=False)
+    assert whole.arms_tokens is None and hand_up(whole, 1) <= 0.1   # the prompt whole: no wave
+    again = regenerate_segment(gen, m, 2, seed=5)
+    assert segment_codes(again, arms=True)[1] == own[1] and segment_codes(again)[1] == segment_codes(m)[1]
+    assert hand_up(again, 1) >= 0.9
+
+
 def test_timeline_segments_are_the_actions_asked(gen):
     """The model's TMA names each segment's own prompt as the closest of the timeline's prompts
     (the action classifier in core/eval needs a built dataset; this judge needs only the model)."""

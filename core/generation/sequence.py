@@ -9,6 +9,15 @@ body (the first segment's [BETA] head, or the shape text's measurements, or give
 planted once (``track.plant``). The Motion keeps ``segment_bounds`` (frames) and
 ``segment_prompts``; ``regenerate_segment`` samples one segment again (continuing from its
 predecessor) and keeps every other segment's codes.
+
+A segment of two things at once ("walks on, waving"; ``parts.plan_of``) is made by body part, as a
+single prompt is (``parts.py``): its legs prompt continues the timeline's codes, its arms prompt
+the arms' codes, for as many codes. The arms' stream is the timeline's own codes wherever a segment
+has no arms of its own, so decoding it gives the timeline's arms there, and ``compose_arms`` puts
+the arms of that stream on the timeline's chest for the whole length: the decoder's own transition
+between codes carries the arms into and out of the gesture. The Motion keeps both streams
+(``tokens``, ``arms_tokens``), so re-decoding for another body composes them again. A named side
+is not mirrored within a timeline.
 """
 from __future__ import annotations
 
@@ -24,7 +33,7 @@ from ..torch_threads import one_torch_thread
 from .prompts import check_prompt
 from .sampling_params import DEFAULT_CANDIDATES, check_candidates, check_sampling
 from .token_sampling import body_for, sample_codes
-from .track import decoded_track, plant
+from .track import Track, decoded_track, plant
 
 PREFIX_CODES = 4          # codes (0.8 s at 4 frames a code) a segment continues from
 MAX_SEGMENTS = 32
@@ -58,6 +67,30 @@ def check_segments(segments) -> list[Segment]:
     return out
 
 
+def _segment(gen, prompt, shape_text, n, prefix, arms_prefix, betas, seed, temperature, top_k, candidates, guidance,
+             by_parts: bool):
+    """(codes, the arms' codes or None, [BETA] prediction) of one segment: two things at once are
+    made by part (module doc), any other prompt whole."""
+    from .parts import plan_of
+
+    plan = plan_of(prompt, gen)[0] if by_parts else None
+    if plan is None:
+        codes, pred = _segment_codes(gen, prompt, shape_text, n, prefix, betas, seed, temperature, top_k, candidates,
+                                     guidance)
+        return codes, None, pred
+    codes, pred = _segment_codes(gen, plan.legs_prompt, shape_text, n, prefix, betas, seed, temperature, top_k,
+                                 candidates, guidance)
+    arms, _ = _segment_codes(gen, plan.arms_prompt, shape_text, len(codes), arms_prefix, betas, seed + 1, temperature,
+                             top_k, candidates, guidance)
+    return codes, arms, pred
+
+
+def _arms_stream(codes_per_segment, arms_per_segment) -> list[int]:
+    """The arms' codes: a segment's own, else the timeline's."""
+    arms_per_segment = arms_per_segment or [None] * len(codes_per_segment)
+    return [c for seg, a in zip(codes_per_segment, arms_per_segment) for c in (seg if a is None else a)]
+
+
 def _segment_codes(gen, prompt, shape_text, n, prefix, betas, seed, temperature, top_k, candidates, guidance):
     cands, pred = sample_codes(gen, prompt, shape_text, candidates, n, n, seed, temperature, top_k, guidance,
                                prefix=prefix)
@@ -80,12 +113,24 @@ def _batch_features(vae, codes: list[list[int]], betas) -> list[np.ndarray]:
     return [f.numpy() for f in out]
 
 
-def _assemble(gen, codes_per_segment, prompts, betas) -> Motion:
+def _assemble(gen, codes_per_segment, prompts, betas, arms_per_segment=None) -> Motion:
     codes = [c for seg in codes_per_segment for c in seg]
     track, feats = decoded_track(codes, gen.vae, betas)
     down = len(track) // len(codes)
+    extra = {}
+    if arms_per_segment is not None and any(a is not None for a in arms_per_segment):
+        from ..geometry.rotations import axis_angle_to_matrix
+        from ..motion.features import posed_features
+        from .part_compose import compose_arms
+
+        arms = _arms_stream(codes_per_segment, arms_per_segment)
+        arms_track, _ = decoded_track(arms, gen.vae, betas)
+        track = Track(compose_arms(track.joints, arms_track.joints), track.contacts)
+        extra, feats = {"arms_tokens": np.asarray(arms, np.int16)}, None
     motion = plant(gen.body, betas, track, gen.ik_refine_iters, prompt=" -> ".join(prompts),
-                   tokens=np.asarray(codes, np.int16), features=feats)
+                   tokens=np.asarray(codes, np.int16), features=feats, **extra)
+    if feats is None:  # composed: the planted motion's features, as parts.assemble computes them
+        motion.features = posed_features(motion.joints, axis_angle_to_matrix(motion.poses), motion.contacts)
     ends = np.cumsum([len(c) for c in codes_per_segment]) * down
     motion.segment_bounds = np.stack([np.r_[0, ends[:-1]], ends], axis=1).astype(np.int64)
     motion.segment_prompts = list(prompts)
@@ -94,8 +139,9 @@ def _assemble(gen, codes_per_segment, prompts, betas) -> Motion:
 
 def generate_sequence(gen, segments, shape_text: str | None = None, betas=None, seed: int = 0,
                       temperature: float = 1.0, top_k: int | None = 50, candidates: int = DEFAULT_CANDIDATES,
-                      guidance: float | None = None, progress=None, cancel=None) -> Motion:
-    """``segments``: [(prompt, seconds)] or ``Segment``s -> one Motion with segment_bounds."""
+                      guidance: float | None = None, progress=None, cancel=None, by_parts: bool = True) -> Motion:
+    """``segments``: [(prompt, seconds)] or ``Segment``s -> one Motion with segment_bounds;
+    ``by_parts``: segments of two things at once made by body part (module doc)."""
     segs = check_segments(segments)
     shape_text = check_prompt(shape_text, "shape text", allow_empty=True) or None
     seed, temperature, top_k = check_sampling(seed, temperature, top_k)
@@ -108,20 +154,21 @@ def generate_sequence(gen, segments, shape_text: str | None = None, betas=None, 
     if shape_text:
         gen.check_text(shape_text, "shape text")
     down = gen.vae.cfg.downsample
-    chosen, source = [], None
+    chosen, arms, source = [], [], None
     for i, s in enumerate(segs):
         if cancel is not None and cancel():
             raise ShapeMoveError("cancelled")
         n = max(1, int(round(s.seconds * FPS / down)))
         prefix = [c for seg in chosen for c in seg][-PREFIX_CODES:]
-        codes, pred = _segment_codes(gen, s.prompt, shape_text, n, prefix, betas, seed + i, temperature, top_k,
-                                     candidates, guidance)
+        codes, own_arms, pred = _segment(gen, s.prompt, shape_text, n, prefix, _arms_stream(chosen, arms)[-PREFIX_CODES:],
+                                         betas, seed + i, temperature, top_k, candidates, guidance, by_parts)
         if source is None:   # one body for the whole timeline: the first segment's
             betas, source = body_for(gen, s.prompt, shape_text, betas, pred)
         chosen.append(codes)
+        arms.append(own_arms)
         if progress is not None:
             progress((i + 1) / (len(segs) + 1), f"segment {i + 1}/{len(segs)}: {s.prompt}")
-    motion = _assemble(gen, chosen, [s.prompt for s in segs], betas)
+    motion = _assemble(gen, chosen, [s.prompt for s in segs], betas, arms)
     motion.shape_source = source
     motion.warnings = warnings
     if progress is not None:
@@ -129,23 +176,34 @@ def generate_sequence(gen, segments, shape_text: str | None = None, betas=None, 
     return motion
 
 
-def segment_codes(motion: Motion) -> list[list[int]]:
-    """The codes of each segment of a timeline motion."""
+def segment_codes(motion: Motion, arms: bool = False) -> list:
+    """The codes of each segment of a timeline motion; ``arms``: the arms' codes of each segment
+    instead (None where a segment has none of its own)."""
     if motion.segment_bounds is None or motion.tokens is None or len(motion.tokens) == 0:
         raise ShapeMoveError("this motion is not a timeline of prompts (no segments or no tokens)")
     down = motion.num_frames // len(motion.tokens)
     if down < 1 or down * len(motion.tokens) != motion.num_frames:
         raise ShapeMoveError("this timeline's frames do not match its tokens (was it time-warped?); generate it again")
     toks = [int(t) for t in motion.tokens]
-    return [toks[s // down:e // down] for s, e in np.asarray(motion.segment_bounds)]
+    per = [toks[s // down:e // down] for s, e in np.asarray(motion.segment_bounds)]
+    if not arms:
+        return per
+    if motion.arms_tokens is None:
+        return [None] * len(per)
+    own = [int(t) for t in motion.arms_tokens]
+    return [None if own[s // down:e // down] == seg else own[s // down:e // down]
+            for seg, (s, e) in zip(per, np.asarray(motion.segment_bounds))]
 
 
 def regenerate_segment(gen, motion: Motion, index: int, seed: int, prompt: str | None = None,
                        seconds: float | None = None, temperature: float = 1.0, top_k: int | None = 50,
-                       candidates: int = DEFAULT_CANDIDATES, guidance: float | None = None) -> Motion:
+                       candidates: int = DEFAULT_CANDIDATES, guidance: float | None = None,
+                       by_parts: bool = True) -> Motion:
     """Segment ``index`` sampled again (new ``seed``, optionally a new ``prompt``/``seconds``),
-    continuing from the previous segment; every other segment keeps its codes, the body its betas."""
+    continuing from the previous segment; every other segment keeps its codes (and its arms'), the
+    body its betas."""
     per = segment_codes(motion)
+    arms = segment_codes(motion, arms=True)
     prompts = list(motion.segment_prompts)
     if not 0 <= index < len(per):
         raise ShapeMoveError(f"segment {index + 1} does not exist: this timeline has {len(per)}")
@@ -154,10 +212,11 @@ def regenerate_segment(gen, motion: Motion, index: int, seed: int, prompt: str |
     seed, temperature, top_k = check_sampling(seed, temperature, top_k)
     n = max(1, int(round(seg.seconds * FPS / gen.vae.cfg.downsample)))
     prefix = [c for s in per[:index] for c in s][-PREFIX_CODES:]
-    per[index], _ = _segment_codes(gen, seg.prompt, None, n, prefix, motion.betas, seed, temperature, top_k,
-                                   check_candidates(candidates), guidance)
+    arms_prefix = _arms_stream(per[:index], arms[:index])[-PREFIX_CODES:]
+    per[index], arms[index], _ = _segment(gen, seg.prompt, None, n, prefix, arms_prefix, motion.betas, seed, temperature,
+                                          top_k, check_candidates(candidates), guidance, by_parts)
     prompts[index] = seg.prompt
-    out = _assemble(gen, per, prompts, motion.betas)
+    out = _assemble(gen, per, prompts, motion.betas, arms)
     out.shape_source = "given"
     return out
 

@@ -73,12 +73,13 @@ def sequence(params, progress, cancel) -> dict:
     out = _out_path(params, op)
     seed = int(param(params, op, "seed", int, 0))
     regen = param(params, op, "regenerate", int, None)
+    by_parts = bool(param(params, op, "by_parts", bool, True))
     progress(0.05, "loading models")
     gen = _generator(param(params, op, "model", str, None), param(params, op, "body", str, None))
     if regen is not None:
         motion = regenerate_segment(gen, load_motion(param(params, op, "motion", str)), regen, seed,
                                     param(params, op, "prompt", str, None) or None,
-                                    param(params, op, "seconds", (int, float), None))
+                                    param(params, op, "seconds", (int, float), None), by_parts=by_parts)
     else:
         segs = param(params, op, "segments", list)
         if not all(isinstance(s, dict) and "prompt" in s and "seconds" in s for s in segs):
@@ -86,7 +87,8 @@ def sequence(params, progress, cancel) -> dict:
         with _cancellable(cancel):
             motion = generate_sequence(gen, [(s["prompt"], s["seconds"]) for s in segs],
                                        param(params, op, "shape_text", str, None) or None, _betas(params, op), seed,
-                                       progress=lambda f, m: progress(0.1 + 0.85 * f, m), cancel=cancel)
+                                       progress=lambda f, m: progress(0.1 + 0.85 * f, m), cancel=cancel,
+                                       by_parts=by_parts)
     return _saved(out, motion, gen.body, progress)
 
 
