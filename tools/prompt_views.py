@@ -2,7 +2,7 @@
 a quick look at what prompts produce, independent of Blender (Pillow stick figures).
 
     python tools/prompt_views.py --model weights/default --out out/views.png \
-        --prompt "a boxer throws a jab" --prompt "someone raises the left hand"
+        --prompt "a boxer throws a jab" --prompt "someone raises the left hand" [--motion seq.npz]
 
 Each prompt is one row: ``--frames`` poses evenly spaced in time, seen from the front (the camera
 looks at the body's face at frame 0: the body's LEFT side appears on the image's RIGHT, as for a
@@ -63,7 +63,9 @@ def draw_row(draw, joints, x0, y0, cell, frames, title, font=None):
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--model", type=Path, default=None)
-    ap.add_argument("--prompt", action="append", required=True)
+    ap.add_argument("--prompt", action="append", default=[])
+    ap.add_argument("--motion", action="append", type=Path, default=[],
+                    help="a saved motion file (a loop, a timeline) drawn as a row of its own")
     ap.add_argument("--shape-text", default=None)
     ap.add_argument("--out", type=Path, required=True)
     ap.add_argument("--frames", type=int, default=6)
@@ -76,7 +78,10 @@ def main(argv=None) -> int:
     from PIL import Image, ImageDraw
 
     from shapemove.core.generation.generate import Generator, Request
-    from shapemove.core.scene.motion_file import fk_joints
+    from shapemove.core.scene.motion_file import fk_joints, load_motion
+
+    if not args.prompt and not args.motion:
+        ap.error("give at least one --prompt or --motion")
 
     gen = Generator(args.model)
     gen.set_retrieval(not args.no_retrieval)
@@ -84,6 +89,9 @@ def main(argv=None) -> int:
     for i, prompt in enumerate(args.prompt):
         m = gen.generate_batch([Request(prompt, args.shape_text, None, args.seconds, args.seed + i)])[0]
         rows.append((prompt + f"   [{m.shape_source or 'head'}]", np.asarray(fk_joints(gen.body, m))[:, :22]))
+    for path in args.motion:
+        m = load_motion(path)
+        rows.append((f"{path.name}: {m.prompt}", np.asarray(fk_joints(gen.body, m))[:, :22]))
     W, H = 2 * args.frames * args.cell, len(rows) * (args.cell + 10)
     img = Image.new("RGB", (W, H), (255, 255, 255))
     d = ImageDraw.Draw(img)
