@@ -98,14 +98,17 @@ def contact_weights(contacts, fade: int = FADE) -> np.ndarray:
     return w
 
 
-def pin_feet(rotations, transl, rest, parents, targets, weights, soft_reach: float = SOFT_REACH) -> np.ndarray:
+def pin_feet(rotations, transl, rest, parents, targets, weights, soft_reach: float = SOFT_REACH,
+             toe=None) -> np.ndarray:
     """The contact-aware IK pass: after the whole-body IK, each leg's hip and knee are turned
     (two-bone IK in the knee's own bending plane) so that a planted heel (ankle joint) lands on its
     target, and the ankle turned so that a planted ball joint does too; where the ball is planted
     more firmly than the heel (toe-off) the foot moves without turning so that the ball lands. ``weights`` (T,4) from ``contact_weights``: the
     leg moves that fraction of its miss (1 in contact: exactly on target where the leg reaches).
     rotations (T,24,3,3) local, transl (T,3), rest (24,3), targets (T,22,3) ->
-    new local rotations (T,24,3,3); frames without weight are unchanged."""
+    new local rotations (T,24,3,3); frames without weight are unchanged. ``toe`` (T,2,3) world
+    rotation vectors (left, right leg) that the toes undo where the foot rolls over its ball
+    (``foot_roll.roll_feet``): the ball joint's rotation turns back so the toes stay on the floor."""
     import torch
 
     from ..geometry.torch_ops import forward_kinematics
@@ -155,6 +158,15 @@ def pin_feet(rotations, transl, rest, parents, targets, weights, soft_reach: flo
         rot[t, hip] = parent.transpose(0, 2, 1) @ g_hip
         rot[t, knee] = g_hip.transpose(0, 2, 1) @ g_knee
         rot[t, ankle] = g_knee.transpose(0, 2, 1) @ g_ankle
+        if toe is not None:
+            leg = 0 if kh == 0 else 1
+            r = np.flatnonzero(np.abs(np.asarray(toe)[t, leg]).sum(-1) > 0)
+            if len(r):
+                from ..geometry.rotations import axis_angle_to_matrix
+
+                back = axis_angle_to_matrix(-np.asarray(toe, np.float64)[t[r], leg])   # undo the roll
+                ga = g_ankle[r]
+                rot[t[r], foot] = ga.transpose(0, 2, 1) @ back @ ga @ rot[t[r], foot]
     return rot
 
 
@@ -259,7 +271,12 @@ def plant_motion(body, betas, joints, contacts, refine_iters: int = 10, gate: bo
         rest = body.rest_joints(torch.as_tensor(b)[None])[0].numpy()
     ik = solve_ik(targets, rest, refine_iters=refine_iters)
     if pin:
-        ik.rotations = pin_feet(ik.rotations, ik.transl, rest, body.parents, targets, contact_weights(c), soft_reach)
+        from .foot_roll import roll_feet
+
+        roll = roll_feet(_posed(ik, rest, body.parents), targets, c, rest, soft_reach)
+        ik.rotations = pin_feet(ik.rotations, ik.transl, rest, body.parents, roll.targets, roll.weights, soft_reach,
+                                toe=roll.toe)
+        c = roll.contacts   # the heels the feet rolled off the floor are released
     transl = np.asarray(ik.transl, dtype=np.float64).copy()
     per_foot, _, low = probe.lowest(ik.rotations, transl)
     shift = ground_shift(per_foot, low, c, max_flight=max_flight)  # predicted contacts can miss steps
