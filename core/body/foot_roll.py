@@ -14,8 +14,10 @@ stance (a run of the ball joint's contact, ``motion.contacts``) with a planted h
   sagittal rotation); the heel (ankle joint) then lies on a circle of radius ``L`` about ``P``,
   rising and moving forward. Per frame, the smallest ``theta`` that brings the heel within the
   leg's reach of the hip (``reach`` of the leg's length, where ``pin_feet`` still lands a joint
-  exactly), from mid-stance on (the frame where the hip is closest to the heel); after the
-  heel's contact ends, also the pitch
+  exactly), once the hip has passed over the ball (a body standing on straight legs does not
+  roll); the pitch of the first such frame is reached by a ramp from mid-stance (the frame where
+  the hip is closest to the heel), so the heel does not jump up. After the heel's contact ends,
+  also the pitch
   the IK pose already has (the decoder's own toe-off). It never decreases within a stance: a heel
   that rose stays up until the foot leaves.
 * **steering**: the leg pass (``pin_feet``) still steers a rolled heel, onto its rolled target,
@@ -124,9 +126,14 @@ def roll_feet(posed, targets, contacts, rest, reach: float, fade: int = FADE) ->
             _move_ball(tgt, weights[:, kt], c[:, kt], ball, sb, eb, P - B, fade)
             e1, e2, _ = _frame(A, P)
             t = np.arange(max(s, sb), eb)
-            mid = int(np.argmin(np.linalg.norm(pos[t, hip] - A, axis=-1)))   # mid-stance: the leg at its shortest
-            theta = reach_angle(pos[t, hip], P, e1, e2, foot, limb)
-            theta[:mid] = 0.0                                 # the heel strike's overstretch is not a roll
+            fwd = (P - A) * [1.0, 0.0, 1.0]
+            ahead = (pos[t, hip] - P) @ fwd > 0               # the hip has passed over the ball
+            theta = np.where(ahead, reach_angle(pos[t, hip], P, e1, e2, foot, limb), 0.0)
+            on = np.flatnonzero(theta > 0)
+            if len(on):                                       # the heel starts rising at mid-stance (the
+                mid = int(np.argmin(np.linalg.norm(pos[t, hip] - A, axis=-1)))   # leg at its shortest)
+                if mid < on[0]:
+                    theta[mid:on[0]] = theta[on[0]] * np.arange(on[0] - mid) / (on[0] - mid)
             after = t >= e                                    # the decoder already lifted the heel
             theta = np.where(after, np.maximum(theta, np.clip(pitch_of(pos[t, ankle], pos[t, ball], e1, e2),
                                                               0.0, MAX_ROLL)), theta)

@@ -14,6 +14,9 @@ in the capture slide and hover on the body, and a body grounded by its lowest fo
 2. ``pin_feet`` (decoding): the whole-body IK spreads its misses over all joints, so a contact
    leg is then turned (soft two-bone IK) to land its planted heel and ball exactly where the
    leg reaches (a planted joint still steps ~0.4 mm per frame on average on real clips).
+   Before it, ``foot_roll.roll_feet`` lets a stance foot roll over its ball where the hip has
+   travelled past the leg's reach of the flat heel: the heel's target pitches up about the pinned
+   ball, the toes stay flat, and the heel's contact is released once it is off the floor.
 3. ``ground_shift``: after posing, a per-frame vertical shift of the whole body computed on the
    mesh (``soles.GroundProbe``): on frames with a contact, the lowest vertex of the foot in
    contact goes to y = 0; between contact frames the shift is interpolated (a jump keeps its
@@ -223,7 +226,7 @@ def smooth_body(joints, sigma: float = BODY_SMOOTH) -> np.ndarray:
 class Planted:
     rotations: np.ndarray   # (T,24,3,3) local rotations
     transl: np.ndarray      # (T,3) as BodyModel.forward: posed joints = FK(rest) + transl
-    contacts: np.ndarray    # (T,4) uint8 of joints 7, 8, 10, 11 (after gating)
+    contacts: np.ndarray    # (T,4) uint8 of joints 7, 8, 10, 11 (after gating; rolled heels released)
     ik_error_cm: float      # mean distance of the posed joints to ``joints`` (floor removed)
 
 
@@ -255,7 +258,9 @@ def plant_motion(body, betas, joints, contacts, refine_iters: int = 10, gate: bo
     ``smooth`` > 0: ``smooth_body`` with that sigma (frames) first. ``pin``: after the IK, the
     contact-aware leg pass ``pin_feet`` puts the planted joints on their targets (the whole-body
     IK spreads its misses over all joints, so a planted foot would otherwise slide by millimetres to
-    centimetres where the decoded body drifts away from it). ``soft_reach``: ``pin_feet``'s soft limit
+    centimetres where the decoded body drifts away from it); before it the stance feet roll over
+    their balls where the leg cannot reach a flat heel (``foot_roll.roll_feet``), and the contacts
+    returned have those heels released where they leave the floor. ``soft_reach``: ``pin_feet``'s soft limit
     (of the leg's length; closer to 1 lands straighter legs on their targets, e.g. animation edits)."""
     import torch
 
