@@ -37,7 +37,6 @@ import numpy as np
 
 from ..errors import ShapeMoveError
 from ..motion.contacts import runs
-from .plant import FADE, LEGS, contact_weights
 
 MAX_ROLL = np.deg2rad(60.0)   # the most the heel is pitched up about the ball
 LIFT_TOL = 0.005              # m: a heel higher than this above its flat height is off the floor
@@ -91,26 +90,28 @@ def pitch_of(ankle, ball, e1, e2) -> np.ndarray:
     return np.arctan2(v @ e2, v @ e1)
 
 
-def roll_feet(posed, targets, contacts, rest, reach: float, fade: int = FADE) -> Roll:
+def roll_feet(posed, targets, contacts, weights, rest, reach: float, legs, fade: int) -> Roll:
     """The stance feet rolled over their balls (see the module doc).
 
     posed (T,22,3) the body after the whole-body IK (its hips stay where they are: the leg pass
     turns only the legs), targets (T,22,3) from ``plant_targets`` (floor at y = 0), contacts (T,4)
-    of joints 7, 8, 10, 11, rest (>=22,3) the body's rest joints, ``reach`` the fraction of the
-    leg's length within which ``pin_feet`` lands a joint exactly (its ``soft_reach``)."""
+    of joints 7, 8, 10, 11, weights (T,4) their leg-pass weights (``plant.contact_weights``, fading
+    over ``fade`` frames), rest (>=22,3) the body's rest joints, ``reach`` the fraction of the
+    leg's length within which ``pin_feet`` lands a joint exactly (its ``soft_reach``), ``legs``
+    ``plant.LEGS`` (hip, knee, ankle, ball joint, heel and ball contact columns per leg)."""
     pos = np.asarray(posed, np.float64)
     tgt = np.array(targets, dtype=np.float64)
     c = np.asarray(contacts).astype(bool)
     rest = np.asarray(rest, np.float64)
     T = len(tgt)
-    if pos.shape[:2] != (T, 22) or c.shape != (T, 4):
+    if pos.shape[:2] != (T, 22) or c.shape != (T, 4) or weights.shape != (T, 4):
         raise ShapeMoveError(f"roll_feet needs (T,22,3) poses and targets and (T,4) contacts, got {pos.shape}, "
                              f"{tgt.shape}, {c.shape}")
-    weights = contact_weights(c, fade)
+    weights = np.array(weights, dtype=np.float64)
     out_c = c.copy()
     toe = np.zeros((T, 2, 3))
     angle = np.zeros((T, 2))
-    for leg, (hip, knee, ankle, ball, kh, kt) in enumerate(LEGS):
+    for leg, (hip, knee, ankle, ball, kh, kt) in enumerate(legs):
         foot = float(np.linalg.norm(rest[ball] - rest[ankle]))
         limb = reach * float(np.linalg.norm(rest[knee] - rest[hip]) + np.linalg.norm(rest[ankle] - rest[knee]))
         heel_runs = runs(c[:, kh])

@@ -278,7 +278,7 @@ def plant_motion(body, betas, joints, contacts, refine_iters: int = 10, gate: bo
     if pin:
         from .foot_roll import roll_feet
 
-        roll = roll_feet(_posed(ik, rest, body.parents), targets, c, rest, soft_reach)
+        roll = roll_feet(_posed(ik, rest, body.parents), targets, c, contact_weights(c), rest, soft_reach, LEGS, FADE)
         ik.rotations = pin_feet(ik.rotations, ik.transl, rest, body.parents, roll.targets, roll.weights, soft_reach,
                                 toe=roll.toe)
         c = roll.contacts   # the heels the feet rolled off the floor are released
