@@ -14,6 +14,9 @@ in the capture slide and hover on the body, and a body grounded by its lowest fo
 2. ``pin_feet`` (decoding): the whole-body IK spreads its misses over all joints, so a contact
    leg is then turned (soft two-bone IK) to land its planted heel and ball exactly where the
    leg reaches (a planted joint still steps ~0.4 mm per frame on average on real clips).
+   Before it, ``foot_roll.roll_feet`` lets a stance foot roll over its ball where the hip has
+   travelled past the leg's reach of the flat heel: the heel's target pitches up about the pinned
+   ball, the toes stay flat, and the heel's contact is released once it is off the floor.
 3. ``ground_shift``: after posing, a per-frame vertical shift of the whole body computed on the
    mesh (``soles.GroundProbe``): on frames with a contact, the lowest vertex of the foot in
    contact goes to y = 0; between contact frames the shift is interpolated (a jump keeps its
@@ -98,14 +101,17 @@ def contact_weights(contacts, fade: int = FADE) -> np.ndarray:
     return w
 
 
-def pin_feet(rotations, transl, rest, parents, targets, weights, soft_reach: float = SOFT_REACH) -> np.ndarray:
+def pin_feet(rotations, transl, rest, parents, targets, weights, soft_reach: float = SOFT_REACH,
+             toe=None) -> np.ndarray:
     """The contact-aware IK pass: after the whole-body IK, each leg's hip and knee are turned
     (two-bone IK in the knee's own bending plane) so that a planted heel (ankle joint) lands on its
     target, and the ankle turned so that a planted ball joint does too; where the ball is planted
     more firmly than the heel (toe-off) the foot moves without turning so that the ball lands. ``weights`` (T,4) from ``contact_weights``: the
     leg moves that fraction of its miss (1 in contact: exactly on target where the leg reaches).
     rotations (T,24,3,3) local, transl (T,3), rest (24,3), targets (T,22,3) ->
-    new local rotations (T,24,3,3); frames without weight are unchanged."""
+    new local rotations (T,24,3,3); frames without weight are unchanged. ``toe`` (T,2,3) world
+    rotation vectors (left, right leg) that the toes undo where the foot rolls over its ball
+    (``foot_roll.roll_feet``): the ball joint's rotation turns back so the toes stay on the floor."""
     import torch
 
     from ..geometry.torch_ops import forward_kinematics
@@ -155,6 +161,15 @@ def pin_feet(rotations, transl, rest, parents, targets, weights, soft_reach: flo
         rot[t, hip] = parent.transpose(0, 2, 1) @ g_hip
         rot[t, knee] = g_hip.transpose(0, 2, 1) @ g_knee
         rot[t, ankle] = g_knee.transpose(0, 2, 1) @ g_ankle
+        if toe is not None:
+            leg = 0 if kh == 0 else 1
+            r = np.flatnonzero(np.abs(np.asarray(toe)[t, leg]).sum(-1) > 0)
+            if len(r):
+                from ..geometry.rotations import axis_angle_to_matrix
+
+                back = axis_angle_to_matrix(-np.asarray(toe, np.float64)[t[r], leg])   # undo the roll
+                ga = g_ankle[r]
+                rot[t[r], foot] = ga.transpose(0, 2, 1) @ back @ ga @ rot[t[r], foot]
     return rot
 
 
@@ -211,7 +226,7 @@ def smooth_body(joints, sigma: float = BODY_SMOOTH) -> np.ndarray:
 class Planted:
     rotations: np.ndarray   # (T,24,3,3) local rotations
     transl: np.ndarray      # (T,3) as BodyModel.forward: posed joints = FK(rest) + transl
-    contacts: np.ndarray    # (T,4) uint8 of joints 7, 8, 10, 11 (after gating)
+    contacts: np.ndarray    # (T,4) uint8 of joints 7, 8, 10, 11 (after gating; rolled heels released)
     ik_error_cm: float      # mean distance of the posed joints to ``joints`` (floor removed)
 
 
@@ -243,7 +258,9 @@ def plant_motion(body, betas, joints, contacts, refine_iters: int = 10, gate: bo
     ``smooth`` > 0: ``smooth_body`` with that sigma (frames) first. ``pin``: after the IK, the
     contact-aware leg pass ``pin_feet`` puts the planted joints on their targets (the whole-body
     IK spreads its misses over all joints, so a planted foot would otherwise slide by millimetres to
-    centimetres where the decoded body drifts away from it). ``soft_reach``: ``pin_feet``'s soft limit
+    centimetres where the decoded body drifts away from it); before it the stance feet roll over
+    their balls where the leg cannot reach a flat heel (``foot_roll.roll_feet``), and the contacts
+    returned have those heels released where they leave the floor. ``soft_reach``: ``pin_feet``'s soft limit
     (of the leg's length; closer to 1 lands straighter legs on their targets, e.g. animation edits)."""
     import torch
 
@@ -259,7 +276,12 @@ def plant_motion(body, betas, joints, contacts, refine_iters: int = 10, gate: bo
         rest = body.rest_joints(torch.as_tensor(b)[None])[0].numpy()
     ik = solve_ik(targets, rest, refine_iters=refine_iters)
     if pin:
-        ik.rotations = pin_feet(ik.rotations, ik.transl, rest, body.parents, targets, contact_weights(c), soft_reach)
+        from .foot_roll import roll_feet
+
+        roll = roll_feet(_posed(ik, rest, body.parents), targets, c, contact_weights(c), rest, soft_reach, LEGS, FADE)
+        ik.rotations = pin_feet(ik.rotations, ik.transl, rest, body.parents, roll.targets, roll.weights, soft_reach,
+                                toe=roll.toe)
+        c = roll.contacts   # the heels the feet rolled off the floor are released
     transl = np.asarray(ik.transl, dtype=np.float64).copy()
     per_foot, _, low = probe.lowest(ik.rotations, transl)
     shift = ground_shift(per_foot, low, c, max_flight=max_flight)  # predicted contacts can miss steps

@@ -1,0 +1,162 @@
+"""The stance foot rolls over its ball: in late stance the heel rises and the foot pivots about the
+ball joint, which stays where it was planted.
+
+A planted foot held flat cannot follow a root that travels as far as a real walker's: once the hip
+has passed over the foot, the leg cannot reach back to a heel still on the floor, so ``pin_feet``'s
+soft IK stops short and the heel is dragged forward (stance slide). A real foot rolls instead. Per
+stance (a run of the ball joint's contact, ``motion.contacts``) with a planted heel:
+
+* **pivot** ``P``: where the flat foot puts its ball joint: the heel's anchor plus the body's own
+  foot length (ankle to ball, ``L``) toward the ball's anchor, so the ball does not move when the
+  roll starts (``pin_feet`` aims the foot the same way); the ball's target is ``P`` for the whole
+  run (and its fade).
+* **pitch** ``theta``: the foot turns about the horizontal axis through ``P`` across the foot (a
+  sagittal rotation); the heel (ankle joint) then lies on a circle of radius ``L`` about ``P``,
+  rising and moving forward. Per frame, the smallest ``theta`` that brings the heel within the
+  leg's reach of the hip (``reach`` of the leg's length, where ``pin_feet`` still lands a joint
+  exactly), once the hip has passed over the ball (a body standing on straight legs does not
+  roll); the pitch of the first such frame is reached by a ramp from mid-stance (the frame where
+  the hip is closest to the heel), so the heel does not jump up. After the heel's contact ends,
+  also the pitch
+  the IK pose already has (the decoder's own toe-off). It never decreases within a stance: a heel
+  that rose stays up until the foot leaves.
+* **steering**: the leg pass (``pin_feet``) still steers a rolled heel, onto its rolled target,
+  with full weight (also after the decoder released the heel, until the ball leaves).
+* **contacts**: the contacts the planted Motion reports follow what its heels do: a heel stays
+  in contact only while the roll keeps it on the floor (within ``LIFT_TOL`` of its flat
+  height, where it moves forward by well under a millimetre per frame); from there to the end of
+  the stance it is off the floor and released.
+* **toes**: the toe segment (the ball joint's rotation) turns back by ``theta``, so the toes stay
+  flat on the floor while the heel rises (the foot bends at the ball).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import ShapeMoveError
+from ..motion.contacts import runs
+
+MAX_ROLL = np.deg2rad(60.0)   # the most the heel is pitched up about the ball
+LIFT_TOL = 0.005              # m: a heel higher than this above its flat height is off the floor
+UP = np.array([0.0, 1.0, 0.0])
+
+
+@dataclass
+class Roll:
+    targets: np.ndarray    # (T,22,3) the planting targets with rolled heels and the balls on their pivots
+    weights: np.ndarray    # (T,4) leg-pass weights (``pin_feet``): a rolled heel keeps weight 1
+    contacts: np.ndarray   # (T,4) uint8: a heel's contact released where the roll lifts it off the floor
+    toe: np.ndarray        # (T,2,3) world rotation vector (axis * theta) the toes of each leg undo
+    angle: np.ndarray      # (T,2) theta of each leg (rad), 0 where the foot is flat or not planted
+
+
+def _frame(heel, pivot) -> tuple[np.ndarray, np.ndarray, float]:
+    """Heel and ball anchors (3,) -> (e1, e2, L0): e1 the unit vector from the pivot to the heel,
+    e2 the unit vector across it in the foot's vertical plane, pointing up; L0 their distance."""
+    v = np.asarray(heel, np.float64) - np.asarray(pivot, np.float64)
+    L0 = float(np.linalg.norm(v))
+    if L0 < 1e-6:
+        raise ShapeMoveError("a planted heel and ball on the same point: the foot has no length to roll over")
+    e1 = v / L0
+    e2 = UP - (UP @ e1) * e1
+    n = np.linalg.norm(e2)
+    if n < 1e-6:
+        raise ShapeMoveError("a planted foot standing upright: it cannot roll over its ball")
+    return e1, e2 / n, L0
+
+
+def reach_angle(hip, pivot, e1, e2, foot: float, reach: float) -> np.ndarray:
+    """Smallest pitch theta >= 0 (rad) per frame that puts the heel, at ``pivot + foot *
+    (cos theta e1 + sin theta e2)``, within ``reach`` (m) of ``hip`` (N,3); where no pitch reaches
+    it, the pitch that comes closest (capped at ``MAX_ROLL``).
+
+    |hip - heel|^2 <= reach^2  <=>  a cos theta + b sin theta >= k, with a, b the hip's offset
+    from the pivot along e1, e2 and k = (|hip - pivot|^2 + foot^2 - reach^2) / (2 foot)."""
+    d = np.asarray(hip, np.float64) - np.asarray(pivot, np.float64)
+    a, b = d @ e1, d @ e2
+    k = ((d * d).sum(-1) + foot ** 2 - reach ** 2) / (2 * foot)
+    rho, alpha = np.hypot(a, b), np.arctan2(b, a)
+    theta = alpha - np.arccos(np.clip(k / np.maximum(rho, 1e-12), -1.0, 1.0))
+    theta = np.where(a >= k, 0.0, theta)                  # the flat foot is within reach already
+    return np.clip(theta, 0.0, MAX_ROLL)
+
+
+def pitch_of(ankle, ball, e1, e2) -> np.ndarray:
+    """(N,3) ankle and ball positions -> (N,) pitch (rad) of the foot about the pivot's axis,
+    relative to the flat foot (e1): how far the heel is already turned up."""
+    v = np.asarray(ankle, np.float64) - np.asarray(ball, np.float64)
+    return np.arctan2(v @ e2, v @ e1)
+
+
+def roll_feet(posed, targets, contacts, weights, rest, reach: float, legs, fade: int) -> Roll:
+    """The stance feet rolled over their balls (see the module doc).
+
+    posed (T,22,3) the body after the whole-body IK (its hips stay where they are: the leg pass
+    turns only the legs), targets (T,22,3) from ``plant_targets`` (floor at y = 0), contacts (T,4)
+    of joints 7, 8, 10, 11, weights (T,4) their leg-pass weights (``plant.contact_weights``, fading
+    over ``fade`` frames), rest (>=22,3) the body's rest joints, ``reach`` the fraction of the
+    leg's length within which ``pin_feet`` lands a joint exactly (its ``soft_reach``), ``legs``
+    ``plant.LEGS`` (hip, knee, ankle, ball joint, heel and ball contact columns per leg)."""
+    pos = np.asarray(posed, np.float64)
+    tgt = np.array(targets, dtype=np.float64)
+    c = np.asarray(contacts).astype(bool)
+    rest = np.asarray(rest, np.float64)
+    T = len(tgt)
+    if pos.shape[:2] != (T, 22) or c.shape != (T, 4) or weights.shape != (T, 4):
+        raise ShapeMoveError(f"roll_feet needs (T,22,3) poses and targets and (T,4) contacts, got {pos.shape}, "
+                             f"{tgt.shape}, {c.shape}")
+    weights = np.array(weights, dtype=np.float64)
+    out_c = c.copy()
+    toe = np.zeros((T, 2, 3))
+    angle = np.zeros((T, 2))
+    for leg, (hip, knee, ankle, ball, kh, kt) in enumerate(legs):
+        foot = float(np.linalg.norm(rest[ball] - rest[ankle]))
+        limb = reach * float(np.linalg.norm(rest[knee] - rest[hip]) + np.linalg.norm(rest[ankle] - rest[knee]))
+        heel_runs = runs(c[:, kh])
+        for sb, eb in runs(c[:, kt]):
+            over = [(s, e) for s, e in heel_runs if s < eb and e > sb and e <= eb]
+            if not over:
+                continue
+            s, e = over[-1]                                   # the heel run the foot rolls off
+            A, B = tgt[s, ankle].copy(), tgt[sb, ball].copy()
+            if np.linalg.norm(B - A) < 1e-6:
+                continue
+            P = A + foot * (B - A) / np.linalg.norm(B - A)
+            _move_ball(tgt, weights[:, kt], c[:, kt], ball, sb, eb, P - B, fade)
+            e1, e2, _ = _frame(A, P)
+            t = np.arange(max(s, sb), eb)
+            fwd = (P - A) * [1.0, 0.0, 1.0]
+            ahead = (pos[t, hip] - P) @ fwd > 0               # the hip has passed over the ball
+            theta = np.where(ahead, reach_angle(pos[t, hip], P, e1, e2, foot, limb), 0.0)
+            on = np.flatnonzero(theta > 0)
+            if len(on):                                       # the heel starts rising at mid-stance (the
+                mid = int(np.argmin(np.linalg.norm(pos[t, hip] - A, axis=-1)))   # leg at its shortest)
+                if mid < on[0]:
+                    theta[mid:on[0]] = theta[on[0]] * np.arange(on[0] - mid) / (on[0] - mid)
+            after = t >= e                                    # the decoder already lifted the heel
+            theta = np.where(after, np.maximum(theta, np.clip(pitch_of(pos[t, ankle], pos[t, ball], e1, e2),
+                                                              0.0, MAX_ROLL)), theta)
+            theta = np.maximum.accumulate(theta)
+            rolled = theta > 0
+            if not rolled.any():
+                continue
+            t, theta = t[rolled], theta[rolled]
+            tgt[t, ankle] = P + foot * (np.cos(theta)[:, None] * e1 + np.sin(theta)[:, None] * e2)
+            weights[t, kh] = 1.0
+            out_c[t[tgt[t, ankle, 1] - A[1] > LIFT_TOL], kh] = False   # the heel is off the floor
+            axis = np.cross(e1, e2)                           # turning e1 toward e2: the heel up
+            toe[t, leg] = theta[:, None] * axis
+            angle[t, leg] = theta
+    return Roll(targets=tgt, weights=weights, contacts=out_c.astype(np.uint8), toe=toe, angle=angle)
+
+
+def _move_ball(tgt, w, on, ball: int, s: int, e: int, shift, fade: int) -> None:
+    """The ball's target of run [s, e) moved by ``shift`` (3,), in place; its fade frames (those
+    not in another run: ``on`` (T,) its contact) by the fraction ``w`` of it they were planted with."""
+    tgt[s:e, ball] += shift
+    for t in [*range(max(s - fade, 0), s), *range(e, min(e + fade, len(tgt)))]:
+        if not on[t]:
+            tgt[t, ball] += w[t] * shift
+

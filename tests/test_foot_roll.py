@@ -1,0 +1,117 @@
+"""The stance foot rolls over its ball (``body/foot_roll.py``): the pitch that keeps the heel within
+the leg's reach, and a synthetic stance whose root travels further than a flat planted foot allows,
+planted end to end (``plant.plant_motion``): the ball stays pinned, the heel rises and is released,
+the toes stay on the floor, the foot keeps its length."""
+import numpy as np
+import pytest
+import torch
+
+from shapemove.core.errors import ShapeMoveError
+
+
+@pytest.fixture(scope="module")
+def body():
+    from shapemove.core.body.load import load_body_model
+
+    return load_body_model(None)
+
+
+def test_reach_angle_is_the_smallest_pitch_that_reaches():
+    from shapemove.core.body.foot_roll import MAX_ROLL, _frame, reach_angle
+
+    pivot = np.zeros(3)
+    heel = np.array([0.0, 0.05, -0.14])                 # behind and above the ball (facing +Z)
+    e1, e2, L = _frame(heel, pivot)
+    assert e2[1] > 0 and abs(e1 @ e2) < 1e-12
+    hips = np.array([[0.0, 0.83, -0.10],                # over the heel: in reach flat
+                     [0.0, 0.80, 0.25],                 # passed over the ball: must roll
+                     [0.0, 0.80, 0.90]])                # out of reach at any pitch
+    reach = 0.80
+    th = reach_angle(hips, pivot, e1, e2, L, reach)
+    assert th[0] == 0.0 and 0 < th[1] < MAX_ROLL and th[2] == MAX_ROLL
+    rolled = pivot + L * (np.cos(th[1]) * e1 + np.sin(th[1]) * e2)
+    assert np.linalg.norm(hips[1] - rolled) == pytest.approx(reach, abs=1e-9)   # just within reach
+    less = pivot + L * (np.cos(th[1] - 0.01) * e1 + np.sin(th[1] - 0.01) * e2)
+    assert np.linalg.norm(hips[1] - less) > reach                              # any less is out of reach
+    with pytest.raises(ShapeMoveError, match="no length"):
+        _frame(pivot, pivot)
+
+
+def _stance(body, betas, T: int = 24, start: float = -0.15, end: float = 0.42, drop: float = 0.06,
+            longer: float = 0.0):
+    """A left-foot stance: the body's rest joints, ``drop`` m lower (the stance knee bends),
+    carried forward (+Z) from ``start`` to ``end`` m past the planted foot, the left ankle and ball flat on the floor where they
+    stand at rest, the left knee bent forward between them (straight where the hip is out of
+    reach), the right foot 10 cm up. Contacts: left heel and ball in every frame (a decoder's
+    flat-foot stance). ``longer``: the ball that much further forward than the body's foot reaches."""
+    with torch.no_grad():
+        rest = body.rest_joints(torch.as_tensor(betas)[None])[0].numpy()[:22].astype(np.float64)
+    rest[:, 1] -= rest[[7, 10], 1].min() - 0.03                     # the floor just under the feet
+    j = np.repeat(rest[None], T, 0)
+    j[:, :, 2] += np.linspace(start, end, T)[:, None]
+    j[:, :, 1] -= drop
+    j[:, [8, 11], 1] += 0.10
+    j[:, [7, 10]] = rest[[7, 10]]                                    # planted flat
+    j[:, 10, 2] += longer                                            # a decoded foot longer than the body's
+    l1, l2 = np.linalg.norm(rest[4] - rest[1]), np.linalg.norm(rest[7] - rest[4])
+    v = j[:, 7] - j[:, 1]
+    d = np.linalg.norm(v, axis=1, keepdims=True)
+    u = v / d
+    side = np.array([0.0, 0.0, 1.0]) - u[:, 2:3] * u                 # the knee bends forward
+    side /= np.linalg.norm(side, axis=1, keepdims=True)
+    cos = ((l1 ** 2 + np.minimum(d, l1 + l2) ** 2 - l2 ** 2) / (2 * l1 * np.minimum(d, l1 + l2))).clip(-1, 1)
+    j[:, 4] = j[:, 1] + l1 * (cos * u + np.sqrt(1 - cos ** 2) * side)
+    c = np.zeros((T, 4), np.uint8)
+    c[:, [0, 2]] = 1
+    return j, c, rest
+
+
+@pytest.mark.parametrize("longer", [0.0, 0.01])
+def test_a_stance_that_outruns_a_flat_foot_rolls_over_the_ball(body, longer):
+    """``longer``: the decoded foot is 1 cm longer than the body's; the ball lands where the flat
+    foot puts it (the pivot), and stays there as the foot rolls."""
+    from shapemove.core.body.foot_roll import LIFT_TOL
+    from shapemove.core.body.plant import plant_motion
+    from shapemove.core.body.soles import GroundProbe
+    from shapemove.core.eval.physics import stance_slide
+    from shapemove.core.geometry.fk import forward_kinematics
+
+    b = np.zeros(10, np.float32)
+    j, c, rest = _stance(body, b, longer=longer)
+    p = plant_motion(body, b, j, c, gate=False, max_flight=None)
+    with torch.no_grad():
+        rj = body.rest_joints(torch.as_tensor(b)[None])[0].numpy()
+    pos = forward_kinematics(np.asarray(p.rotations, np.float64), rj, body.parents)[0][:, :22] + p.transl[:, None]
+    heel, ball = pos[:, 7], pos[:, 10]
+    # the leg cannot reach the flat heel at the end: the hip is out of the leg's reach of it
+    leg = np.linalg.norm(rj[4] - rj[1]) + np.linalg.norm(rj[7] - rj[4])
+    assert np.linalg.norm(j[-1, 1] - j[-1, 7]) > leg
+    # the ball stays pinned through the whole stance (XZ), on its flat height
+    assert np.linalg.norm(ball[:, [0, 2]] - ball[0, [0, 2]], axis=1).max() < 1.5e-3
+    assert np.ptp(ball[:, 1]) < 5e-3           # the toes do not dip into the floor (the body is not lifted by 17 mm)
+    # the heel rises in late stance and moves forward, about the ball: the foot keeps its length
+    assert heel[-1, 1] - heel[0, 1] > 0.03 and heel[-1, 2] > heel[0, 2] + 0.005
+    assert np.allclose(np.linalg.norm(heel - ball, axis=1), np.linalg.norm(rj[10] - rj[7]), atol=1e-6)
+    pitch = np.arctan2(heel[:, 1] - ball[:, 1], np.linalg.norm((ball - heel)[:, [0, 2]], axis=1))
+    assert np.all(np.diff(pitch[len(pitch) // 2:]) > -1e-3)          # it never comes back down within the stance
+    # the heel's contact: kept early (flat), released where it rose; a heel in contact is still
+    hc = p.contacts[:, 0].astype(bool)
+    assert hc[:4].all() and not hc[-4:].any() and p.contacts[:, 2].all()
+    assert (heel[hc, 1] - heel[0, 1]).max() <= LIFT_TOL + 1e-3
+    released = ~hc & c[:, 0].astype(bool)
+    assert (heel[released, 1] - heel[0, 1]).min() > 0.0
+    mm, _ = stance_slide(pos, p.contacts)
+    assert mm.value < 0.5
+    # feet on the floor: no point below it by more than 1 cm, the stance foot's sole on it
+    per_foot, _, low = GroundProbe(body, b).lowest(p.rotations, p.transl)
+    assert low.min() > -0.01 and np.abs(per_foot[:, 0]).max() < 5e-3
+
+
+def test_a_stance_within_reach_stays_flat(body):
+    """The hip never leaves the leg's reach of the flat heel: no roll, every contact kept."""
+    from shapemove.core.body.plant import plant_motion
+
+    b = np.zeros(10, np.float32)
+    j, c, _ = _stance(body, b, end=0.05)
+    p = plant_motion(body, b, j, c, gate=False, max_flight=None)
+    np.testing.assert_array_equal(p.contacts, c)
