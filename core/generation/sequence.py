@@ -8,7 +8,10 @@ segment's prompt (``rerank``). All codes are then decoded as one sequence by the
 body (the first segment's [BETA] head, or the shape text's measurements, or given betas) and
 planted once (``track.plant``). The Motion keeps ``segment_bounds`` (frames) and
 ``segment_prompts``; ``regenerate_segment`` samples one segment again (continuing from its
-predecessor) and keeps every other segment's codes.
+predecessor) and keeps every other segment's codes and frames: the SA-VAE's decoder reads far
+around each code, so the timeline decoded again would move the neighbours too (by 1-6 cm with the
+fine-tuned decoder); instead the new segment's frames are spliced between the old ones
+(``splice``: the frames after it moved rigidly to where it ends, 6-frame fades at the seams).
 
 A segment of two things at once ("walks on, waving"; ``parts.plan_of``) is made by body part, as a
 single prompt is (``parts.py``): its legs prompt continues the timeline's codes, its arms prompt
@@ -33,9 +36,10 @@ from ..torch_threads import one_torch_thread
 from .prompts import check_prompt
 from .sampling_params import DEFAULT_CANDIDATES, check_candidates, check_sampling
 from .token_sampling import body_for, sample_codes
-from .track import Track, decoded_track, plant
+from .track import Track, decoded_track, plant, rotate_y
 
 PREFIX_CODES = 4          # codes (0.8 s at 4 frames a code) a segment continues from
+SPLICE_BLEND = 6          # frames each side of a regenerated segment's seams that fade between old and new
 MAX_SEGMENTS = 32
 MAX_TOTAL_SECONDS = 120.0
 
@@ -113,28 +117,76 @@ def _batch_features(vae, codes: list[list[int]], betas) -> list[np.ndarray]:
     return [f.numpy() for f in out]
 
 
-def _assemble(gen, codes_per_segment, prompts, betas, arms_per_segment=None) -> Motion:
+def _timeline_track(gen, codes_per_segment, betas, arms_per_segment=None) -> tuple[Track, np.ndarray | None, dict]:
+    """The decoded (and, with arms of their own, composed) track of a timeline's codes; its
+    decoded features (None when composed) and the Motion fields that go with it."""
     codes = [c for seg in codes_per_segment for c in seg]
     track, feats = decoded_track(codes, gen.vae, betas)
-    down = len(track) // len(codes)
-    extra = {}
+    extra = {"tokens": np.asarray(codes, np.int16)}
     if arms_per_segment is not None and any(a is not None for a in arms_per_segment):
-        from ..geometry.rotations import axis_angle_to_matrix
-        from ..motion.features import posed_features
         from .part_compose import compose_arms
 
         arms = _arms_stream(codes_per_segment, arms_per_segment)
         arms_track, _ = decoded_track(arms, gen.vae, betas)
         track = Track(compose_arms(track.joints, arms_track.joints), track.contacts)
-        extra, feats = {"arms_tokens": np.asarray(arms, np.int16)}, None
-    motion = plant(gen.body, betas, track, gen.ik_refine_iters, prompt=" -> ".join(prompts),
-                   tokens=np.asarray(codes, np.int16), features=feats, **extra)
-    if feats is None:  # composed: the planted motion's features, as parts.assemble computes them
+        extra["arms_tokens"], feats = np.asarray(arms, np.int16), None
+    return track, feats, extra
+
+
+def _planted(gen, track: Track, feats, extra: dict, codes_per_segment, prompts, betas) -> Motion:
+    motion = plant(gen.body, betas, track, gen.ik_refine_iters, prompt=" -> ".join(prompts), features=feats, **extra)
+    if feats is None:  # composed or spliced: the planted motion's features, as parts.assemble computes them
+        from ..geometry.rotations import axis_angle_to_matrix
+        from ..motion.features import posed_features
+
         motion.features = posed_features(motion.joints, axis_angle_to_matrix(motion.poses), motion.contacts)
+    down = len(track) // sum(len(c) for c in codes_per_segment)
     ends = np.cumsum([len(c) for c in codes_per_segment]) * down
     motion.segment_bounds = np.stack([np.r_[0, ends[:-1]], ends], axis=1).astype(np.int64)
     motion.segment_prompts = list(prompts)
     return motion
+
+
+def _assemble(gen, codes_per_segment, prompts, betas, arms_per_segment=None) -> Motion:
+    track, feats, extra = _timeline_track(gen, codes_per_segment, betas, arms_per_segment)
+    return _planted(gen, track, feats, extra, codes_per_segment, prompts, betas)
+
+
+def splice(old: Track, new: Track, start: int, old_end: int, new_end: int, blend: int = SPLICE_BLEND) -> Track:
+    """``new`` (a timeline decoded with one segment changed: frames ``start``..``new_end``) with
+    every other frame taken from ``old`` (the timeline before: that segment was ``start``..``old_end``).
+    The old frames after the segment are moved rigidly (ground-plane turn and shift) so that where
+    the old segment ended sits where the new one ends. Each seam fades from one track to the other
+    over ``blend`` frames on either side (smoothstep; the old track's own frames on its side of the
+    seam), contacts switching at the middle of the fade."""
+    from .track import headings, root_centre
+
+    oj, nj = old.joints, new.joints
+    T = len(nj)
+    if len(oj) - old_end != T - new_end or not 0 <= start <= min(old_end, new_end):
+        raise ShapeMoveError(f"splice: a segment {start}..{old_end} of {len(oj)} frames cannot become "
+                             f"{start}..{new_end} of {T}")
+    other, ocon = nj.copy(), new.contacts.copy()
+    head = min(start + blend, old_end, new_end)           # the old track runs on into its old segment
+    other[:head], ocon[:head] = oj[:head], old.contacts[:head]
+    nb = min(blend, old_end - start, new_end - start)    # and the old segment's last frames lead into its tail
+    if new_end - nb < T:
+        i, j = min(old_end, len(oj) - 1), min(new_end, T - 1)
+        moved = oj[old_end - nb:].copy()
+        moved[..., [0, 2]] -= root_centre(oj)[i]
+        moved = rotate_y(moved, headings(nj)[j] - headings(oj)[i])
+        moved[..., [0, 2]] += root_centre(nj)[j]
+        other[new_end - nb:], ocon[new_end - nb:] = moved, old.contacts[old_end - nb:]
+    k = np.arange(T, dtype=np.float64)
+
+    def rise(centre):
+        x = np.clip((k - (centre - blend)) / (2 * blend), 0.0, 1.0)
+        return x * x * (3 - 2 * x)
+
+    w = np.minimum(rise(start) if start > 0 else 1.0, 1.0 - rise(new_end) if new_end < T else 1.0)
+    joints = w[:, None, None] * nj + (1 - w[:, None, None]) * other
+    contacts = np.where((w >= 0.5)[:, None], new.contacts, ocon)
+    return Track(joints, contacts)
 
 
 def generate_sequence(gen, segments, shape_text: str | None = None, betas=None, seed: int = 0,
@@ -216,7 +268,15 @@ def regenerate_segment(gen, motion: Motion, index: int, seed: int, prompt: str |
     per[index], arms[index], _ = _segment(gen, seg.prompt, None, n, prefix, arms_prefix, motion.betas, seed, temperature,
                                           top_k, check_candidates(candidates), guidance, by_parts)
     prompts[index] = seg.prompt
-    out = _assemble(gen, per, prompts, motion.betas, arms)
+    # the other segments keep their frames: the decoder reads far around a code, so decoding the
+    # new codes as one sequence would also move the neighbours (module doc, ``splice``)
+    down = gen.vae.cfg.downsample
+    before, _, _ = _timeline_track(gen, segment_codes(motion), motion.betas, segment_codes(motion, arms=True))
+    after, _, extra = _timeline_track(gen, per, motion.betas, arms)
+    start = sum(len(c) for c in per[:index]) * down
+    old_end = start + len(segment_codes(motion)[index]) * down
+    track = splice(before, after, start, old_end, start + len(per[index]) * down)
+    out = _planted(gen, track, None, extra, per, prompts, motion.betas)
     out.shape_source = "given"
     return out
 
