@@ -88,31 +88,6 @@ def test_head_kinds_are_recorded_and_rebuilt():
             build_head(bad, 64)
 
 
-def test_anchor_cosines_are_the_encoders_sentence_similarities():
-    """A head with anchors reads the shape text's sentence vector against theirs: the same cosine
-    ``TextEncoder.embed`` gives, 0 for a prompt without shape words; saved and rebuilt with them."""
-    from shapemove.core.models.beta_head import TextBetaHead, build_head
-    from shapemove.core.models.text_encoder import load_text_encoder
-
-    enc = load_text_encoder()
-    head = TextBetaHead(64, hidden=32, width=32, queries=2, heads=2, anchors=["a woman", "an old person"])
-    head.set_anchor_vectors(enc)
-    texts = ["a grandmother", "a young man with broad shoulders"]
-    x, m = enc.states(texts)
-    want = enc.embed(texts) @ enc.embed(["a woman", "an old person"]).T
-    got = head._anchor_cosines(x, m)
-    assert torch.allclose(got, want, atol=1e-5)
-    assert got[0, 1] > got[1, 1] + 0.1     # the grandmother is nearer "an old person"
-    x0, m0 = torch.zeros(1, 3, 384), torch.zeros(1, 3, dtype=torch.bool)
-    assert torch.equal(head._anchor_cosines(x0, m0), torch.zeros(1, 2))
-    again = build_head(json.loads(json.dumps(head.config())), 64)
-    again.load_state_dict(head.state_dict())
-    h = torch.randn(2, 64)
-    assert torch.equal(head.eval()(h, x, m), again.eval()(h, x, m))
-    with pytest.raises(ShapeMoveError, match="anchors"):
-        TextBetaHead(64, anchors=["a woman", " "])
-
-
 def test_a_head_that_writes_sliders_reads_back_exactly_those(openbody):
     from shapemove.core.models.beta_head import build_head
 

@@ -18,11 +18,6 @@ a folder without that key holds the first kind, as every model saved before it d
   sliders written, so "elderly" or "a woman" can land on its slider without the tiny beta
   directions age lives in having to be hit to a few hundredths. The map rides along in the weights
   (buffers) so the file is the whole head.
-  With ``anchors`` (a list of short descriptions, "a woman", "an old person", ...) it also reads
-  the shape text's MiniLM sentence vector (its token states mean-pooled) as its cosine to each
-  anchor's: the encoder's own sense of which description a word it was never trained on ("a
-  grandmother") is nearest to. The anchors' vectors are buffers, computed once when the head is
-  made.
 """
 from __future__ import annotations
 
@@ -60,7 +55,7 @@ class TextBetaHead(nn.Module):
     reads_text = True
 
     def __init__(self, d_model: int, num_betas: int = 10, hidden: int = 256, text_dim: int = 384, width: int = 128,
-                 queries: int = 4, heads: int = 4, sliders: int = 0, phenotype_map=None, anchors=None):
+                 queries: int = 4, heads: int = 4, sliders: int = 0, phenotype_map=None):
         super().__init__()
         if width % heads:
             raise ShapeMoveError(f"beta head: width {width} is not a multiple of heads {heads}")
@@ -69,31 +64,14 @@ class TextBetaHead(nn.Module):
         if sliders:
             self.sizes["sliders"] = int(sliders)
             self._slider_buffers(int(sliders), num_betas, phenotype_map)
-        K = len(anchors or [])
-        if anchors:
-            if not all(isinstance(a, str) and a.strip() for a in anchors):
-                raise ShapeMoveError(f"beta head: anchors must be non-empty descriptions, got {anchors!r}")
-            self.sizes["anchors"] = list(anchors)
-            self.register_buffer("anchor_vecs", torch.zeros(K, text_dim))  # set by ``set_anchor_vectors``
         self.text_in = nn.Sequential(nn.LayerNorm(text_dim), nn.Linear(text_dim, width))
         self.position = nn.Embedding(64, width)   # token order ("6 ft 2" is not "2 ft 6"); longer texts share the last
         self.none = nn.Parameter(torch.zeros(1, 1, width))  # the "no shape words" slot
         self.mix = nn.TransformerEncoderLayer(width, heads, 2 * width, dropout=0.0, batch_first=True, norm_first=True)
         self.queries = nn.Parameter(torch.randn(queries, width) * 0.02)
         self.pool = nn.MultiheadAttention(width, heads, batch_first=True)
-        self.net = nn.Sequential(nn.Linear(d_model + queries * width + K, hidden), nn.GELU(), nn.Linear(hidden, hidden),
+        self.net = nn.Sequential(nn.Linear(d_model + queries * width, hidden), nn.GELU(), nn.Linear(hidden, hidden),
                                  nn.GELU(), nn.Linear(hidden, num_betas + int(sliders)))
-
-    def set_anchor_vectors(self, encoder) -> None:
-        """The anchors' unit sentence vectors from ``encoder`` (``text_encoder.TextEncoder``)."""
-        self.anchor_vecs.copy_(encoder.embed(self.sizes["anchors"]).float())
-
-    def _anchor_cosines(self, text, text_mask) -> torch.Tensor:
-        """(B, K): the text's mean-pooled, normalised states against the anchors; 0 without text."""
-        keep = text_mask.to(text.dtype)[..., None]
-        pooled = (text * keep).sum(1) / keep.sum(1).clamp_min(1.0)
-        cos = torch.nn.functional.normalize(pooled.float(), dim=-1) @ self.anchor_vecs.T
-        return cos * (keep.sum(1) > 0)
 
     def _slider_buffers(self, P: int, n: int, pmap) -> None:
         """The map (P, n), intercept (n,), null-space projector (n, n) and slider centre/scale (P,):
@@ -124,10 +102,7 @@ class TextBetaHead(nn.Module):
         x = self.mix(x, src_key_padding_mask=~keep)
         q = self.queries[None].expand(B, -1, -1)
         pooled, _ = self.pool(q, x, x, key_padding_mask=~keep, need_weights=False)
-        parts = [hidden_at_beta, pooled.reshape(B, -1)]
-        if "anchors" in self.sizes:
-            parts.append(self._anchor_cosines(text, text_mask).to(hidden_at_beta.dtype))
-        out = self.net(torch.cat(parts, 1))
+        out = self.net(torch.cat([hidden_at_beta, pooled.reshape(B, -1)], 1))
         P = self.sizes.get("sliders", 0)
         if not P:
             return out

@@ -289,8 +289,6 @@ def train_head(model_dir, data, out, config: HeadTrainConfig | None = None, resu
     readback = Readback(examples.body)
     torch.manual_seed(c.seed)
     head = build_head(c.head, t5.d_model, getattr(examples.body, "phenotype_map", None))
-    if "anchors" in getattr(head, "sizes", {}):
-        head.set_anchor_vectors(reader)
     feats = load_features(out, _stamp(model_dir, data, c),
                           lambda: build_features(t5, reader, examples, readback, c, verbose))
     n = len(feats)
