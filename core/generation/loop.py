@@ -41,7 +41,7 @@ GOOD_SEAM = 1.5        # worst joint's wrap jump over its mean step that ends th
 EDGE = 2               # frames at each end of a decoded clip that a cut avoids
 LOOP_MIN_SECONDS = 4.0  # candidates are at least this long, so a cycle has room
 PART_SECONDS = 6.0     # a by-part motion's length when the loop's length is not asked for
-PART_TRIES = 3         # by-part motions (seeds seed, seed + 2, ...) whose best cuts compete
+PART_TRIES = 3         # by-part motions (seeds seed, seed + 2, ...) whose cycles compete
 
 
 @dataclass
@@ -231,13 +231,17 @@ def generate_loop(gen, req, progress=None, cancel=None) -> Motion:
 def _loop_by_parts(gen, req, seconds: float, period, cancel=None):
     """A loop of the by-part motion (``parts.generate_by_parts``) of ``req``: ``PART_TRIES`` of them
     (seeds 2 apart: a by-part motion uses its seed + 1 for the arms), each cut where it loops best
-    and planted, the best planted seam kept. False when the prompt is one action with no named side
-    (the caller loops it whole), None when no motion holds a loop."""
+    and planted. Of those whose planted seam is good (else the best seam alone), the text-motion
+    model keeps the cycle closest to the prompt: the best seam of a walk and a wave can fall where
+    the hand is down. False when the prompt is one action with no named side (the caller loops it
+    whole), None when no motion holds a loop."""
     import dataclasses
 
+    from ..geometry.rotations import axis_angle_to_matrix
+    from ..motion.features import posed_features
     from .parts import generate_by_parts
 
-    best = None
+    tried = []
     for k in range(PART_TRIES):
         if cancel is not None and cancel():
             raise ShapeMoveError("cancelled")
@@ -251,14 +255,16 @@ def _loop_by_parts(gen, req, seconds: float, period, cancel=None):
             continue
         cycle, adv = make_cycle(track, cut)
         m = plant_loop(gen.body, made.betas, cycle, adv, gen.ik_refine_iters, prompt=req.prompt)
-        ratio = seam_report(m)["jump_ratio"]
-        if best is None or ratio < best[0]:
-            m.shape_source, m.part_prompts, m.retrieved_clips = made.shape_source, made.part_prompts, made.retrieved_clips
-            m.seam_cost = cut.cost
-            best = (ratio, m)
-        if ratio <= GOOD_SEAM:
-            break
-    return None if best is None else best[1]
+        m.shape_source, m.part_prompts, m.retrieved_clips = made.shape_source, made.part_prompts, made.retrieved_clips
+        m.seam_cost = cut.cost
+        tried.append((seam_report(m)["jump_ratio"], m))
+    if not tried:
+        return None
+    good = [m for r, m in tried if r <= GOOD_SEAM] or [min(tried, key=lambda t: t[0])[1]]
+    if len(good) > 1 and gen.picker is not None:
+        feats = [posed_features(m.joints, axis_angle_to_matrix(m.poses), m.contacts) for m in good]
+        return good[gen.picker.pick(req.prompt, feats)]
+    return good[0]
 
 
 def seam_report(motion: Motion) -> dict:
