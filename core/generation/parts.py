@@ -9,7 +9,8 @@ tracks have one length. Each track is the SA-VAE's decoding of its tokens for th
 track is mirrored when it names a side that is not the one that moves most, then its arms are put
 on the legs track's chest (``part_compose.compose_arms``) and the whole is planted on the legs
 track's foot contacts (``decode.motion_from_joints``). A single action naming a side ("kick with
-the left foot") is generated as usual and mirrored when the other side moves most.
+the left foot") is generated as usual and mirrored when the other side moves most in the planted
+motion (planting, the foot roll above all, changes how far a foot travels).
 
 The Motion keeps what re-decoding needs: ``tokens`` (the legs, or the whole motion), ``arms_tokens``
 and the two mirror flags; ``features`` are those of the planted motion, computed as the dataset builder computes a clip's
@@ -91,13 +92,13 @@ def generate_by_parts(gen, r) -> Motion | None:
     plan, side = plan_of(r.prompt, gen)
     if plan is None and side is None:
         return None
-    if plan is None:  # one action, a named side
-        codes, pred = gen.tokens_for([r])
+    if plan is None:  # one action, a named side: judged on the planted motion, the one the user sees
+        codes, pred = gen.tokens_for([r])   # (planting, the foot roll above all, changes how far a foot travels)
         betas, source = gen.body_shape(r, pred[0].numpy())
-        track, mirrored = _side_fixed(codes[0], gen.vae, betas, side)
-        m = (assemble(gen.body, betas, track, None, r.prompt, gen.ik_refine_iters,
-                      tokens=np.asarray(codes[0], np.int16), mirrored=True) if mirrored
-             else gen.decode_motion(codes[0], betas, prompt=r.prompt))  # the named side already moves most
+        m = gen.decode_motion(codes[0], betas, prompt=r.prompt)
+        if needs_mirror(m.joints, *side):
+            m = assemble(gen.body, betas, _track(codes[0], gen.vae, betas, True), None, r.prompt, gen.ik_refine_iters,
+                         tokens=np.asarray(codes[0], np.int16), mirrored=True)
         m.shape_source = source
         m.retrieved_clips = [c for c in gen.last_sources if c]
         return m
