@@ -49,9 +49,19 @@ def run(args) -> int:
           f"{len(motion.tokens)} tokens, generated in {t1 - t0:.1f} s")
     if motion.part_prompts:
         print(f"by part:     legs {motion.part_prompts[0]!r}, arms {motion.part_prompts[1]!r}")
-    print(f"body:        {shape_adjectives(m)}: " + format_body(m))
+    print(f"body:        {shape_adjectives(m, _sex(gen.body, motion.betas))}: " + format_body(m))
     print(f"scene:       {(args.out / 'shapemove.blend').resolve()}  ({info['vertices']} vertices, {info['bones']} bones, "
           f"frames {info['frame_start']}-{info['frame_end']})")
     print(f"preview:     {(args.out / 'preview.png').resolve()}  (frames {info['preview_frames']})")
     print(f"motion file: {(args.out / 'motion.npz').resolve()}")
     return 0
+
+
+def _sex(body, betas) -> str | None:
+    """"male" / "female" when the body's gender slider, read back from its betas through the body
+    model's phenotype map, is at most 0.25 / at least 0.75 (the shape-words evaluation's bands); else None."""
+    pmap = getattr(body, "phenotype_map", None)
+    if pmap is None:
+        return None
+    g = float(dict(zip(pmap.names, pmap.from_betas(betas)))["gender"])
+    return "male" if g <= 0.25 else "female" if g >= 0.75 else None

@@ -68,3 +68,17 @@ def test_render_rejects_a_bad_prompts_file(tmp_path):
     bad.write_text('{"prompt": "a person walks"}\nnot json\n')
     r = _run(["render", "--prompts", str(bad), "--out", str(tmp_path / "r")], tmp_path)
     assert r.returncode == 2 and "p.jsonl:2: not valid JSON" in r.stderr
+
+
+def test_demo_names_the_body_by_its_gender_slider():
+    """The demo's body line says "man" / "woman" from the gender slider read back from the betas."""
+    import numpy as np
+
+    from shapemove.cli.demo import _sex
+    from shapemove.core.body.load import load_body_model
+    from shapemove.core.body.shape_from_measurements import betas_for_shape_text
+
+    body = load_body_model(None)
+    assert _sex(body, betas_for_shape_text(body, "a tall, heavy-set man")) == "male"
+    assert _sex(body, betas_for_shape_text(body, "a tall, heavy-set woman")) == "female"
+    assert _sex(body, np.zeros(10, np.float32)) is None          # the average adult: neither
