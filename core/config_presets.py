@@ -40,3 +40,10 @@ def load_config(what: str, config, presets: dict[str, Callable], from_json: Call
     if not isinstance(data, dict):
         raise ShapeMoveError(f"{path}: a {what} config is a JSON object of settings")
     return from_json(data, path)
+
+
+def refuse_unknown(data: dict, known, path, what: str) -> None:
+    """A config JSON's keys that are not settings (``known``) are refused by name."""
+    unknown = set(data) - set(known)
+    if unknown:
+        raise ShapeMoveError(f"{path}: unknown {what} keys {sorted(unknown)}")

@@ -39,6 +39,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT.parent))
 
 DATA_FILES = ("texts", "shape_texts", "betas", "meta")
+WEIGHTS = "model.safetensors"  # of the encoder's files (``text_encoder.FILES``), the one packed in float16
 PROBE = 300  # steps timed before the step count is set
 BANK_SAMPLES = 400  # bank sentences drawn per action (and per action pair) to collect word pieces
 
@@ -64,8 +65,9 @@ def _training_texts(data: Path, ids: list[str]) -> list[str]:
 def pack(args) -> None:
     from safetensors.torch import load_file, save_file
 
-    from shapemove.core.models.text_encoder import extract, load_text_encoder
+    from shapemove.core.models.text_encoder import FILES, extract, load_text_encoder
     from shapemove.core.train.motion_dataset import read_split
+    from shapemove.core.train.train_t5 import vae_stamp
 
     data, out = args.data, args.out
     out.mkdir(parents=True, exist_ok=True)
@@ -79,26 +81,26 @@ def pack(args) -> None:
                 if f.is_file():
                     tar.add(f, f"{d}/{f.name}")
     z = np.load(args.tokens, allow_pickle=False)
-    stamp = f"{args.vae.resolve()}:{args.vae.stat().st_mtime_ns}"
-    if str(z["__vae__"]) != stamp:
+    if str(z["__vae__"]) != vae_stamp(args.vae):
         raise SystemExit(f"{args.tokens} holds the tokens of {str(z['__vae__']).rsplit(':', 1)[0]}, not of {args.vae}")
     np.savez_compressed(out / "tokens.npz", **{k: z[k] for k in z.files if k != "__vae__"})
     (out / "savae.pt").write_bytes(args.vae.read_bytes())
     enc = load_text_encoder()
-    used = {0, 100, 101, 102, 103}
+    used = set(enc.special_ids) | {enc.unk_id}   # [PAD] [UNK] [CLS] [SEP] [MASK]
     texts = _training_texts(data, ids)
     for s in range(0, len(texts), 4096):
         for e in enc.tokenizer.encode_batch(texts[s:s + 4096]):
             used.update(e.ids)
     folder = extract()
-    w = load_file(str(folder / "model.safetensors"))
+    w = load_file(str(folder / WEIGHTS))
     rows = torch.tensor(sorted(used))
     w16 = {k: v.half().contiguous() for k, v in w.items() if k != "embeddings.word_embeddings.weight"}
     w16["kept_rows"] = rows
     w16["kept_embeddings"] = w["embeddings.word_embeddings.weight"][rows].half().contiguous()
     save_file(w16, str(out / "minilm16.safetensors"), metadata={"vocab": str(w["embeddings.word_embeddings.weight"].shape[0])})
-    for name in ("config.json", "tokenizer.json", "tokenizer_config.json", "special_tokens_map.json"):
-        (out / name).write_bytes((folder / name).read_bytes())
+    for name in FILES:
+        if name != WEIGHTS:
+            (out / name).write_bytes((folder / name).read_bytes())
     print(f"{len(texts)} texts, {len(used)} word pieces kept; "
           f"{sum(f.stat().st_size for f in out.iterdir()) / 2**20:.1f} MiB in {out}")
 
@@ -119,9 +121,10 @@ def _encoder_from_pack(p: Path, cache: Path) -> None:
     emb = torch.zeros(vocab, w["kept_embeddings"].shape[1])
     emb[w.pop("kept_rows")] = w.pop("kept_embeddings").float()
     full = {k: v.float() for k, v in w.items()} | {"embeddings.word_embeddings.weight": emb}
-    save_file(full, str(folder / "model.safetensors"))
-    for name in ("config.json", "tokenizer.json", "tokenizer_config.json", "special_tokens_map.json"):
-        (folder / name).write_bytes((p / name).read_bytes())
+    save_file(full, str(folder / WEIGHTS))
+    for name in te.FILES:
+        if name != WEIGHTS:
+            (folder / name).write_bytes((p / name).read_bytes())
     te.set_cache_dir(cache)
     te._verify = lambda folder: None  # the float16 copy: checked by the pack's own use, not the sha
     if torch.cuda.is_available():  # read the captions on the GPU too (57,000 texts: seconds, not minutes)
@@ -135,7 +138,7 @@ def train_one(args) -> None:
     """One config on the GPU (a process of its own: ``train`` starts one per config)."""
     from safetensors.torch import save_file
 
-    from shapemove.core.train.train_t5 import T5TrainConfig, train_t5
+    from shapemove.core.train.train_t5 import T5TrainConfig, train_t5, vae_stamp
 
     p = args.pack
     work = Path(args.work)
@@ -146,9 +149,8 @@ def train_one(args) -> None:
     run = work / name
     run.mkdir(parents=True, exist_ok=True)
     vae = p / "savae.pt"
-    stamp = f"{vae.resolve()}:{vae.stat().st_mtime_ns}"
-    z = np.load(p / "tokens.npz")
-    np.savez(run / "tokens.npz", __vae__=np.array(stamp), **{k: z[k] for k in z.files})
+    z = np.load(p / "tokens.npz")   # the cache train_t5 reads, stamped for the VAE's copy here
+    np.savez(run / "tokens.npz", __vae__=np.array(vae_stamp(vae)), **{k: z[k] for k in z.files})
     torch.set_num_threads(2)
     deadline = time.time() + args.seconds
     c.steps, c.head_steps = args.steps, 0
@@ -170,17 +172,18 @@ def train_one(args) -> None:
     info = {"config": json.dumps(ck["config"]), "step": str(ck["step"]), "seconds": f"{time.time() - t0:.0f}",
             "metrics": json.dumps(metrics, default=str)}
     part, size, n = {}, 0, 0
-    for k in sorted(state):  # files of at most ~14 MiB: what comes back from the machine is 16 MiB a file
+    keys = sorted(state)
+    for k in keys:  # files of at most ~14 MiB: what comes back from the machine is 16 MiB a file
         part[k] = state[k]
         size += state[k].numel() * state[k].element_size()
-        if size > 14 << 20 or k == sorted(state)[-1]:
+        if size > 14 << 20 or k == keys[-1]:
             save_file(part, str(args.out / f"{name}.{n}.safetensors"), metadata=info)
             part, size, n = {}, 0, n + 1
     print(name, "step", ck["step"], f"{time.time() - t0:.0f} s", flush=True)
 
 
 def train(args) -> None:
-    """Unpack once, time 60 steps of each config, then train all at once within ``--minutes``."""
+    """Unpack the data once, then one ``train-one`` process per config, all at once within ``--minutes``."""
     import subprocess
 
     work = Path(args.work)
@@ -194,7 +197,8 @@ def train(args) -> None:
         steps = int(c["steps"])
         cmd = [sys.executable, __file__, "train-one", "--pack", str(args.pack), "--work", str(work),
                "--config", str(cfg), "--out", str(args.out), "--steps", str(steps),
-               "--seconds", str(int(args.minutes * 60 - (time.time() - t_start))), "--device", args.device, "--probe", str(args.probe)] + (["--resume"] if args.resume else [])
+               "--seconds", str(int(args.minutes * 60 - (time.time() - t_start))),
+               "--device", args.device, "--probe", str(args.probe)] + (["--resume"] if args.resume else [])
         procs.append(subprocess.Popen(cmd))
     for pr in procs:
         pr.wait()
@@ -208,6 +212,7 @@ def unpack(args) -> None:
     from shapemove.core.models.shapemove_t5 import ShapeMoveT5, size_from_dict
     from shapemove.core.models.text_encoder import StateCache, load_text_encoder
     from shapemove.core.train.motion_dataset import read_split
+    from shapemove.core.train.t5_dataset import read_lines
     from shapemove.core.train.train_t5 import T5TrainConfig, load_vae
 
     parts = sorted(args.state.parent.glob(args.state.name + ".*.safetensors"))
@@ -229,7 +234,7 @@ def unpack(args) -> None:
 
         z = np.load(args.tokens, allow_pickle=False)
         tokens = {k: z[k] for k in z.files if k != "__vae__"}
-        states.add([t for c_ in train_ids for t in (args.data / "texts" / f"{c_}.txt").read_text().splitlines() if t.strip()])
+        states.add([t for cid in train_ids for t in read_lines(args.data / "texts" / f"{cid}.txt")])
         memory = MotionMemory.from_dataset(args.data, train_ids, tokens, states)
     info = {"vae": str(args.vae), "config": c.__dict__, "downsample": vae.cfg.downsample,
             "max_codes": c.max_codes, "data": str(args.data), "base_model": None, "step": int(meta["step"]),
@@ -241,30 +246,28 @@ def unpack(args) -> None:
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     sub = ap.add_subparsers(dest="cmd", required=True)
+    run = argparse.ArgumentParser(add_help=False)   # what ``train`` passes on to each ``train-one``
+    run.add_argument("--device", default="cuda")
+    run.add_argument("--probe", type=int, default=PROBE)
+    run.add_argument("--resume", action="store_true")
     a = sub.add_parser("pack")
     a.add_argument("--data", type=Path, default=Path("data/built"))
     a.add_argument("--vae", type=Path, default=Path("weights/default/savae.pt"))
     a.add_argument("--tokens", type=Path, required=True, help="tokens.npz of a train t5 run on that VAE")
     a.add_argument("--out", type=Path, default=Path(".gpu"))
-    a = sub.add_parser("train")
+    a = sub.add_parser("train", parents=[run])
     a.add_argument("--pack", type=Path, default=Path(".gpu"))
     a.add_argument("--configs", type=Path, nargs="+", required=True)
     a.add_argument("--minutes", type=float, default=7.0)
     a.add_argument("--work", default="/tmp/gpu_t5")
     a.add_argument("--out", type=Path, required=True)
-    a.add_argument("--device", default="cuda")
-    a.add_argument("--probe", type=int, default=PROBE)
-    a.add_argument("--resume", action="store_true")
-    a = sub.add_parser("train-one")
+    a = sub.add_parser("train-one", parents=[run])
     a.add_argument("--pack", type=Path, required=True)
     a.add_argument("--work", required=True)
     a.add_argument("--config", type=Path, required=True)
     a.add_argument("--out", type=Path, required=True)
     a.add_argument("--steps", type=int, required=True)
     a.add_argument("--seconds", type=int, required=True)
-    a.add_argument("--device", default="cuda")
-    a.add_argument("--probe", type=int, default=PROBE)
-    a.add_argument("--resume", action="store_true")
     a = sub.add_parser("unpack")
     a.add_argument("--state", type=Path, required=True)
     a.add_argument("--data", type=Path, default=Path("data/built"))

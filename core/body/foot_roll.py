@@ -17,9 +17,8 @@ stance (a run of the ball joint's contact, ``motion.contacts``) with a planted h
   exactly), once the hip has passed over the ball (a body standing on straight legs does not
   roll); the pitch of the first such frame is reached by a ramp from mid-stance (the frame where
   the hip is closest to the heel), so the heel does not jump up. After the heel's contact ends,
-  also the pitch
-  the IK pose already has (the decoder's own toe-off). It never decreases within a stance: a heel
-  that rose stays up until the foot leaves.
+  at least the pitch the IK pose already has (the decoder's own toe-off). It never decreases
+  within a stance: a heel that rose stays up until the foot leaves.
 * **steering**: the leg pass (``pin_feet``) still steers a rolled heel, onto its rolled target,
   with full weight (also after the decoder released the heel, until the ball leaves).
 * **contacts**: the contacts the planted Motion reports follow what its heels do: a heel stays
@@ -49,7 +48,6 @@ class Roll:
     weights: np.ndarray    # (T,4) leg-pass weights (``pin_feet``): a rolled heel keeps weight 1
     contacts: np.ndarray   # (T,4) uint8: a heel's contact released where the roll lifts it off the floor
     toe: np.ndarray        # (T,2,3) world rotation vector (axis * theta) the toes of each leg undo
-    angle: np.ndarray      # (T,2) theta of each leg (rad), 0 where the foot is flat or not planted
 
 
 def _frame(heel, pivot) -> tuple[np.ndarray, np.ndarray, float]:
@@ -110,7 +108,6 @@ def roll_feet(posed, targets, contacts, weights, rest, reach: float, legs, fade:
     weights = np.array(weights, dtype=np.float64)
     out_c = c.copy()
     toe = np.zeros((T, 2, 3))
-    angle = np.zeros((T, 2))
     for leg, (hip, knee, ankle, ball, kh, kt) in enumerate(legs):
         foot = float(np.linalg.norm(rest[ball] - rest[ankle]))
         limb = reach * float(np.linalg.norm(rest[knee] - rest[hip]) + np.linalg.norm(rest[ankle] - rest[knee]))
@@ -148,8 +145,7 @@ def roll_feet(posed, targets, contacts, weights, rest, reach: float, legs, fade:
             out_c[t[tgt[t, ankle, 1] - A[1] > LIFT_TOL], kh] = False   # the heel is off the floor
             axis = np.cross(e1, e2)                           # turning e1 toward e2: the heel up
             toe[t, leg] = theta[:, None] * axis
-            angle[t, leg] = theta
-    return Roll(targets=tgt, weights=weights, contacts=out_c.astype(np.uint8), toe=toe, angle=angle)
+    return Roll(targets=tgt, weights=weights, contacts=out_c.astype(np.uint8), toe=toe)
 
 
 def _move_ball(tgt, w, on, ball: int, s: int, e: int, shift, fade: int) -> None:

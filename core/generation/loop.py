@@ -237,8 +237,7 @@ def _loop_by_parts(gen, req, seconds: float, period, cancel=None):
     whole), None when no motion holds a loop."""
     import dataclasses
 
-    from ..geometry.rotations import axis_angle_to_matrix
-    from ..motion.features import posed_features
+    from ..motion.features import motion_features
     from .parts import generate_by_parts
 
     tried = []
@@ -262,8 +261,7 @@ def _loop_by_parts(gen, req, seconds: float, period, cancel=None):
         return None
     good = [m for r, m in tried if r <= GOOD_SEAM] or [min(tried, key=lambda t: t[0])[1]]
     if len(good) > 1 and gen.picker is not None:
-        feats = [posed_features(m.joints, axis_angle_to_matrix(m.poses), m.contacts) for m in good]
-        return good[gen.picker.pick(req.prompt, feats)]
+        return good[gen.picker.pick(req.prompt, [motion_features(m) for m in good])]
     return good[0]
 
 

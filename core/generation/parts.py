@@ -25,8 +25,7 @@ import numpy as np
 
 from ..constants import FPS
 from ..errors import ShapeMoveError
-from ..geometry.rotations import axis_angle_to_matrix
-from ..motion.features import posed_features
+from ..motion.features import motion_features
 from ..scene.motion_file import Motion
 from .decode import motion_from_joints
 from .part_compose import compose_arms, mirror_track, needs_mirror
@@ -56,7 +55,7 @@ def assemble(body, betas, legs: Track, arms: Track | None, prompt: str | None, i
     """The planted Motion of a legs track (and the arms of an arms track, when given)."""
     joints = compose_arms(legs.joints, arms.joints) if arms is not None else legs.joints
     m = motion_from_joints(body, betas, joints, legs.contacts, ik_refine_iters, prompt=prompt, **extra)
-    m.features = posed_features(m.joints, axis_angle_to_matrix(m.poses), m.contacts)  # as the builder's clips
+    m.features = motion_features(m)  # as the builder's clips
     return m
 
 

@@ -136,10 +136,9 @@ def _timeline_track(gen, codes_per_segment, betas, arms_per_segment=None) -> tup
 def _planted(gen, track: Track, feats, extra: dict, codes_per_segment, prompts, betas) -> Motion:
     motion = plant(gen.body, betas, track, gen.ik_refine_iters, prompt=" -> ".join(prompts), features=feats, **extra)
     if feats is None:  # composed or spliced: the planted motion's features, as parts.assemble computes them
-        from ..geometry.rotations import axis_angle_to_matrix
-        from ..motion.features import posed_features
+        from ..motion.features import motion_features
 
-        motion.features = posed_features(motion.joints, axis_angle_to_matrix(motion.poses), motion.contacts)
+        motion.features = motion_features(motion)
     down = len(track) // sum(len(c) for c in codes_per_segment)
     ends = np.cumsum([len(c) for c in codes_per_segment]) * down
     motion.segment_bounds = np.stack([np.r_[0, ends[:-1]], ends], axis=1).astype(np.int64)
@@ -254,8 +253,8 @@ def regenerate_segment(gen, motion: Motion, index: int, seed: int, prompt: str |
     """Segment ``index`` sampled again (new ``seed``, optionally a new ``prompt``/``seconds``),
     continuing from the previous segment; every other segment keeps its codes (and its arms'), the
     body its betas."""
-    per = segment_codes(motion)
-    arms = segment_codes(motion, arms=True)
+    old_per, old_arms = segment_codes(motion), segment_codes(motion, arms=True)
+    per, arms = list(old_per), list(old_arms)
     prompts = list(motion.segment_prompts)
     if not 0 <= index < len(per):
         raise ShapeMoveError(f"segment {index + 1} does not exist: this timeline has {len(per)}")
@@ -271,10 +270,10 @@ def regenerate_segment(gen, motion: Motion, index: int, seed: int, prompt: str |
     # the other segments keep their frames: the decoder reads far around a code, so decoding the
     # new codes as one sequence would also move the neighbours (module doc, ``splice``)
     down = gen.vae.cfg.downsample
-    before, _, _ = _timeline_track(gen, segment_codes(motion), motion.betas, segment_codes(motion, arms=True))
+    before, _, _ = _timeline_track(gen, old_per, motion.betas, old_arms)
     after, _, extra = _timeline_track(gen, per, motion.betas, arms)
     start = sum(len(c) for c in per[:index]) * down
-    old_end = start + len(segment_codes(motion)[index]) * down
+    old_end = start + len(old_per[index]) * down
     track = splice(before, after, start, old_end, start + len(per[index]) * down)
     out = _planted(gen, track, None, extra, per, prompts, motion.betas)
     out.shape_source = "given"

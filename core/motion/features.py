@@ -165,6 +165,14 @@ def posed_features(joints, rotations, contacts) -> np.ndarray:
     return f
 
 
+def motion_features(motion) -> np.ndarray:
+    """``posed_features`` of a planted Motion: its posed joints, its poses as rotations, its
+    contacts (what the rig plays, computed as the dataset builder computes a clip's)."""
+    from ..geometry.rotations import axis_angle_to_matrix
+
+    return posed_features(motion.joints, axis_angle_to_matrix(motion.poses), motion.contacts)
+
+
 def _check_features(features):
     if features.shape[-1] != FEATURE_DIM or features.ndim < 2:
         raise ShapeMoveError(f"features must be (..., frames, {FEATURE_DIM}), got shape {tuple(features.shape)}")

@@ -28,9 +28,10 @@ def set_rng_state(s: dict) -> None:
         torch.cuda.set_rng_state_all([t.cpu() for t in s["cuda"]])
 
 
-def restore(ckpt: dict, model, optimizer, scheduler) -> int:
-    """Load a loaded ``last.pt`` (``load_checkpoint``) into the run; returns its step."""
-    model.load_state_dict(ckpt["model"])
+def restore(ckpt: dict, model, optimizer, scheduler, weights_key: str = "model") -> int:
+    """Load a loaded ``last.pt`` (``load_checkpoint``) into the run; returns its step. ``weights_key``:
+    where the checkpoint holds ``model``'s weights."""
+    model.load_state_dict(ckpt[weights_key])
     optimizer.load_state_dict(ckpt["optimizer"])
     scheduler.load_state_dict(ckpt["scheduler"])
     set_rng_state(ckpt["rng"])

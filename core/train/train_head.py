@@ -38,7 +38,7 @@ import numpy as np
 import torch
 
 from ..atomic import atomic_path
-from ..config_presets import load_config
+from ..config_presets import load_config, refuse_unknown
 from ..errors import ShapeMoveError
 
 KIND = "shapemove-head"
@@ -79,9 +79,7 @@ class HeadTrainConfig:
     @classmethod
     def load(cls, name_or_path: str | None) -> "HeadTrainConfig":
         def from_json(data, p):
-            unknown = set(data) - set(asdict(cls()))
-            if unknown:
-                raise ShapeMoveError(f"{p}: unknown head config keys {sorted(unknown)}")
+            refuse_unknown(data, asdict(cls()), p, "head config")
             return cls(**data)
 
         return load_config("head", name_or_path, {"tiny": cls.tiny, "small": cls, "paper": cls}, from_json)
@@ -257,7 +255,7 @@ def train_head(model_dir, data, out, config: HeadTrainConfig | None = None, resu
     from .distributed import DistInfo
     from .motion_dataset import read_split
     from .optimizer_step import optimizer_step
-    from .resume import rng_state, set_rng_state
+    from .resume import restore, rng_state
     from .run_log import StepLog
     from .t5_dataset import T2MExamples
     from .train_t5 import lr_at
@@ -308,12 +306,8 @@ def train_head(model_dir, data, out, config: HeadTrainConfig | None = None, resu
             raise ShapeMoveError(f"{last}: cannot resume, the configuration differs ({', '.join(diff)})")
         if ckpt.get("source_t5") != _stamp(model_dir, data, c):
             raise ShapeMoveError(f"{last}: this run trained a head for another model or dataset; use another --out")
-        head.load_state_dict(ckpt["head"])
-        optimizer.load_state_dict(ckpt["optimizer"])
-        scheduler.load_state_dict(ckpt["scheduler"])
-        set_rng_state(ckpt["rng"])
+        step = restore(ckpt, head, optimizer, scheduler, weights_key="head")
         rng.setstate((3, tuple(ckpt["py_rng"]), None))
-        step = int(ckpt["step"])
     meta = {"source": str(model_dir), "data": str(data), "config": asdict(c)}
 
     def save(final: bool = False):

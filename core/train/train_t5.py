@@ -30,7 +30,7 @@ import torch
 from torch.nn.parallel import DistributedDataParallel as DDP
 
 from ..atomic import atomic_path
-from ..config_presets import load_config
+from ..config_presets import load_config, refuse_unknown
 from ..data.paraphrase_bank import BANK_SHARE
 from ..errors import ShapeMoveError
 from ..models.shapemove_t5 import ShapeMoveT5, T5Size, size_from_dict
@@ -113,9 +113,7 @@ class T5TrainConfig:
     def load(cls, name_or_path: str | None) -> "T5TrainConfig":
         """A preset (``config_presets.PRESETS``; None = small) or a JSON file of settings."""
         def from_json(data, p):
-            unknown = set(data) - set(asdict(cls()))
-            if unknown:
-                raise ShapeMoveError(f"{p}: unknown T5 config keys {sorted(unknown)}")
+            refuse_unknown(data, asdict(cls()), p, "T5 config")
             return cls(**data)
 
         return load_config("T5", name_or_path, {"tiny": cls.tiny, "small": cls, "paper": cls.paper}, from_json)
@@ -126,6 +124,12 @@ def lr_at(step: int, c: T5TrainConfig) -> float:
         return (step + 1) / c.warmup_steps
     p = (step - c.warmup_steps) / max(1, c.steps - c.warmup_steps)
     return 0.1 + 0.9 * 0.5 * (1 + math.cos(math.pi * min(1.0, p)))  # a float: numpy scalars would make last.pt unloadable
+
+
+def vae_stamp(path: Path) -> str:
+    """What the token cache (``out/tokens.npz``) records of the VAE file that made it: its path
+    and modification time (another file, or the same one changed, tokenizes again)."""
+    return f"{Path(path).resolve()}:{Path(path).stat().st_mtime_ns}"
 
 
 def load_vae(path):
@@ -159,17 +163,17 @@ def _train(data, vae_path, out, c, base_model, resume, dist, progress, cancel, v
 
     ids = sorted(set(read_split(data, "train")) | set(read_split(data, "val")))
     cache = out / "tokens.npz"
-    vae_stamp = f"{vae_path.resolve()}:{vae_path.stat().st_mtime_ns}"
+    stamp = vae_stamp(vae_path)
     tokens = None
     if cache.is_file():
         z = np.load(cache, allow_pickle=False)
-        if str(z["__vae__"]) == vae_stamp:
+        if str(z["__vae__"]) == stamp:
             tokens = {k: z[k] for k in z.files if k != "__vae__"}
     if tokens is None:
         tokens = tokenize_clips(vae, data, ids)
         if dist.is_main:
             with atomic_path(cache, suffix=".npz") as tmp:
-                np.savez(tmp, __vae__=np.array(vae_stamp), **tokens)
+                np.savez(tmp, __vae__=np.array(stamp), **tokens)
     num_codes = int(vae.quantizer.codebook_size)
     # -- 2. text reader: MiniLM states of every training text, or the T5's tokenizer ------------
     from ..models.text_encoder import StateCache, load_text_encoder

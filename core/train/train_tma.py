@@ -30,7 +30,7 @@ from torch import nn
 from torch.nn.parallel import DistributedDataParallel as DDP
 
 from ..atomic import atomic_write_json
-from ..config_presets import load_config
+from ..config_presets import load_config, refuse_unknown
 from ..data.actions import stored_labels
 from ..data.paraphrase_bank import BANK_SHARE, training_caption
 from ..errors import ShapeMoveError
@@ -90,13 +90,9 @@ class TMATrainConfig:
             return cls(model=asdict(config))
 
         def from_json(data, p):
-            unknown = set(data) - set(asdict(cls()))
-            if unknown:
-                raise ShapeMoveError(f"{p}: unknown TMA config keys {sorted(unknown)}")
+            refuse_unknown(data, asdict(cls()), p, "TMA config")
             model = {**asdict(TMAConfig()), **data.pop("model", {})}
-            unknown = set(model) - set(asdict(TMAConfig()))
-            if unknown:
-                raise ShapeMoveError(f"{p}: unknown TMA model keys {sorted(unknown)}")
+            refuse_unknown(model, asdict(TMAConfig()), p, "TMA model")
             return cls(model=model, **data)
 
         return load_config("TMA", config, {"tiny": cls.tiny, "small": cls, "paper": cls.paper}, from_json)
