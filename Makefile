@@ -56,6 +56,7 @@ train-default: setup
 	$(PY) tools/export_default.py --vae $(RUNS)/vae_feet --t5 $(RUNS)/t5 --tma $(RUNS)/tma --out weights/default --card configs/model_card.json
 	$(PY) -m shapemove train head --model weights/default --data $(BUILT) --out $(RUNS)/head --resume
 	rm -rf weights/default && cp -r $(RUNS)/head/model weights/default
+	$(PY) tools/build_motion_memory.py --model weights/default --data $(BUILT)
 
 # Evaluation tables of docs/evaluation.md (needs $(BUILT) from train-default); the 1-step SA-VAE is the untrained baseline.
 eval: setup

@@ -56,3 +56,32 @@ def test_not_two_things_at_once(text):
 ])
 def test_named_side(text, side):
     assert named_side(text) == side
+
+
+@pytest.mark.parametrize("text, acts", [
+    ("she walks around in a circle holding one hand up", ("walk in a circle", "raise hand")),  # the longer span
+    ("a guide walks ahead and beckons the tourists", ("walk", "beckon")),   # not the noun at the front
+])
+def test_each_part_takes_the_most_specific_action_of_its_own_clause(text, acts):
+    plan = plan_parts(text)
+    assert plan is not None and (plan.legs_action, plan.arms_action) == acts
+
+
+def test_clauses_the_patterns_miss_are_classified_when_they_say_what_someone_does():
+    """A clause the action patterns do not know goes to ``classify`` when it has a verb: one of
+    the caption tables', a participle, a verb after its subject ("the player hurls") or leading
+    the clause ("tosses the ball"); a clause of manner ("like an old man") never does."""
+    asked = []
+
+    def classify(clauses):
+        asked.extend(clauses)
+        return ["throw" if ("hurls" in c or "tosses" in c) else "sneak" if "tiptoes" in c else None for c in clauses]
+
+    plan = plan_parts("Walking backwards, the player hurls a stone.", classify)
+    assert plan is not None and (plan.legs_action, plan.arms_action) == ("walk backward", "throw")
+    assert plan.arms_prompt == "the player hurls a stone"
+    plan = plan_parts("A thief tiptoes along and tosses the keys", classify)   # neither part in the patterns
+    assert plan is not None and (plan.legs_action, plan.arms_action) == ("sneak", "throw")
+    asked.clear()
+    assert plan_parts("a person waves, like an old man", classify) is None
+    assert asked == []

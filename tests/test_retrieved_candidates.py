@@ -96,19 +96,22 @@ def test_a_judge_does_not_find_the_retrieved_take_itself():
 
 
 def test_a_users_library_becomes_retrieved_candidates(gen, tmp_path):
-    """A model folder without a memory (the default) gets one from ``add_library``: the user's
-    captioned motion is then a candidate that wins when only retrieved clips compete."""
+    """``add_library`` adds a user's captioned motions to the model's memory (the default ships the
+    memory of its training clips): the user's motion is then a candidate that wins when only
+    retrieved clips compete."""
     from shapemove.core.generation.generate import Generator, Request
     from shapemove.core.scene.motion_file import save_motion
 
     lib = tmp_path / "library"
     lib.mkdir()
-    m = gen.generate_batch([Request("a person does jumping jacks", seconds=5, seed=0, by_parts=False)])[0]
+    text = "a person does jumping jacks on a purple trampoline"   # a caption no training clip has
+    m = gen.generate_batch([Request(text, seconds=5, seed=0, by_parts=False)])[0]
     save_motion(lib / "jacks.npz", m)
     own = Generator(None)
-    assert own.t5.memory is None
-    assert own.add_library(lib) == 1
-    out = own.generate_batch([Request("someone does jumping jacks", seconds=4, seed=0, retrieval_first=0.0)])[0]
+    before = len(own.t5.memory)
+    assert before > 1000 and own.add_library(lib) == 1 and len(own.t5.memory) == before + 1
+    out = own.generate_batch([Request("someone does jumping jacks on a purple trampoline", seconds=4, seed=0,
+                                      retrieval_first=0.0)])[0]
     assert out.retrieved_clips and out.retrieved_clips[0].startswith("library:")
     (tmp_path / "empty").mkdir()
     with pytest.raises(ShapeMoveError, match="no motion with a caption"):

@@ -39,7 +39,10 @@ SIDES, PARTS = ("left", "right"), ("hand", "foot")
 def _items(path: Path, what: str) -> list:
     from ..io.limits import read_json
 
-    doc = read_json(path, what, MAX_PROMPTS_BYTES)
+    return _prompts(read_json(path, what, MAX_PROMPTS_BYTES), path)
+
+
+def _prompts(doc, path: Path) -> list:
     items = doc.get("prompts") if isinstance(doc, dict) else doc
     if not isinstance(items, list) or not items:
         raise ShapeMoveError(f"{path}: no prompts (expected {{\"prompts\": [...]}})")
@@ -61,16 +64,20 @@ def load_sides(path=None) -> list[dict]:
 
 def load_two_things(path=None) -> list[dict]:
     """The two-things prompts [{text, legs, arms}] of a JSON file; every (legs, arms) pair must be
-    one of ``HELD_OUT_PAIRS`` (pairs composed for training would not test anything new)."""
+    one of ``HELD_OUT_PAIRS`` (pairs composed for training would not test anything new), unless the
+    file says ``"tuning": true`` (a set to tune on, of trained pairs: ``configs/tuning_two_things.json``)."""
     from ..data.compose_parts import HELD_OUT_PAIRS
+    from ..io.limits import read_json
 
     path = Path(path) if path else DEFAULT_TWO_THINGS
+    doc = read_json(path, "two-things prompt list", MAX_PROMPTS_BYTES)
+    tuning = isinstance(doc, dict) and doc.get("tuning") is True
     out = []
-    for i, it in enumerate(_items(path, "two-things prompt list")):
+    for i, it in enumerate(_prompts(doc, path)):
         if not (isinstance(it, dict) and isinstance(it.get("text"), str) and isinstance(it.get("legs"), str)
                 and isinstance(it.get("arms"), str)):
             raise ShapeMoveError(f"{path}: prompt {i} must be {{\"text\": ..., \"legs\": ..., \"arms\": ...}}")
-        if (it["legs"], it["arms"]) not in HELD_OUT_PAIRS:
+        if not tuning and (it["legs"], it["arms"]) not in HELD_OUT_PAIRS:
             raise ShapeMoveError(f"{path}: prompt {i} pairs {it['legs']!r} with {it['arms']!r}, not one of the "
                                  "held-out pairs of core/data/compose_parts.py (HELD_OUT_PAIRS)")
         out.append({"text": it["text"], "legs": it["legs"], "arms": it["arms"]})

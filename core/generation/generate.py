@@ -26,6 +26,7 @@ from ..models.shapemove_t5 import NULL_PROMPT, ShapeMoveT5
 from ..models.text_encoder import load_text_encoder
 from ..scene.motion_file import Motion
 from ..torch_threads import one_torch_thread
+from .action_clips import ACTION_CLIPS, action_clips
 from .decode import decode_features, decode_tokens, redecode
 from .model_bundle import model_files, part_warnings, resolve_model_dir
 from .parts import generate_by_parts, is_by_parts, redecode_parts
@@ -54,6 +55,7 @@ class Request:
     retrieved: int = DEFAULT_RETRIEVED  # real clips nearest by caption added to the candidates (0: none)
     retrieval_first: float | None = DEFAULT_RETRIEVAL_FIRST  # caption similarity from which only retrieved clips compete
     by_parts: bool = True  # two things at once composed by body part, a named side mirrored (parts.py)
+    action: str | None = None  # the action the prompt names (the planner's reading): its captured clips compete alone
 
 
 def _rows(inputs: tuple | None, a: int, b: int) -> tuple | None:
@@ -148,35 +150,56 @@ class Generator:
             for r in reqs:  # one at a time: each has its own seed, length and temperature
                 g = torch.Generator().manual_seed(int(r.seed))
                 lo, hi = self._length(r.seconds)
-                n = r.candidates if r.temperature > 0 and self.picker is not None else 1
-                seeds = self._retrieval_seeds(r, n)
-                s = self.default_guidance if r.guidance is None else r.guidance
-                inputs = self.t5.inputs_for(self.tok, [r.prompt] * n, [r.shape_text] * n)  # read once for all rows
-                null = self.t5.inputs_for(self.tok, [NULL_PROMPT] * n, [r.shape_text] * n) if s > 0 else None
-                cands, beta = [], None
-                for a, b, prefix in ((0, n - len(seeds), None), (n - len(seeds), n, seeds)):
-                    if a == b:
-                        continue
-                    out = decode(self.t5, _rows(inputs, a, b), lo, hi, temperature=r.temperature, top_k=r.top_k,
-                                 generator=g, guidance=s, null_inputs=_rows(null, a, b), prefix_codes=prefix)
-                    cands += out.codes
-                    beta = out.betas[0] if beta is None else beta  # [BETA] precedes the codes: one body for all
-                sources = [None] * len(cands)
-                if n > 1:  # real clips nearest by caption compete with the samples, or replace them
-                    found = self._retrieved(r, lo, hi)
-                    if found and r.retrieval_first is not None and found[0][1] >= r.retrieval_first:
-                        cands, sources = [], []
-                    for cid, _, c in found:
-                        cands.append(c)
-                        sources.append(cid)
+                found = self._action_clips(r, lo, hi)
+                cands, sources, beta = (self._from_action_clips(r, found) if found
+                                        else self._sampled(r, lo, hi, g))
                 best = 0
-                if len(cands) > 1:
+                if len(cands) > 1 and self.picker is not None:
                     feats = [decode_features(c, self.vae, beta.numpy()).numpy() for c in cands]
                     best = self.picker.pick(r.prompt, feats)
                 codes.append(cands[best])
                 betas.append(beta)
                 self.last_sources.append(sources[best])
         return codes, torch.stack(betas)
+
+    def _sampled(self, r: Request, lo: int, hi: int, g: torch.Generator):
+        """(candidate codes, their memory clip or None, betas): best-of-N's T5 samples (some seeded
+        by retrieved clips) and the retrieved clips nearest by caption."""
+        n = r.candidates if r.temperature > 0 and self.picker is not None else 1
+        seeds = self._retrieval_seeds(r, n)
+        s = self.default_guidance if r.guidance is None else r.guidance
+        inputs = self.t5.inputs_for(self.tok, [r.prompt] * n, [r.shape_text] * n)  # read once for all rows
+        null = self.t5.inputs_for(self.tok, [NULL_PROMPT] * n, [r.shape_text] * n) if s > 0 else None
+        cands, beta = [], None
+        for a, b, prefix in ((0, n - len(seeds), None), (n - len(seeds), n, seeds)):
+            if a == b:
+                continue
+            out = decode(self.t5, _rows(inputs, a, b), lo, hi, temperature=r.temperature, top_k=r.top_k,
+                         generator=g, guidance=s, null_inputs=_rows(null, a, b), prefix_codes=prefix)
+            cands += out.codes
+            beta = out.betas[0] if beta is None else beta  # [BETA] precedes the codes: one body for all
+        sources = [None] * len(cands)
+        if n > 1:  # real clips nearest by caption compete with the samples, or replace them
+            found = self._retrieved(r, lo, hi)
+            if found and r.retrieval_first is not None and found[0][1] >= r.retrieval_first:
+                cands, sources = [], []
+            for cid, _, c in found:
+                cands.append(c)
+                sources.append(cid)
+        return cands, sources, beta
+
+    def _action_clips(self, r: Request, lo: int, hi: int) -> list[tuple[str, list[int]]]:
+        """The memory's clips of the action the request names (``action_clips.py``), when it names
+        one, the model folder has a memory and retrieval is on."""
+        if not r.action or self.t5.memory is None or not self.t5.memory_enabled:
+            return []
+        return action_clips(self.t5.memory, self._text_encoder(), r.prompt, r.action, ACTION_CLIPS, r.seed, lo, hi)
+
+    def _from_action_clips(self, r: Request, found):
+        """(candidate codes, their clips, betas) from clips of the asked-for action."""
+        inputs = self.t5.inputs_for(self.tok, [r.prompt], [r.shape_text])
+        beta = decode(self.t5, inputs, 0, 0).betas[0]   # the [BETA] state alone: no codes written
+        return [c for _, c in found], [cid for cid, _ in found], beta
 
     def _retrieved(self, r: Request, lo: int, hi: int) -> list[tuple[str, float, list[int]]]:
         """(clip id, caption similarity, codes) of the memory's clips nearest to the prompt (``retrieved_candidates.py``),

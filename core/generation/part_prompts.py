@@ -101,6 +101,13 @@ def _with_subject(clause: str, subject: str = "a person") -> str:
     return clause if SUBJECT.match(clause) else f"{subject} {clause}"
 
 
+def _part_action(clause: str, part: frozenset) -> str | None:
+    """The action of ``part`` (LEGS or ARMS) a clause names: the longest matching span ("walks
+    around in a circle" is a circle, not a walk), None when it names none."""
+    spans = [sp for sp in action_spans(clause) if sp[2] in part]
+    return max(spans, key=lambda sp: (sp[1] - sp[0], -sp[0]))[2] if spans else None
+
+
 def _plan(legs_prompt: str, arms_prompt: str, legs_action: str, arms_action: str) -> PartPlan:
     """The plan, with the side the arms prompt names when it names a hand."""
     side = named_side(arms_prompt)
@@ -138,8 +145,12 @@ def plan_parts(text: str, classify=None) -> PartPlan | None:
     if SEQUENCE.search(t):
         return None
     spans = action_spans(t)
-    legs = next((s for s in spans if s[2] in LEGS), None)
-    arms = next((s for s in spans if s[2] in ARMS), None)
+    legs = max((sp for sp in spans if sp[2] in LEGS), key=lambda sp: (sp[1] - sp[0], -sp[0]), default=None)
+    arms = None
+    if legs is not None:  # a gesture outside the locomotion's span; one a connector parts from it first
+        apart = [sp for sp in spans if sp[2] in ARMS and (sp[1] <= legs[0] or sp[0] >= legs[1])]
+        joined = [sp for sp in apart if CONNECTOR.search(t, min(sp[1], legs[1]), max(sp[0], legs[0]))]
+        arms = (joined or apart or [None])[0]
     if legs is None or arms is None:
         return _plan_by_clauses(t, classify) if classify is not None else None
     first, second = sorted([legs, arms])
@@ -149,7 +160,9 @@ def plan_parts(text: str, classify=None) -> PartPlan | None:
     if not a or not b:
         return None
     legs_clause, arms_clause = (a, b) if first is legs else (b, a)
-    return _plan(_with_subject(legs_clause), _with_subject(arms_clause), legs[2], arms[2])
+    legs_action = _part_action(legs_clause, LEGS) or legs[2]
+    arms_action = _part_action(arms_clause, ARMS) or arms[2]
+    return _plan(_with_subject(legs_clause), _with_subject(arms_clause), legs_action, arms_action)
 
 
 STOP = frozenset("a an the this that his her their its my your our one some is are was be being been it he she they "
@@ -163,14 +176,30 @@ def _content(clause: str) -> list[str]:
     return [w for w in re.findall(r"[a-z'-]+", rest) if w not in STOP]
 
 
+NOT_VERBS = frozenset("something anything nothing everything morning evening ceiling building clothing ring string "
+                      "thing arms hands legs feet knees fists shoulders fingers toes elbows hips steps stairs "
+                      "circles times ways yards metres meters sides others friends its his this is was has does "
+                      "as us plus".split())
+SUBJECT_VERB = re.compile(r"^(?:he|she|it|someone|somebody|(?:a|an|the|this|that|one)\s+(?:[a-z-]+\s+){0,2}?[a-z-]+)"
+                          r"\s+([a-z]+s)\b")
+
+
 def _has_verb(clause: str) -> bool:
-    """Whether a clause says what someone does (a verb of the caption tables, or a participle):
-    "like an elderly person" or "with youthful vigour" say how, and are left alone."""
+    """Whether a clause says what someone does: a verb of the caption tables, a participle, a
+    verb after its subject ("the player hurls", "she lifts") or leading the clause ("tosses the
+    ball"). "like an elderly person" or "with youthful vigour" say how, and are left alone."""
     from ..data.captions import _verbs
 
     verbs = _verbs()
-    return any(w in verbs or w + "s" in verbs or (len(w) > 4 and w.endswith(("ing", "ed")))
-               for w in _content(clause))
+    if any(w not in NOT_VERBS and (w in verbs or w + "s" in verbs or (len(w) > 4 and w.endswith(("ing", "ed"))))
+           for w in _content(clause)):
+        return True
+    m = SUBJECT_VERB.match(clause)
+    if m and m.group(1) not in NOT_VERBS and m.group(1) not in STOP:
+        return True
+    first = re.match(r"[a-z]+", clause)
+    return bool(first and first.group(0).endswith("s") and first.group(0) not in NOT_VERBS | STOP
+                and len(first.group(0)) > 3)
 
 
 def _plan_by_clauses(t: str, classify) -> PartPlan | None:
@@ -178,9 +207,7 @@ def _plan_by_clauses(t: str, classify) -> PartPlan | None:
     cs = clauses(t)
     if len(cs) < 2:
         return None
-    acts = [next((a for _, _, a in action_spans(c) if a in LEGS or a in ARMS), None) for c in cs]
-    if not any(acts):  # one part at least must be named in words the action patterns know
-        return None
+    acts = [_part_action(c, LEGS) or _part_action(c, ARMS) for c in cs]
     todo = [i for i, a in enumerate(acts) if a is None and len(_content(cs[i])) >= 2 and _has_verb(cs[i])]
     for i, a in zip(todo, classify([cs[i] for i in todo]) if todo else []):
         acts[i] = a

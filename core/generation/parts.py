@@ -59,7 +59,7 @@ def assemble(body, betas, legs: Track, arms: Track | None, prompt: str | None, i
     return m
 
 
-CLAUSE_NEAR = 0.6   # MiniLM cosine from which a clause takes the action of its nearest training caption
+CLAUSE_NEAR = 0.5   # MiniLM cosine from which a clause takes the action of its nearest training caption
 
 
 def clause_classifier(gen):
@@ -101,11 +101,11 @@ def generate_by_parts(gen, r) -> Motion | None:
         m.shape_source = source
         m.retrieved_clips = [c for c in gen.last_sources if c]
         return m
-    legs_req = dataclasses.replace(r, prompt=plan.legs_prompt)
+    legs_req = dataclasses.replace(r, prompt=plan.legs_prompt, action=plan.legs_action)
     codes, pred = gen.tokens_for([legs_req])
     retrieved = [c for c in gen.last_sources if c]
     seconds = len(codes[0]) * gen.vae.cfg.downsample / FPS
-    arms_req = dataclasses.replace(r, prompt=plan.arms_prompt, seconds=seconds, seed=r.seed + 1)
+    arms_req = dataclasses.replace(r, prompt=plan.arms_prompt, seconds=seconds, seed=r.seed + 1, action=plan.arms_action)
     arms_codes, _ = gen.tokens_for([arms_req])
     retrieved += [c for c in gen.last_sources if c]
     betas, source = gen.body_shape(r, pred[0].numpy())

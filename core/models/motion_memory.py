@@ -48,6 +48,14 @@ def take_of(cid: str) -> str:
     return cid
 
 
+def _caption_actions(captions) -> list[str]:
+    """The actions a clip's captions name (``data/actions.py`` patterns), first named first: the
+    actions of a clip without labels (a user's library)."""
+    from ..data.actions import action_spans
+
+    return list(dict.fromkeys(a for t in captions for _, _, a in action_spans(str(t))))
+
+
 def sentence_vectors(reader, texts: list[str], batch: int = 256) -> torch.Tensor:
     """(N, 384) unit MiniLM sentence vectors (mean of token states) of ``texts``; ``reader`` is a
     TextEncoder or a StateCache."""
@@ -62,7 +70,8 @@ def sentence_vectors(reader, texts: list[str], batch: int = 256) -> torch.Tensor
 
 class MotionMemory:
     def __init__(self, texts: list[str], vectors: torch.Tensor, text_clips: list[list[int]], clip_ids: list[str],
-                 clip_tokens: list[np.ndarray], clip_family: list[frozenset] | None = None):
+                 clip_tokens: list[np.ndarray], clip_family: list[frozenset] | None = None,
+                 clip_actions: list[list[str]] | None = None):
         if not (len(texts) == len(vectors) == len(text_clips)) or len(clip_ids) != len(clip_tokens):
             raise ShapeMoveError("motion memory: texts, vectors and clip lists do not match")
         self.texts, self.vectors = list(texts), vectors.float()
@@ -70,6 +79,9 @@ class MotionMemory:
         self.clip_ids, self.clip_tokens = list(clip_ids), [np.asarray(t, dtype=np.int64) for t in clip_tokens]
         self.clip_family = clip_family or [frozenset([c]) for c in clip_ids]
         self._index = {t: i for i, t in enumerate(self.texts)}
+        if clip_actions is None or len(clip_actions) != len(self.clip_ids):
+            clip_actions = [_caption_actions(self.texts[t] for t in ts) for ts in self._clip_texts()]
+        self.clip_actions = [[str(a) for a in acts] for acts in clip_actions]   # labelled actions, main one first
 
     def __len__(self) -> int:
         return len(self.clip_ids)
@@ -90,7 +102,7 @@ class MotionMemory:
 
         root = Path(root)
         mem = cls.empty()
-        clips, captions, fams = [], [], []
+        clips, captions, fams, acts = [], [], [], []
         for cid in ids:
             if cid not in tokens or not len(tokens[cid]):
                 continue
@@ -98,15 +110,20 @@ class MotionMemory:
             caps = [ln.strip() for ln in path.read_text(encoding="utf-8").splitlines() if ln.strip()] \
                 if path.is_file() else []
             if caps:
+                meta = clip_meta(root, cid)
                 clips.append(cid)
                 captions.append(caps)
-                fams.append(family(cid, clip_meta(root, cid)))
-        mem.add_clips(clips, captions, [tokens[c] for c in clips], reader, fams)
+                fams.append(family(cid, meta))
+                labels = meta.get("labels") if isinstance(meta.get("labels"), dict) else {}
+                named = [a for a in labels.get("actions") or [] if isinstance(a, str)]
+                acts.append(named if named and not labels.get("sequence") else _caption_actions(caps))
+        mem.add_clips(clips, captions, [tokens[c] for c in clips], reader, fams, acts)
         return mem
 
     def add_clips(self, clip_ids: list[str], captions: list[list[str]], clip_tokens: list, reader,
-                  families: list[frozenset] | None = None) -> None:
-        """Add clips (a user's library, or the training set) with their captions and FSQ tokens."""
+                  families: list[frozenset] | None = None, actions: list[list[str]] | None = None) -> None:
+        """Add clips (a user's library, or the training set) with their captions and FSQ tokens;
+        ``actions``: each clip's labelled actions, main one first (default: those its captions name)."""
         new_texts = []
         for cid, caps, toks in zip(clip_ids, captions, clip_tokens):
             c = len(self.clip_ids)
@@ -121,10 +138,30 @@ class MotionMemory:
                     new_texts.append(t)
                 self.text_clips[i].append(c)
         self.clip_family += list(families) if families is not None else [frozenset([c]) for c in clip_ids]
+        self.clip_actions += ([[str(a) for a in acts] for acts in actions] if actions is not None
+                              else [_caption_actions(c) for c in captions])
         if new_texts:
             self.vectors = torch.cat([self.vectors, sentence_vectors(reader, new_texts)])
 
     # -- lookup ---------------------------------------------------------------------------------
+    def _clip_texts(self) -> list[list[int]]:
+        """For each clip, the indices of its captions."""
+        out: list[list[int]] = [[] for _ in self.clip_ids]
+        for t, clips in enumerate(self.text_clips):
+            for c in clips:
+                out[c].append(t)
+        return out
+
+    def clips_of_action(self, action: str) -> list[tuple[int, list[int]]]:
+        """(clip index, its caption indices) of the clips whose main labelled action is ``action``;
+        when none is, those labelled with it at all ("walk in a circle" is a walk's second label)."""
+        texts = self._clip_texts()
+        for ok in (lambda acts: acts[:1] == [action], lambda acts: action in acts):
+            found = [(c, texts[c]) for c, acts in enumerate(self.clip_actions) if ok(acts) and texts[c]]
+            if found:
+                return found
+        return []
+
     def nearest(self, vectors: torch.Tensor, k: int, exclude: list | None = None,
                 rng: random.Random | None = None) -> list[list[tuple[int, float]]]:
         """For each unit vector (B, 384): up to ``k`` (clip index, similarity), nearest caption
@@ -197,7 +234,8 @@ class MotionMemory:
         text_lens = np.array([len(c) for c in self.text_clips], dtype=np.int64)
         flat_clips = np.concatenate([np.asarray(c, np.int64) for c in self.text_clips]) if self.text_clips else np.zeros(0, np.int64)
         flat_tokens = np.concatenate(self.clip_tokens) if self.clip_tokens else np.zeros(0, np.int64)
-        (folder / MEMORY_JSON).write_text(json.dumps({"texts": self.texts, "clip_ids": self.clip_ids}))
+        (folder / MEMORY_JSON).write_text(json.dumps({"texts": self.texts, "clip_ids": self.clip_ids,
+                                                      "clip_actions": self.clip_actions}))
         save_file({"vectors": self.vectors.to(torch.float16).contiguous(),
                    "token_lengths": torch.as_tensor(lens), "tokens": torch.as_tensor(flat_tokens.astype(np.int16)),
                    "text_lengths": torch.as_tensor(text_lens), "text_clips": torch.as_tensor(flat_clips.astype(np.int32))},
@@ -233,5 +271,8 @@ class MotionMemory:
             raise ShapeMoveError(f"{folder}: {MEMORY_JSON} and {MEMORY_TENSORS} do not match; copy the model folder again")
         cut = np.cumsum(lens.numpy())[:-1]
         tcut = np.cumsum(tlens.numpy())[:-1]
+        acts = doc.get("clip_actions") if isinstance(doc, dict) else None
+        acts = [[str(a) for a in x] for x in acts] if (isinstance(acts, list) and len(acts) == len(clip_ids)
+                                                        and all(isinstance(x, list) for x in acts)) else None
         return cls(texts, vectors, [list(x) for x in np.split(tclips, tcut)] if len(texts) else [],
-                   clip_ids, list(np.split(tokens, cut)) if len(clip_ids) else [])
+                   clip_ids, list(np.split(tokens, cut)) if len(clip_ids) else [], clip_actions=acts)
