@@ -75,13 +75,17 @@ def test_clauses_the_patterns_miss_are_classified_when_they_say_what_someone_doe
 
     def classify(clauses):
         asked.extend(clauses)
-        return ["throw" if ("hurls" in c or "tosses" in c) else "sneak" if "tiptoes" in c else None for c in clauses]
+        return ["throw" if ("hurls" in c or "tosses" in c) else "sneak" if "tiptoes" in c
+                else "arm circles" if "circles" in c else None for c in clauses]
 
     plan = plan_parts("Walking backwards, the player hurls a stone.", classify)
     assert plan is not None and (plan.legs_action, plan.arms_action) == ("walk backward", "throw")
     assert plan.arms_prompt == "the player hurls a stone"
     plan = plan_parts("A thief tiptoes along and tosses the keys", classify)   # neither part in the patterns
     assert plan is not None and (plan.legs_action, plan.arms_action) == ("sneak", "throw")
+    # the patterns read "around in circles" as a circle walk; with the arms named, the clause is asked
+    plan = plan_parts("Marching in place while swinging the arms around in circles", classify)
+    assert plan is not None and (plan.legs_action, plan.arms_action) == ("march", "arm circles")
     asked.clear()
     assert plan_parts("a person waves, like an old man", classify) is None
     assert asked == []

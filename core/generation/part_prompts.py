@@ -208,6 +208,9 @@ def _plan_by_clauses(t: str, classify) -> PartPlan | None:
     if len(cs) < 2:
         return None
     acts = [_part_action(c, LEGS) or _part_action(c, ARMS) for c in cs]
+    for i, c in enumerate(cs):  # "swinging the arms around in circles": arms, whatever its words' gait
+        if acts[i] in LEGS and re.search(r"\b(?:" + HAND_WORDS + r")\b", c) and not _part_action(c, ARMS):
+            acts[i] = None
     todo = [i for i, a in enumerate(acts) if a is None and len(_content(cs[i])) >= 2 and _has_verb(cs[i])]
     for i, a in zip(todo, classify([cs[i] for i in todo]) if todo else []):
         acts[i] = a
