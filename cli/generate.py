@@ -34,7 +34,8 @@ def add_arguments(p):
     p.add_argument("--library", type=Path, default=None,
                    help="a folder of your own captioned motions added to the retrieval memory (no retraining)")
     p.add_argument("--no-retrieval", action="store_true",
-                   help="the decoder reads the prompt alone, without the retrieved training clips")
+                   help="the model's motion memory is not used: no retrieved clips among the candidates, no captured "
+                        "clips of a part's action; the T5 writes everything from the prompt alone")
     p.add_argument("--retrieval-prefix", type=int, default=None, metavar="CODES",
                    help="half the candidates continue the first CODES codes (4 frames each) of the nearest "
                         "clips by caption (default 2; 0 = none)")
@@ -45,7 +46,7 @@ def add_arguments(p):
                    help="from this caption similarity (0-1) only the retrieved clips compete (default: never)")
     p.add_argument("--no-parts", action="store_true",
                    help="generate the prompt whole: no legs + arms composition of two things at once, no mirroring "
-                        "to a named left or right")
+                        "to a named left or right, no circle walked for 'in a circle', no turn given back for 'turns around'")
     add_animation_arguments(p)
 
 

@@ -147,3 +147,21 @@ def test_bad_prompt_files(tmp_path):
         load_two_things(tmp_path / "e.json")
     with pytest.raises(ShapeMoveError, match="not found"):
         load_sides(tmp_path / "missing.json")
+
+
+def test_the_tuning_set_holds_trained_pairs_only_and_says_so(tmp_path):
+    """configs/tuning_two_things.json may pair what training composes (it is marked "tuning"); the
+    held-out set may not, and the two share no pair and no prompt."""
+    import json
+
+    tune = load_two_things(Path(__file__).resolve().parents[1] / "configs" / "tuning_two_things.json")
+    assert len(tune) == 32 and all(t["tuning"] for t in tune) and not any(t["tuning"] for t in TWO)
+    assert not {(t["legs"], t["arms"]) for t in tune} & HELD_OUT_PAIRS
+    assert not {t["text"].lower() for t in tune} & {t["text"].lower() for t in TWO}
+    p = tmp_path / "trained.json"
+    p.write_text(json.dumps({"prompts": [{"text": "a man walks and waves", "legs": "walk", "arms": "wave"}]}))
+    with pytest.raises(ShapeMoveError, match="held-out pairs"):
+        load_two_things(p)
+    p.write_text(json.dumps({"tuning": True, "prompts": [{"text": "a man walks and waves", "legs": "walk",
+                                                          "arms": "wave"}]}))
+    assert load_two_things(p)[0]["tuning"] is True

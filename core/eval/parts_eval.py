@@ -80,7 +80,7 @@ def load_two_things(path=None) -> list[dict]:
         if not tuning and (it["legs"], it["arms"]) not in HELD_OUT_PAIRS:
             raise ShapeMoveError(f"{path}: prompt {i} pairs {it['legs']!r} with {it['arms']!r}, not one of the "
                                  "held-out pairs of core/data/compose_parts.py (HELD_OUT_PAIRS)")
-        out.append({"text": it["text"], "legs": it["legs"], "arms": it["arms"]})
+        out.append({"text": it["text"], "legs": it["legs"], "arms": it["arms"], "tuning": tuning})
     return out
 
 
@@ -151,6 +151,7 @@ def eval_parts(model_dir=None, data=None, sides=None, two_things=None, seed: int
         "two_things": {"both": _share([r["both_right"] for r in two_rows]),
                        "legs": _share([r["legs_right"] for r in two_rows]),
                        "arms": _share([r["arms_right"] for r in two_rows]), "prompts": len(two_rows),
+                       "tuning_set": bool(two_items and two_items[0]["tuning"]),
                        "per_pair": _by(two_rows, "pair", ("both_right", "legs_right", "arms_right"))},
         "targets": TARGETS,
         "judge_real": real,
@@ -173,7 +174,7 @@ def format_results(res: dict) -> str:
     s, t, tg = res["sides"], res["two_things"], res["targets"]
     lines = [f"Held-out left/right prompts ({s['prompts']}): the named side moves most {_pct(s['named_side_moves_most'])} "
              f"(target {_pct(tg['sides'])}); " + ", ".join(f"{k} {_pct(v['right'])} of {v['n']}" for k, v in s["per_part"].items()),
-             f"Held-out two-things prompts ({t['prompts']}): both parts right {_pct(t['both'])} (target {_pct(tg['both'])}), "
+             f"{'Tuning-set' if t.get('tuning_set') else 'Held-out'} two-things prompts ({t['prompts']}): both parts right {_pct(t['both'])} (target {_pct(tg['both'])}), "
              f"legs {_pct(t['legs'])}, arms {_pct(t['arms'])} (target {_pct(tg['legs'])} each)"]
     w = max([len(p) for p in t["per_pair"]] + [4])
     lines.append(f"  {'pair'.ljust(w)}  {'n':>2}  {'both':>6}  {'legs':>6}  {'arms':>6}")

@@ -27,9 +27,10 @@ from ..models.text_encoder import load_text_encoder
 from ..scene.motion_file import Motion
 from ..torch_threads import one_torch_thread
 from .action_clips import ACTION_CLIPS, action_clips
+from .circle_walk import CIRCLE, circle_motion, names_circle
 from .decode import decode_features, decode_tokens, redecode
 from .model_bundle import model_files, part_warnings, resolve_model_dir
-from .parts import generate_by_parts, is_by_parts, redecode_parts
+from .parts import clause_classifier, generate_by_parts, is_by_parts, redecode_parts
 from .prompts import check_prompt
 from .rerank import CandidatePicker
 from .retrieval_seeds import seed_prefixes, seeded_count
@@ -37,6 +38,7 @@ from .retrieved_candidates import retrieved_codes
 from .sampling_params import (DEFAULT_CANDIDATES, DEFAULT_GUIDANCE, DEFAULT_RETRIEVAL_FIRST, DEFAULT_RETRIEVAL_PREFIX,
                               DEFAULT_RETRIEVED, check_candidates, check_guidance, check_retrieval_first,
                               check_retrieval_prefix, check_retrieved, check_sampling)
+from .turn_words import turn_motion
 
 
 @dataclass
@@ -215,6 +217,14 @@ class Generator:
             return []
         return seed_prefixes(self.t5.memory, self.tok, r.prompt, seeded_count(n), r.retrieval_prefix)
 
+    def asks_circle(self, prompt: str) -> bool:
+        """Whether a prompt asks to walk in a circle: in the action patterns' words, or by its nearest
+        training caption ("pace around in a loop"; ``parts.clause_classifier``)."""
+        if names_circle(prompt):
+            return True
+        classify = clause_classifier(self)
+        return classify is not None and classify([prompt])[0] == CIRCLE
+
     # -- what the model knows ----------------------------------------------------------------
     @property
     def known_actions(self) -> list[str]:
@@ -320,6 +330,10 @@ class Generator:
                 motion = self.decode_motion(codes[0], betas, prompt=r.prompt)
                 motion.shape_source = source
                 motion.retrieved_clips = [c for c in self.last_sources if c]
+                if r.by_parts:  # the codec does not carry turning: a circle or a turn the words name, given back
+                    motion = (circle_motion(motion, self.body, r.prompt, self.ik_refine_iters)   # circle_walk.py
+                              if self.asks_circle(r.prompt) else
+                              turn_motion(motion, self.body, r.prompt, self.ik_refine_iters))    # turn_words.py
             motion.warnings = [check.warning] if check is not None and check.warning else []
             if r.candidates > 1 and r.temperature > 0:  # best-of-N wanted: say when the model cannot pick
                 motion.warnings += part_warnings(self.model_dir)

@@ -27,6 +27,7 @@ from ..constants import FPS
 from ..errors import ShapeMoveError
 from ..motion.features import motion_features
 from ..scene.motion_file import Motion
+from .circle_walk import CIRCLE, circled
 from .decode import motion_from_joints
 from .part_compose import compose_arms, mirror_track, needs_mirror
 from .part_prompts import PartPlan, named_side, plan_parts
@@ -111,9 +112,13 @@ def generate_by_parts(gen, r) -> Motion | None:
     betas, source = gen.body_shape(r, pred[0].numpy())
     legs = _track(codes[0], gen.vae, betas, False)
     arms, arms_mirrored = _side_fixed(arms_codes[0], gen.vae, betas, plan.arms_side)
-    m = assemble(gen.body, betas, legs, arms, r.prompt, gen.ik_refine_iters,
-                 tokens=np.asarray(codes[0], np.int16), arms_tokens=np.asarray(arms_codes[0], np.int16),
-                 arms_mirrored=arms_mirrored)
+    if plan.legs_action == CIRCLE:  # the codec does not carry turning: the words' circle is walked (circle_walk.py)
+        legs = circled(legs, plan.legs_prompt)
+        m = assemble(gen.body, betas, legs, arms, r.prompt, gen.ik_refine_iters)   # an edit: no tokens kept
+    else:
+        m = assemble(gen.body, betas, legs, arms, r.prompt, gen.ik_refine_iters,
+                     tokens=np.asarray(codes[0], np.int16), arms_tokens=np.asarray(arms_codes[0], np.int16),
+                     arms_mirrored=arms_mirrored)
     m.shape_source = source
     m.part_prompts = (plan.legs_prompt, plan.arms_prompt)
     m.retrieved_clips = retrieved

@@ -9,9 +9,8 @@ the body. Without ``seconds`` the clip ends where the path ends (the motion must
 that far: ``generate_along_path`` asks the model for a long enough motion); with it, the motion
 keeps its length and goes on along the last tangent if it is longer than the path.
 
-Paths: a JSON list of [x, z] points in metres (Y up, as the motion file). The polyline is
-resampled every ``STEP`` m and its tangent smoothed over ``TURN_RADIUS`` m, so a corner becomes a
-short arc the feet can follow.
+Paths: a JSON list of [x, z] points in metres (Y up, as the motion file), read into a
+``polyline.Polyline`` (resampled, corners rounded) and walked with ``polyline.follow_track``.
 """
 from __future__ import annotations
 
@@ -22,34 +21,10 @@ import numpy as np
 
 from ..constants import FPS
 from ..errors import ShapeMoveError
-from ..motion.skeleton_ops import facing_directions, gaussian_smooth, heading_angles
+from ..motion.skeleton_ops import facing_directions, heading_angles
 from ..scene.motion_file import Motion
-from .track import Track, headings, plant, root_centre, rotate_y, track_of, travel
-
-STEP = 0.02          # m between resampled path points
-TURN_RADIUS = 0.25   # m (Gaussian sigma along the path) over which a corner's tangent turns
-MIN_LENGTH = 0.2     # m
-MAX_LENGTH = 1000.0  # m
-MIN_SPEED = 0.15     # m/s: a motion slower than this does not travel (a wave, a sit)
-MAX_POINTS = 100_000
-
-
-def check_path(points) -> np.ndarray:
-    """A list of [x, z] pairs -> (N,2) float64; ShapeMoveError when it is not a usable path."""
-    try:
-        p = np.asarray(points, dtype=np.float64)
-    except (TypeError, ValueError):
-        raise ShapeMoveError("a path must be a list of [x, z] number pairs (metres)") from None
-    if p.ndim != 2 or p.shape[1] != 2 or not 2 <= len(p) <= MAX_POINTS:
-        raise ShapeMoveError(f"a path must be a list of 2 to {MAX_POINTS} [x, z] pairs, got shape {p.shape}")
-    if not np.isfinite(p).all():
-        raise ShapeMoveError("a path's points must be finite numbers")
-    keep = np.r_[True, np.linalg.norm(np.diff(p, axis=0), axis=1) > 1e-6]
-    p = p[keep]
-    length = float(np.linalg.norm(np.diff(p, axis=0), axis=1).sum()) if len(p) > 1 else 0.0
-    if not MIN_LENGTH <= length <= MAX_LENGTH:
-        raise ShapeMoveError(f"a path must be {MIN_LENGTH} to {MAX_LENGTH:g} m long, this one is {length:.2f} m")
-    return p
+from .polyline import MAX_LENGTH, MIN_LENGTH, MIN_SPEED, Polyline, check_path, follow_track  # noqa: F401 (read_path, users)
+from .track import plant, track_of, travel
 
 
 def read_path(path) -> np.ndarray:
@@ -68,68 +43,11 @@ def read_path(path) -> np.ndarray:
     return check_path(data)
 
 
-class Polyline:
-    """A path resampled by arc length: ``point(s)`` and ``heading(s)`` (yaw of the tangent,
-    0 along +Z, +pi/2 along +X) at distances ``s`` from its start."""
-
-    def __init__(self, points):
-        p = check_path(points)
-        seg = np.linalg.norm(np.diff(p, axis=0), axis=1)
-        cum = np.r_[0.0, np.cumsum(seg)]
-        self.length = float(cum[-1])
-        self.s = np.linspace(0.0, self.length, max(2, int(np.ceil(self.length / STEP)) + 1))
-        self.xz = np.stack([np.interp(self.s, cum, p[:, 0]), np.interp(self.s, cum, p[:, 1])], axis=1)
-        tangent = np.gradient(self.xz, axis=0)
-        tangent = gaussian_smooth(tangent / np.maximum(np.linalg.norm(tangent, axis=1, keepdims=True), 1e-12),
-                                  TURN_RADIUS / (self.s[1] - self.s[0]))
-        self.yaw = np.unwrap(np.arctan2(tangent[:, 0], tangent[:, 1]))
-
-    def point(self, s) -> np.ndarray:
-        """(N,2) points at distances ``s``; beyond the end, along the last tangent."""
-        s = np.asarray(s, np.float64)
-        inside = np.clip(s, 0.0, self.length)
-        xz = np.stack([np.interp(inside, self.s, self.xz[:, 0]), np.interp(inside, self.s, self.xz[:, 1])], axis=-1)
-        extra = (s - inside)[..., None]
-        return xz + extra * np.stack([np.sin(self.yaw[-1]), np.cos(self.yaw[-1])])
-
-    def heading(self, s) -> np.ndarray:
-        return np.interp(np.clip(s, 0.0, self.length), self.s, self.yaw)
-
-    def nearest(self, xz) -> tuple[np.ndarray, np.ndarray]:
-        """(distance (N,), tangent yaw (N,)) of points (N,2) to the resampled path."""
-        xz = np.asarray(xz, np.float64)
-        d = np.linalg.norm(xz[:, None] - self.xz[None], axis=-1)
-        i = d.argmin(1)
-        return d[np.arange(len(xz)), i], self.yaw[i]
-
-
 def motion_speed(motion_or_joints, fps: float = FPS) -> float:
     """Mean speed (m/s) of the smoothed root along its own course."""
     joints = motion_or_joints.joints if isinstance(motion_or_joints, Motion) else motion_or_joints
     s = travel(joints)
     return float(s[-1] / max(len(s) - 1, 1) * fps)
-
-
-def follow_track(track: Track, line: Polyline, crop: bool = True) -> Track:
-    """The track's body moved onto ``line`` (see the module doc); ``crop``: frames after the
-    one that reaches the end of the path are dropped."""
-    J = track.joints
-    h = headings(J)
-    c = root_centre(J)
-    s = travel(J)
-    local = J.copy()
-    local[..., 0] -= c[:, None, 0]
-    local[..., 2] -= c[:, None, 1]
-    local = rotate_y(local, -h)
-    xz = line.point(s)
-    out = rotate_y(local, line.heading(s))
-    out[..., 0] += xz[:, None, 0]
-    out[..., 2] += xz[:, None, 1]
-    n = len(J)
-    if crop:
-        reached = np.flatnonzero(s >= line.length)
-        n = int(reached[0]) + 1 if len(reached) else n
-    return Track(out[:n], track.contacts[:n])
 
 
 def follow_path(motion: Motion, body, path, crop: bool = True, ik_refine_iters: int = 10) -> Motion:

@@ -1,0 +1,64 @@
+"""Turning on the spot (core/generation/turn_words.py): the angle the words name, and the track
+turned by it in all, its course turning with it."""
+import numpy as np
+import pytest
+
+from shapemove.core.generation.track import Track, headings, root_centre
+from shapemove.core.generation.turn_words import angle_of, turned
+
+from test_circle_walk import _straight_walk
+
+
+@pytest.mark.parametrize("text, angle", [
+    ("a person turns around", np.pi),
+    ("someone turns around to the right", -np.pi),
+    ("a man turns to the left", np.pi / 2),
+    ("she turns right", -np.pi / 2),
+    ("a person makes a quarter turn to the right", -np.pi / 2),
+    ("someone spins around", 2 * np.pi),
+    ("someone turns around twice", 2 * np.pi),
+    ("turn clockwise all the way around", -2 * np.pi),
+    ("he turns his head", None),                       # a part turns, not the body
+    ("back away slowly without turning around", None),  # negated
+    ("walks forward then turns around", None),         # another action too: the timeline's job
+    ("a person turns", None),                          # no amount named
+    ("a person waves", None),
+])
+def test_the_words_name_the_angle(text, angle):
+    got = angle_of(text)
+    assert (got is None) if angle is None else got == pytest.approx(angle)
+
+
+def test_a_walk_turned_around_walks_back_and_turns_in_all_what_was_asked():
+    walk = _straight_walk(frames=100, speed=1.0)
+    back = turned(walk, np.pi)
+    h = np.unwrap(headings(back.joints))
+    assert h[-1] - h[0] == pytest.approx(np.pi, abs=0.15)
+    c = root_centre(back.joints)
+    assert c[-1, 1] < c[60, 1] - 0.5          # after the turn it comes back along -Z
+    assert 0.5 < abs(c[-1, 0]) < 2.5          # a U-turn on an arc of the steps taken while turning
+    stride = lambda J: np.linalg.norm(J[:, 10] - J[:, 11], axis=-1)  # noqa: E731
+    assert np.allclose(stride(back.joints), stride(walk.joints), atol=1e-6)   # the pose itself kept
+    again = turned(back, np.pi)               # its own turn is counted: asked for pi, it stays pi
+    h2 = np.unwrap(headings(again.joints))
+    assert h2[-1] - h2[0] == pytest.approx(np.pi, abs=0.15)
+
+
+def test_a_turn_on_the_spot_stays_on_the_spot():
+    still = _straight_walk(speed=0.0)
+    spun = turned(still, 2 * np.pi)
+    h = np.unwrap(headings(spun.joints))
+    assert h[-1] - h[0] == pytest.approx(2 * np.pi, abs=0.15)
+    assert np.abs(root_centre(spun.joints) - root_centre(still.joints)).max() < 1e-6
+
+
+def test_generation_turns_the_body_as_far_as_the_words_say():
+    from shapemove.core.generation.generate import Generator, Request
+
+    gen = Generator(None)
+    m = gen.generate_batch([Request("a person turns around", seconds=4, seed=0)])[0]
+    h = np.unwrap(headings(m.joints))
+    assert h[-1] - h[0] == pytest.approx(np.pi, abs=0.4) and m.tokens is None and m.features is not None
+    assert m.joints[:, :, 1].min() > -0.05
+    plain = gen.generate_batch([Request("a person turns around", seconds=4, seed=0, by_parts=False)])[0]
+    assert plain.tokens is not None
