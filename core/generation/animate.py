@@ -31,7 +31,7 @@ class Animation:
 
 
 def check_animation(a: Animation) -> Animation:
-    from .path_follow import check_path
+    from .polyline import check_path
 
     if a.speed is not None:
         a.speed = check_speed(a.speed)
@@ -55,7 +55,8 @@ def check_animation(a: Animation) -> Animation:
 def animation_from(params: dict) -> Animation:
     """Options from a JSON object (batch line, worker params): "loop", "in_place", "path"
     ([[x, z], ...] or a file name), "speed", "stretch"."""
-    from .path_follow import check_path, read_path
+    from .path_follow import read_path
+    from .polyline import check_path
 
     path = params.get("path")
     if isinstance(path, str):

@@ -22,8 +22,9 @@ import re
 import numpy as np
 
 from ..data.actions import find_actions
+from ..constants import FPS
 from .polyline import MIN_SPEED, Polyline, follow_track
-from .track import Track, travel
+from .track import Track, motion_speed, travel
 
 CIRCLE = "walk in a circle"
 MIN_RADIUS, MAX_RADIUS = 1.0, 3.0   # m
@@ -59,13 +60,11 @@ def circle_line(distance: float, right: bool) -> Polyline:
     return Polyline(np.stack([x, z], axis=1))
 
 
-def circled(track: Track, text: str, fps: float = 20.0) -> Track:
+def circled(track: Track, text: str, fps: float = FPS) -> Track:
     """``track`` walked along the circle ``text`` asks for; unchanged when it does not travel."""
-    s = travel(track.joints)
-    if len(s) < 2 or s[-1] / max(len(s) - 1, 1) * fps < MIN_SPEED:
+    if motion_speed(track.joints, fps) < MIN_SPEED:
         return track
-    return follow_track(track, circle_line(float(s[-1]), turns_right(text)), crop=False)
-
+    return follow_track(track, circle_line(float(travel(track.joints)[-1]), turns_right(text)), crop=False)
 
 
 def circle_motion(motion, body, text: str, ik_refine_iters: int = 10):

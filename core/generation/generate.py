@@ -30,7 +30,7 @@ from .action_clips import ACTION_CLIPS, action_clips
 from .circle_walk import CIRCLE, circle_motion, names_circle
 from .decode import decode_features, decode_tokens, redecode
 from .model_bundle import model_files, part_warnings, resolve_model_dir
-from .parts import clause_classifier, generate_by_parts, is_by_parts, redecode_parts
+from .parts import CLAUSE_NEAR, generate_by_parts, is_by_parts, redecode_parts
 from .prompts import check_prompt
 from .rerank import CandidatePicker
 from .retrieval_seeds import seed_prefixes, seeded_count
@@ -199,8 +199,7 @@ class Generator:
 
     def _from_action_clips(self, r: Request, found):
         """(candidate codes, their clips, betas) from clips of the asked-for action."""
-        inputs = self.t5.inputs_for(self.tok, [r.prompt], [r.shape_text])
-        beta = decode(self.t5, inputs, 0, 0).betas[0]   # the [BETA] state alone: no codes written
+        beta = self.t5.predict_betas(self.t5.inputs_for(self.tok, [r.prompt], [r.shape_text]))[0]
         return [c for _, c in found], [cid for cid, _ in found], beta
 
     def _retrieved(self, r: Request, lo: int, hi: int) -> list[tuple[str, float, list[int]]]:
@@ -217,13 +216,14 @@ class Generator:
             return []
         return seed_prefixes(self.t5.memory, self.tok, r.prompt, seeded_count(n), r.retrieval_prefix)
 
-    def asks_circle(self, prompt: str) -> bool:
+    @staticmethod
+    def asks_circle(prompt: str, check) -> bool:
         """Whether a prompt asks to walk in a circle: in the action patterns' words, or by its nearest
-        training caption ("pace around in a loop"; ``parts.clause_classifier``)."""
+        training caption ("pace around in a loop"), read from its ``check_text`` (None: no known
+        captions) as ``parts.clause_classifier`` reads a clause's."""
         if names_circle(prompt):
             return True
-        classify = clause_classifier(self)
-        return classify is not None and classify([prompt])[0] == CIRCLE
+        return check is not None and check.similarity >= CLAUSE_NEAR and check.nearest_action == CIRCLE
 
     # -- what the model knows ----------------------------------------------------------------
     @property
@@ -332,7 +332,7 @@ class Generator:
                 motion.retrieved_clips = [c for c in self.last_sources if c]
                 if r.by_parts:  # the codec does not carry turning: a circle or a turn the words name, given back
                     motion = (circle_motion(motion, self.body, r.prompt, self.ik_refine_iters)   # circle_walk.py
-                              if self.asks_circle(r.prompt) else
+                              if self.asks_circle(r.prompt, check) else
                               turn_motion(motion, self.body, r.prompt, self.ik_refine_iters))    # turn_words.py
             motion.warnings = [check.warning] if check is not None and check.warning else []
             if r.candidates > 1 and r.temperature > 0:  # best-of-N wanted: say when the model cannot pick

@@ -112,13 +112,11 @@ def generate_by_parts(gen, r) -> Motion | None:
     betas, source = gen.body_shape(r, pred[0].numpy())
     legs = _track(codes[0], gen.vae, betas, False)
     arms, arms_mirrored = _side_fixed(arms_codes[0], gen.vae, betas, plan.arms_side)
+    tokens = dict(tokens=np.asarray(codes[0], np.int16), arms_tokens=np.asarray(arms_codes[0], np.int16),
+                  arms_mirrored=arms_mirrored)
     if plan.legs_action == CIRCLE:  # the codec does not carry turning: the words' circle is walked (circle_walk.py)
-        legs = circled(legs, plan.legs_prompt)
-        m = assemble(gen.body, betas, legs, arms, r.prompt, gen.ik_refine_iters)   # an edit: no tokens kept
-    else:
-        m = assemble(gen.body, betas, legs, arms, r.prompt, gen.ik_refine_iters,
-                     tokens=np.asarray(codes[0], np.int16), arms_tokens=np.asarray(arms_codes[0], np.int16),
-                     arms_mirrored=arms_mirrored)
+        legs, tokens = circled(legs, plan.legs_prompt), {}   # an edit: no tokens kept
+    m = assemble(gen.body, betas, legs, arms, r.prompt, gen.ik_refine_iters, **tokens)
     m.shape_source = source
     m.part_prompts = (plan.legs_prompt, plan.arms_prompt)
     m.retrieved_clips = retrieved

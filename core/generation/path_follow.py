@@ -19,12 +19,11 @@ from pathlib import Path
 
 import numpy as np
 
-from ..constants import FPS
 from ..errors import ShapeMoveError
 from ..motion.skeleton_ops import facing_directions, heading_angles
 from ..scene.motion_file import Motion
-from .polyline import MAX_LENGTH, MIN_LENGTH, MIN_SPEED, Polyline, check_path, follow_track  # noqa: F401 (read_path, users)
-from .track import plant, track_of, travel
+from .polyline import MIN_SPEED, Polyline, check_path, follow_track
+from .track import motion_speed, plant, track_of, travel
 
 
 def read_path(path) -> np.ndarray:
@@ -41,13 +40,6 @@ def read_path(path) -> np.ndarray:
     if isinstance(data, dict):
         data = data.get("points")
     return check_path(data)
-
-
-def motion_speed(motion_or_joints, fps: float = FPS) -> float:
-    """Mean speed (m/s) of the smoothed root along its own course."""
-    joints = motion_or_joints.joints if isinstance(motion_or_joints, Motion) else motion_or_joints
-    s = travel(joints)
-    return float(s[-1] / max(len(s) - 1, 1) * fps)
 
 
 def follow_path(motion: Motion, body, path, crop: bool = True, ik_refine_iters: int = 10) -> Motion:

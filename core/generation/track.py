@@ -140,6 +140,13 @@ def travel(joints) -> np.ndarray:
     return np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(c, axis=0), axis=1))]
 
 
+def motion_speed(motion_or_joints, fps: float = FPS) -> float:
+    """Mean speed (m/s) of the smoothed root along its own course."""
+    joints = motion_or_joints.joints if isinstance(motion_or_joints, Motion) else motion_or_joints
+    s = travel(joints)
+    return float(s[-1] / max(len(s) - 1, 1) * fps)
+
+
 def rotate_y(points, angle) -> np.ndarray:
     """Rotate (...,3) points about +Y by ``angle`` (per leading frame when an array)."""
     a = np.asarray(angle, np.float64)

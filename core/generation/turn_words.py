@@ -70,14 +70,10 @@ def turned(track: Track, angle: float) -> Track:
     u = np.clip((np.arange(n) / max(n - 1, 1) - TURN_SPAN[0]) / (TURN_SPAN[1] - TURN_SPAN[0]), 0.0, 1.0)
     phi = (angle - (own[-1] - own[0])) * u * u * (3 - 2 * u)
     c = root_centre(J)
-    steps = np.diff(c, axis=0)
-    cos, sin = np.cos(phi[1:]), np.sin(phi[1:])
-    turned_steps = np.stack([steps[:, 0] * cos + steps[:, 1] * sin, -steps[:, 0] * sin + steps[:, 1] * cos], axis=1)
-    course = np.vstack([c[:1], c[:1] + np.cumsum(turned_steps, axis=0)])
-    old_centre, new_centre = np.zeros((n, 1, 3)), np.zeros((n, 1, 3))
-    old_centre[:, 0, 0], old_centre[:, 0, 2] = c[:, 0], c[:, 1]
-    new_centre[:, 0, 0], new_centre[:, 0, 2] = course[:, 0], course[:, 1]
-    return Track(rotate_y(J - old_centre, phi) + new_centre, track.contacts)
+    old = np.stack([c[:, 0], np.zeros(n), c[:, 1]], axis=1)              # (T,3) the course, on the floor
+    new = old[:1] + np.vstack([np.zeros((1, 3)), np.cumsum(rotate_y(np.diff(old, axis=0), phi[1:]), axis=0)])
+    return Track(rotate_y(J - old[:, None], phi) + new[:, None], track.contacts)
+
 
 def turn_motion(motion, body, text: str, ik_refine_iters: int = 10):
     """A generated ``Motion`` turned as far as ``text`` says (``track.replanted``: an edit, no

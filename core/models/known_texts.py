@@ -41,6 +41,7 @@ class PromptCheck:
     nearest_caption: str
     nearest_actions: list[str] = field(default_factory=list)
     warning: str | None = None
+    nearest_action: str | None = None   # the nearest caption's own action (None: it names none)
 
 
 def _read_lines(path: Path) -> list[str]:
@@ -121,7 +122,7 @@ class Known:
             close = ", ".join(nearest) if nearest else repr(self.captions[best])
             warning = (f"nothing like {prompt!r} in the training data (closest caption {sim:.2f} similar: "
                        f"{self.captions[best]!r}); closest known actions: {close}")
-        return PromptCheck(sim, self.captions[best], nearest, warning)
+        return PromptCheck(sim, self.captions[best], nearest, warning, self.caption_actions[best] or None)
 
     def nearest_actions(self, sims: torch.Tensor, k: int = 3) -> list[str]:
         best: dict[str, float] = {}
