@@ -1,7 +1,7 @@
 """`python -m shapemove eval KIND ...`: evaluation commands, each printing a table beside the
 ground truth and writing the numbers as JSON (atomically).
 
-    eval recon --data DIR [--split test] --checkpoint RUN|savae.pt --json OUT [--max-clips N]
+    eval recon --data DIR [--split test] --checkpoint RUN|savae.pt --json OUT [--max-clips N] [--base-only]
 
 ``recon``: SA-VAE reconstruction (``core/eval/recon.py``). JSON: the reconstruction's metrics as
 flat keys (mpjpe_mm, bone_err_mm, penetrate_cm, float_cm, skate_pct, dyn_stable_pct,
@@ -31,6 +31,8 @@ def add_recon(sub):
     p.add_argument("--json", type=Path, required=True, help="write the metrics here")
     p.add_argument("--max-clips", type=int, default=None, help="evaluate a seeded random subset of N clips")
     p.add_argument("--body-model", default=None, help="openbody (default) or an SMPL-family file")
+    p.add_argument("--base-only", action="store_true",
+                   help="a codec with a residual code: decode the base codes alone (what the T5 writes)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(_run=run_recon)
 
@@ -53,7 +55,7 @@ def run_recon(args) -> int:
     clips: list = []
     try:
         result = eval_recon(args.data, args.checkpoint, split=args.split, body=args.body_model,
-                            max_clips=args.max_clips, progress=progress, per_clip=clips)
+                            max_clips=args.max_clips, progress=progress, per_clip=clips, base_only=args.base_only)
     finally:
         bar.close()
     atomic_write_json(args.json, result, nan_to_null=True)

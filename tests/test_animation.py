@@ -41,8 +41,11 @@ def test_prefix_codes_continue_and_count_only_new(gen):
     out = decode(gen.t5, inputs, 3, 3, temperature=0, prefix_codes=[5, 6, 7, 8])
     assert len(out.codes[0]) == 3
     assert out.token_ids[0][2:6] == [gen.t5.vocab.first_code_id + c for c in (5, 6, 7, 8)]
-    with pytest.raises(ValueError):
-        decode(gen.t5, inputs, 3, 3, temperature=0, prefix_codes=[10**6])
+    for bad in (-1, 1000 * 1001):  # tokens lie in [0, 1000 x 1001): base codes, or a residual packed in
+        with pytest.raises(ValueError, match="motion tokens"):
+            decode(gen.t5, inputs, 3, 3, temperature=0, prefix_codes=[bad])
+    packed = decode(gen.t5, inputs, 3, 3, temperature=0, prefix_codes=[5 + 1000 * 17, 6, 7, 8])  # a residual is dropped
+    assert packed.codes == out.codes and packed.token_ids == out.token_ids
 
 
 def test_loop_seam_and_advance(gen):

@@ -40,11 +40,17 @@ def test_mirror_is_a_reflection_consistent_with_fk(openbody):
 def test_mirrored_walk_is_a_walk_of_the_same_speed(tiny_dataset, tmp_path, openbody):
     data = tmp_path / "d"
     shutil.copytree(tiny_dataset, data)
-    for p in (data / "meta").glob("*.json"):   # make every clip a training clip for this test
+    sources_own = None
+    for p in sorted((data / "meta").glob("*.json")):   # make every clip a training clip for this test
         m = json.loads(p.read_text())
         m["split"] = "train"
+        if sources_own is None and "walk" not in m["id"] and "wave" not in m["id"]:
+            sources_own = m["id"]  # as DeepMimic's own *_mirror motions say of themselves
+            m.setdefault("labels", {})["mirrored"] = True
         p.write_text(json.dumps(m))
     written = mr.mirror_dataset(data, body=openbody, verbose=False)
+    assert sources_own is not None and sources_own + mr.SUFFIX not in written   # its mirror image is its source
+    assert not (data / "meta" / f"{sources_own}{mr.SUFFIX}.json").exists()
     cid = "dataset-1_walk_feminine_001"
     assert cid + mr.SUFFIX in written and not any(w.endswith(mr.SUFFIX + mr.SUFFIX) for w in written)
     f = np.load(data / "new_joint_vecs" / f"{cid}.npy")

@@ -139,7 +139,7 @@ def test_a_model_folder_with_a_memory_retrieves_from_it(gen, tmp_path):
     m = own.generate_batch([Request("someone punches", seconds=4, seed=0, retrieval_first=0.0)])[0]
     assert m.retrieved_clips == ["punch_9"]
     bad = MotionMemory.empty()
-    bad.add_clips(["x"], [["a person waves."]], [[5000, 1]], gen._text_encoder())
+    bad.add_clips(["x"], [["a person waves."]], [[1000 * 1001, 1]], gen._text_encoder())  # past base + residual
     bad.save(model / "t5")
     write_manifest(model)
     with pytest.raises(ShapeMoveError, match="codes outside"):

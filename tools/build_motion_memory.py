@@ -46,7 +46,7 @@ def main(argv=None) -> int:
     vae = load_savae(a.model / "savae.pt")
     bar = tqdm(total=len(ids), desc="tokens", unit="clip")
     with torch.no_grad():
-        tokens = tokenize_clips(vae, a.data, ids, progress=lambda f, c: bar.update(1))
+        tokens = tokenize_clips(vae, a.data, ids, progress=lambda f, c: bar.update(1), residual=vae.has_residual)
     bar.close()
     mem = MotionMemory.from_dataset(a.data, ids, tokens, load_text_encoder())
     mem.save(a.model / "t5")

@@ -133,7 +133,8 @@ def mirror_labels(labels: dict) -> dict:
 
 def mirror_dataset(data, body=None, verbose: bool = True, progress=None, cancel=None,
                    shard: tuple[int, int] = (0, 1)) -> list[str]:
-    """Add the mirror image of every training clip (not mirrors themselves) of built dataset
+    """Add the mirror image of every training clip (not mirrors themselves, nor clips their source
+    mirrored: ``labels.mirrored``) of built dataset
     ``data``; resumable (a clip whose meta exists is skipped). ``shard`` (i, n): only every n-th
     clip from the i-th (n processes can share the work). Returns the ids written."""
     from tqdm import tqdm
@@ -142,7 +143,10 @@ def mirror_dataset(data, body=None, verbose: bool = True, progress=None, cancel=
     if not (data / "meta").is_dir():
         raise ShapeMoveError(f"{data}: not a built dataset (no meta/ folder); run `data build` first")
     metas = [json.loads(p.read_text(encoding="utf-8")) for p in sorted((data / "meta").glob("*.json"))]
-    todo = [m for m in metas if m.get("split") == "train" and not m.get("mirror_of")]
+    # a clip the source itself mirrored (DeepMimic's ``*_mirror`` motions: ``labels.mirrored``) has its
+    # mirror image in the data already: the clip it was mirrored from
+    todo = [m for m in metas if m.get("split") == "train" and not m.get("mirror_of")
+            and not (m.get("labels") or {}).get("mirrored")]
     index, count = shard
     if not 0 <= index < count:
         raise ShapeMoveError(f"shard must be i/n with 0 <= i < n, got {index}/{count}")

@@ -32,6 +32,7 @@ from ..errors import ShapeMoveError
 from ..generation.retarget import load_vae
 from ..geometry.rotations import axis_angle_to_matrix
 from ..models.fsq import codebook_usage
+from ..models.motion_codes import base_of
 from ..motion.features import joints_from_features
 from ..train.motion_dataset import read_split
 from .bones import mpjpe_mm
@@ -61,27 +62,33 @@ def _pick(agg: dict) -> dict:
     return {k: float(agg[k]) for k in KEYS}
 
 
-def recon_clip(vae, body, norm_feats: np.ndarray, betas: np.ndarray, ik_refine_iters: int = 10):
+def recon_clip(vae, body, norm_feats: np.ndarray, betas: np.ndarray, ik_refine_iters: int = 10,
+               base_only: bool = False):
     """(T-1,263) canonical features + betas -> (joints (n,22,3), rotations (n,24,3,3), transl (n,3),
-    token indices (n/4,)) of the reconstruction, n = (T-1) cut to a multiple of the downsampling."""
+    base token indices (n/4,)) of the reconstruction, n = (T-1) cut to a multiple of the
+    downsampling. A codec with a residual code decodes both codes unless ``base_only`` (what the
+    T5, which writes base codes, can reach)."""
     n = len(norm_feats) // vae.cfg.downsample * vae.cfg.downsample
     if n == 0:
         raise ShapeMoveError(f"clip too short for the SA-VAE ({len(norm_feats)} feature rows)")
     b = torch.as_tensor(betas, dtype=torch.float32).reshape(1, 10)
     with torch.no_grad():  # (not around the IK: its refinement takes gradients)
-        codes, indices = vae.encode(vae.normalize(torch.as_tensor(norm_feats[:n]))[None])
-        feats = vae.denormalize(vae.decode_long(codes, b))[0]
+        x = vae.normalize(torch.as_tensor(norm_feats[:n]))[None]
+        tokens = vae.encode(x)[1] if base_only else vae.encode_tokens(x)
+        indices = base_of(tokens, vae.quantizer.codebook_size)
+        feats = vae.denormalize(vae.decode_tokens_long(tokens, b))[0]
         joints = joints_from_features(feats.double()).float().numpy()
     ik = solve_ik(joints, body.rest_joints(b)[0].numpy(), refine_iters=ik_refine_iters)
     return joints, ik.rotations, ik.transl, indices[0]
 
 
 def eval_recon(data, checkpoint, split: str = "test", body=None, max_clips: int | None = None, progress=None,
-               ik_refine_iters: int = 10, per_clip: list | None = None) -> dict:
+               ik_refine_iters: int = 10, per_clip: list | None = None, base_only: bool = False) -> dict:
     """Reconstruction metrics of the SA-VAE ``checkpoint`` (run folder or .pt) on the ``split``
     clips of the dataset folder ``data``, with the ground truth's beside (see the module doc).
     progress(fraction, clip id) after each clip; ``per_clip``: a list to receive one dict per clip
-    ({"id", "frames", the KEYS, "ground_truth": {KEYS}})."""
+    ({"id", "frames", the KEYS, "ground_truth": {KEYS}}); ``base_only``: a residual codec decodes
+    its base codes alone (``recon_clip``)."""
     root = Path(data)
     if not root.is_dir():
         raise ShapeMoveError(f"dataset folder not found: {root}")
@@ -97,7 +104,8 @@ def eval_recon(data, checkpoint, split: str = "test", body=None, max_clips: int 
     model_rows, gt_rows, all_indices = [], [], []
     for i, cid in enumerate(ids):
         betas = _load(root, "betas", cid).reshape(-1)
-        joints, rot, transl, idx = recon_clip(vae, body, _load(root, "norm_joint_vecs", cid), betas, ik_refine_iters)
+        joints, rot, transl, idx = recon_clip(vae, body, _load(root, "norm_joint_vecs", cid), betas, ik_refine_iters,
+                                                   base_only)
         n = len(joints)
         gt_joints = joints_from_features(_load(root, "new_joint_vecs", cid)[:n].astype(np.float64))
         m = evaluate_motion(body, betas, rot, transl, joints=joints)

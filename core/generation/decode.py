@@ -28,7 +28,7 @@ def decode_features(codes: list[int], vae, betas) -> torch.Tensor:
         raise ShapeMoveError("no motion tokens to decode")
     b = torch.as_tensor(check_betas(betas))[None]
     idx = torch.as_tensor(codes, dtype=torch.long)[None]
-    return vae.denormalize(vae.decode_long(vae.quantizer.indices_to_codes(idx), b))[0]
+    return vae.denormalize(vae.decode_tokens_long(idx, b))[0]
 
 
 def decode_tokens(codes: list[int], vae, body, betas, ik_refine_iters: int = 10, prompt: str | None = None,
@@ -53,7 +53,7 @@ def decode_tokens(codes: list[int], vae, body, betas, ik_refine_iters: int = 10,
     else:
         contacts = contacts_from_features(feats.numpy())
     return motion_from_joints(body, betas, joints, contacts, ik_refine_iters, prompt=prompt, known_contacts=known,
-                              tokens=np.asarray(codes, np.int16), features=feats.numpy().astype(np.float32))
+                              tokens=np.asarray(codes, np.int32), features=feats.numpy().astype(np.float32))
 
 
 def redecode(motion: Motion, vae, body, betas, ik_refine_iters: int = 10) -> Motion:

@@ -261,7 +261,7 @@ class Generator:
         with torch.no_grad(), one_torch_thread():
             for f in feats:
                 n = (len(f) // down) * down
-                _, idx = self.vae.encode(self.vae.normalize(torch.as_tensor(f[:n], dtype=torch.float32)[None]))
+                idx = self.vae.encode_tokens(self.vae.normalize(torch.as_tensor(f[:n], dtype=torch.float32)[None]))
                 tokens.append(idx[0].numpy())
         self.t5.memory.add_clips([f"library:{i}" for i in ids], [[c] for c in captions], tokens, self.tok)
         return len(ids)

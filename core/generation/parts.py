@@ -98,7 +98,7 @@ def generate_by_parts(gen, r) -> Motion | None:
         m = gen.decode_motion(codes[0], betas, prompt=r.prompt)
         if needs_mirror(m.joints, *side):
             m = assemble(gen.body, betas, _track(codes[0], gen.vae, betas, True), None, r.prompt, gen.ik_refine_iters,
-                         tokens=np.asarray(codes[0], np.int16), mirrored=True)
+                         tokens=np.asarray(codes[0], np.int32), mirrored=True)
         m.shape_source = source
         m.retrieved_clips = [c for c in gen.last_sources if c]
         return m
@@ -112,7 +112,7 @@ def generate_by_parts(gen, r) -> Motion | None:
     betas, source = gen.body_shape(r, pred[0].numpy())
     legs = _track(codes[0], gen.vae, betas, False)
     arms, arms_mirrored = _side_fixed(arms_codes[0], gen.vae, betas, plan.arms_side)
-    tokens = dict(tokens=np.asarray(codes[0], np.int16), arms_tokens=np.asarray(arms_codes[0], np.int16),
+    tokens = dict(tokens=np.asarray(codes[0], np.int32), arms_tokens=np.asarray(arms_codes[0], np.int32),
                   arms_mirrored=arms_mirrored)
     if plan.legs_action == CIRCLE:  # the codec does not carry turning: the words' circle is walked (circle_walk.py)
         legs, tokens = circled(legs, plan.legs_prompt), {}   # an edit: no tokens kept

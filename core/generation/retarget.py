@@ -121,11 +121,11 @@ def encode_windowed(vae, x: torch.Tensor, window: int = ENCODE_WINDOW) -> torch.
     window = max(down, window // down * down)
     reach, n = encoder_reach(vae), len(x)
     if n <= window + 2 * reach:
-        return vae.encode(x[None])[1][0]
+        return vae.encode_tokens(x[None])[0]
     out = []
     for s in range(0, n, window):
         lo, hi = max(0, s - reach), min(n, s + window + reach)
-        idx = vae.encode(x[lo:hi][None])[1][0]
+        idx = vae.encode_tokens(x[lo:hi][None])[0]
         out.append(idx[(s - lo) // down:(min(n, s + window) - lo) // down])
     return torch.cat(out)
 

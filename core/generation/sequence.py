@@ -113,7 +113,7 @@ def _batch_features(vae, codes: list[list[int]], betas) -> list[np.ndarray]:
     with one_torch_thread():
         idx = torch.as_tensor(codes, dtype=torch.long)
         b = torch.as_tensor(np.asarray(betas, np.float32))[None].expand(len(codes), -1)
-        out = vae.denormalize(vae.decode_long(vae.quantizer.indices_to_codes(idx), b))
+        out = vae.denormalize(vae.decode_tokens_long(idx, b))
     return [f.numpy() for f in out]
 
 
@@ -122,14 +122,14 @@ def _timeline_track(gen, codes_per_segment, betas, arms_per_segment=None) -> tup
     decoded features (None when composed) and the Motion fields that go with it."""
     codes = [c for seg in codes_per_segment for c in seg]
     track, feats = decoded_track(codes, gen.vae, betas)
-    extra = {"tokens": np.asarray(codes, np.int16)}
+    extra = {"tokens": np.asarray(codes, np.int32)}
     if arms_per_segment is not None and any(a is not None for a in arms_per_segment):
         from .part_compose import compose_arms
 
         arms = _arms_stream(codes_per_segment, arms_per_segment)
         arms_track, _ = decoded_track(arms, gen.vae, betas)
         track = Track(compose_arms(track.joints, arms_track.joints), track.contacts)
-        extra["arms_tokens"], feats = np.asarray(arms, np.int16), None
+        extra["arms_tokens"], feats = np.asarray(arms, np.int32), None
     return track, feats, extra
 
 

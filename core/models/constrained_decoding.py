@@ -17,6 +17,8 @@ from dataclasses import dataclass
 
 import torch
 
+from .motion_codes import base_of, token_limit
+
 
 @dataclass
 class Decoded:
@@ -41,9 +43,9 @@ def _prefix_rows(prefix_codes, rows: int, num_codes: int) -> list[list[int]]:
     out = [[int(c) for c in r] for r in p] if per_row else [[int(c) for c in p]] * rows
     if len(out) != rows or len({len(r) for r in out}) > 1:
         raise ValueError(f"per-row prefix codes: {rows} rows of one length needed")
-    if any(not 0 <= c < num_codes for r in out for c in r):
-        raise ValueError(f"prefix codes must lie in 0..{num_codes - 1}")
-    return out
+    if any(not 0 <= c < token_limit(num_codes) for r in out for c in r):
+        raise ValueError(f"prefix codes must be motion tokens (0..{num_codes - 1}, or with a residual packed in)")
+    return [base_of(r, num_codes) for r in out]  # the T5 reads base codes: a packed residual is dropped
 
 
 @torch.no_grad()
@@ -52,7 +54,7 @@ def decode(model, inputs: tuple, min_codes: int, max_codes: int, temperature: fl
            null_inputs: tuple | None = None, prefix_codes: list[int] | None = None) -> Decoded:
     """``inputs``: ``model.inputs_for(...)`` (token ids + mask for a T5, states + mask + segments
     for MiniLM); ``null_inputs`` the same for the empty motion text, needed when ``guidance`` > 0.
-    ``prefix_codes``: motion codes (0..NUM_CODES-1) already written after ``[SOM]`` for every row
+    ``prefix_codes``: motion codes (tokens; a residual packed in is dropped) already written after ``[SOM]`` for every row
     (e.g. the last tokens of the previous segment of a timeline), or one list per row, all of one
     length (the starts of retrieved clips, ``retrieval_seeds``): the decoder continues from them;
     ``codes`` holds only the new ones and ``min_codes``/``max_codes`` count only those."""

@@ -25,7 +25,9 @@ from pathlib import Path
 import numpy as np
 import torch
 
+from ..constants import NUM_CODES
 from ..errors import ShapeMoveError
+from .motion_codes import base_of
 
 MEMORY_JSON, MEMORY_TENSORS = "motion_memory.json", "motion_memory.safetensors"
 TOP_TEXTS = 64          # nearest distinct captions searched for k clips outside the prompt's families
@@ -220,7 +222,7 @@ class MotionMemory:
         found = self.nearest(vec, k, [exclude[b] for b in todo] if exclude is not None else None, rng)
         for b, near in zip(todo, found):
             for j, (c, s) in enumerate(near):
-                codes = self.clip_tokens[c][:max_codes]
+                codes = base_of(self.clip_tokens[c][:max_codes], NUM_CODES)  # the T5 reads base codes
                 ids[b, j, : len(codes)] = torch.as_tensor(codes) + vocab_offset
                 sims[b, j] = s
         return ids, sims
@@ -237,7 +239,7 @@ class MotionMemory:
         (folder / MEMORY_JSON).write_text(json.dumps({"texts": self.texts, "clip_ids": self.clip_ids,
                                                       "clip_actions": self.clip_actions}))
         save_file({"vectors": self.vectors.to(torch.float16).contiguous(),
-                   "token_lengths": torch.as_tensor(lens), "tokens": torch.as_tensor(flat_tokens.astype(np.int16)),
+                   "token_lengths": torch.as_tensor(lens), "tokens": torch.as_tensor(flat_tokens.astype(np.int32)),
                    "text_lengths": torch.as_tensor(text_lens), "text_clips": torch.as_tensor(flat_clips.astype(np.int32))},
                   str(folder / MEMORY_TENSORS))
 

@@ -406,6 +406,7 @@ class ShapeMoveT5(nn.Module):
             head.load_state_dict({k: v.float() for k, v in load_file(str(directory / "beta_head.safetensors")).items()})
         model = cls(lm, head, vocab, info.get("beta_weight", 1.0), encoder)
         model.info = info
+        from .motion_codes import token_limit
         from .motion_memory import MEMORY_JSON, MEMORY_TENSORS, MotionMemory
 
         model.memory = MotionMemory.load(directory)  # a model that does not read it still retrieves candidates
@@ -413,8 +414,10 @@ class ShapeMoveT5(nn.Module):
             raise ShapeMoveError(f"{directory}: this model reads retrieved clips but {MEMORY_JSON} and "
                                  f"{MEMORY_TENSORS} are missing; copy the whole model folder again")
         if model.memory is not None:
+            # tokens are base codes, or base codes with a residual packed in (motion_codes.py); the
+            # SA-VAE checks the residual's range when it decodes one
             bad = [c for c, t in zip(model.memory.clip_ids, model.memory.clip_tokens)
-                   if len(t) and (t.min() < 0 or t.max() >= vocab.num_codes)]
+                   if len(t) and (t.min() < 0 or t.max() >= token_limit(vocab.num_codes))]
             if bad:
                 raise ShapeMoveError(f"{directory}: {MEMORY_TENSORS} holds codes outside the model's "
                                      f"{vocab.num_codes} (clip {bad[0]}); copy the model folder again")

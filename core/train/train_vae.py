@@ -24,7 +24,7 @@ from ..body.load import load_body_model
 from ..body.soles import sole_offsets
 from ..errors import ShapeMoveError
 from ..models.fsq import codebook_usage
-from ..models.savae import SAVAE, SAVAEConfig, TrainSettings, load_savae
+from ..models.savae import SAVAE, SAVAEConfig, TrainSettings, add_residual, load_savae
 from ..models.vae_losses import bone_lengths, vae_losses
 from . import distributed
 from .checkpoint_cadence import finish, save_if_due
@@ -83,7 +83,9 @@ def start_from(cfg: SAVAEConfig, body_name: str) -> SAVAE:
     have the same network as ``cfg``: only losses and training settings may differ."""
     src = load_savae(cfg.train.init_from, body=body_name)
     theirs, mine = src.cfg.to_dict(), cfg.to_dict()
-    diff = config_differences(theirs, mine, ignore=("loss", "train"))
+    # a residual code may be added to a codec that has none (savae.add_residual)
+    adds = ("residual_levels", "residual_dropout") if cfg.residual_levels and not src.has_residual else ()
+    diff = config_differences(theirs, mine, ignore=("loss", "train") + adds)
     if diff:
         shown = "; ".join(f"{k}: {theirs.get(k)!r} there, {mine.get(k)!r} here" for k in diff)
         raise ShapeMoveError(f"train.init_from {cfg.train.init_from}: another network ({shown})")
@@ -162,7 +164,9 @@ def _train(data, out, cfg, t, resume, body, dist, progress, cancel, verbose) -> 
     # -- model, optimizer, schedule ----------------------------------------------------------
     torch.manual_seed(t.seed)  # same initial weights on every rank
     model = SAVAE(cfg, mean, std)
-    if source is not None:
+    if source is not None and model.has_residual and not source.has_residual:
+        add_residual(model, source)
+    elif source is not None:
         model.load_state_dict(source.state_dict())
     freeze(model, t.freeze)
     model = model.to(dist.device)
