@@ -75,5 +75,12 @@ def test_mirrored_walk_is_a_walk_of_the_same_speed(tiny_dataset, tmp_path, openb
     arrays = mr.mirror_arrays(mr.ClipProcessor(openbody), data, cid + mr.SUFFIX)
     np.testing.assert_allclose(arrays["new_joints"], np.load(data / "new_joints" / f"{cid}.npy"), atol=1e-5)
     np.testing.assert_allclose(arrays["new_joint_vecs"], f, atol=1e-4)
+    # the features' own mirror (no joints, no IK) is the builder's mirrored clip, and twice the identity
+    for name in (cid, wave):
+        own = np.load(data / "new_joint_vecs" / f"{name}.npy")
+        built = np.load(data / "new_joint_vecs" / f"{name}{mr.SUFFIX}.npy")
+        np.testing.assert_allclose(mr.mirror_features(own), built, atol=2e-4)
+        np.testing.assert_array_equal(mr.mirror_features(mr.mirror_features(own)), own)
+    assert np.abs(mr.mirror_features(f) - f).max() > 0.1
     meta = json.loads((data / "meta" / f"{cid}{mr.SUFFIX}.json").read_text())
     assert meta["mirror_of"] == cid and meta["split"] == "train"

@@ -70,6 +70,34 @@ def mirror_contacts(contacts: np.ndarray) -> np.ndarray:
     return np.asarray(contacts)[:, [1, 0, 3, 2]].copy()
 
 
+def mirror_features(features: np.ndarray) -> np.ndarray:
+    """(T, 263) HumanML3D features -> those of the mirror image, computed on the features alone
+    (no joints, no IK): turning and sideways travel negated, the joint positions, velocities and
+    local rotations (``M R M`` on the first two columns) of the left and right joints swapped, x
+    negated, the contacts of the two feet swapped. What the builder computes from the mirrored
+    joints and rotations (``mirror_arrays``), to float precision."""
+    from ..motion.features import FEATURE_DIM, NUM_JOINTS, feature_slices as fs
+
+    f = np.asarray(features)
+    if f.ndim != 2 or f.shape[1] != FEATURE_DIM:
+        raise ShapeMoveError(f"mirror: features must be (T, {FEATURE_DIM}), got {f.shape}")
+    T, out = len(f), f.copy()
+    out[:, fs["root_rot_vel"]] *= -1
+    out[:, fs["root_lin_vel"].start] *= -1
+    order = swap_order(NUM_JOINTS)
+    ric = f[:, fs["ric"]].reshape(T, NUM_JOINTS - 1, 3)[:, order[1:] - 1].copy()
+    ric[..., 0] *= -1
+    out[:, fs["ric"]] = ric.reshape(T, -1)
+    vel = f[:, fs["local_vel"]].reshape(T, NUM_JOINTS, 3)[:, order].copy()
+    vel[..., 0] *= -1
+    out[:, fs["local_vel"]] = vel.reshape(T, -1)
+    rot = f[:, fs["rot6d"]].reshape(T, NUM_JOINTS - 1, 6)[:, order[1:] - 1].copy()
+    rot[..., [1, 2, 3]] *= -1    # columns c0, c1 of M R M: (c0x, -c0y, -c0z), (-c1x, c1y, c1z)
+    out[:, fs["rot6d"]] = rot.reshape(T, -1)
+    out[:, fs["contacts"]] = f[:, fs["contacts"]][:, [2, 3, 0, 1]]
+    return out
+
+
 _SIDE_WORDS = [
     ("counter-clockwise", "clockwise"), ("counterclockwise", "clockwise"), ("anti-clockwise", "clockwise"),
     ("anticlockwise", "clockwise"), ("left-handed", "right-handed"), ("left-hand", "right-hand"),

@@ -20,7 +20,9 @@ has no arms of its own, so decoding it gives the timeline's arms there, and ``co
 the arms of that stream on the timeline's chest for the whole length: the decoder's own transition
 between codes carries the arms into and out of the gesture. The Motion keeps both streams
 (``tokens``, ``arms_tokens``), so re-decoding for another body composes them again. A named side
-is not mirrored within a timeline.
+is kept: a segment of one action naming a side ("waves with the left hand") that the other side does
+more of is replaced by its mirror image, mirrored by the codec itself (``_on_side``: decoded,
+mirrored as features, encoded again), so the timeline's tokens carry the side.
 """
 from __future__ import annotations
 
@@ -77,16 +79,39 @@ def _segment(gen, prompt, shape_text, n, prefix, arms_prefix, betas, seed, tempe
     made by part (module doc), any other prompt whole."""
     from .parts import plan_of
 
-    plan = plan_of(prompt, gen)[0] if by_parts else None
+    plan, side = plan_of(prompt, gen) if by_parts else (None, None)
     if plan is None:
         codes, pred = _segment_codes(gen, prompt, shape_text, n, prefix, betas, seed, temperature, top_k, candidates,
                                      guidance)
-        return codes, None, pred
+        return (_on_side(gen.vae, codes, prefix, side) if side is not None else codes), None, pred
     codes, pred = _segment_codes(gen, plan.legs_prompt, shape_text, n, prefix, betas, seed, temperature, top_k,
                                  candidates, guidance)
     arms, _ = _segment_codes(gen, plan.arms_prompt, shape_text, len(codes), arms_prefix, betas, seed + 1, temperature,
                              top_k, candidates, guidance)
     return codes, arms, pred
+
+
+@torch.no_grad()
+def _on_side(vae, codes: list[int], prefix: list[int], side: tuple[str, str]) -> list[int]:
+    """A segment's codes moving the named ``side`` (("left" | "right", "hand" | "foot")): as they
+    are when that side moves most, else their mirror image, made by the codec itself: decoded after
+    the codes it continues (on the canonical body), mirrored as features (``data.mirror``) and
+    encoded again, so the timeline's tokens carry it (re-decoding for another body, regenerating a
+    neighbour and splicing keep it)."""
+    from ..data.mirror import mirror_features
+    from ..motion.features import joints_from_features
+    from .part_compose import needs_mirror
+
+    down = vae.cfg.downsample
+    with one_torch_thread():
+        feats = vae.denormalize(vae.decode_tokens_long(torch.as_tensor([list(prefix) + list(codes)]).long(),
+                                                       torch.zeros(1, 10)))[0]
+        joints = joints_from_features(feats.double()).numpy()[len(prefix) * down:]
+        if not needs_mirror(joints, *side):
+            return list(codes)
+        mirrored = torch.as_tensor(mirror_features(feats.numpy()))
+        tokens = vae.encode_tokens(vae.normalize(mirrored)[None])[0]
+    return [int(t) for t in tokens[len(prefix):]]
 
 
 def _arms_stream(codes_per_segment, arms_per_segment) -> list[int]:
