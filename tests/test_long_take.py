@@ -68,7 +68,8 @@ def test_windowed_steps_equal_one_pass(joints, openbody):
 
 def test_windowed_encoder_gives_the_same_tokens(joints, openbody):
     """The shipped SA-VAE encodes the take window by window with its receptive field on both
-    sides (``encoder_reach``): every token equals the one-pass token."""
+    sides (``encoder_reach``; the residual encoder has the same layers): every token, base and
+    residual, equals the one-pass token."""
     from shapemove.core.generation.retarget import encode_windowed, encoder_reach, load_vae, processor
 
     vae = load_vae(None, openbody)
@@ -77,10 +78,10 @@ def test_windowed_encoder_gives_the_same_tokens(joints, openbody):
     feats = processor(openbody, 2).process(joints[:1201])["norm_joint_vecs"]
     x = vae.normalize(torch.as_tensor(feats[:1200], dtype=torch.float32))
     with torch.no_grad():
-        whole = vae.encode(x[None])[1][0]
+        whole = vae.encode_tokens(x[None])[0]   # base and residual codes (the shipped codec has both)
     win = encode_windowed(vae, x, window=128)  # 9 windows, each with `reach` frames of context
     assert len(win) == 300 and torch.equal(win, whole)
-    assert len(set(whole.tolist())) > 20  # a real walk's many codes, not a constant
+    assert len(set(whole.tolist())) > 20 and bool((whole >= 1000).all())  # a real walk's many codes, residuals packed in
 
 
 def _retarget_peak_mb(path, out) -> float:

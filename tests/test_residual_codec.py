@@ -40,27 +40,26 @@ def test_widened_codec_keeps_the_base():
     with torch.no_grad():
         codes, idx = base.encode(x)
         assert torch.equal(wide.encode(x)[1], idx)                       # the same base tokens
+        assert torch.equal(wide.decode(codes, betas), base.decode(codes, betas))   # decoded by the same decoder
         res, ridx = wide.encode_residual(x)
         assert res.shape == (2, 8, 4) and int(ridx.max()) < 1000
-        # untrained, the base codes alone decode exactly as the base codec's; the residual changes it
-        assert torch.allclose(wide.decode(codes, betas), base.decode(codes, betas), atol=1e-6)
+        # the residual branch starts as a copy of the base one, but reads the residual too
         assert not torch.allclose(wide.decode(codes, betas, res), base.decode(codes, betas), atol=1e-4)
         tokens = wide.encode_tokens(x)
         assert torch.equal(base_of(tokens, 1000), idx) and bool((tokens >= 1000).all())
-        # the packed tokens decode as the codes do (per step: a step without a residual reads base alone)
-        full = wide.decode_tokens_long(tokens, betas)
-        assert torch.allclose(full, wide.decode(codes, betas, res), atol=1e-5)
-        assert not torch.allclose(full, wide.decode(codes, betas), atol=1e-3)
-        assert torch.allclose(wide.decode_tokens_long(idx, betas), wide.decode(codes, betas), atol=1e-5)
+        # packed tokens decode through the residual branch; base tokens, or any step without a
+        # residual, through the base decoder
+        assert torch.allclose(wide.decode_tokens_long(tokens, betas), wide.decode(codes, betas, res), atol=1e-5)
+        assert torch.equal(wide.decode_tokens_long(idx, betas), base.decode_tokens_long(idx, betas))
         mixed = tokens.clone()
         mixed[:, 4:] = idx[:, 4:]
-        present = torch.zeros(2, 8)
-        present[:, :4] = 1
-        assert torch.allclose(wide.decode_tokens_long(mixed, betas), wide.decode(codes, betas, res, present), atol=1e-5)
+        assert torch.equal(wide.decode_tokens_long(mixed, betas), base.decode_tokens_long(idx, betas))
         # a codec without a residual decodes the base of packed tokens
-        assert torch.allclose(base.decode_tokens_long(tokens, betas), base.decode(codes, betas), atol=1e-6)
+        assert torch.equal(base.decode_tokens_long(tokens, betas), base.decode_tokens_long(idx, betas))
     with pytest.raises(ShapeMoveError, match="no residual code"):
         base.encode_residual(x)
+    with pytest.raises(ShapeMoveError, match="no residual code to decode"):
+        base.decode(codes, betas, res)
     with pytest.raises(ShapeMoveError, match="needs a codec without"):
         add_residual(base, wide)
     with pytest.raises(ShapeMoveError, match="residual codes must be"):
@@ -72,39 +71,45 @@ def test_config_refuses_bad_residual_settings():
         SAVAEConfig.from_dict({"base": "tiny", "residual_levels": [8, 5, 5, 5], "residual_dropout": 1.5})
     with pytest.raises(ShapeMoveError, match="may not be larger"):
         SAVAEConfig.from_dict({"base": "tiny", "residual_levels": [8, 8, 8, 8]})
-    with pytest.raises(ShapeMoveError, match="residual_encoder needs residual_levels"):
+    with pytest.raises(ShapeMoveError, match="residual parts need residual_levels"):
         tiny(init_from="x.pt", freeze=("residual_encoder",)).validate()
-    assert tiny([8, 5, 5, 5]).decoder_input_dim == 9 and tiny().decoder_input_dim == 4
+    with pytest.raises(ShapeMoveError, match="leaves nothing to train"):
+        tiny([8, 5, 5, 5], init_from="x.pt", freeze=("residual_encoder", "residual_decoder",
+                                                     "residual_shape_embedding")).validate()
+    assert tiny([8, 5, 5, 5]).residual_input_dim == 9
 
 
 def test_residual_training_keeps_every_base_token(tiny_dataset, tmp_path):
-    """A residual code trained onto a codec with its encoder and quantizer frozen: every base token
-    stays (the T5 needs no retraining), the residual encoder and the decoder learn, the checkpoint
-    loads as a residual codec whose full tokens decode otherwise than their base codes alone, and a
-    fine-tune of it starts from it (same network) while one of another residual is refused."""
+    """A residual branch trained onto a codec, its base parts frozen: every base token and the base
+    decoding stay bit for bit (the T5 and what it generates are unchanged), the residual branch
+    learns, the checkpoint loads as a residual codec whose full tokens decode otherwise than their
+    base codes, and a fine-tune of it starts from it while one of another residual is refused."""
     from shapemove.core.train.motion_dataset import MotionClips
     from shapemove.core.train.train_vae import train_vae
 
     train_vae(tiny_dataset, tmp_path / "src", tiny(steps=20, lr=3e-3), device="cpu", verbose=False)
     src = load_savae(tmp_path / "src" / "savae.pt")
-    cfg = tiny([8, 5, 5, 5], steps=10, lr=3e-3, init_from=str(tmp_path / "src" / "savae.pt"),
-               freeze=("encoder", "quantizer"), val_every=1000)
+    frozen = ("encoder", "quantizer", "decoder", "shape_embedding")
+    cfg = tiny([8, 5, 5, 5], steps=10, lr=3e-3, init_from=str(tmp_path / "src" / "savae.pt"), freeze=frozen,
+               val_every=1000)
     train_vae(tiny_dataset, tmp_path / "res", cfg, device="cpu", verbose=False)
     res = load_savae(tmp_path / "res" / "savae.pt")
     assert res.has_residual and not src.has_residual and res.cfg.residual_dropout == 0.5
+    for name, v in src.state_dict().items():
+        assert torch.equal(v, res.state_dict()[name]), name                          # the base codec as it was
     start = SAVAE(cfg)
     add_residual(start, src)
-    last = f"residual_encoder.net.{len(res.encoder.net) - 1}.weight"
-    assert not torch.equal(res.state_dict()[last], start.state_dict()[last])           # the residual learnt
-    assert not torch.equal(res.decoder.lift.weight, start.decoder.lift.weight)
+    for part in ("residual_encoder.net.6.weight", "residual_decoder.lift.weight", "residual_shape_embedding.mlp.0.weight"):
+        assert not torch.equal(res.state_dict()[part], start.state_dict()[part]), part   # the branch learnt
     item = MotionClips(tiny_dataset, "train", 32)[(0, 0)]
     x, b = item["x"][None], item["betas"][None]
     with torch.no_grad():
-        assert torch.equal(src.encode(x)[1], res.encode(x)[1])
         tokens = res.encode_tokens(x)
+        assert torch.equal(base_of(tokens, 1000), src.encode(x)[1])
+        assert torch.equal(res.decode_tokens_long(base_of(tokens, 1000), b), src.decode(src.encode(x)[0], b))
         assert not torch.allclose(res.decode_tokens_long(tokens, b), res.decode_tokens_long(base_of(tokens, 1000), b),
                                   atol=1e-4)
-    again = tiny([8, 5, 5, 5], steps=2, init_from=str(tmp_path / "res" / "savae.pt"), freeze=("encoder", "quantizer"))
+    again = tiny([8, 5, 5, 5], steps=2, init_from=str(tmp_path / "res" / "savae.pt"), freeze=frozen)
     train_vae(tiny_dataset, tmp_path / "again", again, device="cpu", verbose=False)
     with pytest.raises(ShapeMoveError, match="another network.*residual_levels"):
         train_vae(tiny_dataset, tmp_path / "other", tiny([5, 5, 5], steps=2, init_from=str(tmp_path / "res" / "savae.pt")),

@@ -247,3 +247,17 @@ def test_cli_train_head_says_what_is_wrong(tmp_path, capsys):
     assert main(["train", "head", "--model", str(tmp_path / "none"), "--data", str(tmp_path), "--out",
                  str(tmp_path / "run"), "--quiet"]) == 2
     assert "model folder not found" in capsys.readouterr().err
+
+
+def test_head_training_words_leave_the_evaluation_words_out():
+    """The words the head's pool adds to phenotype_texts never include the evaluation's muscle words
+    or the nouns of its own check phrases (tools/head_words_check.py): those measure how far the
+    head carries over to words it never saw."""
+    from shapemove.core.eval.shape_words_eval import MUSCLE_TEST_WORDS
+    from shapemove.core.train.beta_head_refit import MORE_AGE, MORE_BUILD, MORE_NOUNS
+
+    added = {w for group in (MORE_NOUNS, MORE_AGE, MORE_BUILD) for words in group.values() for w in words}
+    assert not added & set(MUSCLE_TEST_WORDS), added & set(MUSCLE_TEST_WORDS)
+    checked = {"grandmother", "powerlifter", "nurse", "linebacker", "lumberjack", "ballerina", "schoolgirl",
+               "basketball player", "heavyweight boxer", "gymnast", "hulking", "burly", "frail", "stout"}
+    assert not {w for w in added if any(c in w for c in checked)}

@@ -4,7 +4,10 @@ similarity (``core/models/motion_memory.py``; retrieved candidates, ``core/gener
 
     python tools/build_motion_memory.py --model weights/default --data data/built
 
-Tokens come from the folder's own SA-VAE (``savae.pt``), so they decode as the model's own would.
+Tokens come from the folder's own SA-VAE (``savae.pt``), so they decode as the model's own would:
+its base codes, decoded by the base decoder as the T5's are (a residual codec's residual is left
+out: generation with clips decoded through the residual branch was judged lower on the held-out
+sets, docs/codec.md).
 Shape-augmented copies (the same motion on another body) and composed clips (two clips put
 together) are left out: the memory holds each captured performance once per side. The folder's
 ``manifest.json`` is rewritten. Deterministic for a dataset and a codec.
@@ -46,7 +49,7 @@ def main(argv=None) -> int:
     vae = load_savae(a.model / "savae.pt")
     bar = tqdm(total=len(ids), desc="tokens", unit="clip")
     with torch.no_grad():
-        tokens = tokenize_clips(vae, a.data, ids, progress=lambda f, c: bar.update(1), residual=vae.has_residual)
+        tokens = tokenize_clips(vae, a.data, ids, progress=lambda f, c: bar.update(1))
     bar.close()
     mem = MotionMemory.from_dataset(a.data, ids, tokens, load_text_encoder())
     mem.save(a.model / "t5")

@@ -15,10 +15,6 @@ from __future__ import annotations
 import random
 
 MALE, FEMALE = 0.25, 0.75   # gender slider: <= MALE a man's body, >= FEMALE a woman's
-# height words as people use them, among men, among women (a 176 cm woman is "tall"), and for a
-# body of neither: (very tall from, tall from, short up to, very short up to), cm
-HEIGHT_WORDS_CM = {"man": (195.0, 184.0, 167.0, 157.0), "woman": (182.0, 173.0, 156.0, 147.0),
-                   "person": (195.0, 184.0, 162.0, 152.0)}
 
 
 def _nouns(g: float, age: float) -> tuple[list[str], str, str]:
@@ -72,14 +68,13 @@ def _build_words(muscle: float, weight: float, height_cm: float | None, g: float
     elif weight <= 0.32:
         out += ["slim", "thin", "slender", "lean"]
     if height_cm is not None:
-        very_tall, tall, short, very_short = HEIGHT_WORDS_CM["man" if g <= MALE else "woman" if g >= FEMALE else "person"]
-        if height_cm >= very_tall:
+        if height_cm >= 195:
             out += ["very tall", "towering"]
-        elif height_cm >= tall:
+        elif height_cm >= 184:
             out += ["tall"] + (["lanky"] if weight <= 0.35 else [])
-        elif height_cm <= very_short:
+        elif height_cm <= 152:
             out += ["very short", "tiny"]
-        elif height_cm <= short:
+        elif height_cm <= 162:
             out += ["short"] + (["petite"] if g >= FEMALE and weight <= 0.5 else [])
     return out
 

@@ -209,9 +209,11 @@ class MotionMemory:
         return next((c for c in order if ok(c)), None)
 
     def lookup(self, reader, texts: list[str], k: int, max_codes: int, vocab_offset: int = 0,
-               exclude: list | None = None, rng: random.Random | None = None, empty: list[bool] | None = None):
+               exclude: list | None = None, rng: random.Random | None = None, empty: list[bool] | None = None,
+               codebook: int = NUM_CODES):
         """(ids (B, k, max_codes) long: vocab ids ``vocab_offset + code``, -1 where empty; sims (B, k)).
-        ``empty[b]``: give prompt b no memory (the null prompt of guidance, memory dropout)."""
+        ``empty[b]``: give prompt b no memory (the null prompt of guidance, memory dropout); the
+        codes are the clips' base codes (``codebook``: the T5's number of motion codes)."""
         ids = torch.full((len(texts), k, max_codes), -1, dtype=torch.long)
         sims = torch.zeros(len(texts), k)
         todo = [b for b in range(len(texts)) if not (empty and empty[b]) and str(texts[b]).strip()]
@@ -222,7 +224,7 @@ class MotionMemory:
         found = self.nearest(vec, k, [exclude[b] for b in todo] if exclude is not None else None, rng)
         for b, near in zip(todo, found):
             for j, (c, s) in enumerate(near):
-                codes = base_of(self.clip_tokens[c][:max_codes], NUM_CODES)  # the T5 reads base codes
+                codes = base_of(self.clip_tokens[c][:max_codes], codebook)  # the T5 reads base codes
                 ids[b, j, : len(codes)] = torch.as_tensor(codes) + vocab_offset
                 sims[b, j] = s
         return ids, sims

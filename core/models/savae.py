@@ -5,9 +5,12 @@ encode: normalized features of the motion on the canonical body (betas = 0), (B,
 decode: codes + betas (B, 10) -> normalized SHAPE-AWARE features (B, T, 263)
 
 A codec with ``residual_levels`` has a second, residual code (``encode_residual``: its own encoder
-and FSQ, one more index per step; ``motion_codes.py`` packs the two in one token). The decoder
-reads both when the residual is given and the base codes alone when it is not (the T5 writes base
-codes only), so training drops the residual of ``residual_dropout`` of the clips.
+and FSQ, one more index per step; ``motion_codes.py`` packs the two in one token) and a residual
+branch that decodes both: a decoder and shape embedding of its own (``residual_decoder``,
+``residual_shape_embedding``). The base decoder is left as it was, so the base codes the T5 writes
+decode exactly as before; a motion encoded by the codec (a retargeted take, a user's library)
+decodes through the residual branch. Training drops the residual of ``residual_dropout`` of the
+clips (the branch then reads base codes and a flag saying the residual is missing).
 Features are normalized with the dataset Mean/Std, kept in the model as buffers (``mean``,
 ``std``) so a checkpoint carries them.
 """
@@ -68,7 +71,9 @@ class TrainSettings:
     freeze: tuple = ()           # parts left as they are: "encoder", "quantizer", "shape_embedding", "decoder"
 
 
-PARTS = ("encoder", "quantizer", "shape_embedding", "decoder", "residual_encoder")  # sub-modules, by attribute name
+PARTS = ("encoder", "quantizer", "shape_embedding", "decoder", "residual_encoder", "residual_decoder",
+         "residual_shape_embedding")  # sub-modules, by attribute name
+RESIDUAL_PARTS = PARTS[4:]
 
 
 @dataclass
@@ -83,7 +88,7 @@ class SAVAEConfig:
     shape_hidden: int = 256
     shape_token_dim: int = 0     # width of the decoder's time stream: 0 = `width`; len(levels) = raw codes
     residual_levels: tuple = ()  # FSQ levels of a residual code beside the base one; () = none
-    residual_dropout: float = 0.5  # training: share of clips decoded from the base codes alone
+    residual_dropout: float = 0.5  # training: share of clips the residual branch decodes from base codes
     loss: LossWeights = field(default_factory=LossWeights)
     train: TrainSettings = field(default_factory=TrainSettings)
 
@@ -161,11 +166,12 @@ class SAVAEConfig:
             raise ShapeMoveError(f"train.freeze: unknown part(s) {', '.join(map(repr, unknown))}; parts are {', '.join(PARTS)}")
         if self.train.freeze and not self.train.init_from:
             raise ShapeMoveError("train.freeze needs train.init_from: freezing untrained weights keeps them random")
-        trainable = {"encoder", "shape_embedding", "decoder"} | ({"residual_encoder"} if self.residual_levels else set())
+        # a residual codec trains its residual branch (the base one is not in its forward pass)
+        trainable = set(RESIDUAL_PARTS) if self.residual_levels else {"encoder", "shape_embedding", "decoder"}
         if set(self.train.freeze) >= trainable:
             raise ShapeMoveError("train.freeze leaves nothing to train")
-        if "residual_encoder" in self.train.freeze and not self.residual_levels:
-            raise ShapeMoveError("train.freeze: residual_encoder needs residual_levels")
+        if set(self.train.freeze) & set(RESIDUAL_PARTS) and not self.residual_levels:
+            raise ShapeMoveError("train.freeze: the residual parts need residual_levels")
         if self.residual_levels and math.prod(self.residual_levels) > math.prod(self.levels):
             raise ShapeMoveError("residual_levels: the residual codebook may not be larger than the base one "
                                  f"({math.prod(self.levels)} codes), so a token holds both (motion_codes.py)")
@@ -173,11 +179,10 @@ class SAVAEConfig:
             raise ShapeMoveError(f"residual_dropout must be in [0, 1], got {self.residual_dropout!r}")
 
     @property
-    def decoder_input_dim(self) -> int:
-        """Channels the decoder reads per step: the base code, and with a residual code its
-        channels and a flag saying whether it is there."""
-        r = len(self.residual_levels)
-        return len(self.levels) + (r + 1 if r else 0)
+    def residual_input_dim(self) -> int:
+        """Channels the residual decoder reads per step: the base code, the residual code and a
+        flag saying whether it is there."""
+        return len(self.levels) + len(self.residual_levels) + 1
 
 
 class SAVAE(nn.Module):
@@ -189,12 +194,14 @@ class SAVAE(nn.Module):
         self.encoder = Encoder(cfg.feature_dim, c, cfg.width, cfg.depth, cfg.dilation_growth, cfg.down_t)
         self.quantizer = FSQ(cfg.levels)
         self.shape_embedding = ShapeEmbedding(cfg.num_betas, cfg.shape_hidden, cfg.token_dim)
-        self.decoder = Decoder(cfg.decoder_input_dim, cfg.token_dim, cfg.feature_dim, cfg.width, cfg.depth,
-                               cfg.dilation_growth, cfg.down_t)
+        self.decoder = Decoder(c, cfg.token_dim, cfg.feature_dim, cfg.width, cfg.depth, cfg.dilation_growth, cfg.down_t)
         if cfg.residual_levels:
             r = len(cfg.residual_levels)
             self.residual_encoder = Encoder(cfg.feature_dim, r, cfg.width, cfg.depth, cfg.dilation_growth, cfg.down_t)
             self.residual_quantizer = FSQ(cfg.residual_levels)
+            self.residual_shape_embedding = ShapeEmbedding(cfg.num_betas, cfg.shape_hidden, cfg.token_dim)
+            self.residual_decoder = Decoder(cfg.residual_input_dim, cfg.token_dim, cfg.feature_dim, cfg.width,
+                                            cfg.depth, cfg.dilation_growth, cfg.down_t)
         self.register_buffer("mean", torch.zeros(cfg.feature_dim))
         self.register_buffer("std", torch.ones(cfg.feature_dim))
         if mean is not None:
@@ -228,34 +235,25 @@ class SAVAE(nn.Module):
             raise ShapeMoveError("this SA-VAE has no residual code")
         return self.residual_quantizer(self.residual_encoder(x))
 
-    def decoder_input(self, codes: torch.Tensor, residual: torch.Tensor | None = None,
-                      present: torch.Tensor | None = None) -> torch.Tensor:
-        """What the decoder reads per step: base codes (B, N, C), then (residual codec) the residual
-        codes (B, N, R) and a 0/1 flag; ``residual`` None, or ``present`` (B,) or (B, N) 0 for a row
-        or a step, reads it from its base codes alone."""
-        if not self.has_residual:
-            if residual is not None:
-                raise ShapeMoveError("this SA-VAE has no residual code to decode")
-            return codes
+    def residual_input(self, codes: torch.Tensor, residual: torch.Tensor,
+                       present: torch.Tensor | None = None) -> torch.Tensor:
+        """What the residual decoder reads per step: base codes (B, N, C), residual codes (B, N, R)
+        and a 0/1 flag; ``present`` (B,) 0 for a row reads it from its base codes alone (training)."""
         B, N, _ = codes.shape
         r = len(self.cfg.residual_levels)
-        if residual is None:
-            residual, flag = codes.new_zeros(B, N, r), codes.new_zeros(B, N, 1)
-        else:
-            if residual.shape != (B, N, r):
-                raise ShapeMoveError(f"residual codes must be {(B, N, r)}, got {tuple(residual.shape)}")
-            if present is None:
-                flag = codes.new_ones(B, N, 1)
-            else:  # (B,) per row or (B, N) per step
-                flag = present.to(codes).reshape(B, -1, 1).expand(B, N, 1)
-            residual = residual * flag
-        return torch.cat([codes, residual, flag], dim=-1)
+        if residual.shape != (B, N, r):
+            raise ShapeMoveError(f"residual codes must be {(B, N, r)}, got {tuple(residual.shape)}")
+        flag = codes.new_ones(B, N, 1) if present is None else present.to(codes).reshape(B, 1, 1).expand(B, N, 1)
+        return torch.cat([codes, residual * flag, flag], dim=-1)
 
-    def decode(self, codes: torch.Tensor, betas: torch.Tensor, residual: torch.Tensor | None = None,
-               present: torch.Tensor | None = None) -> torch.Tensor:
-        """Codes (B, N, C) [+ residual codes (B, N, R), where ``present``], betas (B, 10) ->
-        normalized shape-aware features (B, 4N, D)."""
-        return self.decoder(self.decoder_input(codes, residual, present), self.shape_embedding(betas))
+    def decode(self, codes: torch.Tensor, betas: torch.Tensor, residual: torch.Tensor | None = None) -> torch.Tensor:
+        """Codes (B, N, C), betas (B, 10) -> normalized shape-aware features (B, 4N, D), by the base
+        decoder; with ``residual`` codes (B, N, R), by the residual branch."""
+        if residual is None:
+            return self.decoder(codes, self.shape_embedding(betas))
+        if not self.has_residual:
+            raise ShapeMoveError("this SA-VAE has no residual code to decode")
+        return self.residual_decoder(self.residual_input(codes, residual), self.residual_shape_embedding(betas))
 
     def decode_indices(self, indices: torch.Tensor, betas: torch.Tensor) -> torch.Tensor:
         return self.decode(self.quantizer.indices_to_codes(indices), betas)
@@ -271,15 +269,16 @@ class SAVAE(nn.Module):
     @torch.no_grad()
     def decode_tokens_long(self, tokens: torch.Tensor, betas: torch.Tensor) -> torch.Tensor:
         """Tokens (B, N) (base, or with packed residuals) + betas -> normalized shape-aware features
-        (``decode_long``). A codec without a residual code decodes the base of each token."""
+        (``decode_long``): through the residual branch when every step carries a residual, else the
+        base codes through the base decoder (what the T5 writes; a codec without a residual code
+        decodes the base of every token)."""
         base, res = unpack(torch.as_tensor(tokens).long(), self.quantizer.codebook_size)
         codes = self.quantizer.indices_to_codes(base)
-        if not self.has_residual or not bool((res >= 0).any()):
+        if not self.has_residual or not bool((res >= 0).all()):
             return self.decode_long(codes, betas)
         if int(res.max()) >= self.residual_quantizer.codebook_size:
             raise ShapeMoveError(f"residual code out of range [0, {self.residual_quantizer.codebook_size})")
-        residual = self.residual_quantizer.indices_to_codes(res.clamp(min=0))
-        return self.decode_long(codes, betas, residual=residual, present=(res >= 0).float())
+        return self.decode_long(codes, betas, residual=self.residual_quantizer.indices_to_codes(res))
 
     def forward(self, x: torch.Tensor, betas: torch.Tensor) -> dict:
         codes, indices = self.encode(x)
@@ -289,12 +288,13 @@ class SAVAE(nn.Module):
         present = None
         if self.training and self.cfg.residual_dropout > 0:
             present = (torch.rand(x.shape[0], device=x.device) >= self.cfg.residual_dropout).float()
-        stream = self.decoder_input(codes, residual, present)
-        return {"recon": self.decoder(stream, self.shape_embedding(betas)), "codes": codes, "indices": indices}
+        stream = self.residual_input(codes, residual, present)
+        return {"recon": self.residual_decoder(stream, self.residual_shape_embedding(betas)), "codes": codes,
+                "indices": indices}
 
     @torch.no_grad()
     def decode_long(self, codes: torch.Tensor, betas: torch.Tensor, chunk: int | None = None, overlap: int = 4,
-                    residual: torch.Tensor | None = None, present: torch.Tensor | None = None) -> torch.Tensor:
+                    residual: torch.Tensor | None = None) -> torch.Tensor:
         """Decode a sequence longer than the training window: overlapping chunks of ``chunk`` codes
         (default window/4), each with its own shape token, cross-faded over ``overlap`` codes, so
         every frame sits as close to a shape token as in training."""
@@ -302,7 +302,7 @@ class SAVAE(nn.Module):
         overlap = min(overlap, chunk // 2)  # short training windows give short chunks
         n, up = codes.shape[1], self.cfg.downsample
         if n <= chunk:
-            return self.decode(codes, betas, residual, present)
+            return self.decode(codes, betas, residual)
         if not 0 <= overlap < chunk:
             raise ShapeMoveError("decode_long: overlap must be in [0, chunk)")
         starts = list(range(0, n - chunk + 1, chunk - overlap))
@@ -318,8 +318,7 @@ class SAVAE(nn.Module):
             if ramp and s + chunk < n:
                 w[-ramp:, 0] = torch.linspace(1, 0, ramp + 2)[1:-1]
             res = None if residual is None else residual[:, s:s + chunk]
-            has = None if present is None else present[:, s:s + chunk]
-            out[:, s * up:(s + chunk) * up] += self.decode(codes[:, s:s + chunk], betas, res, has) * w
+            out[:, s * up:(s + chunk) * up] += self.decode(codes[:, s:s + chunk], betas, res) * w
             total[s * up:(s + chunk) * up] += w
         return out / total
 
@@ -327,11 +326,10 @@ class SAVAE(nn.Module):
 @torch.no_grad()
 def add_residual(model: SAVAE, base: SAVAE) -> None:
     """Start ``model`` (a residual codec) from ``base``, a trained codec of the same network without
-    one: every weight of ``base`` is kept, so ``model`` encodes the same base codes and, before
-    training, decodes base codes alone exactly as ``base`` does (their flag is 0 and their residual
-    channels read 0). The decoder's weights on the residual channels start as a fresh layer's (at
-    zero the residual would get no gradient to learn from); the residual encoder starts from the
-    base encoder's layers but its last."""
+    one: every weight of ``base`` is kept, so ``model`` encodes the same base codes and decodes them
+    exactly as ``base`` does. The residual branch starts as a copy of the base one (its decoder's
+    weights on the residual channels and flag as a fresh layer's: at zero the residual would get
+    no gradient to learn from), the residual encoder from the base encoder's layers but its last."""
     if base.has_residual or not model.has_residual:
         raise ShapeMoveError("add_residual: needs a codec without a residual code and one with it")
     if not isinstance(base.decoder.lift, nn.Linear):
@@ -339,16 +337,18 @@ def add_residual(model: SAVAE, base: SAVAE) -> None:
                              "number of levels); a residual code needs its per-step projection")
     theirs = base.state_dict()
     mine = model.state_dict()
-    for k, v in theirs.items():
-        if k == "decoder.lift.weight":  # the base columns kept, the residual ones as initialised
-            w = mine[k].clone()
-            w[:, :v.shape[1]] = v
-            mine[k] = w
-        else:
-            mine[k] = v.clone()
     last = len(base.encoder.net) - 1
     for k, v in theirs.items():
-        if k.startswith("encoder.net.") and not k.startswith(f"encoder.net.{last}."):
+        mine[k] = v.clone()
+        if k.startswith(("decoder.", "shape_embedding.")):
+            r = "residual_" + k
+            if k == "decoder.lift.weight":  # the base columns kept, the residual ones as initialised
+                w = mine[r].clone()
+                w[:, :v.shape[1]] = v
+                mine[r] = w
+            else:
+                mine[r] = v.clone()
+        elif k.startswith("encoder.net.") and not k.startswith(f"encoder.net.{last}."):
             mine["residual_" + k] = v.clone()
     model.load_state_dict(mine)
 

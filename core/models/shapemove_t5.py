@@ -173,7 +173,8 @@ class ShapeMoveT5(nn.Module):
                                  "(motion_memory.json/.safetensors missing from its folder)")
         return self.memory.lookup(reader, motion_texts, self.memory_k, self.lm.config.memory_codes,
                                   self.vocab.first_code_id, exclude, rng,
-                                  empty=[t == NULL_PROMPT or not self.memory_enabled for t in motion_texts])
+                                  empty=[t == NULL_PROMPT or not self.memory_enabled for t in motion_texts],
+                                  codebook=self.vocab.num_codes)
 
     @property
     def d_model(self) -> int:
