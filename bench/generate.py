@@ -91,7 +91,7 @@ def _rig_call(gen, seconds, seed: int) -> dict:
     t1 = time.perf_counter()
     motion = generate_by_parts(gen, r)  # two things at once: both parts' tokens, shape, decode, IK
     if motion is None:
-        codes, pred = gen.tokens_for([r])
+        codes, pred, _ = gen.tokens_for([r])
         t2 = time.perf_counter()
         betas, _ = gen.body_shape(r, pred[0].numpy())
         t3 = time.perf_counter()

@@ -174,11 +174,11 @@ def progressive(vp: str) -> str:
     words = vp.split()
     out = [gerund(words[0])] if words else []
     for prev, w in zip(words, words[1:]):
-        out.append(gerund(w) if prev == "and" and w in _verbs() else w)
+        out.append(gerund(w) if prev == "and" and w in table_verbs() else w)
     return " ".join(out)
 
 
-def _verbs() -> set:
+def table_verbs() -> set:
     """The verbs the phrase tables start with ('walks', 'turns', ...)."""
     global _VERBS
     if _VERBS is None:

@@ -12,6 +12,7 @@ joints from the HumanML3D features -> IK onto the body with those betas -> ``Mot
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 import torch
@@ -39,6 +40,13 @@ from .sampling_params import (DEFAULT_CANDIDATES, DEFAULT_GUIDANCE, DEFAULT_RETR
                               DEFAULT_RETRIEVED, check_candidates, check_guidance, check_retrieval_first,
                               check_retrieval_prefix, check_retrieved, check_sampling)
 from .turn_words import turn_motion
+
+
+class Chosen(NamedTuple):
+    """What ``Generator.tokens_for`` chose, per request."""
+    codes: list[list[int]]        # motion tokens
+    betas: torch.Tensor           # (B, 10) the [BETA] head's bodies
+    kept: list[str | None]        # the memory clip whose tokens were kept, None for a T5 sample
 
 
 @dataclass
@@ -121,7 +129,6 @@ class Generator:
         self.default_guidance = DEFAULT_GUIDANCE if trained_null > 0 else 0.0  # a model without a null prompt: none
         self._tma_file = files.get("tma")
         self._picker = None
-        self.last_sources: list[str | None] = []  # tokens_for: the retrieved clip each request kept, or None
 
     @property
     def picker(self) -> CandidatePicker | None:
@@ -143,11 +150,12 @@ class Generator:
         return n, n
 
     @torch.no_grad()
-    def tokens_for(self, reqs: list[Request]) -> tuple[list[list[int]], torch.Tensor]:
+    def tokens_for(self, reqs: list[Request]) -> "Chosen":
+        """Each request's chosen motion tokens, the [BETA] head's betas (B, 10) and the memory clip
+        whose tokens were kept (None for a T5 sample)."""
         if self.t5 is None:
             raise ShapeMoveError(f"{self.model_dir} has no t5/ model: text-to-motion needs one (train t5)")
-        codes, betas = [], []
-        self.last_sources = []  # per request: the memory clip whose tokens were kept, None for a sample
+        codes, betas, kept = [], [], []
         with one_torch_thread():
             for r in reqs:  # one at a time: each has its own seed, length and temperature
                 g = torch.Generator().manual_seed(int(r.seed))
@@ -161,8 +169,8 @@ class Generator:
                     best = self.picker.pick(r.prompt, feats)
                 codes.append(cands[best])
                 betas.append(beta)
-                self.last_sources.append(sources[best])
-        return codes, torch.stack(betas)
+                kept.append(sources[best])
+        return Chosen(codes, torch.stack(betas), kept)
 
     def _sampled(self, r: Request, lo: int, hi: int, g: torch.Generator):
         """(candidate codes, their memory clip or None, betas): best-of-N's T5 samples (some seeded
@@ -325,11 +333,11 @@ class Generator:
                 break
             motion = generate_by_parts(self, r) if r.by_parts else None
             if motion is None:  # one action, no side named: the motion as the model writes it
-                codes, pred = self.tokens_for([r])
+                codes, pred, kept = self.tokens_for([r])
                 betas, source = self.body_shape(r, pred[0].numpy())
                 motion = self.decode_motion(codes[0], betas, prompt=r.prompt)
                 motion.shape_source = source
-                motion.retrieved_clips = [c for c in self.last_sources if c]
+                motion.retrieved_clips = [c for c in kept if c]
                 if r.by_parts:  # the codec does not carry turning: a circle or a turn the words name, given back
                     motion = (circle_motion(motion, self.body, r.prompt, self.ik_refine_iters)   # circle_walk.py
                               if self.asks_circle(r.prompt, check) else

@@ -188,9 +188,9 @@ def _has_verb(clause: str) -> bool:
     """Whether a clause says what someone does: a verb of the caption tables, a participle, a
     verb after its subject ("the player hurls", "she lifts") or leading the clause ("tosses the
     ball"). "like an elderly person" or "with youthful vigour" say how, and are left alone."""
-    from ..data.captions import _verbs
+    from ..data.captions import table_verbs
 
-    verbs = _verbs()
+    verbs = table_verbs()
     if any(w not in NOT_VERBS and (w in verbs or w + "s" in verbs or (len(w) > 4 and w.endswith(("ing", "ed"))))
            for w in _content(clause)):
         return True

@@ -93,22 +93,21 @@ def generate_by_parts(gen, r) -> Motion | None:
     if plan is None and side is None:
         return None
     if plan is None:  # one action, a named side: judged on the planted motion, the one the user sees
-        codes, pred = gen.tokens_for([r])   # (planting, the foot roll above all, changes how far a foot travels)
+        codes, pred, kept = gen.tokens_for([r])   # (planting, the foot roll above all, changes how far a foot travels)
         betas, source = gen.body_shape(r, pred[0].numpy())
         m = gen.decode_motion(codes[0], betas, prompt=r.prompt)
         if needs_mirror(m.joints, *side):
             m = assemble(gen.body, betas, _track(codes[0], gen.vae, betas, True), None, r.prompt, gen.ik_refine_iters,
                          tokens=np.asarray(codes[0], np.int32), mirrored=True)
         m.shape_source = source
-        m.retrieved_clips = [c for c in gen.last_sources if c]
+        m.retrieved_clips = [c for c in kept if c]
         return m
     legs_req = dataclasses.replace(r, prompt=plan.legs_prompt, action=plan.legs_action)
-    codes, pred = gen.tokens_for([legs_req])
-    retrieved = [c for c in gen.last_sources if c]
+    codes, pred, kept = gen.tokens_for([legs_req])
     seconds = len(codes[0]) * gen.vae.cfg.downsample / FPS
     arms_req = dataclasses.replace(r, prompt=plan.arms_prompt, seconds=seconds, seed=r.seed + 1, action=plan.arms_action)
-    arms_codes, _ = gen.tokens_for([arms_req])
-    retrieved += [c for c in gen.last_sources if c]
+    arms_codes, _, arms_kept = gen.tokens_for([arms_req])
+    retrieved = [c for c in kept + arms_kept if c]
     betas, source = gen.body_shape(r, pred[0].numpy())
     legs = _track(codes[0], gen.vae, betas, False)
     arms, arms_mirrored = _side_fixed(arms_codes[0], gen.vae, betas, plan.arms_side)
