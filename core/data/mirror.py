@@ -84,13 +84,10 @@ def mirror_features(features: np.ndarray) -> np.ndarray:
     T, out = len(f), f.copy()
     out[:, fs["root_rot_vel"]] *= -1
     out[:, fs["root_lin_vel"].start] *= -1
+    ric = np.concatenate([np.zeros((T, 1, 3), f.dtype), f[:, fs["ric"]].reshape(T, NUM_JOINTS - 1, 3)], axis=1)
+    out[:, fs["ric"]] = mirror_joints(ric)[:, 1:].reshape(T, -1)     # joints 1..21 (the root is not stored)
+    out[:, fs["local_vel"]] = mirror_joints(f[:, fs["local_vel"]].reshape(T, NUM_JOINTS, 3)).reshape(T, -1)
     order = swap_order(NUM_JOINTS)
-    ric = f[:, fs["ric"]].reshape(T, NUM_JOINTS - 1, 3)[:, order[1:] - 1].copy()
-    ric[..., 0] *= -1
-    out[:, fs["ric"]] = ric.reshape(T, -1)
-    vel = f[:, fs["local_vel"]].reshape(T, NUM_JOINTS, 3)[:, order].copy()
-    vel[..., 0] *= -1
-    out[:, fs["local_vel"]] = vel.reshape(T, -1)
     rot = f[:, fs["rot6d"]].reshape(T, NUM_JOINTS - 1, 6)[:, order[1:] - 1].copy()
     rot[..., [1, 2, 3]] *= -1    # columns c0, c1 of M R M: (c0x, -c0y, -c0z), (-c1x, c1y, c1z)
     out[:, fs["rot6d"]] = rot.reshape(T, -1)

@@ -150,7 +150,7 @@ class Generator:
         return n, n
 
     @torch.no_grad()
-    def tokens_for(self, reqs: list[Request]) -> "Chosen":
+    def tokens_for(self, reqs: list[Request]) -> Chosen:
         """Each request's chosen motion tokens, the [BETA] head's betas (B, 10) and the memory clip
         whose tokens were kept (None for a T5 sample)."""
         if self.t5 is None:

@@ -35,6 +35,7 @@ from ..constants import FPS
 from ..errors import ShapeMoveError
 from ..scene.motion_file import Motion
 from ..torch_threads import one_torch_thread
+from .decode import decode_features
 from .prompts import check_prompt
 from .sampling_params import DEFAULT_CANDIDATES, check_candidates, check_sampling
 from .token_sampling import body_for, sample_codes
@@ -104,8 +105,7 @@ def _on_side(vae, codes: list[int], prefix: list[int], side: tuple[str, str]) ->
 
     down = vae.cfg.downsample
     with one_torch_thread():
-        feats = vae.denormalize(vae.decode_tokens_long(torch.as_tensor([list(prefix) + list(codes)]).long(),
-                                                       torch.zeros(1, 10)))[0]
+        feats = decode_features(list(prefix) + list(codes), vae, np.zeros(10, np.float32))
         joints = joints_from_features(feats.double()).numpy()[len(prefix) * down:]
         if not needs_mirror(joints, *side):
             return list(codes)

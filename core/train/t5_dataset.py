@@ -29,9 +29,9 @@ def read_lines(path: Path) -> list[str]:
 
 
 @torch.no_grad()
-def tokenize_clips(vae, root: Path, ids: list[str], progress=None, residual: bool = False) -> dict[str, np.ndarray]:
+def tokenize_clips(vae, root: Path, ids: list[str], progress=None) -> dict[str, np.ndarray]:
     """FSQ indices (N,) of each clip's normalized motion (cropped to a multiple of 4 frames): the
-    base codes the T5 learns, or with ``residual`` the codec's full tokens (``motion_codes``)."""
+    base codes, which the T5 learns (a residual code is left out)."""
     vae.eval()
     down = vae.cfg.downsample
     out = {}
@@ -41,10 +41,7 @@ def tokenize_clips(vae, root: Path, ids: list[str], progress=None, residual: boo
         if n < down:
             continue
         x = vae.normalize(torch.as_tensor(f[:n], dtype=torch.float32)[None])
-        if residual:
-            out[cid] = vae.encode_tokens(x)[0].numpy().astype(np.int32)
-        else:
-            out[cid] = vae.encode(x)[1][0].numpy().astype(np.int16)
+        out[cid] = vae.encode(x)[1][0].numpy().astype(np.int16)
         if progress:
             progress((i + 1) / len(ids), cid)
     return out
