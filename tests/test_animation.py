@@ -223,6 +223,7 @@ def test_timeline_segment_naming_a_side_moves_that_side(gen):
     assert _on_side(gen.vae, codes, prefix, ("left", "hand")) == codes  # asked for: kept as it is
     mirrored = _on_side(gen.vae, codes, prefix, ("right", "hand"))
     assert len(mirrored) == len(codes) and mirrored != codes
+    assert max(mirrored) < gen.vae.quantizer.codebook_size  # base codes, like the T5's: no residual packed in
     ml, mr = hands(mirrored)
     assert mr > 1.5 * ml and mr == pytest.approx(left, rel=0.35)        # the same wave, by the right hand
 

@@ -92,3 +92,24 @@ def test_steps_shortened_while_training_end_cleanly(tiny_bundle, tmp_path):  # n
     assert res["step"] == 9
     ck = torch.load(tmp_path / "run" / "last.pt", map_location="cpu", weights_only=True)
     assert ck["step"] == 9 and ck["config"]["steps"] == 9
+
+
+def test_pack_names_a_vae_of_the_repository_and_copies_any_other(tmp_path):
+    """The repository travels to the GPU machine anyway: its own VAE file is named, not copied
+    (5.5 MB of the 64 MiB that travel); a VAE from elsewhere is copied."""
+    tool = _tool()
+    shipped = ROOT / "weights" / "default" / "savae.pt"
+    inside = tmp_path / "inside"
+    inside.mkdir()
+    tool._pack_vae(shipped, inside)
+    assert (inside / "vae.txt").read_text() == "weights/default/savae.pt"
+    assert not (inside / "savae.pt").exists()
+    assert tool._vae_of(inside) == shipped
+
+    other = tmp_path / "elsewhere.pt"
+    other.write_bytes(b"0123456789")
+    (inside / "savae.pt").write_bytes(b"stale")
+    tool._pack_vae(other, inside)  # packing again into the same folder: no stale name is left behind
+    assert not (inside / "vae.txt").exists()
+    assert (inside / "savae.pt").read_bytes() == b"0123456789"
+    assert tool._vae_of(inside) == inside / "savae.pt"

@@ -6,7 +6,7 @@
 
 Only 64 MiB travel to the GPU machine, the repository included, so ``pack`` writes what
 ``train_t5`` reads and nothing else: the training split's captions, shape texts, betas and clip meta
-(a tar), the SA-VAE and the FSQ tokens it gave every clip (``tokens.npz`` of a ``train t5`` run,
+(a tar), the SA-VAE (named, not copied, when it is the repository's own file) and the FSQ tokens it gave every clip (``tokens.npz`` of a ``train t5`` run,
 refused unless it was made by that very VAE file: a T5 trained on another codec's tokens writes
 motions the shipped decoder reads as noise), and the frozen MiniLM in float16 with only the rows of its word-piece
 table that the training texts use (the bank's sentences sampled exhaustively): about 24 MB instead of
@@ -62,6 +62,24 @@ def _training_texts(data: Path, ids: list[str]) -> list[str]:
     return sorted(texts)
 
 
+def _pack_vae(vae: Path, out: Path) -> None:
+    """The VAE into the pack: a file of the repository (which travels anyway) is named in
+    ``vae.txt``, any other is copied as ``savae.pt``."""
+    vae = Path(vae).resolve()
+    if vae.is_relative_to(ROOT):
+        (out / "savae.pt").unlink(missing_ok=True)
+        (out / "vae.txt").write_text(vae.relative_to(ROOT).as_posix())
+    else:
+        (out / "vae.txt").unlink(missing_ok=True)
+        (out / "savae.pt").write_bytes(vae.read_bytes())
+
+
+def _vae_of(pack: Path) -> Path:
+    """The packed VAE's path on this machine (``_pack_vae``)."""
+    named = pack / "vae.txt"
+    return ROOT / named.read_text().strip() if named.is_file() else pack / "savae.pt"
+
+
 def pack(args) -> None:
     from safetensors.torch import load_file, save_file
 
@@ -84,7 +102,7 @@ def pack(args) -> None:
     if str(z["__vae__"]) != vae_stamp(args.vae):
         raise SystemExit(f"{args.tokens} holds the tokens of {str(z['__vae__']).rsplit(':', 1)[0]}, not of {args.vae}")
     np.savez_compressed(out / "tokens.npz", **{k: z[k] for k in z.files if k != "__vae__"})
-    (out / "savae.pt").write_bytes(args.vae.read_bytes())
+    _pack_vae(args.vae, out)
     enc = load_text_encoder()
     used = set(enc.special_ids) | {enc.unk_id}   # [PAD] [UNK] [CLS] [SEP] [MASK]
     texts = _training_texts(data, ids)
@@ -148,7 +166,7 @@ def train_one(args) -> None:
     c = T5TrainConfig.load(str(args.config))
     run = work / name
     run.mkdir(parents=True, exist_ok=True)
-    vae = p / "savae.pt"
+    vae = _vae_of(p)
     z = np.load(p / "tokens.npz")   # the cache train_t5 reads, stamped for the VAE's copy here
     np.savez(run / "tokens.npz", __vae__=np.array(vae_stamp(vae)), **{k: z[k] for k in z.files})
     torch.set_num_threads(2)

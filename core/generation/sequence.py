@@ -98,7 +98,8 @@ def _on_side(vae, codes: list[int], prefix: list[int], side: tuple[str, str]) ->
     are when that side moves most, else their mirror image, made by the codec itself: decoded after
     the codes it continues (on the canonical body), mirrored as features (``data.mirror``) and
     encoded again, so the timeline's tokens carry it (re-decoding for another body, regenerating a
-    neighbour and splicing keep it)."""
+    neighbour and splicing keep it). Base codes only: a timeline decodes through one decoder
+    whichever of its segments were mirrored."""
     from ..data.mirror import mirror_features
     from ..motion.features import joints_from_features
     from .part_compose import needs_mirror
@@ -110,7 +111,7 @@ def _on_side(vae, codes: list[int], prefix: list[int], side: tuple[str, str]) ->
         if not needs_mirror(joints, *side):
             return list(codes)
         mirrored = torch.as_tensor(mirror_features(feats.numpy()))
-        tokens = vae.encode_tokens(vae.normalize(mirrored)[None])[0]
+        tokens = vae.encode(vae.normalize(mirrored)[None])[1][0]  # base codes, as the T5 writes them
     return [int(t) for t in tokens[len(prefix):]]
 
 
