@@ -6,9 +6,10 @@
 
 Only 64 MiB travel to the GPU machine, the repository included, so ``pack`` writes what
 ``train_t5`` reads and nothing else: the training split's captions, shape texts, betas and clip meta
-(a tar), the SA-VAE (named, not copied, when it is the repository's own file) and the FSQ tokens it gave every clip (``tokens.npz`` of a ``train t5`` run,
-refused unless it was made by that very VAE file: a T5 trained on another codec's tokens writes
-motions the shipped decoder reads as noise), and the frozen MiniLM in float16 with only the rows of its word-piece
+(a tar), the SA-VAE (named, not copied, when it is the repository's own file) and the FSQ tokens it
+gave every clip (``tokens.npz`` of a ``train t5`` run, refused unless it was made by that very VAE
+file: a T5 trained on another codec's tokens writes motions the shipped decoder reads as noise),
+and the frozen MiniLM in float16 with only the rows of its word-piece
 table that the training texts use (the bank's sentences sampled exhaustively): about 24 MB instead of
 the 83 MB package. Its token states differ from the float32 encoder's by float16 rounding, the same
 rounding ``StateCache`` applies to every state it keeps.

@@ -253,7 +253,12 @@ class SAVAE(nn.Module):
             return self.decoder(codes, self.shape_embedding(betas))
         if not self.has_residual:
             raise ShapeMoveError("this SA-VAE has no residual code to decode")
-        return self.residual_decoder(self.residual_input(codes, residual), self.residual_shape_embedding(betas))
+        return self._decode_residual(codes, residual, betas)
+
+    def _decode_residual(self, codes, residual, betas, present=None) -> torch.Tensor:
+        """The residual branch: base and residual codes (``residual_input``) + betas -> features."""
+        stream = self.residual_input(codes, residual, present)
+        return self.residual_decoder(stream, self.residual_shape_embedding(betas))
 
     def decode_indices(self, indices: torch.Tensor, betas: torch.Tensor) -> torch.Tensor:
         return self.decode(self.quantizer.indices_to_codes(indices), betas)
@@ -288,9 +293,7 @@ class SAVAE(nn.Module):
         present = None
         if self.training and self.cfg.residual_dropout > 0:
             present = (torch.rand(x.shape[0], device=x.device) >= self.cfg.residual_dropout).float()
-        stream = self.residual_input(codes, residual, present)
-        return {"recon": self.residual_decoder(stream, self.residual_shape_embedding(betas)), "codes": codes,
-                "indices": indices}
+        return {"recon": self._decode_residual(codes, residual, betas, present), "codes": codes, "indices": indices}
 
     @torch.no_grad()
     def decode_long(self, codes: torch.Tensor, betas: torch.Tensor, chunk: int | None = None, overlap: int = 4,
