@@ -1,7 +1,7 @@
 """`python -m shapemove eval KIND ...`: evaluation commands, each printing a table beside the
 ground truth and writing the numbers as JSON (atomically).
 
-    eval recon --data DIR [--split test] --checkpoint RUN|savae.pt --json OUT [--max-clips N] [--base-only]
+    eval recon --data DIR [--split test] --checkpoint RUN|savae.pt --json OUT [--max-clips N] [--base-only] [--no-search]
 
 ``recon``: SA-VAE reconstruction (``core/eval/recon.py``). JSON: the reconstruction's metrics as
 flat keys (mpjpe_mm, bone_err_mm, penetrate_cm, float_cm, skate_pct, dyn_stable_pct,
@@ -33,6 +33,9 @@ def add_recon(sub):
     p.add_argument("--body-model", default=None, help="openbody (default) or an SMPL-family file")
     p.add_argument("--base-only", action="store_true",
                    help="a codec with a residual code: decode the base codes alone (what the T5 writes)")
+    p.add_argument("--no-search", action="store_true",
+                   help="decode the encoders' codes instead of searching for the codes closest to each clip "
+                        "(as retargeting encodes a take)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(_run=run_recon)
 
@@ -55,7 +58,8 @@ def run_recon(args) -> int:
     clips: list = []
     try:
         result = eval_recon(args.data, args.checkpoint, split=args.split, body=args.body_model,
-                            max_clips=args.max_clips, progress=progress, per_clip=clips, base_only=args.base_only)
+                            max_clips=args.max_clips, progress=progress, per_clip=clips, base_only=args.base_only,
+                            search=not args.no_search)
     finally:
         bar.close()
     atomic_write_json(args.json, result, nan_to_null=True)
@@ -142,6 +146,8 @@ def add_retarget(sub):
     p.add_argument("--json", type=Path, required=True, help="write the metrics here")
     p.add_argument("--max-clips", type=int, default=10, help="a seeded random subset of N clips (default 10)")
     p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--no-search", action="store_true",
+                   help="the SA-VAE side: the encoders' codes instead of the codes searched for on the subject's body")
     p.set_defaults(_run=run_retarget)
 
 
@@ -163,7 +169,7 @@ def run_retarget(args) -> int:
     clips = [clips[i] for i in sorted(rng.choice(len(clips), min(args.max_clips, len(clips)), replace=False))]
     body = load_body_model(None)
     bodies = [betas_from_shape_text(body, text) for text in RETARGET_BODIES.values()]
-    result = compare_retargeting(args.data, args.checkpoint, clips, bodies, body=body)
+    result = compare_retargeting(args.data, args.checkpoint, clips, bodies, body=body, search=not args.no_search)
     result["bodies"] = list(RETARGET_BODIES)
     atomic_write_json(args.json, result, nan_to_null=True)
     src = result.get("source")  # the capture on its own fitted body, for reference

@@ -23,6 +23,8 @@ def add_arguments(p):
                    help="SA-VAE run folder or .pt (default: the embedded model's savae.pt)")
     p.add_argument("--out", type=Path, required=True, help="output motion file (.npz)")
     p.add_argument("--naive", action="store_true", help="copy the rotations instead of going through the SA-VAE")
+    p.add_argument("--no-search", action="store_true",
+                   help="the SA-VAE's encoders' codes, not searched for on the subject's body (faster, less faithful)")
     p.add_argument("--body-model", default=None, help="openbody (default) or an SMPL-family file")
     add_reader_arguments(p)
 
@@ -67,7 +69,12 @@ def run(args) -> int:
         motion = naive_retarget(args.motion, body, betas, read=read)
         how = "naive (rotations copied)"
     else:
-        motion = retarget(args.motion, load_vae(args.checkpoint, body), body, betas, read=read)
+        from tqdm import tqdm
+
+        search = not getattr(args, "no_search", False)
+        with tqdm(total=100, desc="searching codes", unit="%", disable=not search) as bar:
+            motion = retarget(args.motion, load_vae(args.checkpoint, body), body, betas, read=read,
+                              search=search, progress=lambda f: bar.update(round(100 * f) - bar.n))
         how = f"SA-VAE, {len(motion.tokens)} tokens"
     save_motion(args.out, motion)
     m = measure(body, motion.betas)

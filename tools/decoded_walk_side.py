@@ -29,6 +29,7 @@ def main(argv=None) -> int:
     ap.add_argument("--out", type=Path, required=True)
     ap.add_argument("--every", type=int, default=6, help="a stick figure every N frames")
     ap.add_argument("--seconds", type=float, default=4.0, help="show the first N seconds")
+    ap.add_argument("--no-search", action="store_true", help="the encoders' codes (default: searched for, as retargeting)")
     args = ap.parse_args(argv)
 
     import torch
@@ -47,7 +48,7 @@ def main(argv=None) -> int:
     vae = load_vae(args.checkpoint, body)
     load = lambda sub: np.load(args.data / sub / f"{args.clip}.npy")  # noqa: E731
     betas = load("betas").reshape(-1)
-    codes = encode_clip(vae, load("norm_joint_vecs"))
+    codes = encode_clip(vae, load("norm_joint_vecs"), betas, load("new_joint_vecs"), not args.no_search)
     dec = decode_tokens(codes, vae, body, betas).joints.astype(np.float64)
     orig = joints_from_features(load("new_joint_vecs")[:len(dec)].astype(np.float64))
     n = min(len(dec), int(args.seconds * 20))

@@ -1,7 +1,8 @@
 """SA-VAE reconstruction quality on a built dataset split, beside the ground truth.
 
-For each clip: the canonical features (``norm_joint_vecs``) are normalized, encoded to tokens and
-decoded with the clip's own betas (``decode_long``, as generation does) -> shape-aware features
+For each clip: the canonical features (``norm_joint_vecs``) are normalized, encoded to tokens (by
+default searched for against the clip's own shape-aware joints, ``code_search``, as a retargeted
+take is encoded; ``search=False``: the encoders' codes) and decoded with the clip's own betas (``decode_long``, as generation does) -> shape-aware features
 -> joints (``joints_from_features``; NOT re-grounded, so the model's floor errors count) -> IK
 onto the body with those betas -> mesh metrics (``evaluate_motion``; bone metrics on the decoded
 joints). MPJPE is against the ground-truth shape-aware joints recovered from ``new_joint_vecs``
@@ -29,7 +30,7 @@ import torch
 from ..body.ik import solve_ik
 from ..body.load import load_body_model
 from ..errors import ShapeMoveError
-from ..generation.retarget import load_vae
+from ..generation.retarget import encode_take, load_vae
 from ..geometry.rotations import axis_angle_to_matrix
 from ..models.fsq import codebook_usage
 from ..models.motion_codes import base_of
@@ -63,18 +64,23 @@ def _pick(agg: dict) -> dict:
 
 
 def recon_clip(vae, body, norm_feats: np.ndarray, betas: np.ndarray, ik_refine_iters: int = 10,
-               base_only: bool = False):
+               base_only: bool = False, shaped_feats: np.ndarray | None = None):
     """(T-1,263) canonical features + betas -> (joints (n,22,3), rotations (n,24,3,3), transl (n,3),
     base token indices (n/4,)) of the reconstruction, n = (T-1) cut to a multiple of the
     downsampling. A codec with a residual code decodes both codes unless ``base_only`` (what the
-    T5, which writes base codes, can reach)."""
+    T5, which writes base codes, can reach: the base encoder's codes). With ``shaped_feats`` (the
+    clip's shape-aware features) the codes are searched for, as retargeting encodes a take
+    (``generation.retarget.encode_take``); else they are the encoders'."""
     n = len(norm_feats) // vae.cfg.downsample * vae.cfg.downsample
     if n == 0:
         raise ShapeMoveError(f"clip too short for the SA-VAE ({len(norm_feats)} feature rows)")
     b = torch.as_tensor(betas, dtype=torch.float32).reshape(1, 10)
+    if base_only:
+        with torch.no_grad():
+            tokens = vae.encode(vae.normalize(torch.as_tensor(norm_feats[:n]))[None])[1]
+    else:
+        tokens = torch.as_tensor(encode_take(vae, norm_feats, b[0], shaped_feats, shaped_feats is not None))[None]
     with torch.no_grad():  # (not around the IK: its refinement takes gradients)
-        x = vae.normalize(torch.as_tensor(norm_feats[:n]))[None]
-        tokens = vae.encode(x)[1] if base_only else vae.encode_tokens(x)
         indices = base_of(tokens, vae.quantizer.codebook_size)
         feats = vae.denormalize(vae.decode_tokens_long(tokens, b))[0]
         joints = joints_from_features(feats.double()).float().numpy()
@@ -83,12 +89,15 @@ def recon_clip(vae, body, norm_feats: np.ndarray, betas: np.ndarray, ik_refine_i
 
 
 def eval_recon(data, checkpoint, split: str = "test", body=None, max_clips: int | None = None, progress=None,
-               ik_refine_iters: int = 10, per_clip: list | None = None, base_only: bool = False) -> dict:
+               ik_refine_iters: int = 10, per_clip: list | None = None, base_only: bool = False,
+               search: bool = True) -> dict:
     """Reconstruction metrics of the SA-VAE ``checkpoint`` (run folder or .pt) on the ``split``
     clips of the dataset folder ``data``, with the ground truth's beside (see the module doc).
     progress(fraction, clip id) after each clip; ``per_clip``: a list to receive one dict per clip
     ({"id", "frames", the KEYS, "ground_truth": {KEYS}}); ``base_only``: a residual codec decodes
-    its base codes alone (``recon_clip``)."""
+    its base codes alone (``recon_clip``); ``search``: the codes are searched for against the
+    clip's shape-aware joints, as retargeting encodes a take (``code_search``), else the encoders'
+    codes (never with ``base_only``)."""
     root = Path(data)
     if not root.is_dir():
         raise ShapeMoveError(f"dataset folder not found: {root}")
@@ -104,10 +113,11 @@ def eval_recon(data, checkpoint, split: str = "test", body=None, max_clips: int 
     model_rows, gt_rows, all_indices = [], [], []
     for i, cid in enumerate(ids):
         betas = _load(root, "betas", cid).reshape(-1)
+        shaped = _load(root, "new_joint_vecs", cid)
         joints, rot, transl, idx = recon_clip(vae, body, _load(root, "norm_joint_vecs", cid), betas, ik_refine_iters,
-                                                   base_only)
+                                              base_only, shaped if search else None)
         n = len(joints)
-        gt_joints = joints_from_features(_load(root, "new_joint_vecs", cid)[:n].astype(np.float64))
+        gt_joints = joints_from_features(shaped[:n].astype(np.float64))
         m = evaluate_motion(body, betas, rot, transl, joints=joints)
         m["mpjpe_mm"] = mpjpe_mm(joints, gt_joints)
         m["mpjpe_local_mm"] = mpjpe_mm(joints, gt_joints, root_aligned=True)  # pose only, no trajectory drift

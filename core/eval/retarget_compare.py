@@ -83,7 +83,7 @@ def source_score(body, data, clip):
 
 
 def compare_retargeting(data, checkpoint, clips, target_betas_list, body=None, ik_refine_iters: int = 10,
-                        progress=None, plant_source_contacts: bool = True) -> dict:
+                        progress=None, plant_source_contacts: bool = True, search: bool = True) -> dict:
     """{"savae": metrics, "naive": metrics, "naive_frame": metrics, "swap": metrics, "source": metrics}
     (``KEYS`` + "clips", "bodies"; "naive_frame": ``ground_each_frame`` of naive, each frame's
     lowest point on the floor: naive without its hovering, which hides slides from the 5 cm contact
@@ -92,7 +92,8 @@ def compare_retargeting(data, checkpoint, clips, target_betas_list, body=None, i
     ``clips`` (dataset clip ids or mocap files) moved onto every body of ``target_betas_list``
     ((10,) betas each). ``checkpoint``: SA-VAE run folder or .pt. progress(fraction, clip).
     The SA-VAE side is decoded as ``generation.retarget.retarget`` does (the source's contacts
-    planted unless ``plant_source_contacts`` is False: the decoder's own contacts)."""
+    planted unless ``plant_source_contacts`` is False: the decoder's own contacts; the codes searched
+    for on the subject's body unless ``search`` is False: the encoders' codes)."""
     from ..generation.retarget import (check_betas, decode_tokens, encode_source, ground_each_frame, load_vae,
                                        naive_retarget, source_contacts, source_joints, swap_betas_retarget)
     from ..io.mocap import Motion22
@@ -107,7 +108,7 @@ def compare_retargeting(data, checkpoint, clips, target_betas_list, body=None, i
     for i, clip in enumerate(clips):
         joints, name = source_joints(source_motion(data, clip), body)
         src = Motion22(joints=joints, fps=float(FPS), source=name, subject="", offsets=np.zeros((22, 3)))  # read once
-        codes = encode_source(joints, vae, body, ik_refine_iters)
+        codes = encode_source(joints, vae, body, ik_refine_iters, search)
         known = source_contacts(joints)        # also where the slide of planted feet is measured
         contacts = known if plant_source_contacts else None
         for betas in targets:

@@ -1,8 +1,9 @@
 """Does the motion codec keep locomotion's speed? (issue #24) The check behind `eval speed`.
 
 (a) Real clips: every clip of the split whose main action (``labels.actions[0]`` in its meta) is
-    walk, jog, run or sprint is encoded (its canonical features, ``norm_joint_vecs``) and decoded
-    on the clip's own betas (as ``eval recon`` and retargeting do). Its root speed is compared with
+    walk, jog, run or sprint is encoded (its canonical features, ``norm_joint_vecs``; the codes
+    searched for on its own body, ``generation.retarget.encode_take``, unless ``search`` is False)
+    and decoded on the clip's own betas (as ``eval recon`` and retargeting do). Its root speed is compared with
     the clip's own shape-aware motion (``new_joint_vecs``, same body, same frames) two ways:
     ``decoded``: the root of the decoded features (``joints_from_features``), what the codec
     carries; ``final``: the root of the Motion the user gets (``generation.decode.decode_tokens``:
@@ -38,7 +39,7 @@ from ..body.plant import contacts_from_features
 from ..data.built_meta import read_meta
 from ..errors import ShapeMoveError
 from ..generation.decode import decode_features, decode_tokens, motion_from_joints
-from ..generation.retarget import encode_windowed, load_vae
+from ..generation.retarget import encode_take, load_vae
 from ..motion.features import joints_from_features
 from ..motion.root_from_feet import root_from_feet
 from ..train.motion_dataset import read_split
@@ -85,13 +86,11 @@ def locomotion_clips(data, split: str = "test", actions=LOCOMOTION) -> dict[str,
     return out
 
 
-def encode_clip(vae, norm_feats: np.ndarray) -> list[int]:
-    """(T-1,263) canonical features -> motion tokens (the rows cut to a multiple of the downsampling)."""
-    n = len(norm_feats) // vae.cfg.downsample * vae.cfg.downsample
-    if n == 0:
-        raise ShapeMoveError(f"clip too short for the SA-VAE ({len(norm_feats)} feature rows)")
-    with torch.no_grad():
-        return [int(i) for i in encode_windowed(vae, vae.normalize(torch.as_tensor(norm_feats[:n])))]
+def encode_clip(vae, norm_feats: np.ndarray, betas=None, shape_feats=None, search: bool = True) -> list[int]:
+    """(T-1,263) canonical features -> motion tokens (the rows cut to a multiple of the downsampling),
+    encoded as a retargeted take is (``encode_take``: searched for on ``betas`` against
+    ``shape_feats`` when both are given and ``search``)."""
+    return encode_take(vae, norm_feats, betas, shape_feats, search)
 
 
 def _decoded_joints(codes, vae, betas) -> tuple[np.ndarray, np.ndarray]:
@@ -100,11 +99,13 @@ def _decoded_joints(codes, vae, betas) -> tuple[np.ndarray, np.ndarray]:
         return joints_from_features(feats).numpy(), feats.numpy()
 
 
-def clip_speeds(vae, body, norm_feats, shape_feats, betas, feet: bool = False, ik_refine_iters: int = 10) -> dict:
+def clip_speeds(vae, body, norm_feats, shape_feats, betas, feet: bool = False, ik_refine_iters: int = 10,
+                search: bool = True) -> dict:
     """One real clip through the codec on its own betas -> {"frames", "orig_mps", and for each of
     "decoded", "final" (and with ``feet`` "feet", "feet_final"): "<kind>_mps", "<kind>_corr",
-    "<kind>_swing_m"} (``gait.swing``: how far the feet reach apart; "orig_swing_m" the clip's)."""
-    codes = encode_clip(vae, norm_feats)
+    "<kind>_swing_m"} (``gait.swing``: how far the feet reach apart; "orig_swing_m" the clip's).
+    ``search``: encoded as a retargeted take is (``encode_clip``), else by the encoders alone."""
+    codes = encode_clip(vae, norm_feats, betas, shape_feats, search)
     joints, feats = _decoded_joints(codes, vae, betas)
     n = len(joints)
     orig = joints_from_features(np.asarray(shape_feats[:n], np.float64))
@@ -208,9 +209,12 @@ def generated_speeds(model_dir, body, real: dict[str, dict], real_betas: dict[st
 
 
 def speed_check(data, checkpoint, split: str = "test", model_dir=None, feet: bool = False, max_clips: int | None = None,
-                shape_clips: int = 8, seeds=(0, 1), body=None, ik_refine_iters: int = 10, progress=None) -> dict:
+                shape_clips: int = 8, seeds=(0, 1), body=None, ik_refine_iters: int = 10, progress=None,
+                search: bool = True) -> dict:
     """The whole check (module doc). ``max_clips``: at most that many clips per action (a seeded
-    random subset); ``shape_clips``: walk clips for the shape check (0: none). Returns::
+    random subset); ``shape_clips``: walk clips for the shape check (0: none); ``search``: real
+    clips are encoded as a retargeted take is (codes searched for on the clip's own body), else by
+    the encoders alone. Returns::
 
         {"checkpoint", "split", "target": 0.95, "kinds": [...],
          "actions": {action: summary}, "all": summary over every clip,
@@ -241,7 +245,7 @@ def speed_check(data, checkpoint, split: str = "test", model_dir=None, feet: boo
     for a, ids in by_action.items():
         for cid in ids:
             r = clip_speeds(vae, body, _load(root, "norm_joint_vecs", cid), _load(root, "new_joint_vecs", cid),
-                            _load(root, "betas", cid).reshape(-1), feet, ik_refine_iters)
+                            _load(root, "betas", cid).reshape(-1), feet, ik_refine_iters, search)
             rows.append({"id": cid, "action": a, **r})
             done += 1
             if progress is not None:
@@ -254,8 +258,9 @@ def speed_check(data, checkpoint, split: str = "test", model_dir=None, feet: boo
         bodies = shape_bodies(body)
         per = []
         for cid in walks:
-            per.append(shape_gait(encode_clip(vae, _load(root, "norm_joint_vecs", cid)), vae, body, bodies,
-                                  ik_refine_iters))
+            codes = encode_clip(vae, _load(root, "norm_joint_vecs", cid), _load(root, "betas", cid).reshape(-1),
+                                _load(root, "new_joint_vecs", cid), search)
+            per.append(shape_gait(codes, vae, body, bodies, ik_refine_iters))
             done += 1
             if progress is not None:
                 progress(done / n_total, f"shape {cid}")

@@ -29,6 +29,9 @@ def add_arguments(p) -> None:
     p.add_argument("--shape-clips", type=int, default=8,
                    help="walk clips decoded on a short and a tall body (stride vs cadence); 0: skip")
     p.add_argument("--seeds", type=int, nargs="+", default=[0, 1], help="generation seeds per prompt (with --model)")
+    p.add_argument("--no-search", action="store_true",
+                   help="encode the real clips by the encoders alone (default: the codes searched for on each "
+                        "clip's own body, as retargeting encodes a take)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
 
 
@@ -75,7 +78,7 @@ def from_cli(args) -> int:
     try:
         result = speed_check(args.data, args.checkpoint, split=args.split, model_dir=args.model, feet=args.feet,
                              max_clips=args.max_clips, shape_clips=args.shape_clips, seeds=tuple(args.seeds),
-                             progress=progress)
+                             progress=progress, search=not args.no_search)
     finally:
         bar.close()
     atomic_write_json(args.json, result, nan_to_null=True)

@@ -6,7 +6,8 @@
   2. the dataset builder's per-clip steps (``data.build.ClipProcessor``): fit the subject's betas
      to its bone lengths, IK onto that body, the same rotations on the canonical body (betas = 0,
      stride scaled by the pelvis height) -> canonical HumanML3D features;
-  3. SA-VAE encode -> motion tokens; decode them with the NEW betas -> shape-aware features ->
+  3. SA-VAE encode -> motion tokens (searched for: the codes whose decoding on the subject's own
+     body comes closest to its motion, ``encode_take``); decode them with the NEW betas -> shape-aware features ->
      joints -> the feet in contact planted, IK onto the new body, the mesh grounded on its soles
      (``decode_tokens``, the generator's decoding), so feet stay planted and bones take the new
      body's lengths. The contacts planted are the SOURCE motion's (``source_contacts``: detected
@@ -31,6 +32,7 @@ import torch
 from ..constants import FPS
 from ..errors import ShapeMoveError
 from ..io.mocap import Motion22
+from ..models.motion_codes import pack
 from ..scene.motion_file import Motion, make_motion, validate
 from .decode import check_betas, decode_tokens
 
@@ -112,32 +114,68 @@ def encoder_reach(vae) -> int:
 
 
 @torch.no_grad()
-def encode_windowed(vae, x: torch.Tensor, window: int = ENCODE_WINDOW) -> torch.Tensor:
-    """Normalized features (T,D) (T a multiple of the downsampling) -> (T/down,) token indices,
+def encode_latents(vae, x: torch.Tensor, window: int = ENCODE_WINDOW):
+    """Normalized features (T,D) (T a multiple of the downsampling) -> the encoders' latents before
+    quantization: base (1, T/down, C) and residual (1, T/down, R) (None without a residual code),
     encoded ``window`` frames at a time with ``encoder_reach`` frames of context on each side:
-    every token sees what it sees in one pass over the whole take (the same tokens), and memory
+    every step sees what it sees in one pass over the whole take (the same latents), and memory
     stays a constant however long the take."""
     down = vae.cfg.downsample
     window = max(down, window // down * down)
     reach, n = encoder_reach(vae), len(x)
+    encoders = [vae.encoder] + ([vae.residual_encoder] if vae.has_residual else [])
     if n <= window + 2 * reach:
-        return vae.encode_tokens(x[None])[0]
-    out = []
-    for s in range(0, n, window):
-        lo, hi = max(0, s - reach), min(n, s + window + reach)
-        idx = vae.encode_tokens(x[lo:hi][None])[0]
-        out.append(idx[(s - lo) // down:(min(n, s + window) - lo) // down])
-    return torch.cat(out)
+        out = [e(x[None]) for e in encoders]
+    else:
+        parts = [[] for _ in encoders]
+        for s in range(0, n, window):
+            lo, hi = max(0, s - reach), min(n, s + window + reach)
+            for part, e in zip(parts, encoders):
+                part.append(e(x[lo:hi][None])[:, (s - lo) // down:(min(n, s + window) - lo) // down])
+        out = [torch.cat(part, 1) for part in parts]
+    return out[0], (out[1] if vae.has_residual else None)
 
 
-def encode_source(joints: np.ndarray, vae, body, ik_refine_iters: int = 10) -> list[int]:
-    """(T,22,3) source joints -> motion tokens: the builder's canonical features, SA-VAE encoded
-    (``encode_windowed``). T-1 feature rows are cut to a multiple of the VAE's downsampling (4):
-    (T-1)//4 tokens."""
-    feats = processor(body, ik_refine_iters).process(joints)["norm_joint_vecs"]
-    n = len(feats) // vae.cfg.downsample * vae.cfg.downsample
-    x = vae.normalize(torch.as_tensor(feats[:n], dtype=torch.float32))
-    return [int(i) for i in encode_windowed(vae, x)]
+@torch.no_grad()
+def encode_windowed(vae, x: torch.Tensor, window: int = ENCODE_WINDOW) -> torch.Tensor:
+    """Normalized features (T,D) -> (T/down,) tokens (``vae.encode_tokens``: the residual packed in
+    when the codec has one), from the windowed latents of ``encode_latents``."""
+    zb, zr = encode_latents(vae, x, window)
+    base = vae.quantizer(zb)[1][0]
+    if zr is None:
+        return base
+    return pack(base, vae.residual_quantizer(zr)[1][0], vae.quantizer.codebook_size)
+
+
+def encode_take(vae, norm_feats, betas=None, shaped_feats=None, search: bool = True, progress=None) -> list[int]:
+    """How a take is encoded to be decoded again (retargeting, ``eval recon``, ``eval speed``):
+    its canonical features (T,263) -> tokens ((T cut to a multiple of the downsampling) / down).
+    With ``search`` and the take's own body (``betas``) and shape-aware features (``shaped_feats``,
+    the same frames on that body), the codes are searched for from the encoders' latents
+    (``models.code_search``: the codes whose decoding on that body comes closest to the take's
+    joints); else the encoders' codes (``encode_windowed``). ``progress(fraction)``."""
+    down = vae.cfg.downsample
+    n = len(norm_feats) // down * down
+    if n == 0:
+        raise ShapeMoveError(f"clip too short for the SA-VAE ({len(norm_feats)} feature rows)")
+    x = vae.normalize(torch.as_tensor(np.asarray(norm_feats[:n]), dtype=torch.float32))
+    if not search or betas is None or shaped_feats is None:
+        return [int(i) for i in encode_windowed(vae, x)]
+    from ..models.code_search import search_tokens
+
+    if len(shaped_feats) < n:
+        raise ShapeMoveError(f"encode_take: {len(shaped_feats)} shape-aware feature rows for {n} canonical ones")
+    return [int(i) for i in search_tokens(vae, encode_latents(vae, x), betas, np.asarray(shaped_feats[:n]),
+                                          progress=progress)]
+
+
+def encode_source(joints: np.ndarray, vae, body, ik_refine_iters: int = 10, search: bool = True,
+                  progress=None) -> list[int]:
+    """(T,22,3) source joints -> motion tokens: the builder's canonical features and the subject's
+    own (its fitted body), encoded by ``encode_take`` (searched, unless ``search`` is False).
+    T-1 feature rows are cut to a multiple of the VAE's downsampling (4): (T-1)//4 tokens."""
+    arrays = processor(body, ik_refine_iters).process(joints)
+    return encode_take(vae, arrays["norm_joint_vecs"], arrays["betas"], arrays["new_joint_vecs"], search, progress)
 
 
 def source_contacts(joints) -> np.ndarray:
@@ -149,14 +187,16 @@ def source_contacts(joints) -> np.ndarray:
 
 
 def retarget(motion, vae, body, betas, ik_refine_iters: int = 10, plant_source_contacts: bool = True,
-             read: dict | None = None) -> Motion:
+             read: dict | None = None, search: bool = True, progress=None) -> Motion:
     """``motion`` (mocap file path or Motion22) performed by the body ``betas`` (10,), through the
     SA-VAE ``vae`` (trained for ``body``). Returns a validated Motion with tokens: 4*((T-1)//4)
     frames at 20 fps. ``plant_source_contacts``: plant the source's contacts (default) rather
-    than the decoder's predicted ones. ``read``: see ``source_joints``."""
+    than the decoder's predicted ones. ``read``: see ``source_joints``. ``search``: the codes
+    searched for on the subject's body (``encode_take``; else the encoders'); ``progress(fraction)``
+    during the search."""
     betas = check_betas(betas)
     joints, _ = source_joints(motion, body, read)
-    codes = encode_source(joints, vae, body, ik_refine_iters)
+    codes = encode_source(joints, vae, body, ik_refine_iters, search, progress)
     out = decode_tokens(codes, vae, body, betas, ik_refine_iters,
                         contacts=source_contacts(joints) if plant_source_contacts else None)
     validate(out)

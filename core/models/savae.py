@@ -300,7 +300,13 @@ class SAVAE(nn.Module):
                     residual: torch.Tensor | None = None) -> torch.Tensor:
         """Decode a sequence longer than the training window: overlapping chunks of ``chunk`` codes
         (default window/4), each with its own shape token, cross-faded over ``overlap`` codes, so
-        every frame sits as close to a shape token as in training."""
+        every frame sits as close to a shape token as in training. No gradient (``decode_chunked``
+        is the same with one)."""
+        return self.decode_chunked(codes, betas, chunk, overlap, residual)
+
+    def decode_chunked(self, codes: torch.Tensor, betas: torch.Tensor, chunk: int | None = None, overlap: int = 4,
+                       residual: torch.Tensor | None = None) -> torch.Tensor:
+        """``decode_long`` with gradients (``code_search``)."""
         chunk = chunk or self.cfg.train.window // self.cfg.downsample
         overlap = min(overlap, chunk // 2)  # short training windows give short chunks
         n, up = codes.shape[1], self.cfg.downsample

@@ -162,7 +162,8 @@ def retarget(params, progress, cancel) -> dict:
     """params {"source" (BVH / ASF+AMC / AMASS .npz), "body", "betas" (10, optional: else the
     source subject's own shape, fitted to its bone lengths), "source_fps" / "angle_unit" (optional
     overrides of what the file declares: ``io.mocap.reader_options``), "method" ("auto" | "savae" | "naive";
-    auto = through the SA-VAE when a model has one, else naive), "model", "out"} -> the motion on
+    auto = through the SA-VAE when a model has one, else naive), "search" (optional, default true:
+    the SA-VAE's codes searched for on the subject's body), "model", "out"} -> the motion on
     the body, written to ``out``."""
     from ..body.fit import bone_lengths, fit_betas_to_bone_lengths
     from ..body.load import load_body_model
@@ -195,7 +196,13 @@ def retarget(params, progress, cancel) -> dict:
     if cancel():
         raise JobCancelled
     progress(0.3, "retargeting" + (" through the SA-VAE" if vae is not None else " (naive: no SA-VAE model)"))
-    motion = (savae_retarget(source, vae, body, betas, read=read) if vae is not None
+    def searching(fraction):
+        if cancel():
+            raise JobCancelled
+        progress(0.3 + 0.6 * fraction, "retargeting through the SA-VAE: searching codes")
+
+    motion = (savae_retarget(source, vae, body, betas, read=read, search=param(params, op, "search", bool, True),
+                             progress=searching) if vae is not None
               else naive_retarget(source, body, betas, read=read))
     motion.prompt = motion.prompt or (source.subject if not isinstance(source, Path) else source.stem)
     save_motion(out, motion)
