@@ -116,8 +116,9 @@ def test_a_long_take_is_searched_window_by_window(codec, walk):
     assert len(win) == n // 4 and seen[-1] == 1.0 and seen == sorted(seen)
     assert len(seen) == windows * (1 + 15 // 10 + 1)     # every 10 steps (0 and 10 of 15) and each window's end
     plain = encode_windowed(codec, x)
-    loss = lambda t: float(joint_loss(torch.as_tensor(_decoded(codec, t, walk["betas"]), dtype=torch.float32),  # noqa: E731
-                                      target))
+    def loss(tokens):
+        return float(joint_loss(torch.as_tensor(_decoded(codec, tokens, walk["betas"]), dtype=torch.float32), target))
+
     assert loss(win) < 0.97 * loss(plain)
     assert (win != plain).sum() > len(win) // 4               # every window moved codes, not only the first
 

@@ -1,14 +1,16 @@
 """SA-VAE reconstruction quality on a built dataset split, beside the ground truth.
 
 For each clip: the canonical features (``norm_joint_vecs``) are normalized, encoded to tokens (by
-default searched for against the clip's own shape-aware joints, ``code_search``, as a retargeted
-take is encoded; ``search=False``: the encoders' codes) and decoded with the clip's own betas (``decode_long``, as generation does) -> shape-aware features
--> joints (``joints_from_features``; NOT re-grounded, so the model's floor errors count) -> IK
-onto the body with those betas -> mesh metrics (``evaluate_motion``; bone metrics on the decoded
-joints). MPJPE is against the ground-truth shape-aware joints recovered from ``new_joint_vecs``
-(same canonical frame, same frames); ``mpjpe_local_mm`` is the same with both motions' roots
-aligned per frame (the pose error without the drift of the integrated root trajectory). The ground truth column is the dataset's shape-aware motion
-itself: ``poses``/``transl`` on the body with the clip's betas (its MPJPE is 0 by definition).
+default searched for against the clip's own shape-aware motion, ``code_search``, as a retargeted
+take is encoded; ``search=False``: the encoders' codes) and decoded with the clip's own betas
+(``decode_long``, as generation does) -> shape-aware features -> joints (``joints_from_features``;
+NOT re-grounded, so the model's floor errors count) -> IK onto the body with those betas -> mesh
+metrics (``evaluate_motion``; bone metrics on the decoded joints). MPJPE is against the
+ground-truth shape-aware joints recovered from ``new_joint_vecs`` (same canonical frame, same
+frames); ``mpjpe_local_mm`` is the same with both motions' roots aligned per frame (the pose error
+without the drift of the integrated root trajectory). The ground truth column is the dataset's
+shape-aware motion itself: ``poses``/``transl`` on the body with the clip's betas (its MPJPE is 0
+by definition).
 Frames: the (T-1) feature rows cut to a multiple of the VAE's downsampling.
 
 Result (also the JSON of ``eval recon``)::

@@ -92,7 +92,8 @@ def _search_window(vae, zb, zr, fixed_b, fixed_r, lo, hi, betas, target, steps, 
         zr = zr[:, lo:hi].clone().requires_grad_(True)
         params.append(zr)
     opt = torch.optim.Adam(params, lr=lr)
-    sched = torch.optim.lr_scheduler.LambdaLR(opt, lambda i: 0.5 * (1 + math.cos(math.pi * min(i, steps) / max(steps, 1))))
+    cosine = lambda i: 0.5 * (1 + math.cos(math.pi * min(i, steps) / max(steps, 1)))  # noqa: E731
+    sched = torch.optim.lr_scheduler.LambdaLR(opt, cosine)
     best, best_codes = float("inf"), None
     for i in range(steps + 1):
         if tick is not None and i % TICK == 0:
