@@ -6,6 +6,7 @@ on CUDA) and each process drives one device.
 from __future__ import annotations
 
 import os
+from contextlib import contextmanager
 from dataclasses import dataclass
 
 import torch
@@ -46,6 +47,19 @@ def setup(device: str | None = None) -> DistInfo:
 def cleanup() -> None:
     if dist.is_available() and dist.is_initialized():
         dist.destroy_process_group()
+
+
+@contextmanager
+def process_group(device: str | None = None):
+    """``setup`` for the body of a training run, ``cleanup`` after it. A body that ends without an
+    error waits for every rank first: a rank that tore its gloo group down while another still
+    wrote its last checkpoint was seen to abort ("terminate called without an active exception")."""
+    info = setup(device)
+    try:
+        yield info
+        barrier(info)
+    finally:
+        cleanup()
 
 
 def barrier(info: DistInfo) -> None:

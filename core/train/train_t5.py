@@ -147,11 +147,8 @@ def train_t5(data, vae, out, config: T5TrainConfig | None = None, base_model=Non
         c.encoder = "t5"  # a pretrained T5 folder brings its own encoder
     c.validate(base_model)
     data, out = Path(data), Path(out)
-    dist = distributed.setup(device)
-    try:
+    with distributed.process_group(device) as dist:
         return _train(data, Path(vae), out, c, base_model, resume, dist, progress, cancel, verbose)
-    finally:
-        distributed.cleanup()
 
 
 def _train(data, vae_path, out, c, base_model, resume, dist, progress, cancel, verbose) -> dict:

@@ -194,11 +194,8 @@ def train_tma(data, out, config=None, steps: int | None = None, batch_size: int 
     data, out = Path(data), Path(out)
     if not data.is_dir():
         raise ShapeMoveError(f"dataset folder not found: {data}")
-    dist = distributed.setup(device)
-    try:
+    with distributed.process_group(device) as dist:
         return _train(data, out, c, resume, body or "openbody", dist, progress, cancel, verbose)
-    finally:
-        distributed.cleanup()
 
 
 def _text_reader(data: Path, out: Path, c: TMATrainConfig, dist, texts: list[str], verbose: bool):

@@ -143,11 +143,8 @@ def train_vae(data, out, config: SAVAEConfig | None = None, steps: int | None = 
     cfg.validate()
     t = cfg.train
     out = Path(out)
-    dist = distributed.setup(device)
-    try:
+    with distributed.process_group(device) as dist:
         return _train(Path(data), out, cfg, t, resume, body, dist, progress, cancel, verbose)
-    finally:
-        distributed.cleanup()
 
 
 def _train(data, out, cfg, t, resume, body, dist, progress, cancel, verbose) -> dict:
