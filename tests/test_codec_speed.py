@@ -135,12 +135,13 @@ def test_decoded_walk_speed_is_measured_on_both_roots(walk, codec, openbody):
 
 
 def test_shape_changes_stride_not_cadence(walk, codec, openbody):
-    from shapemove.core.eval.speed import encode_clip, shape_bodies, shape_gait
+    from shapemove.core.eval.speed import shape_bodies, shape_gait
+    from shapemove.core.generation.retarget import encode_take
 
     bodies = shape_bodies(openbody)
     legs = {k: leg_length(openbody, b) for k, b in bodies.items()}
     assert legs["tall"] / legs["short"] > 1.25                               # really different legs
-    g = shape_gait(encode_clip(codec, walk["norm"]), codec, openbody, bodies)
+    g = shape_gait(encode_take(codec, walk["norm"]), codec, openbody, bodies)
     for kind in ("decoded", "final"):
         assert g[f"{kind}_cadence_ratio"] == pytest.approx(1.0, abs=0.05)    # same steps per second
         assert g[f"{kind}_stride_ratio"] > 1.15                              # longer legs, longer strides

@@ -37,9 +37,8 @@ def main(argv=None) -> int:
 
     from shapemove.core.body.load import load_body_model
     from shapemove.core.eval.gait import mean_speed
-    from shapemove.core.eval.speed import encode_clip
     from shapemove.core.generation.decode import decode_tokens
-    from shapemove.core.generation.retarget import load_vae
+    from shapemove.core.generation.retarget import encode_take, load_vae
     from shapemove.core.motion.contacts import detect_contacts
     from shapemove.core.motion.features import joints_from_features
 
@@ -48,7 +47,7 @@ def main(argv=None) -> int:
     vae = load_vae(args.checkpoint, body)
     load = lambda sub: np.load(args.data / sub / f"{args.clip}.npy")  # noqa: E731
     betas = load("betas").reshape(-1)
-    codes = encode_clip(vae, load("norm_joint_vecs"), betas, load("new_joint_vecs"), not args.no_search)
+    codes = encode_take(vae, load("norm_joint_vecs"), betas, load("new_joint_vecs"), not args.no_search)
     dec = decode_tokens(codes, vae, body, betas).joints.astype(np.float64)
     orig = joints_from_features(load("new_joint_vecs")[:len(dec)].astype(np.float64))
     n = min(len(dec), int(args.seconds * 20))

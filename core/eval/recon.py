@@ -81,7 +81,7 @@ def recon_clip(vae, body, norm_feats: np.ndarray, betas: np.ndarray, ik_refine_i
         with torch.no_grad():
             tokens = vae.encode(vae.normalize(torch.as_tensor(norm_feats[:n]))[None])[1]
     else:
-        tokens = torch.as_tensor(encode_take(vae, norm_feats, b[0], shaped_feats, shaped_feats is not None))[None]
+        tokens = torch.as_tensor(encode_take(vae, norm_feats, b[0], shaped_feats))[None]
     with torch.no_grad():  # (not around the IK: its refinement takes gradients)
         indices = base_of(tokens, vae.quantizer.codebook_size)
         feats = vae.denormalize(vae.decode_tokens_long(tokens, b))[0]

@@ -86,13 +86,6 @@ def locomotion_clips(data, split: str = "test", actions=LOCOMOTION) -> dict[str,
     return out
 
 
-def encode_clip(vae, norm_feats: np.ndarray, betas=None, shape_feats=None, search: bool = True) -> list[int]:
-    """(T-1,263) canonical features -> motion tokens (the rows cut to a multiple of the downsampling),
-    encoded as a retargeted take is (``encode_take``: searched for on ``betas`` against
-    ``shape_feats`` when both are given and ``search``)."""
-    return encode_take(vae, norm_feats, betas, shape_feats, search)
-
-
 def _decoded_joints(codes, vae, betas) -> tuple[np.ndarray, np.ndarray]:
     feats = decode_features(codes, vae, betas).double()
     with torch.no_grad():
@@ -104,8 +97,8 @@ def clip_speeds(vae, body, norm_feats, shape_feats, betas, feet: bool = False, i
     """One real clip through the codec on its own betas -> {"frames", "orig_mps", and for each of
     "decoded", "final" (and with ``feet`` "feet", "feet_final"): "<kind>_mps", "<kind>_corr",
     "<kind>_swing_m"} (``gait.swing``: how far the feet reach apart; "orig_swing_m" the clip's).
-    ``search``: encoded as a retargeted take is (``encode_clip``), else by the encoders alone."""
-    codes = encode_clip(vae, norm_feats, betas, shape_feats, search)
+    ``search``: encoded as a retargeted take is (``encode_take``), else by the encoders alone."""
+    codes = encode_take(vae, norm_feats, betas, shape_feats, search)
     joints, feats = _decoded_joints(codes, vae, betas)
     n = len(joints)
     orig = joints_from_features(np.asarray(shape_feats[:n], np.float64))
@@ -258,7 +251,7 @@ def speed_check(data, checkpoint, split: str = "test", model_dir=None, feet: boo
         bodies = shape_bodies(body)
         per = []
         for cid in walks:
-            codes = encode_clip(vae, _load(root, "norm_joint_vecs", cid), _load(root, "betas", cid).reshape(-1),
+            codes = encode_take(vae, _load(root, "norm_joint_vecs", cid), _load(root, "betas", cid).reshape(-1),
                                 _load(root, "new_joint_vecs", cid), search)
             per.append(shape_gait(codes, vae, body, bodies, ik_refine_iters))
             done += 1

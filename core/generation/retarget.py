@@ -32,7 +32,6 @@ import torch
 from ..constants import FPS
 from ..errors import ShapeMoveError
 from ..io.mocap import Motion22
-from ..models.motion_codes import pack
 from ..scene.motion_file import Motion, make_motion, validate
 from .decode import check_betas, decode_tokens
 
@@ -141,10 +140,8 @@ def encode_windowed(vae, x: torch.Tensor, window: int = ENCODE_WINDOW) -> torch.
     """Normalized features (T,D) -> (T/down,) tokens (``vae.encode_tokens``: the residual packed in
     when the codec has one), from the windowed latents of ``encode_latents``."""
     zb, zr = encode_latents(vae, x, window)
-    base = vae.quantizer(zb)[1][0]
-    if zr is None:
-        return base
-    return pack(base, vae.residual_quantizer(zr)[1][0], vae.quantizer.codebook_size)
+    residual = None if zr is None else vae.residual_quantizer.quantize(zr)
+    return vae.tokens_of_codes(vae.quantizer.quantize(zb), residual)[0]
 
 
 def encode_take(vae, norm_feats, betas=None, shaped_feats=None, search: bool = True, progress=None) -> list[int]:

@@ -34,7 +34,6 @@ from ..body.skeleton import BODY_BONES
 from ..constants import FPS
 from ..errors import ShapeMoveError
 from ..motion.features import joints_from_features
-from .motion_codes import pack
 
 STEPS = 200
 LR = 0.05
@@ -145,16 +144,13 @@ def search_tokens(vae, latents, betas, target_features, steps: int = STEPS, lr: 
         with torch.no_grad():
             cb = vae.quantizer.quantize(zb)
             cr = vae.residual_quantizer.quantize(zr) if residual else None
-        n = cb.shape[1]
-        # windows and their context fall on decode_long's chunk starts, so a window's span is cut
-        # into the same chunks as the whole take is when it is decoded
         # a window's span, decoded, is cut into the chunks the whole take is cut into when it is
         # decoded (decode_long: chunks start every `step` tokens): it starts one step before the
         # window (codes already searched) and ends a chunk after it (the encoders' codes). It is
         # scored up to the window's end, the context before it included (its frames hear the
         # window's codes), not after it (searched next).
-        chunk = vae.cfg.train.window // down
-        step = chunk - min(4, chunk // 2)
+        chunk, overlap = vae.chunking()
+        step = chunk - overlap
         window = max(step, window // step * step)
         starts = list(range(0, n, window))
         for i, s in enumerate(starts):
@@ -175,7 +171,4 @@ def search_tokens(vae, latents, betas, target_features, steps: int = STEPS, lr: 
         for p, g in zip(vae.parameters(), grads):
             p.requires_grad_(g)
         vae.train(was_training)
-    base = vae.quantizer.codes_to_indices(cb)[0]
-    if not residual:
-        return base
-    return pack(base, vae.residual_quantizer.codes_to_indices(cr)[0], vae.quantizer.codebook_size)
+    return vae.tokens_of_codes(cb, cr)[0]

@@ -266,10 +266,15 @@ class SAVAE(nn.Module):
     def encode_tokens(self, x: torch.Tensor) -> torch.Tensor:
         """Normalized canonical features (B, T, D) -> tokens (B, T/4): the base indices, with the
         residual packed in (``motion_codes.pack``) when the codec has one."""
-        _, base = self.encode(x)
-        if not self.has_residual:
+        return self.tokens_of_codes(self.encode(x)[0], self.encode_residual(x)[0] if self.has_residual else None)
+
+    def tokens_of_codes(self, codes: torch.Tensor, residual: torch.Tensor | None = None) -> torch.Tensor:
+        """Base codes (B, N, C) and residual codes (B, N, R) or None -> tokens (B, N): the base
+        indices, the residual's packed in (``motion_codes.pack``) when given."""
+        base = self.quantizer.codes_to_indices(codes.detach())
+        if residual is None:
             return base
-        return pack(base, self.encode_residual(x)[1], self.quantizer.codebook_size)
+        return pack(base, self.residual_quantizer.codes_to_indices(residual.detach()), self.quantizer.codebook_size)
 
     @torch.no_grad()
     def decode_tokens_long(self, tokens: torch.Tensor, betas: torch.Tensor) -> torch.Tensor:
@@ -304,11 +309,16 @@ class SAVAE(nn.Module):
         is the same with one)."""
         return self.decode_chunked(codes, betas, chunk, overlap, residual)
 
+    def chunking(self, chunk: int | None = None, overlap: int = 4) -> tuple[int, int]:
+        """The codes per chunk and the codes two neighbouring chunks share, as ``decode_long`` cuts
+        a sequence (chunks start every chunk - overlap codes)."""
+        chunk = chunk or self.cfg.train.window // self.cfg.downsample
+        return chunk, min(overlap, chunk // 2)  # short training windows give short chunks
+
     def decode_chunked(self, codes: torch.Tensor, betas: torch.Tensor, chunk: int | None = None, overlap: int = 4,
                        residual: torch.Tensor | None = None) -> torch.Tensor:
         """``decode_long`` with gradients (``code_search``)."""
-        chunk = chunk or self.cfg.train.window // self.cfg.downsample
-        overlap = min(overlap, chunk // 2)  # short training windows give short chunks
+        chunk, overlap = self.chunking(chunk, overlap)
         n, up = codes.shape[1], self.cfg.downsample
         if n <= chunk:
             return self.decode(codes, betas, residual)
