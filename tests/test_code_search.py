@@ -64,8 +64,9 @@ def test_loss_of_hand_made_motions():
 
 def test_search_brings_a_real_walk_closer_than_the_encoders(codec, walk, openbody):
     """The shipped codec on a real Bandai walk, decoded on its own body: the searched codes give a
-    smaller root-aligned MPJPE (42.7 -> 38.0 mm when written), a far smaller MPJPE with the root's
-    path (101 -> 47 mm) and no larger bone error than the encoders' codes; the search is deterministic."""
+    smaller root-aligned MPJPE (40.9 -> 37.6 mm when written), a far smaller MPJPE with the root's
+    path (65 -> 43 mm) and a smaller bone error (4.50 -> 3.21 mm) than the encoders' codes; the
+    search is deterministic."""
     from shapemove.core.eval.bones import bone_length_error_mm, mpjpe_mm, target_bone_lengths
     from shapemove.core.generation.retarget import encode_take
 
@@ -76,9 +77,9 @@ def test_search_brings_a_real_walk_closer_than_the_encoders(codec, walk, openbod
     a, b = _decoded(codec, plain, walk["betas"]), _decoded(codec, searched, walk["betas"])
     gt = joints_from_features(walk["shaped"][:len(a)].astype(np.float64))
     assert mpjpe_mm(b, gt, root_aligned=True) < 0.95 * mpjpe_mm(a, gt, root_aligned=True)
-    assert mpjpe_mm(b, gt) < 0.6 * mpjpe_mm(a, gt)
+    assert mpjpe_mm(b, gt) < 0.75 * mpjpe_mm(a, gt)
     bones = target_bone_lengths(openbody, torch.as_tensor(walk["betas"])[None])
-    assert bone_length_error_mm(b, bones) <= bone_length_error_mm(a, bones)
+    assert bone_length_error_mm(b, bones) < 0.85 * bone_length_error_mm(a, bones)
     assert encode_take(codec, walk["norm"], walk["betas"], walk["shaped"]) == searched
 
 

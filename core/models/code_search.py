@@ -38,7 +38,7 @@ from ..motion.features import joints_from_features
 STEPS = 200
 LR = 0.05
 TRAJECTORY_WEIGHT = 0.1
-BONE_WEIGHT = 4.0
+BONE_WEIGHT = 6.0
 VELOCITY_WEIGHT = 0.2
 WINDOW = 256  # tokens searched at once (about 1,024 frames)
 TICK = 10  # steps between progress reports
