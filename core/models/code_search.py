@@ -30,10 +30,10 @@ import math
 import numpy as np
 import torch
 
-from ..body.skeleton import BODY_BONES
 from ..constants import FPS
 from ..errors import ShapeMoveError
 from ..motion.features import joints_from_features
+from .vae_losses import bone_lengths
 
 STEPS = 200
 LR = 0.05
@@ -43,13 +43,6 @@ VELOCITY_WEIGHT = 0.2
 WINDOW = 256  # tokens searched at once (about 1,024 frames)
 TICK = 10  # steps between progress reports
 
-
-_PARENT = [p for p, _ in BODY_BONES]
-_CHILD = [c for _, c in BODY_BONES]
-
-
-def _bones(joints):
-    return (joints[:, _CHILD] - joints[:, _PARENT]).norm(dim=-1)
 
 
 def joint_loss(joints: torch.Tensor, target: torch.Tensor, trajectory_weight: float = TRAJECTORY_WEIGHT,
@@ -63,7 +56,7 @@ def joint_loss(joints: torch.Tensor, target: torch.Tensor, trajectory_weight: fl
     aligned = (joints - joints[:, :1]) - (target - target[:, :1])
     loss = _norm(aligned).mean() + trajectory_weight * _norm(joints - target).mean()
     if bone_weight:
-        loss = loss + bone_weight * (_bones(joints) - _bones(target)).abs().mean()
+        loss = loss + bone_weight * (bone_lengths(joints) - bone_lengths(target)).abs().mean()
     if velocity_weight and len(joints) > 1:
         k = min(FPS, len(joints) - 1)  # the root's horizontal travel over each second (m/s)
         travel = lambda j: (j[k:, 0] - j[:-k, 0])[:, [0, 2]] * (FPS / k)  # noqa: E731
