@@ -132,7 +132,7 @@ def test_default_model_classifier_ceiling_on_real_test_clips():
 
 
 def test_composed_clips_are_left_out_and_reachable_skips_the_same_source(tmp_path):
-    from shapemove.core.eval.action_classifier import source_of
+    from shapemove.core.models.motion_memory import take_of
 
     data = _synthetic_built(tmp_path / "built")
     # a composed "walk, then run" clip right among the walks, and an augmented copy of r1 at r1's angle
@@ -145,7 +145,7 @@ def test_composed_clips_are_left_out_and_reachable_skips_the_same_source(tmp_pat
     (data / "train.txt").write_text((data / "train.txt").read_text() + "comp0_00000\nr1_aug\n")
     clf = ActionClassifier.from_data(None, data, ["walk", "run"], k=3, embed=_embed_first_two, progress=False)
     assert clf.info["clips"] == 7  # w1-3, r1-3, r1_aug; not the composed clip
-    assert source_of("r1_aug") == "r1" and source_of("r1") == "r1"
+    assert take_of("r1_aug") == "r1" and take_of("r1") == "r1"
     assert sorted(clf.sources).count("r1") == 2
     reach = clf.reachable()
     # every clip is classified among the others: walks among walks (3 of 3 right); r1 and r1_aug may not
@@ -186,3 +186,23 @@ def test_a_copied_reference_is_judged_without_its_own_source():
     # clip 0's nearest other reference is clip 1 (same source "a": left out), then clip 3 (walk)
     assert clf.classify_references([0]) == ["walk"]
     assert clf.classify_embeddings(emb[:1]) == ["kick"]
+
+
+def test_reachable_leaves_out_the_mirror_image_of_the_same_take(tmp_path):
+    """A mirror image X_mirror is the same captured take as X: judging X among the references
+    must not find it, or a copied real clip is judged right by its own reflection."""
+    data = _synthetic_built(tmp_path / "built")
+    # a "hop" take and its mirror image right beside the walks: the only hops there are
+    np.save(data / "new_joint_vecs" / "h1.npy", _angle_features(2))
+    np.save(data / "new_joint_vecs" / "h1_mirror.npy", _angle_features(2))
+    with open(data / "meta.jsonl", "a") as fh:
+        for cid in ("h1", "h1_mirror"):
+            fh.write(json.dumps({"id": cid, "split": "train", "labels": {"actions": ["hop"]}}) + "\n")
+    (data / "train.txt").write_text((data / "train.txt").read_text() + "h1\nh1_mirror\n")
+    clf = ActionClassifier.from_data(None, data, ["walk", "run", "hop"], k=1, embed=_embed_first_two, progress=False)
+    assert clf.sources.count("h1") == 2
+    # without its take, each hop's nearest reference is the walk w1 at 0 degrees: never a hop
+    assert clf.reachable()["hop"] == {"n": 2, "accuracy": 0.0}
+    assert clf.classify_references([clf.labels.index("hop")]) == ["walk"]
+    # a motion that is not a copy still finds the hops (nothing is left out)
+    assert clf.classify([_angle_features(2)]) == ["hop"]

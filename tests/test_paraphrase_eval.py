@@ -49,6 +49,10 @@ def test_paraphrase_eval_on_a_tiny_model(tiny_bundle, tmp_path, capsys):  # noqa
     counts = {a: labelled.count(a) for a in set(labelled)}
     assert res["frequent"]["actions"] == sorted({r["action"] for r in rows if counts.get(r["action"], 0) >= 20})
     assert "nearest caption (MiniLM) copied" in out
+    # what a perfect generator could score on the frequent actions' prompts, by each judge
+    fr = res["frequent"]
+    assert set(fr["reachable"]) == set(res["reachable"]) and all(v is None or 0 <= v <= 1 for v in fr["reachable"].values())
+    assert (fr["reachable"]["motion"] is None) == (fr["motion"]["prompts"] == 0)
 
 
 def test_bad_prompt_files(tmp_path):

@@ -100,3 +100,54 @@ def test_bad_input_is_refused(tiny_dataset):
         side_of(load_joints(tiny_dataset, WAVE_LEFT), "elbow")
     with pytest.raises(ShapeMoveError, match="not a built dataset"):
         PartJudge.from_data(tiny_dataset / "meta")
+
+
+def test_leave_one_out_reads_each_reference_without_its_own_take():
+    """A class of one captured take is never read right once that take is left out; a clip and
+    its source's own mirrored take (``m``, ``m_mirror``) are one take."""
+    from shapemove.core.eval.part_judge import PartKNN, best
+
+    # each reference clip is followed by its mirror image (the judge's layout): same source
+    pos = [0.0, 0.1, 0.05, 0.15, 1.0, 1.1, 2.0, 2.0, 2.05, 2.05]
+    labels = ["a"] * 4 + ["b"] * 2 + ["c"] * 4
+    sources = ["a1", "a1", "a2", "a2", "b1", "b1", "m", "m", "m_mirror", "m_mirror"]
+    knn = PartKNN([{"g": np.array([p])} for p in pos], labels, sources, describe=None, k=1)
+
+    class Judge:
+        legs = arms = knn
+
+    loo = leave_one_out(Judge())["legs"]["per_class"]
+    assert loo["a"] == {"n": 2, "accuracy": 1.0, "takes": 2}    # a1 finds a2, and back
+    assert loo["b"] == {"n": 1, "accuracy": 0.0, "takes": 1}    # b1 alone: its nearest other is an "a"
+    assert loo["c"] == {"n": 2, "accuracy": 0.0, "takes": 1}    # m without m_mirror (one take): a "b"
+    # judged with every reference (a motion that is no copy), each point reads as its own class
+    assert [best(knn.scores_of(x)) for x in knn.X] == labels
+
+
+def test_reachable_parts_averages_the_expected_classes_of_the_prompts():
+    from shapemove.core.eval.parts_eval import reachable_parts
+
+    reach = {"legs": {"per_class": {"walk": {"accuracy": 0.9}, "march": {"accuracy": 0.0}}},
+             "arms": {"per_class": {"wave": {"accuracy": 1.0}, "punch": {"accuracy": 0.5}}}}
+    items = [{"legs": "walk in a circle", "arms": "wave goodbye"}, {"legs": "march", "arms": "punch"},
+             {"legs": "walk", "arms": "beckon"}]   # beckon: no reference at all, 0
+    out = reachable_parts(reach, items)["two_things"]
+    assert out["legs"] == pytest.approx((0.9 + 0.0 + 0.9) / 3)
+    assert out["arms"] == pytest.approx((1.0 + 0.5 + 0.0) / 3)
+    assert out["both"] == pytest.approx((0.9 * 1.0 + 0.0 + 0.0) / 3)
+
+
+def test_format_results_names_what_copies_could_score():
+    from shapemove.core.eval.parts_eval import TARGETS, format_results, reachable_parts
+
+    loo = {"legs": {"per_class": {"walk": {"accuracy": 0.9, "takes": 150}, "march": {"accuracy": 0.0, "takes": 1}}},
+           "arms": {"per_class": {"wave": {"accuracy": 1.0, "takes": 150}}}}
+    res = {"sides": {"named_side_moves_most": 1.0, "prompts": 1, "per_part": {"hand": {"right": 1.0, "n": 1}}},
+           "two_things": {"both": 0.0, "legs": 0.5, "arms": 1.0, "prompts": 2, "per_pair": {}},
+           "targets": TARGETS, "judge_real": None,
+           "reachable": reachable_parts(loo, [{"legs": "walk", "arms": "wave"}, {"legs": "march", "arms": "wave"}]),
+           "settings": {"seed": 0, "seconds": 4.0, "candidates": 8, "retrieval": "on"},
+           "rows": {"sides": [], "two_things": []}}
+    text = format_results(res)
+    assert "could score: legs 45.0%, arms 100.0%, both 45.0%" in text
+    assert "march 0.0% (1 take)" in text and "walk" not in text.split("this way:")[1]

@@ -16,8 +16,10 @@ classification of motions is much weaker (``paraphrase_eval`` still reports it, 
 main action) and lenient (any of its ``labels.actions``), overall and per action. Held-out test
 clips are mostly of the frequent actions, so ``reachable`` also asks, per action, how often a NEW
 performance of it is named right: each training clip classified among the other training clips
-without itself and its shape-augmented copies (same source, ids ``X`` and ``X_aug``). Actions with
-one to five clips are rarely reachable by a 5-NN vote however good the generator is.
+without its captured take (``motion_memory.take_of``: ``X``, its mirror image ``X_mirror`` and
+shape-augmented copies ``X_aug``), as a copied real clip is judged (``classify_references``) and as
+a generated motion is judged without the retrieved clips it kept. Actions with one to five takes
+are rarely reachable by a 5-NN vote however good the generator is.
 
 Composed "A, then B" clips (``labels.sequence``) are left out of the reference set: they hold two
 actions, so neither label describes them.
@@ -171,11 +173,6 @@ def score(preds: list[str], label_lists: list[list[str]]) -> dict:
                            for a, d in sorted(per.items())}}
 
 
-def source_of(cid: str) -> str:
-    """The captured clip a built clip comes from: a shape-augmented copy ``X_aug`` is ``X``."""
-    return cid[:-4] if cid.endswith("_aug") else cid
-
-
 class FeatureEmbedder:
     """Unit vectors of raw (T, 263) features without any learned model: the features normalized
     with the dataset's Mean/Std, then their mean and std over time and the means of the four
@@ -249,7 +246,9 @@ class ActionClassifier:
                                  f"{FEATURES}/ features")
         main = [a[0] for a in labels]
         gone = set(skipped)
-        sources = [source_of(cid) for cid, _ in clips if cid not in gone]
+        from ..models.motion_memory import take_of
+
+        sources = [take_of(cid) for cid, _ in clips if cid not in gone]
         ids = [cid for cid, _ in clips if cid not in gone]
         info = {"kind": f"{k}-nearest training clips in TMA motion space", "k": k, "data": str(data),
                 "split": split, "clips": len(main), "skipped_without_features": len(skipped),
@@ -282,8 +281,8 @@ class ActionClassifier:
 
     def reachable(self, chunk: int = 512) -> dict:
         """Per action, the share of its reference clips named right when each is classified among
-        the others without its own source (the clip and its augmented copies): how often a new
-        performance of the action can be judged right. {action: {"n", "accuracy"}}."""
+        the others without its own take (the clip, its mirror image and augmented copies): how often
+        a new performance of the action can be judged right. {action: {"n", "accuracy"}}."""
         src = np.asarray(self.sources)
         preds: list[str] = []
         for s in range(0, len(self.labels), chunk):
@@ -298,7 +297,7 @@ class ActionClassifier:
         return {a: {"n": d["n"], "accuracy": d["right"] / d["n"]} for a, d in sorted(out.items())}
 
     def classify_references(self, index: list[int]) -> list[str]:
-        """Action of reference clips ``index`` each judged among the others without its own source
+        """Action of reference clips ``index`` each judged among the others without its own take
         (as ``reachable`` does): how a copied real clip is judged, without finding itself."""
         src = np.asarray(self.sources)
         if not len(index):

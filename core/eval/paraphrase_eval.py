@@ -21,7 +21,7 @@ the model generates a motion, and its action is read three ways:
   similarity (``generation/rerank.py``), and this judge cannot be flattered by that choice.
 
 ``reachable`` is what a perfect generator could score on these prompts under each classifier: the
-mean over the prompts of their action's leave-one-source-out accuracy on the training clips
+mean over the prompts of their action's leave-one-take-out accuracy on the training clips
 (``ActionClassifier.reachable``; 0 for an action that is no clip's main action).
 
 Each strict (the expected action) and lenient (also one of "also"), per action and overall, over
@@ -186,6 +186,7 @@ def eval_paraphrase(model_dir=None, prompts=None, tma=None, seed: int = 0, secon
             **({"nearest_caption": _tally(rows, "nearest_caption_pred")} if nearest else {}),
             "frequent": {"min_clips": frequent, "actions": sorted({r["action"] for r in often}),
                          "motion": _tally(often, "motion_pred"),
+                         "reachable": {k: _reachable(c, often) for k, c in clfs.items() if c is not None},
                          **({"nearest_caption": _tally(often, "nearest_caption_pred")} if nearest else {})},
             "retrieval": bool(retrieval and gen.reads_memory),
             "candidates": candidates,
@@ -229,7 +230,7 @@ def nearest_caption_baseline(classifier, data, rows: list[dict], gen) -> bool:
 
 
 def _reachable(classifier, rows: list[dict]) -> float | None:
-    """Mean over the prompts of their action's leave-one-source-out accuracy (0 without clips)."""
+    """Mean over the prompts of their action's leave-one-take-out accuracy (0 without clips)."""
     if not rows:
         return None
     per = classifier.reachable()
@@ -267,7 +268,7 @@ def format_results(res: dict) -> str:
                      f"({_pct(res['motion_features']['accuracy_lenient'])} lenient)")
     reach = res.get("reachable") or {}
     if reach:
-        lines.append("reachable (a perfect generator, each prompt's action judged by leave-one-source-out on the "
+        lines.append("reachable (a perfect generator, each prompt's action judged by leave-one-take-out on the "
                      "training clips): " + ", ".join(f"{k} {_pct(v)}" for k, v in reach.items()))
     if res.get("nearest_caption"):
         lines.append(f"no generation, the real clip with the nearest caption (MiniLM) copied and judged the same "
@@ -276,7 +277,9 @@ def format_results(res: dict) -> str:
     if fr.get("motion"):
         lines.append(f"actions with >= {fr['min_clips']} real training clips ({fr['motion']['prompts']} prompts): motion "
                      f"{_pct(fr['motion']['accuracy'])} ({_pct(fr['motion']['accuracy_lenient'])} lenient)"
-                     + (f", nearest caption {_pct(fr['nearest_caption']['accuracy'])}" if fr.get("nearest_caption") else ""))
+                     + (f", nearest caption {_pct(fr['nearest_caption']['accuracy'])}" if fr.get("nearest_caption") else "")
+                     + (", reachable " + ", ".join(f"{k} {_pct(v)}" for k, v in fr["reachable"].items())
+                        if fr.get("reachable") else ""))
     lines.append(f"retrieved clips read by the decoder: {'yes' if res.get('retrieval') else 'no'}; real clips "
                  f"retrieved as candidates: {res.get('retrieved', 0)} per prompt"
                  + (f", alone from caption similarity {res['retrieval_first']:g}" if res.get("retrieval_first") else "")

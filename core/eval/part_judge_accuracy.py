@@ -12,7 +12,7 @@
   mirror image of each (``data/mirror.py``, the other side), judged by ``side_of`` on the named part.
 
 Each as {"accuracy", "n", "per_class": {label: {"n", "accuracy"}}, "confusion": {label: {pred: n}}}.
-``leave_one_out(judge)`` is the same on the judge's own references, each without its own clip.
+``leave_one_out(judge)`` is the same on the judge's own references, each without its own take.
 """
 from __future__ import annotations
 
@@ -90,12 +90,22 @@ def real_accuracy(judge, data, split: str = "test", max_clips: int | None = None
 
 
 def leave_one_out(judge) -> dict:
-    """Each reference classified among the others without its own clip (nor its mirror)."""
+    """Each reference clip classified among the others without its captured take
+    (``motion_memory.take_of``: the clip, its mirror image, a source's own mirrored take such as
+    DeepMimic's ``*_mirror``), as a copied memory clip is judged: how often a real performance of a
+    class is read right when it is not one of the references. ``tally`` per part, each class also
+    with its number of takes (a class of one take is never read right this way)."""
+    from ..models.motion_memory import take_of
+
     out = {}
     for name, knn in (("legs", judge.legs), ("arms", judge.arms)):
+        takes = np.asarray([take_of(str(s)) for s in knn.sources])
         pairs = []
         for i in range(0, len(knn.labels), 2):  # the clip itself; its mirror follows it
-            pairs.append((str(knn.labels[i]), best(knn.scores_of(knn.X[i], knn.sources[i]))))
+            away = sorted(set(knn.sources[takes == takes[i]]))
+            pairs.append((str(knn.labels[i]), best(knn.scores_of(knn.X[i], away))))
         out[name] = tally(pairs)
+        for c, v in out[name]["per_class"].items():
+            v["takes"] = len(set(takes[knn.labels == c]))
     return out
 
