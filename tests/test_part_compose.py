@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 from shapemove.core.errors import ShapeMoveError
-from shapemove.core.generation.part_compose import (ARM_JOINTS, CHEST, chest_frames, compose_arms, mirror_track,
-                                                     needs_mirror, side_activity)
+from shapemove.core.generation.part_compose import (ARM_JOINTS, CHEST, GIRDLE, LIMBS, chest_frames, compose_arms,
+                                                     heading_frames, mirror_track, needs_mirror, side_activity)
 
 pytestmark = pytest.mark.usefixtures("one_thread")
 
@@ -32,19 +32,44 @@ def _turn(j: np.ndarray, deg: float, shift) -> np.ndarray:
     return j @ R.T + np.asarray(shift)
 
 
-def test_compose_keeps_the_legs_and_carries_the_arms_in_the_chest_frame():
+def test_compose_keeps_the_legs_girdle_in_the_chest_frame_limbs_in_the_heading_frame():
     legs, arms = _track(0), _track(1)
     out = compose_arms(legs, arms)
     other = [i for i in range(22) if i not in ARM_JOINTS]
     assert np.array_equal(out[:, other], legs[:, other])
-    # the arms relative to the chest, in the chest's frame, are the arms track's own
-    rel = lambda j: np.einsum("tji,tkj->tki", chest_frames(j), j[:, ARM_JOINTS] - j[:, CHEST:CHEST + 1])  # noqa: E731
-    got = np.einsum("tji,tkj->tki", chest_frames(legs), out[:, ARM_JOINTS] - out[:, CHEST:CHEST + 1])
-    assert np.allclose(got, rel(arms), atol=1e-9)
+    # collars and shoulders relative to the chest, in the chest's frame, are the arms track's own
+    rel = lambda j, idx: np.einsum("tji,tkj->tki", chest_frames(j), j[:, idx] - j[:, CHEST:CHEST + 1])  # noqa: E731
+    assert np.allclose(rel(out, GIRDLE), rel(arms, GIRDLE), atol=1e-9)
+    # each upper arm and forearm keeps its direction in the heading frame, and its length
+    for joint, parent in LIMBS:
+        seg = lambda j: np.einsum("tji,tj->ti", heading_frames(j), j[:, joint] - j[:, parent])  # noqa: E731
+        got = np.einsum("tji,tj->ti", heading_frames(legs), out[:, joint] - out[:, parent])
+        assert np.allclose(got, seg(arms), atol=1e-9)
     # where the arms track stands and which way it faces does not matter
     assert np.allclose(compose_arms(legs, _turn(arms, 73.0, [3.0, 0.2, -1.0])), out, atol=1e-9)
     # a track composed with itself is itself
     assert np.allclose(compose_arms(legs, legs), legs, atol=1e-9)
+
+
+def test_a_raised_hand_stays_raised_on_a_body_leaning_forward():
+    """Hand-derived: the arms track stands upright with the left arm straight up; the legs track
+    is the same body leaning 30 degrees forward (a runner). The composed left elbow and wrist are
+    straight above the shoulder (world vertical); carried in the chest's frame they tipped 30
+    degrees forward with the torso."""
+    T = 12
+    stand = np.repeat(_track(0, 1)[:1], T, axis=0)
+    stand[..., 2] = 0.0                                      # a flat body in the x-y plane, facing +Z
+    stand[:, [13, 14, 16, 17, 18, 19, 20, 21], 1] = 1.4     # collars, shoulders, elbows, wrists level
+    stand[:, 16, 0], stand[:, 18, 0], stand[:, 20, 0] = 0.2, 0.2, 0.2
+    stand[:, 18, 1], stand[:, 20, 1] = 1.7, 2.0             # left upper arm and forearm straight up
+    a = np.radians(30.0)
+    R = np.array([[1, 0, 0], [0, np.cos(a), -np.sin(a)], [0, np.sin(a), np.cos(a)]])  # lean toward +Z
+    lean = (stand - stand[:, :1]) @ R.T + stand[:, :1]
+    out = compose_arms(lean, stand)
+    up = out[:, 20] - out[:, 16]
+    assert np.allclose(up[:, [0, 2]], 0.0, atol=1e-9) and np.allclose(up[:, 1], 0.6, atol=1e-9)
+    # the left shoulder rides the leaning chest: where the leaning body's own shoulder is
+    assert np.allclose(out[:, 16], lean[:, 16], atol=1e-9)
 
 
 def test_compose_refuses_tracks_of_different_lengths():
