@@ -33,6 +33,22 @@ def motion_bounds(scene, rig, samples: int = 12) -> tuple[np.ndarray, np.ndarray
     return lo, hi
 
 
+def framing_distance(lo, hi, view, tan_w: float, tan_h: float, margin: float = 1.15, least: float = 0.5) -> float:
+    """How far from the centre of the box ``lo``-``hi`` (3,) a camera looking at that centre along
+    the unit ``view`` (up: the world's +Z) must stand so that all 8 corners of the box are inside
+    its field of view (tangents of the half angles ``tan_w``, ``tan_h``) shrunk by ``margin``. A
+    motion toward the camera makes its near corners large in the picture: each corner is fitted at
+    its own depth, not the centre's."""
+    lo, hi, view = (np.asarray(v, np.float64) for v in (lo, hi, view))
+    right = np.cross(view, [0.0, 0.0, 1.0])
+    right /= np.linalg.norm(right)
+    up = np.cross(right, view)
+    centre = (lo + hi) / 2
+    corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])]) - centre
+    need = np.maximum(np.abs(corners @ right) * margin / tan_w, np.abs(corners @ up) * margin / tan_h) - corners @ view
+    return float(max(need.max(), least))
+
+
 def add_preview_stage(context, rig, resolution=(320, 240), lens: float = 50.0):
     """Camera in front of the body (it faces -Y) framing the motion's bounds, a ground plane under
     the lowest vertex, Workbench with the body and ground in flat distinct colours. Returns the camera."""
@@ -55,15 +71,14 @@ def add_preview_stage(context, rig, resolution=(320, 240), lens: float = 50.0):
     scene.collection.objects.link(cam)
     scene.render.resolution_x, scene.render.resolution_y = resolution
     scene.render.resolution_percentage = 100
-    # distance so the bounds (with 15 % margin) fit both field-of-view directions
     # sensor fit AUTO: the sensor width spans the longer image side
     aspect = resolution[0] / resolution[1]
     half_long = cam_data.sensor_width / (2 * lens)  # tan(half field of view) along the longer side
     tan_w, tan_h = (half_long, half_long / aspect) if aspect >= 1 else (half_long * aspect, half_long)
-    need_w, need_h = 1.15 * max(size[0], 0.5), 1.15 * max(size[2], 0.5)
-    dist = max(need_w / 2 / tan_w, need_h / 2 / tan_h) + size[1] / 2
     elevation = math.radians(10)
-    cam.location = Vector((centre[0], centre[1] - dist * math.cos(elevation), centre[2] + dist * math.sin(elevation)))
+    view = np.array([0.0, math.cos(elevation), -math.sin(elevation)])   # looking along +Y, a little down
+    dist = framing_distance(lo, hi, view, tan_w, tan_h)
+    cam.location = Vector((centre - dist * view).tolist())
     cam.rotation_euler = (Vector(centre.tolist()) - cam.location).to_track_quat("-Z", "Y").to_euler()
     scene.camera = cam
 

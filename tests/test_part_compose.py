@@ -134,6 +134,18 @@ def test_two_things_at_once_are_composed_and_redecode_as_themselves(gen, tmp_pat
     assert plain.arms_tokens is None and plain.part_prompts is None
 
 
+def test_captured_clips_left_to_the_model_last_at_least_four_seconds(gen):
+    """The README's demo prompt, no length asked: its jog comes from a captured clip of 8 codes
+    (a 1.6 s DeepMimic jog cycle), which is played again to 4 s instead of delivered as 1.6 s."""
+    from shapemove.core.generation.action_clips import UNASKED_SECONDS
+    from shapemove.core.generation.generate import Request
+
+    m = gen.generate_batch([Request("a person jogs forward and waves", seed=0)])[0]
+    assert m.part_prompts == ("a person jogs forward", "a person waves") and m.retrieved_clips
+    assert len(m.tokens) == len(m.arms_tokens) == round(UNASKED_SECONDS * 20 / 4) == 20
+    assert len(m.joints) == 80
+
+
 def test_a_named_side_moves_most(gen):
     from shapemove.core.generation.generate import Request
 

@@ -17,6 +17,8 @@ the filter and the caption similarity the order:
   (``retrieved_candidates.windows``); a shorter one (HDM05's throws and arm circles last 1-2 s) is
   played again until the length is filled, as a captured gesture repeated (measured on the tuning
   two-things prompts against letting the T5 continue the clip: arms right 50.0 % against 46.9 %).
+  When the request leaves the length to the model, it is at least ``UNASKED_SECONDS``: a 1.6 s
+  jog cycle is played again to 4 s rather than delivered as 1.6 s of jogging.
 
 The parts of a two-things prompt name their actions (``parts.py``: the planner's reading), so
 they take this path. A whole prompt of one rare action does not (measured on the tuning
@@ -36,6 +38,7 @@ from .retrieved_candidates import windows
 
 ACTION_CLIPS = 3   # clips of the action offered to the TMA
 POOL = 2           # drawn from the POOL x ACTION_CLIPS nearest
+UNASKED_SECONDS = 4.0  # the least a motion of captured clips lasts when the request gives no length
 
 
 def action_clips(memory, reader, prompt: str, action: str, count: int, seed: int, min_codes: int,

@@ -27,7 +27,7 @@ from ..models.shapemove_t5 import NULL_PROMPT, ShapeMoveT5
 from ..models.text_encoder import load_text_encoder
 from ..scene.motion_file import Motion
 from ..torch_threads import one_torch_thread
-from .action_clips import ACTION_CLIPS, action_clips
+from .action_clips import ACTION_CLIPS, UNASKED_SECONDS, action_clips
 from .circle_walk import CIRCLE, circle_motion, names_circle
 from .decode import decode_features, decode_tokens, redecode
 from .model_bundle import model_files, part_warnings, resolve_model_dir
@@ -203,6 +203,8 @@ class Generator:
         one, the model folder has a memory and retrieval is on."""
         if not r.action or self.t5.memory is None or not self.t5.memory_enabled:
             return []
+        if r.seconds is None:  # the model decides: no shorter than UNASKED_SECONDS of captured motion
+            lo = max(lo, min(hi, self._length(UNASKED_SECONDS)[0]))
         return action_clips(self.t5.memory, self._text_encoder(), r.prompt, r.action, ACTION_CLIPS, r.seed, lo, hi)
 
     def _from_action_clips(self, r: Request, found):
