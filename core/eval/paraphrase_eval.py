@@ -178,7 +178,8 @@ def eval_paraphrase(model_dir=None, prompts=None, tma=None, seed: int = 0, secon
         counts[a] = counts.get(a, 0) + 1
     often = [r for r in rows if counts.get(r["action"], 0) >= frequent]
     clfs = {"motion": classifier, "motion_features": feature_classifier}
-    reach = {k: _reachable(c, rows) for k, c in clfs.items() if c is not None}
+    per_action = {k: c.reachable() for k, c in clfs.items() if c is not None}   # one leave-one-take-out pass each
+    reach = {k: _reachable(per, rows) for k, per in per_action.items()}
     return {"motion": _tally(rows, "motion_pred"), "text": _tally(rows, "text_pred"),
             "motion_vs_text_prototypes": _tally(rows, "motion_proto_pred"),
             **({"motion_features": _tally(rows, "motion_features_pred")} if feature_classifier is not None else {}),
@@ -186,7 +187,7 @@ def eval_paraphrase(model_dir=None, prompts=None, tma=None, seed: int = 0, secon
             **({"nearest_caption": _tally(rows, "nearest_caption_pred")} if nearest else {}),
             "frequent": {"min_clips": frequent, "actions": sorted({r["action"] for r in often}),
                          "motion": _tally(often, "motion_pred"),
-                         "reachable": {k: _reachable(c, often) for k, c in clfs.items() if c is not None},
+                         "reachable": {k: _reachable(per, often) for k, per in per_action.items()},
                          **({"nearest_caption": _tally(often, "nearest_caption_pred")} if nearest else {})},
             "retrieval": bool(retrieval and gen.reads_memory),
             "candidates": candidates,
@@ -229,12 +230,12 @@ def nearest_caption_baseline(classifier, data, rows: list[dict], gen) -> bool:
     return True
 
 
-def _reachable(classifier, rows: list[dict]) -> float | None:
-    """Mean over the prompts of their action's leave-one-take-out accuracy (0 without clips)."""
+def _reachable(per_action: dict, rows: list[dict]) -> float | None:
+    """Mean over the prompts of their action's leave-one-take-out accuracy (``ActionClassifier.reachable``
+    as ``per_action``; 0 without clips)."""
     if not rows:
         return None
-    per = classifier.reachable()
-    return float(np.mean([per.get(r["action"], {}).get("accuracy", 0.0) for r in rows]))
+    return float(np.mean([per_action.get(r["action"], {}).get("accuracy", 0.0) for r in rows]))
 
 
 def _pct(v, digits: int = 1) -> str:

@@ -173,12 +173,11 @@ def eval_parts(model_dir=None, data=None, sides=None, two_things=None, seed: int
 
 def reachable_parts(reach: dict, two_items: list[dict]) -> dict:
     """``leave_one_out`` of the judge, and for the two-things prompts the mean over them of the
-    expected legs and arms classes' reach (``walk in a circle``: the walk's; a gesture judged as
-    another, ``wave goodbye``: as that one) and of their product (both)."""
-    from .part_judge import CIRCLE, SAME_MOTION
+    expected legs and arms classes' reach (the judge's own classes: ``walk in a circle`` is a walk,
+    ``legs_label``; ``wave goodbye`` is judged as a wave) and of their product (both)."""
+    from .part_judge import SAME_MOTION, legs_label
 
-    legs = [reach["legs"]["per_class"].get("walk" if it["legs"] == CIRCLE else it["legs"], {}).get("accuracy", 0.0)
-            for it in two_items]
+    legs = [reach["legs"]["per_class"].get(legs_label([it["legs"]]), {}).get("accuracy", 0.0) for it in two_items]
     arms = [reach["arms"]["per_class"].get(SAME_MOTION.get(it["arms"], it["arms"]), {}).get("accuracy", 0.0)
             for it in two_items]
     mean = lambda v: sum(v) / len(v) if v else None  # noqa: E731

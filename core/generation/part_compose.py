@@ -62,12 +62,12 @@ def chest_frames(joints) -> np.ndarray:
     return np.stack([left, up, fwd], axis=-1)
 
 
-def heading_frames(joints) -> np.ndarray:
+def heading_frames(joints, chest: np.ndarray | None = None) -> np.ndarray:
     """(T,3,3) frames columns (left, up, forward) with up the world's vertical (+Y) and left the
     collars' left-right on the floor: the body's heading, not its lean. Where the collar line is
-    within ~12 degrees of vertical (a body on its side) the chest's own frame stands in."""
-    j = _check(joints, "heading frames")
-    chest = chest_frames(j)
+    within ~12 degrees of vertical (a body on its side) the chest's own frame stands in.
+    ``chest``: the joints' ``chest_frames`` when already computed."""
+    chest = chest_frames(joints) if chest is None else chest
     left = chest[:, :, 0].copy()
     left[:, 1] = 0.0
     n = np.linalg.norm(left, axis=-1, keepdims=True)
@@ -93,7 +93,7 @@ def compose_arms(legs_joints, arms_joints) -> np.ndarray:
     rel = b[:, GIRDLE] - b[:, CHEST:CHEST + 1]                             # (T,4,3) world, about b's chest
     local = np.einsum("tji,tkj->tki", rb, rel)                              # in b's chest frame: R_b^T p
     out[:, GIRDLE] = a[:, CHEST:CHEST + 1] + np.einsum("tij,tkj->tki", ra, local)
-    ha, hb = heading_frames(a), heading_frames(b)
+    ha, hb = heading_frames(a, ra), heading_frames(b, rb)
     for joint, parent in LIMBS:   # parents first: each segment hangs from its already placed parent
         seg = np.einsum("tji,tj->ti", hb, b[:, joint] - b[:, parent])      # in b's heading frame
         out[:, joint] = out[:, parent] + np.einsum("tij,tj->ti", ha, seg)
