@@ -261,3 +261,121 @@ def test_head_training_words_leave_the_evaluation_words_out():
     checked = {"grandmother", "powerlifter", "nurse", "linebacker", "lumberjack", "ballerina", "schoolgirl",
                "basketball player", "heavyweight boxer", "gymnast", "hulking", "burly", "frail", "stout"}
     assert not {w for w in added if any(c in w for c in checked)}
+
+
+def test_the_pool_draws_teenagers_and_tall_women_when_asked(openbody):
+    """``teen_share`` draws that share at 14-19 years (the map extrapolated below its 18, as the parser
+    does for "teenage"); ``height_margin`` widens the height slider past its range, so tall women and
+    short men are drawn. With neither, the draw is the dataset builder's, number for number."""
+    from shapemove.core.body.phenotype_sample import TEEN_AGES, sample_phenotypes
+
+    pmap = openbody.phenotype_map
+    names = list(pmap.names)
+    age, height = names.index("age"), names.index("height")
+    plain = sample_phenotypes(pmap, np.random.default_rng(4), 4000)
+    assert np.array_equal(plain, sample_phenotypes(pmap, np.random.default_rng(4), 4000, 0.0, 0.0))
+    assert plain[:, age].min() >= 18.0 and (plain[:, age] < 20).mean() < 0.05
+    wide = sample_phenotypes(pmap, np.random.default_rng(4), 4000, teen_share=0.25, height_margin=0.2)
+    teen = wide[:, age] < TEEN_AGES[1]
+    assert 0.24 < teen.mean() < 0.31   # 25 % drawn as teenagers + the 3 % of 18-19s of the uniform draw
+    assert wide[:, age].min() >= TEEN_AGES[0] and (wide[:, age] < 18).mean() > 0.15
+    lo, hi = pmap.ranges[height]
+    span = 0.2 * (hi - lo)
+    assert wide[:, height].min() >= lo - span and wide[:, height].max() <= hi + span
+    assert (wide[:, height] > hi).mean() > 0.08 and (wide[:, height] < lo).mean() > 0.08
+
+
+def test_stated_texts_say_an_age_with_any_noun():
+    """A teenager is also "a teenage woman" or "a guy in his teens", not only "a girl" or "a boy", so the
+    head learns the age words apart from the nouns that usually carry them."""
+    from shapemove.core.data.phenotype_captions import decade_words
+    from shapemove.core.train.beta_head_refit import stated_text
+
+    assert [decade_words(a) for a in (14, 19.9, 20, 47, 72, 80, 95)] == [
+        "teens", "teens", "twenties", "forties", "seventies", "eighties", "eighties"]
+    teen = {"gender": 0.95, "age": 16.0, "muscle": 0.4, "weight": 0.4}
+    texts = [stated_text(teen, {"height_cm": 160.0, "mass_kg": 52.0}, f"k{i}").lower() for i in range(400)]
+    adult_nouns = ("woman", "lady", "mom", "aunt", "daughter", "girlfriend", "madam")
+    said = [t for t in texts if any(w in t for w in ("teenage", "adolescent", "in her teens"))]
+    assert any(any(n in t for n in adult_nouns) for t in said), said[:10]
+    assert any("in her teens" in t for t in texts)
+    assert not any(" he " in f" {t} " or "his " in t for t in texts)   # her, never his
+
+
+def test_a_head_that_meets_its_sizes_lands_the_mesh_on_them(openbody):
+    """``meet`` moves betas along the height and weight sliders until the rest mesh measures the
+    height and mass asked; checked with ``fast_measure`` (the mesh's top minus bottom vertex, its
+    volume x density), not with the head's own arrays. Saved and loaded, the head meets them the same."""
+    from shapemove.core.body.shape_from_measurements import fast_measure
+    from shapemove.core.models.beta_head import build_head
+    from shapemove.core.train.beta_head_refit import Readback
+
+    config = {"kind": "text", "hidden": 32, "width": 32, "queries": 2, "heads": 2, "sliders": 6, "numbers": 6,
+              "meets": 1}
+    torch.manual_seed(0)
+    head = build_head(config, 16, openbody.phenotype_map, Readback(openbody).size_model())
+    start = torch.tensor(np.random.default_rng(0).normal(size=(5, 10)).clip(-1.5, 1.5), dtype=torch.float32)
+    target = torch.tensor([[180.0, 80.0], [150.0, 45.0], [195.0, 120.0], [165.0, 60.0], [172.0, 95.0]])
+    before = fast_measure(openbody, start.numpy(), ("height_cm", "mass_kg"))
+    assert np.abs(before - target.numpy()).max() > 20
+    met = head.meet(start, target)
+    after = fast_measure(openbody, met.numpy(), ("height_cm", "mass_kg"))
+    assert np.abs(after - target.numpy()).max() < 0.05
+    # only the height and weight sliders moved: the others read back as before
+    pmap = openbody.phenotype_map
+    keep = [i for i, n in enumerate(pmap.names) if n not in ("height", "weight")]
+    p0 = np.stack([np.linalg.lstsq(pmap.matrix.T, b - pmap.intercept, rcond=None)[0] for b in start.numpy()])
+    p1 = np.stack([np.linalg.lstsq(pmap.matrix.T, b - pmap.intercept, rcond=None)[0] for b in met.numpy()])
+    assert np.abs(p0[:, keep] - p1[:, keep]).max() < 1e-3
+    loaded = build_head(head.config(), 16)
+    loaded.load_state_dict(head.state_dict())
+    assert torch.allclose(loaded.meet(start, target), met, atol=1e-4)
+    h, text = torch.randn(2, 16), torch.randn(2, 4, 384)
+    mask, numbers = torch.ones(2, 4, dtype=torch.bool), torch.zeros(2, 4, 6)
+    with torch.no_grad():
+        betas = loaded(h, text, mask, numbers)
+        loaded.reading_sizes = True
+        raw, said = loaded(h, text, mask, numbers)
+    sizes = fast_measure(openbody, betas.numpy(), ("height_cm", "mass_kg"))
+    assert np.abs(sizes - said.numpy()).max() < 0.05   # the body is the size the head read
+    assert not torch.allclose(raw, betas)
+
+
+def test_train_head_trains_a_head_that_reads_numbers_and_meets_them(tiny_bundle, tmp_path):
+    from shapemove.core.models.shapemove_t5 import ShapeMoveT5
+    from shapemove.core.train.train_head import HeadTrainConfig, train_head
+
+    model_dir, data = tiny_bundle
+    c = HeadTrainConfig.tiny()
+    c.head = {**c.head, "numbers": 6, "meets": 1}
+    res = train_head(model_dir, data, tmp_path / "run", c, verbose=False)
+    assert res["step"] == c.steps
+    t5, reader = ShapeMoveT5.load(tmp_path / "run" / "model" / "t5")
+    assert t5.info["beta_head"]["meets"] == 1 and t5.beta_head.reads_numbers
+    betas = t5.predict_betas(t5.inputs_for(reader, ["a person walks."] * 2, ["a man, 180 cm, 80 kg", None]))
+    assert betas.shape == (2, 10) and torch.isfinite(betas).all()
+
+
+def test_a_pointing_head_leaves_a_body_described_in_words_alone(openbody):
+    """meets 2: with no number in the text the body keeps its own size (``meet`` is a no-op); with a
+    number pointed at, the mesh measures what it states."""
+    from shapemove.core.body.shape_from_measurements import fast_measure
+    from shapemove.core.models.beta_head import build_head
+    from shapemove.core.train.beta_head_refit import Readback
+
+    torch.manual_seed(1)
+    head = build_head({"kind": "text", "hidden": 32, "width": 32, "queries": 2, "heads": 2, "sliders": 6,
+                       "numbers": 6, "meets": 2}, 16, openbody.phenotype_map, Readback(openbody).size_model())
+    h, text, mask = torch.randn(2, 16), torch.randn(2, 4, 384), torch.ones(2, 4, dtype=torch.bool)
+    numbers = torch.zeros(2, 4, 6)
+    numbers[1, 2] = torch.tensor([1.0, 0.0, 0.0, 1.80, 0.0, 0.0])   # "180" in the second text
+    with torch.no_grad():
+        head.pointer.weight.zero_()
+        head.pointer.bias.copy_(torch.tensor([30.0, -30.0, 0.0, 0.0]))   # the number is a height in cm
+        betas = head(h, text, mask, numbers)
+        head.reading_sizes = True
+        raw, said = head(h, text, mask, numbers)
+    assert torch.allclose(betas[0], raw[0], atol=1e-4)          # words only: untouched
+    sizes = fast_measure(openbody, betas.numpy(), ("height_cm", "mass_kg"))
+    own = fast_measure(openbody, raw.numpy(), ("height_cm", "mass_kg"))
+    assert abs(sizes[1, 0] - 180.0) < 0.05 and abs(sizes[1, 1] - own[1, 1]) < 0.05   # height met, mass kept

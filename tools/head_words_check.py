@@ -1,6 +1,6 @@
 """Free text the shape-word parser does not cover, read by the `[BETA]` head alone (issue #25 part 3).
 
-    python tools/head_words_check.py --model weights/default --model runs/head_a/model [--json out/head/check.json]
+    python tools/head_words_check.py --model weights/default --model runs/head_a/model [--set blind] [--json out/head/check.json]
 
 A small check list written for the head, kept OUT of its training texts (``beta_head_refit`` never
 uses these phrases, nor the words "retired", "linebacker", "frail", "lumberjack", "ballerina",
@@ -39,10 +39,55 @@ CHECKS = {
     "a short chubby woman": {"gender": "f", "weight": "hi", "height_cm": (0, 163)},
     "a young female gymnast": {"gender": "f", "age": (0, 30)},
 }
+# a second list, written on 2026-11-26 (twelfth session) BEFORE the head variants of that session were
+# trained and never looked at while choosing them: its words are in no training text either
+BLIND = {
+    "an old fisherman": {"gender": "m", "age": (60, 200)},
+    "a teenage skateboarder": {"age": (0, 21)},
+    "a grandmother in her eighties": {"gender": "f", "age": (65, 200)},
+    "a young mother of two": {"gender": "f", "age": (0, 35)},
+    "a muscular firefighter": {"muscle": True},
+    "a retired army colonel": {"age": (58, 200)},
+    "a schoolboy": {"gender": "m", "age": (0, 21)},
+    "a university student": {"age": (0, 30)},
+    "an elderly gentleman with a cane": {"gender": "m", "age": (65, 200)},
+    "a sumo wrestler": {"weight": "hi"},
+    "a marathon runner": {"weight": "lo"},
+    "a pregnant woman": {"gender": "f"},
+    "a bearded man": {"gender": "m"},
+    "a widow in her seventies": {"gender": "f", "age": (65, 200)},
+    "a nephew, aged 16": {"gender": "m", "age": (0, 21)},
+    "a middle-aged housewife": {"gender": "f", "age": (35, 65)},
+    "the king, an old man": {"gender": "m", "age": (65, 200)},
+    "a princess": {"gender": "f"},
+    "a monk in his sixties": {"gender": "m", "age": (55, 200)},
+    "a queen": {"gender": "f"},
+    "a businesswoman": {"gender": "f"},
+    "a businessman": {"gender": "m"},
+    "a young soldier": {"age": (0, 30)},
+    "an aging rock star": {"age": (55, 200)},
+    "a female weight trainer": {"gender": "f", "muscle": True},
+    "a girl of seventeen": {"gender": "f", "age": (0, 21)},
+    "a lad of nineteen": {"gender": "m", "age": (0, 21)},
+    "a great-grandfather": {"gender": "m", "age": (65, 200)},
+    "a male model": {"gender": "m"},
+    "an actress": {"gender": "f"},
+    "a mighty Viking warrior": {"gender": "m", "muscle": True},
+    "a lady in her nineties": {"gender": "f", "age": (65, 200)},
+    "my teenage son": {"gender": "m", "age": (0, 21)},
+    "my teenage daughter": {"gender": "f", "age": (0, 21)},
+    "a strong woman who lifts weights": {"gender": "f", "muscle": True},
+    "a tall slim woman": {"gender": "f", "weight": "lo"},
+    "a short stocky man": {"gender": "m", "weight": "hi"},
+    "a tall actress": {"gender": "f"},
+    "a short fat grandpa": {"gender": "m", "age": (60, 200), "weight": "hi"},
+    "a petite young man": {"gender": "m", "age": (0, 30)},
+}
+SETS = {"own": CHECKS, "blind": BLIND}
 MOTION = "a person walks forward."
 
 
-def read(model_dir) -> list[dict]:
+def read(model_dir, checks: dict = CHECKS) -> list[dict]:
     import numpy as np
 
     from shapemove.core.body.load import load_body_model
@@ -53,14 +98,14 @@ def read(model_dir) -> list[dict]:
 
     body = load_body_model(None)
     t5, reader = ShapeMoveT5.load(model_files(resolve_model_dir(model_dir))["t5"])
-    texts = list(CHECKS)
+    texts = list(checks)
     betas = head_betas(t5, reader, [MOTION] * len(texts), texts)
     m = fast_measure(body, betas, ("height_cm", "mass_kg"))
     names = body.phenotype_map.names
     rows = []
     for i, t in enumerate(texts):
         p = dict(zip(names, body.phenotype_map.from_betas(betas[i])))
-        want, ok = CHECKS[t], {}
+        want, ok = checks[t], {}
         if "gender" in want:
             ok["gender"] = p["gender"] <= 0.25 if want["gender"] == "m" else p["gender"] >= 0.75
         if "age" in want:
@@ -98,6 +143,8 @@ def numeric_share(model_dir, texts: int = 200, seed: int = 0) -> dict:
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--model", action="append", type=Path, required=True, help="model folder (repeat to compare)")
+    ap.add_argument("--set", choices=sorted(SETS), default="own",
+                    help="own: the first list; blind: the twelfth session's list, never used to choose a head")
     ap.add_argument("--json", type=Path, default=None)
     args = ap.parse_args()
     import torch
@@ -105,14 +152,14 @@ def main() -> int:
     torch.set_num_threads(1)
     res = {}
     for md in args.model:
-        rows = read(md)
+        rows = read(md, SETS[args.set])
         num = numeric_share(md)
         res[str(md)] = {"phrases": rows, "numeric": num}
         met = [v for r in rows for v in r["met"].values()]
         print(f"\n{md}: {sum(met)}/{len(met)} expectations met")
         for r in rows:
             miss = [k for k, v in r["met"].items() if not v]
-            print(f"  {r['text']:32s} gender {r['gender']:.2f} age {r['age']:4.0f} muscle {r['muscle']:.2f} "
+            print(f"  {r['text']:34s} gender {r['gender']:.2f} age {r['age']:4.0f} muscle {r['muscle']:.2f} "
                   f"weight {r['weight']:.2f} {r['height_cm']:5.1f} cm {r['mass_kg']:5.1f} kg"
                   + (f"   MISSED {', '.join(miss)}" if miss else ""))
         print(f"  eval shape-words numeric texts: {num['within_2cm_3kg_pct']:.1f} % within 2 cm and 3 kg "

@@ -15,12 +15,27 @@ RESIDUAL_SCALE = 0.6  # of sqrt(1 - r2): the variation the sliders leave unexpla
 BETA_CLIP = 3.0
 
 
-def sample_phenotypes(pmap, rng: np.random.Generator, n: int) -> np.ndarray:
+TEEN_AGES = (14.0, 20.0)  # years: the parser's teenagers (13-19, "teenage" 16), the map extrapolated below its 18
+
+
+def sample_phenotypes(pmap, rng: np.random.Generator, n: int, teen_share: float = 0.0,
+                      height_margin: float = 0.0) -> np.ndarray:
     """(n, P) slider values: gender near 0 or near 1 for 90 % (men and women), age uniform over the
-    range, the others uniform over their ranges (proportions over the middle half)."""
+    range, the others uniform over their ranges (proportions over the middle half).
+
+    ``teen_share``: that share of the bodies are teenagers, aged over ``TEEN_AGES`` (below the map's
+    18 the map is extrapolated, as the parser does for "teenage"); ``height_margin``: the height
+    slider is drawn that fraction of its range beyond each end, so that a tall woman and a short man
+    (who the map's range barely holds) are drawn too. Both 0 (the dataset builder): as before."""
     names = list(pmap.names)
-    lo, hi = pmap.ranges[:, 0], pmap.ranges[:, 1]
+    lo, hi = pmap.ranges[:, 0].copy(), pmap.ranges[:, 1].copy()
+    if height_margin and "height" in names:
+        j = names.index("height")
+        lo[j], hi[j] = lo[j] - height_margin * (hi[j] - lo[j]), hi[j] + height_margin * (hi[j] - lo[j])
     p = lo + (hi - lo) * rng.random((n, len(names)))
+    if teen_share and "age" in names:
+        teen = rng.random(n) < teen_share
+        p[teen, names.index("age")] = rng.uniform(*TEEN_AGES, int(teen.sum()))
     if "gender" in names:
         g = names.index("gender")
         kind = rng.random(n)
@@ -42,8 +57,10 @@ def betas_for_phenotypes(pmap, phenotypes: np.ndarray, rng: np.random.Generator 
     return np.clip(b, -BETA_CLIP, BETA_CLIP).astype(np.float32)
 
 
-def sample_bodies(pmap, seed: int, n: int, r2=None) -> tuple[np.ndarray, np.ndarray]:
-    """(phenotypes (n, P), betas (n, 10)): ``n`` new bodies, the same for a seed."""
+def sample_bodies(pmap, seed: int, n: int, r2=None, teen_share: float = 0.0,
+                  height_margin: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+    """(phenotypes (n, P), betas (n, 10)): ``n`` new bodies, the same for a seed (``sample_phenotypes``'s
+    options)."""
     rng = np.random.default_rng(seed)
-    p = sample_phenotypes(pmap, rng, n)
+    p = sample_phenotypes(pmap, rng, n, teen_share, height_margin)
     return p, betas_for_phenotypes(pmap, p, rng, r2)

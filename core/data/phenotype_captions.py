@@ -36,7 +36,7 @@ def _nouns(g: float, age: float) -> tuple[list[str], str, str]:
     return ["person", "adult"], "they", "their"
 
 
-def _age_words(age: float) -> list[str]:
+def age_words(age: float) -> list[str]:
     if age < 20:
         return ["teenage", "adolescent"]
     if age <= 30:
@@ -46,6 +46,13 @@ def _age_words(age: float) -> list[str]:
     if age >= 65:
         return ["elderly", "old", "aged"]
     return []
+
+
+def decade_words(age: float) -> str:
+    """"teens", "twenties", ... "eighties" for an age in years (as in "a woman in her seventies")."""
+    names = {10: "teens", 20: "twenties", 30: "thirties", 40: "forties", 50: "fifties", 60: "sixties",
+             70: "seventies", 80: "eighties"}
+    return names.get(int(age // 10) * 10, "teens" if age < 20 else "eighties" if age >= 80 else "forties")
 
 
 def _build_words(muscle: float, weight: float, height_cm: float | None, g: float) -> list[str]:
@@ -107,7 +114,7 @@ def phenotype_texts(phenotype: dict, measures: dict | None, key: str, n: int = 4
     h = measures.get("height_cm")
     kg = measures.get("mass_kg")
     nouns, pron, poss = _nouns(g, age)
-    ages, builds = _age_words(age), _build_words(muscle, weight, h, g)
+    ages, builds = age_words(age), _build_words(muscle, weight, h, g)
     out = []
     for _ in range(n * 3):
         noun = rng.choice(nouns)
@@ -120,11 +127,8 @@ def phenotype_texts(phenotype: dict, measures: dict | None, key: str, n: int = 4
         elif kind == 1:                                                        # "a 72-year-old woman, slim"
             s = f"a {age:.0f}-year-old {noun}" + (f", {rng.choice(builds)}" if builds else "")
         elif kind == 2:                                                        # "a woman in her seventies"
-            decade = int(age // 10) * 10
-            names = {10: "teens", 20: "twenties", 30: "thirties", 40: "forties", 50: "fifties", 60: "sixties",
-                     70: "seventies", 80: "eighties"}
             phrase = " ".join(adjs[:1] + [noun])
-            s = f"{_article(phrase)} {phrase} in {poss} {names.get(decade, 'forties')}"
+            s = f"{_article(phrase)} {phrase} in {poss} {decade_words(age)}"
         elif kind == 3:                                                        # "a man, 188 cm, 92 kg"
             parts = [_height(h, rng)] + ([_mass(kg, rng)] if kg else [])
             s = f"{_article(noun)} {noun}, " + ", ".join(parts)

@@ -18,6 +18,16 @@ a folder without that key holds the first kind, as every model saved before it d
   sliders written, so "elderly" or "a woman" can land on its slider without the tiny beta
   directions age lives in having to be hit to a few hundredths. The map rides along in the weights
   (buffers) so the file is the whole head.
+  With ``numbers`` = F > 0 each token also carries the value of the number it spells
+  (``text_numbers.number_features``: "188" is 188, all three pieces of "1.88" are 1.88), added to
+  its state; what the number measures it learns from the words around it. ``reads_numbers``:
+  ``ShapeMoveT5.inputs_for`` then appends those features to the inputs.
+  With ``meets`` = 1 it also writes the height (cm) and mass (kg) it reads in the text (2: it
+  points at the numbers that state them and scales each by what its context says it is, ``_point``;
+  where none is stated, the body's own size), and the body it writes is then moved along OpenBody's
+  height and weight sliders until its rest mesh measures exactly those (``meet``: a few Newton steps on the mesh height, linear in the betas,
+  and the mesh mass, an exact cubic; the arrays ride along as buffers). The head's reading of
+  "188 cm, 92 kg" then decides the body's size, not how closely 10 betas can be regressed.
 """
 from __future__ import annotations
 
@@ -27,6 +37,7 @@ from torch import nn
 from ..errors import ShapeMoveError
 
 HEAD_KINDS = ("mlp", "text")
+MEET_CM, MEET_KG = (130.0, 215.0), (30.0, 180.0)   # the sizes a head that meets them writes at most
 
 
 class BetaHead(nn.Module):
@@ -39,7 +50,9 @@ class BetaHead(nn.Module):
         self.net = nn.Sequential(nn.Linear(d_model, hidden), nn.GELU(), nn.Linear(hidden, hidden), nn.GELU(),
                                  nn.Linear(hidden, num_betas))
 
-    def forward(self, hidden_at_beta: torch.Tensor, text=None, text_mask=None) -> torch.Tensor:
+    reads_numbers = False
+
+    def forward(self, hidden_at_beta: torch.Tensor, text=None, text_mask=None, numbers=None) -> torch.Tensor:
         """(B, d_model) -> (B, 10); ``text`` is ignored (this head reads the state alone)."""
         return self.net(hidden_at_beta)
 
@@ -55,7 +68,8 @@ class TextBetaHead(nn.Module):
     reads_text = True
 
     def __init__(self, d_model: int, num_betas: int = 10, hidden: int = 256, text_dim: int = 384, width: int = 128,
-                 queries: int = 4, heads: int = 4, sliders: int = 0, phenotype_map=None):
+                 queries: int = 4, heads: int = 4, sliders: int = 0, phenotype_map=None, numbers: int = 0,
+                 meets: int = 0, size_model: dict | None = None):
         super().__init__()
         if width % heads:
             raise ShapeMoveError(f"beta head: width {width} is not a multiple of heads {heads}")
@@ -64,6 +78,21 @@ class TextBetaHead(nn.Module):
         if sliders:
             self.sizes["sliders"] = int(sliders)
             self._slider_buffers(int(sliders), num_betas, phenotype_map)
+        if numbers:
+            self.sizes["numbers"] = int(numbers)
+            self.number_in = nn.Sequential(nn.Linear(int(numbers), width), nn.GELU(), nn.Linear(width, width))
+        if meets:
+            if not sliders:
+                raise ShapeMoveError("beta head: meets needs sliders (it moves the height and weight sliders)")
+            self.sizes["meets"] = int(meets)
+            self._size_buffers(num_betas, size_model)
+            if int(meets) == 2:
+                if not numbers:
+                    raise ShapeMoveError("beta head: meets 2 points at numbers; it needs numbers")
+                self.pointer = nn.Linear(width, 4)   # per token: height and mass gate, log of the scale
+                with torch.no_grad():
+                    self.pointer.weight.mul_(0.1)
+                    self.pointer.bias.copy_(torch.tensor([-2.0, -2.0, 0.0, 0.0]))
         self.text_in = nn.Sequential(nn.LayerNorm(text_dim), nn.Linear(text_dim, width))
         self.position = nn.Embedding(64, width)   # token order ("6 ft 2" is not "2 ft 6"); longer texts share the last
         self.none = nn.Parameter(torch.zeros(1, 1, width))  # the "no shape words" slot
@@ -71,7 +100,7 @@ class TextBetaHead(nn.Module):
         self.queries = nn.Parameter(torch.randn(queries, width) * 0.02)
         self.pool = nn.MultiheadAttention(width, heads, batch_first=True)
         self.net = nn.Sequential(nn.Linear(d_model + queries * width, hidden), nn.GELU(), nn.Linear(hidden, hidden),
-                                 nn.GELU(), nn.Linear(hidden, num_betas + int(sliders)))
+                                 nn.GELU(), nn.Linear(hidden, num_betas + int(sliders) + (2 if meets == 1 else 0)))
 
     def _slider_buffers(self, P: int, n: int, pmap) -> None:
         """The map (P, n), intercept (n,), null-space projector (n, n) and slider centre/scale (P,):
@@ -89,33 +118,130 @@ class TextBetaHead(nn.Module):
         for k, v in z.items():
             self.register_buffer(k, v.float())
 
+    SIZE_BUFFERS = ("size_y0", "size_yd", "mass_c", "mass_l", "mass_q", "mass_k", "meet_dirs")
+
+    def _size_buffers(self, n: int, size_model: dict | None) -> None:
+        """``size_model`` (``beta_head_refit.head_size_model``): rest-vertex heights y0 (V,) + yd (V, n)
+        @ betas in metres, the mass polynomial (kg: c + l.b + b'qb + k[b,b,b]) and the betas of one
+        slider range of height and of weight (2, n); zeros until ``load_state_dict`` without it."""
+        if size_model is None:
+            V = 1
+            size_model = {"size_y0": torch.zeros(V), "size_yd": torch.zeros(V, n), "mass_c": torch.zeros(1),
+                          "mass_l": torch.zeros(n), "mass_q": torch.zeros(n, n), "mass_k": torch.zeros(n, n, n),
+                          "meet_dirs": torch.zeros(2, n)}
+        for k in self.SIZE_BUFFERS:
+            self.register_buffer(k, torch.as_tensor(size_model[k], dtype=torch.float32).clone())
+
+    def _load_from_state_dict(self, state_dict, prefix, *args, **kwargs):
+        # the vertex count of the size buffers is the body's: take the saved shape
+        for k in self.SIZE_BUFFERS if self.sizes.get("meets") else ():
+            if prefix + k in state_dict and getattr(self, k).shape != state_dict[prefix + k].shape:
+                setattr(self, k, torch.zeros_like(state_dict[prefix + k]))
+        super()._load_from_state_dict(state_dict, prefix, *args, **kwargs)
+
+    def height_mass(self, betas: torch.Tensor) -> tuple:
+        """(B,) rest-mesh height (cm) and mass (kg) of (B, n) betas, and their gradients (B, n)."""
+        ys = self.size_y0[None] + betas @ self.size_yd.T
+        top, bottom = ys.argmax(1), ys.argmin(1)
+        height = 100.0 * (ys.gather(1, top[:, None]) - ys.gather(1, bottom[:, None]))[:, 0]
+        g_height = 100.0 * (self.size_yd[top] - self.size_yd[bottom])
+        k = self.mass_k
+        six = (self.mass_c + betas @ self.mass_l + torch.einsum("bp,pq,bq->b", betas, self.mass_q, betas)
+               + torch.einsum("bp,bq,br,pqr->b", betas, betas, betas, k))
+        ksym = k + k.permute(1, 0, 2) + k.permute(2, 0, 1)
+        g_six = self.mass_l + betas @ (self.mass_q + self.mass_q.T) + torch.einsum("pjk,bj,bk->bp", ksym, betas, betas)
+        sign = torch.where(six < 0, -1.0, 1.0)
+        return height, six.abs(), g_height, sign[:, None] * g_six
+
+    def meet(self, betas: torch.Tensor, target: torch.Tensor, iterations: int = 5) -> torch.Tensor:
+        """``betas`` moved along the height and weight slider directions until the rest mesh measures
+        ``target`` (B, 2): height cm, mass kg (Newton, each step at most half a slider range)."""
+        dirs = self.meet_dirs
+        for _ in range(iterations):
+            h, m, gh, gm = self.height_mass(betas)
+            J = torch.stack([gh @ dirs.T, gm @ dirs.T], 1)            # (B, 2 equations, 2 sliders)
+            r = torch.stack([h, m], 1) - target
+            det = J[:, 0, 0] * J[:, 1, 1] - J[:, 0, 1] * J[:, 1, 0]
+            ok = det.abs() > 1e-6
+            safe = torch.where(ok, det, torch.ones_like(det))
+            step = torch.stack([J[:, 1, 1] * r[:, 0] - J[:, 0, 1] * r[:, 1],
+                                -J[:, 1, 0] * r[:, 0] + J[:, 0, 0] * r[:, 1]], 1) / safe[:, None]
+            step = torch.where(ok[:, None], step, torch.zeros_like(step)).clamp(-0.5, 0.5)
+            betas = betas - step @ dirs
+        return betas
+
+    @property
+    def reads_numbers(self) -> bool:
+        return bool(self.sizes.get("numbers"))
+
     def forward(self, hidden_at_beta: torch.Tensor, text: torch.Tensor | None = None,
-                text_mask: torch.Tensor | None = None) -> torch.Tensor:
+                text_mask: torch.Tensor | None = None, numbers: torch.Tensor | None = None) -> torch.Tensor:
+        """``numbers`` (B, L, F): the value features of ``text``'s tokens, for a head that reads them
+        (required then, whenever there is text)."""
         B = hidden_at_beta.shape[0]
         if text is None or text.shape[1] == 0:
             text = hidden_at_beta.new_zeros(B, 0, self.sizes["text_dim"])
             text_mask = torch.zeros(B, 0, dtype=torch.bool, device=hidden_at_beta.device)
+            numbers = hidden_at_beta.new_zeros(B, 0, self.sizes.get("numbers", 0))
         L = text.shape[1]
         pos = torch.arange(L, device=text.device).clamp(max=self.position.num_embeddings - 1)
-        x = torch.cat([self.none.expand(B, 1, -1), self.text_in(text) + self.position(pos)[None]], 1)
+        tokens = self.text_in(text) + self.position(pos)[None]
+        if self.reads_numbers:
+            if numbers is None or tuple(numbers.shape[:2]) != (B, L):
+                raise ShapeMoveError("this [BETA] head reads the values of the numbers in the shape text: "
+                                     "give it number features for every text token")
+            tokens = tokens + self.number_in(numbers.to(tokens.dtype))
+        x = torch.cat([self.none.expand(B, 1, -1), tokens], 1)
         keep = torch.cat([torch.ones(B, 1, dtype=torch.bool, device=x.device), text_mask.bool()], 1)
         x = self.mix(x, src_key_padding_mask=~keep)
         q = self.queries[None].expand(B, -1, -1)
         pooled, _ = self.pool(q, x, x, key_padding_mask=~keep, need_weights=False)
         out = self.net(torch.cat([hidden_at_beta, pooled.reshape(B, -1)], 1))
-        P = self.sizes.get("sliders", 0)
+        P, n = self.sizes.get("sliders", 0), self.sizes["num_betas"]
         if not P:
             return out
         sliders = self.slider_mid + out[:, :P] * self.slider_half
-        return self.map_intercept + sliders @ self.map_matrix + out[:, P:] @ self.map_null
+        betas = self.map_intercept + sliders @ self.map_matrix + out[:, P:P + n] @ self.map_null
+        if not self.sizes.get("meets"):
+            return betas
+        if self.sizes["meets"] == 2:   # the numbers pointed at; the body's own size where none is stated
+            height, mass, _, _ = self.height_mass(betas)
+            said = self._point(torch.stack([height, mass], 1), x[:, 1:], numbers)
+        else:
+            said = torch.stack([170.0 + 20.0 * out[:, P + n], 70.0 + 20.0 * out[:, P + n + 1]], 1)   # cm, kg
+        said = torch.stack([said[:, 0].clamp(*MEET_CM), said[:, 1].clamp(*MEET_KG)], 1)
+        if self.reading_sizes:
+            return betas, said
+        return self.meet(betas, said)
+
+    reading_sizes = False   # training: forward gives (betas before ``meet``, the height and mass read)
+
+    def _point(self, guess: torch.Tensor, tokens: torch.Tensor, numbers: torch.Tensor) -> torch.Tensor:
+        """(B, 2) height and mass: each number of the text (its first token) may count towards either,
+        gated and scaled by what its context says it is (gate ~ 1 and scale ~ 30.48 for the "6" of
+        "6 ft 2", ~ 2.54 for its "2"; ~ 0.454 for "200" in "200 lb"), the sum of those standing in for
+        ``guess`` (the body's own size: ``meet`` then leaves a body described in words alone as it is)
+        as far as the gates add up to 1."""
+        flag, value = numbers[..., 0], numbers[..., 3] * 100.0
+        prev_flag = torch.cat([torch.zeros_like(flag[:, :1]), flag[:, :-1]], 1)
+        prev_value = torch.cat([torch.zeros_like(value[:, :1]), value[:, :-1]], 1)
+        start = (flag > 0) & ~((prev_flag > 0) & (prev_value == value))    # a number's first word piece
+        g = self.pointer(tokens)
+        gate = torch.sigmoid(g[..., :2]) * start[..., None]
+        scale = torch.exp(g[..., 2:].clamp(-4.0, 6.0))
+        stated = (gate * scale * value[..., None]).sum(1)                    # (B, 2)
+        weight = gate.sum(1).clamp(max=1.0)
+        return (1.0 - weight) * guess + stated
 
     def config(self) -> dict:
         return {"kind": self.kind, **self.sizes}
 
 
-def build_head(config: dict | None, d_model: int, phenotype_map=None) -> nn.Module:
+def build_head(config: dict | None, d_model: int, phenotype_map=None, size_model: dict | None = None) -> nn.Module:
     """The head a saved ``"beta_head"`` entry describes (None: the first kind, ``BetaHead(d_model)``).
-    ``phenotype_map``: OpenBody's, for a new head that writes sliders (a loaded one reads its buffers)."""
+    ``phenotype_map``: OpenBody's, for a new head that writes sliders; ``size_model``
+    (``Readback.size_model``) for a new head that meets the sizes it reads (a loaded one reads its
+    buffers)."""
     if config is None:
         return BetaHead(d_model)
     if not isinstance(config, dict) or config.get("kind") not in HEAD_KINDS:
@@ -127,6 +253,8 @@ def build_head(config: dict | None, d_model: int, phenotype_map=None) -> nn.Modu
     cls = BetaHead if config["kind"] == "mlp" else TextBetaHead
     if sizes.get("sliders") and cls is TextBetaHead:
         sizes["phenotype_map"] = phenotype_map
+    if sizes.get("meets") and cls is TextBetaHead:
+        sizes["size_model"] = size_model
     try:
         return cls(**sizes)
     except TypeError as exc:

@@ -222,15 +222,21 @@ class ShapeMoveT5(nn.Module):
         the TextEncoder / a StateCache of it."""
         if self.encoder_kind == "minilm":
             inputs = minilm_inputs(reader, motion_texts, shape_texts)
-            return inputs + self.memory_inputs(reader, motion_texts) if self.memory_k else inputs
+            numbers = (shape_numbers(reader, shape_texts, inputs[0].shape[1]),) if self._head_numbers() else ()
+            return inputs + (self.memory_inputs(reader, motion_texts) if self.memory_k else ()) + numbers
         enc = reader([shapemove_prompt(m, s) for m, s in zip(motion_texts, shape_texts)], return_tensors="pt",
                      padding=True, truncation=True, max_length=256)
         return enc.input_ids, enc.attention_mask
 
+    def _head_numbers(self) -> bool:
+        """The `[BETA]` head reads the values of the shape text's numbers: ``inputs_for`` appends them
+        (last), ``encode`` leaves them out and ``head_text`` hands them to the head."""
+        return bool(getattr(self.beta_head, "reads_numbers", False))
+
     def encode(self, *inputs):
         """(encoder states (B, L, d_model), mask (B, L)) of ``inputs_for``'s inputs."""
         if self.encoder_kind == "minilm":
-            return self.lm.encode(*inputs)
+            return self.lm.encode(*(inputs[:-1] if self._head_numbers() else inputs))
         ids, mask = inputs
         return self.lm.get_encoder()(input_ids=ids, attention_mask=mask).last_hidden_state, mask
 
@@ -264,6 +270,8 @@ class ShapeMoveT5(nn.Module):
         if self.encoder_kind != "minilm":
             raise ShapeMoveError("a [BETA] head that reads the words needs the MiniLM encoder")
         states, mask, segments = inputs[:3]
+        if self._head_numbers():
+            return states, mask & (segments == 0), inputs[-1]
         return states, mask & (segments == 0)
 
     def betas_at(self, hidden_at_beta: torch.Tensor, inputs) -> torch.Tensor:
@@ -300,6 +308,9 @@ class ShapeMoveT5(nn.Module):
             pos = is_beta.float().argmax(1) + 1
             pos = pos.clamp(max=hidden.shape[1] - 1)
             h = hidden[torch.arange(hidden.shape[0]), pos][has_beta]
+            if self._head_numbers():
+                raise ShapeMoveError("a [BETA] head that reads numbers is trained by `train head` on an exported "
+                                     "model, not together with the T5")
             text, text_mask = self.head_text((inputs_a, inputs_b, segments))
             pred = self.beta_head(h, *((text[has_beta], text_mask[has_beta]) if text is not None else ()))
             if betas is not None:
@@ -452,6 +463,19 @@ def minilm_inputs(reader, motion_texts: list[str], shape_texts: list[str | None]
         mask[i, : len(p)] = True
         seg[i, :k] = 0
     return states, mask, seg
+
+
+def shape_numbers(reader, shape_texts: list[str | None], length: int) -> torch.Tensor:
+    """(B, length, F) value features of the numbers in each shape text (``text_numbers``), in the
+    rows of ``minilm_inputs``'s states where that text's tokens sit (first in each row)."""
+    from .text_numbers import FEATURES, number_features
+
+    tokenizer = reader.tokenizer if hasattr(reader, "tokenizer") else reader.encoder.tokenizer
+    out = torch.zeros(len(shape_texts), length, FEATURES)
+    has = [i for i, s in enumerate(shape_texts) if s and str(s).strip()]
+    for i, f in zip(has, number_features(tokenizer, [str(shape_texts[i]) for i in has])):
+        out[i, :len(f)] = f
+    return out
 
 
 def size_from_dict(d: dict) -> T5Size:

@@ -29,17 +29,33 @@ MEASURES = ("height_cm", "waist_cm")
 
 
 def head_loss(head, states: torch.Tensor, betas: torch.Tensor, measure, weight: float, text=None, text_mask=None,
-              extra=None, l1_target=None) -> tuple:
+              extra=None, l1_target=None, numbers=None, mass=None, mass_weight: float = 0.0) -> tuple:
     """(loss, L1 of the betas, mean |height error| + |waist error| in cm). ``measure``: (B,10) -> (B,2) cm.
-    ``text``/``text_mask``: the shape text's MiniLM states for a head that reads them; ``extra``:
+    ``text``/``text_mask``/``numbers``: the shape text's MiniLM states and its numbers' value
+    features for a head that reads them; ``extra``:
     (B,10) predicted betas -> a further loss term (``Readback.loss``); ``l1_target``: the betas the
-    L1 reads instead of ``betas`` (which the measurements still read)."""
-    pred = head(states, text, text_mask)
+    L1 reads instead of ``betas`` (which the measurements still read). A head that meets the sizes it
+    reads (``TextBetaHead`` with ``meets``) is trained on its betas before ``meet`` and, beside them,
+    on the height (x ``weight``) and mass (``mass``: (B,10) -> (B,) kg, x ``mass_weight``) it reads."""
+    args = (states, text, text_mask, *((numbers,) if getattr(head, "reads_numbers", False) else ()))
+    said = None
+    if getattr(head, "sizes", {}).get("meets"):
+        head.reading_sizes = True
+        try:
+            pred, said = head(*args)
+        finally:
+            head.reading_sizes = False
+    else:
+        pred = head(*args)
     l1 = (pred - (betas if l1_target is None else l1_target)).abs().mean()
     with torch.no_grad():
         true = measure(betas)
     cm = (measure(pred) - true).abs().mean(0).sum()
     loss = l1 + weight * cm
+    if said is not None:
+        with torch.no_grad():
+            true_kg = mass(betas)
+        loss = loss + weight * (said[:, 0] - true[:, 0]).abs().mean() + mass_weight * (said[:, 1] - true_kg).abs().mean()
     if extra is not None:
         loss = loss + extra(pred)
     return loss, l1.detach(), cm.detach()
@@ -58,12 +74,14 @@ def synthetic_bodies(body, girths, seed: int, n: int) -> tuple[list[str], torch.
     return texts, betas
 
 
-def synthetic_pool(body, girths, seed: int, n: int, stated_share: float = 0.0) -> tuple:
+def synthetic_pool(body, girths, seed: int, n: int, stated_share: float = 0.0, teen_share: float = 0.0,
+                   height_margin: float = 0.0) -> tuple:
     """``synthetic_bodies``'s pool plus each body's phenotype: (shape texts, (n, 10) betas, (n, P)
     phenotype sliders (P = 0 without a phenotype map)). ``stated_share`` > 0 (phenotype map
     needed): the bodies are also weighed (mass from the mesh volume, so phenotype texts state kg
     and lb too) and that share of them is described by ``stated_text`` (more nouns and build words,
-    height and weight in the units people type) instead."""
+    height and weight in the units people type) instead. ``teen_share``, ``height_margin``:
+    ``phenotype_sample.sample_phenotypes``'s (teenagers; tall women and short men)."""
     import random
 
     import numpy as np
@@ -77,7 +95,7 @@ def synthetic_pool(body, girths, seed: int, n: int, stated_share: float = 0.0) -
     rng = random.Random(seed)
     pmap = getattr(body, "phenotype_map", None)
     if pmap is not None:
-        pheno, b = sample_bodies(pmap, seed, n, pmap.r2)
+        pheno, b = sample_bodies(pmap, seed, n, pmap.r2, teen_share, height_margin)
     else:
         pheno, b = np.zeros((n, 0)), np.clip(np.random.default_rng(seed).standard_normal((n, body.num_betas)), -2.5, 2.5)
     keys = list(MEASUREMENTS) + (["mass_kg"] if stated_share > 0 and pmap is not None else [])
@@ -117,7 +135,7 @@ def stated_text(phenotype: dict, measures: dict, key: str) -> str:
     kg, lb or stones, in varied sentence shapes. Deterministic for a ``key``."""
     import random
 
-    from ..data.phenotype_captions import FEMALE, MALE, phenotype_texts
+    from ..data.phenotype_captions import FEMALE, MALE, age_words, decade_words, phenotype_texts
 
     rng = random.Random(f"stated/{key}")
     g, age = float(phenotype.get("gender", 0.5)), float(phenotype.get("age", 40.0))
@@ -125,8 +143,8 @@ def stated_text(phenotype: dict, measures: dict, key: str) -> str:
     sex = "male" if g <= MALE else "female" if g >= FEMALE else "person"
     words = []
     band = "teen" if age < 20 else "young" if age <= 30 else "old" if age >= 65 else None
-    if band and rng.random() < 0.5:
-        words.append(rng.choice(MORE_AGE[band]))
+    if band and rng.random() < 0.5:   # the age said with any noun ("a teenage woman", "an elderly fellow")
+        words.append(rng.choice(MORE_AGE[band] + age_words(age)))
     if muscle >= 0.75 and rng.random() < 0.6:
         words.append(rng.choice(MORE_BUILD["muscle"]))
     if weight >= 0.7 and muscle < 0.6 and rng.random() < 0.6:
@@ -144,6 +162,8 @@ def stated_text(phenotype: dict, measures: dict, key: str) -> str:
                                                    f"{rng.choice(MORE_BUILD['muscle_nouns'])}"] if sex != "person" else [])
         phrase = " ".join(words + [rng.choice(nouns)])
         desc = f"{'an' if phrase[0] in 'aeiou' else 'a'} {phrase}"
+        if sex != "person" and rng.random() < 0.2:   # "a guy in his teens", "a lady in her seventies"
+            desc += f" in {'his' if sex == 'male' else 'her'} {decade_words(age)}"
     else:
         desc = ""
     h, kg = measures.get("height_cm"), measures.get("mass_kg")
@@ -217,11 +237,22 @@ class Readback:
         emphasis = np.asarray(self.EMPHASIS) / np.mean(self.EMPHASIS)
         self.scale = torch.as_tensor(emphasis / (pmap.ranges[self.index, 1] - pmap.ranges[self.index, 0]),
                                      dtype=torch.float32)
-        _, _, _, _, v0, vd = _linear_vertices(body)
+        y0, yd, _, _, v0, vd = _linear_vertices(body)
+        self.y0, self.yd = torch.as_tensor(y0, dtype=torch.float32), torch.as_tensor(yd, dtype=torch.float32)
         poly = VolumePolynomial(v0, vd.reshape(*v0.shape, -1), body.faces)
         f = DENSITY_KG_M3 / 6.0
         self.c, self.l, self.q, self.k = (torch.as_tensor(np.asarray(x) * f, dtype=torch.float32)
                                           for x in (poly.c, poly.l, poly.q, poly.k))
+
+    def size_model(self) -> dict:
+        """What ``TextBetaHead(meets=1)`` measures a body with (its buffers): the rest vertices'
+        heights (m) as y0 + yd @ betas, this mass polynomial (kg) and the betas of one slider range
+        of height and of weight."""
+        names = list(self.names)
+        span = torch.as_tensor(self.ranges[:, 1] - self.ranges[:, 0], dtype=torch.float32)
+        dirs = torch.stack([self.matrix[names.index(k)] * span[names.index(k)] for k in ("height", "weight")])
+        return {"size_y0": self.y0, "size_yd": self.yd, "mass_c": self.c.reshape(1), "mass_l": self.l,
+                "mass_q": self.q, "mass_k": self.k, "meet_dirs": dirs}
 
     def sliders(self, betas: torch.Tensor) -> torch.Tensor:
         """(B, 10) -> (B, P) phenotype sliders, unclipped."""
@@ -256,7 +287,8 @@ class HeadExamples:
     (``synthetic_bodies``) described beside a random training caption. ``measure``: the
     differentiable height/waist of OpenBody, whose betas -> girth regression ships."""
 
-    def __init__(self, examples, vae_body: str | None, seed: int, pool_size: int, stated_share: float = 0.0):
+    def __init__(self, examples, vae_body: str | None, seed: int, pool_size: int, stated_share: float = 0.0,
+                 teen_share: float = 0.0, height_margin: float = 0.0):
         from ..body.load import load_body_model
         from ..body.shape_from_measurements import girth_regression, torch_measure
         from ..errors import ShapeMoveError
@@ -269,7 +301,8 @@ class HeadExamples:
         self.examples, self.measure = examples, torch_measure(body, MEASURES)
         self.captions = sorted({t for caps in examples.captions.values() for t in caps})
         self.pool_texts, self.pool_betas, self.pool_phenotypes = (
-            synthetic_pool(body, girth_regression(body), seed, pool_size, stated_share) if pool_size
+            synthetic_pool(body, girth_regression(body), seed, pool_size, stated_share, teen_share, height_margin)
+            if pool_size
             else ([], torch.zeros(0, body.num_betas), None))
 
     def batch(self, rng, n: int, share: float) -> tuple[list[str], list, torch.Tensor]:

@@ -42,8 +42,8 @@ from ..config_presets import load_config, refuse_unknown
 from ..errors import ShapeMoveError
 
 KIND = "shapemove-head"
-FEATURE_KEYS = ("seed", "dataset_examples", "pool", "stated_share", "no_shape_average")
-FEATURES_FORMAT = 2
+FEATURE_KEYS = ("seed", "dataset_examples", "pool", "stated_share", "no_shape_average", "teen_share", "height_margin")
+FEATURES_FORMAT = 3   # 3: the shape texts' number features beside their states
 
 
 @dataclass
@@ -67,6 +67,8 @@ class HeadTrainConfig:
     mass_weight: float = 0.2         # per kg of mass error
     l1_from_sliders: bool = True     # a pool body described in words only: betas L1 against its drawn sliders' betas
     teen_weight: float = 4.0         # pool bodies under 20 drawn this many times as often (3 % of the ages drawn)
+    teen_share: float = 0.0          # share of the pool drawn as teenagers, 14-19 (phenotype_sample.TEEN_AGES)
+    height_margin: float = 0.0       # the pool's height slider drawn this fraction of its range past each end
     log_every: int = 100
     ckpt_every: int = 500
 
@@ -89,8 +91,10 @@ class HeadTrainConfig:
             raise ShapeMoveError("head config: steps and batch_size must be >= 1, dataset_examples and pool >= 0")
         if self.dataset_examples + self.pool < 2:
             raise ShapeMoveError("head config: dataset_examples + pool must give at least 2 examples")
-        if not 0 <= self.stated_share <= 1 or not 0 <= self.val_share < 1:
-            raise ShapeMoveError("head config: stated_share must be in [0, 1] and val_share in [0, 1)")
+        if not 0 <= self.stated_share <= 1 or not 0 <= self.val_share < 1 or not 0 <= self.teen_share <= 1:
+            raise ShapeMoveError("head config: stated_share and teen_share must be in [0, 1] and val_share in [0, 1)")
+        if not 0 <= self.height_margin <= 0.5:
+            raise ShapeMoveError("head config: height_margin must be in [0, 0.5]")
         if self.lr <= 0 or min(self.measure_weight, self.slider_weight, self.mass_weight) < 0 or self.teen_weight <= 0:
             raise ShapeMoveError("head config: lr > 0, non-negative loss weights and teen_weight > 0 are required")
         if not isinstance(self.head, dict) or self.head.get("kind") not in ("mlp", "text"):
@@ -99,30 +103,34 @@ class HeadTrainConfig:
 
 # -- features: the frozen model's reading of every example, computed once ----------------------------
 class Features:
-    """Per example: the `[BETA]` state (N, d), the shape text's MiniLM states (stored as one float16
-    block, rows ``offsets[i]:offsets[i+1]``, none for no shape text; held padded to the longest),
-    betas (N, 10), phenotype targets (N, P), pool flag (N,)."""
+    """Per example: the `[BETA]` state (N, d), the shape text's MiniLM states and its tokens' number
+    features (``text_numbers``; each stored as one float16 block, rows ``offsets[i]:offsets[i+1]``,
+    none for no shape text; held padded to the longest), betas (N, 10), phenotype targets (N, P),
+    pool flag (N,)."""
 
     def __init__(self, d: dict):
         self.h, self.betas, self.pheno, self.pool = d["h"], d["betas"], d["pheno"], d["pool"]
         self.numbers = torch.tensor([any(ch.isdigit() for ch in t) for t in d["texts"]])  # the text states sizes
         offsets = d["offsets"]
         self.lens = offsets[1:] - offsets[:-1]
-        self.padded = torch.zeros(len(self.lens), max(1, int(self.lens.max())), d["states"].shape[1],
-                                  dtype=torch.float16)
+        L = max(1, int(self.lens.max()))
+        self.padded = torch.zeros(len(self.lens), L, d["states"].shape[1], dtype=torch.float16)
+        self.padded_numbers = torch.zeros(len(self.lens), L, d["numbers"].shape[1], dtype=torch.float16)
         for i, (o, n) in enumerate(zip(offsets[:-1].tolist(), self.lens.tolist())):
             self.padded[i, :n] = d["states"][o:o + n]
+            self.padded_numbers[i, :n] = d["numbers"][o:o + n]
 
     def __len__(self) -> int:
         return len(self.h)
 
     def batch(self, idx) -> tuple:
-        """(states at [BETA], shape text states (B, L, 384), their mask, betas, phenotype targets)."""
+        """(states at [BETA], shape text states (B, L, 384), their mask, their number features (B, L, F),
+        betas, phenotype targets)."""
         idx = torch.as_tensor(idx, dtype=torch.long)
         n = self.lens[idx]
         L = max(1, int(n.max()))
-        return (self.h[idx], self.padded[idx, :L].float(), torch.arange(L)[None] < n[:, None], self.betas[idx],
-                self.pheno[idx])
+        return (self.h[idx], self.padded[idx, :L].float(), torch.arange(L)[None] < n[:, None],
+                self.padded_numbers[idx, :L].float(), self.betas[idx], self.pheno[idx])
 
     def bins(self, idx, size: int) -> list:
         """``idx`` sorted by text length and cut into runs of about ``size``: a batch drawn from one
@@ -155,7 +163,9 @@ def build_features(t5, reader, examples, readback, c: HeadTrainConfig, progress:
         pheno[:, age] = torch.where(torch.as_tensor(pool), pheno[:, age].floor(), pheno[:, age])  # whole years
     cache = StateCache(reader)
     cache.add([m for m in motions] + [s for s in shapes if s], progress=progress)
-    hs, blocks, lens = [], [], []
+    from ..models.text_numbers import FEATURES, number_features
+
+    hs, blocks, lens, numbers = [], [], [], []
     bar = tqdm(total=len(motions), desc="read examples", unit="ex", disable=not progress)
     for s in range(0, len(motions), 128):
         m, sh = motions[s:s + 128], shapes[s:s + 128]
@@ -163,12 +173,18 @@ def build_features(t5, reader, examples, readback, c: HeadTrainConfig, progress:
         bar.update(len(m))
     bar.close()
     for sh in shapes:
-        x = cache.states_of[str(sh)] if sh and str(sh).strip() else torch.zeros(0, cache.encoder.dim, dtype=torch.float16)
+        said = bool(sh and str(sh).strip())
+        x = cache.states_of[str(sh)] if said else torch.zeros(0, cache.encoder.dim, dtype=torch.float16)
+        f = number_features(cache.encoder.tokenizer, [str(sh)])[0] if said else torch.zeros(0, FEATURES)
+        if len(f) != len(x):
+            raise ShapeMoveError(f"shape text {sh!r}: {len(x)} token states but {len(f)} tokens")
         blocks.append(x)
+        numbers.append(f.to(torch.float16))
         lens.append(len(x))
     offsets = torch.zeros(len(lens) + 1, dtype=torch.long)
     offsets[1:] = torch.as_tensor(lens).cumsum(0)
-    return {"h": torch.cat(hs), "states": torch.cat(blocks), "offsets": offsets, "betas": betas,
+    return {"h": torch.cat(hs), "states": torch.cat(blocks), "numbers": torch.cat(numbers), "offsets": offsets,
+            "betas": betas,
             "pheno": pheno, "pool": torch.as_tensor(pool), "texts": [s or "" for s in shapes], "motions": motions}
 
 
@@ -227,8 +243,8 @@ def export_model(src: Path, dst: Path, head, meta: dict) -> Path:
 def _metrics(head, feats: Features, idx, readback, measure) -> dict:
     """Held-out pool bodies: betas L1, height/waist/mass errors, slider errors, gender right."""
     with torch.no_grad():
-        h, text, mask, betas, pheno = feats.batch(idx)
-        pred = head(h, text, mask)
+        h, text, mask, numbers, betas, pheno = feats.batch(idx)
+        pred = head(h, text, mask, *((numbers,) if getattr(head, "reads_numbers", False) else ()))
         dm = (measure(pred) - measure(betas)).abs().mean(0)
         kg = (readback.mass(pred) - readback.mass(betas)).abs().mean()
         sl = readback.sliders(pred)
@@ -283,10 +299,12 @@ def train_head(model_dir, data, out, config: HeadTrainConfig | None = None, resu
         raise ShapeMoveError(f"{data}: no training clips (train.txt missing or empty): build the dataset with `data build`")
     # the head reads no motion codes: every training clip takes part (T2MExamples wants tokens)
     train_set = T2MExamples(data, "train", {cid: np.zeros(1, np.int16) for cid in ids}, max_codes=1)
-    examples = HeadExamples(train_set, t5.info.get("vae_body"), c.seed, c.pool, c.stated_share)
+    examples = HeadExamples(train_set, t5.info.get("vae_body"), c.seed, c.pool, c.stated_share, c.teen_share,
+                            c.height_margin)
     readback = Readback(examples.body)
     torch.manual_seed(c.seed)
-    head = build_head(c.head, t5.d_model, getattr(examples.body, "phenotype_map", None))
+    head = build_head(c.head, t5.d_model, getattr(examples.body, "phenotype_map", None),
+                      readback.size_model() if c.head.get("meets") else None)
     feats = load_features(out, _stamp(model_dir, data, c),
                           lambda: build_features(t5, reader, examples, readback, c, verbose))
     n = len(feats)
@@ -340,13 +358,14 @@ def train_head(model_dir, data, out, config: HeadTrainConfig | None = None, resu
             break
         k = rng.choices(range(len(bins)), weights)[0]
         pick = bins[k][torch.as_tensor(rng.choices(range(len(bins[k])), cum_weights=cum[k], k=c.batch_size))]
-        h, text, mask, betas, pheno = feats.batch(pick)
+        h, text, mask, numbers, betas, pheno = feats.batch(pick)
         target = None
         if c.l1_from_sliders and pheno.shape[1]:  # words only: the body the words describe (the residual the
             words = feats.pool[pick] & ~feats.numbers[pick]  # sliders leave is in no word); numbers: the body itself
             target = torch.where(words[:, None], readback.to_betas(pheno), betas)
         loss, l1, cm = head_loss(head, h, betas, examples.measure, c.measure_weight, text, mask,
-                                 extra=lambda pred: extra(pred, pheno, betas), l1_target=target)
+                                 extra=lambda pred: extra(pred, pheno, betas), l1_target=target, numbers=numbers,
+                                 mass=readback.mass, mass_weight=c.mass_weight)
         optimizer_step(loss, optimizer, scheduler, head.parameters(), c.grad_clip)
         step += 1
         log.bar.update(1)
