@@ -47,6 +47,15 @@ def bmi(mass: np.ndarray, height_cm: np.ndarray) -> np.ndarray:
     return np.asarray(mass, np.float64) / (np.asarray(height_cm, np.float64) / 100.0) ** 2
 
 
+def cubic_in_betas(betas, c, l, q, k):
+    """c + l.b + b'Qb + K[b,b,b] for (B, n) torch betas and torch coefficients (``VolumePolynomial``'s,
+    as given: x density / 6 they give a mass in kg) -> (B,), differentiable."""
+    import torch
+
+    return (c + betas @ l + torch.einsum("bp,pq,bq->b", betas, q, betas)
+            + torch.einsum("bp,bq,br,pqr->b", betas, betas, betas, k))
+
+
 def _cross_all(x: np.ndarray, y: np.ndarray) -> np.ndarray:
     """Cross products over axis 1 of (F,3,...) arrays, broadcast over the trailing axes."""
     return np.stack([x[:, 1] * y[:, 2] - x[:, 2] * y[:, 1], x[:, 2] * y[:, 0] - x[:, 0] * y[:, 2],

@@ -25,15 +25,17 @@ a folder without that key holds the first kind, as every model saved before it d
   With ``meets`` = 1 it also writes the height (cm) and mass (kg) it reads in the text (2: it
   points at the numbers that state them and scales each by what its context says it is, ``_point``;
   where none is stated, the body's own size), and the body it writes is then moved along OpenBody's
-  height and weight sliders until its rest mesh measures exactly those (``meet``: a few Newton steps on the mesh height, linear in the betas,
-  and the mesh mass, an exact cubic; the arrays ride along as buffers). The head's reading of
-  "188 cm, 92 kg" then decides the body's size, not how closely 10 betas can be regressed.
+  height and weight sliders until its rest mesh measures exactly those (``meet``: a few Newton
+  steps on the mesh height, linear in the betas, and the mesh mass, an exact cubic; the arrays ride
+  along as buffers). The head's reading of "188 cm, 92 kg" then decides the body's size, not how
+  closely 10 betas can be regressed.
 """
 from __future__ import annotations
 
 import torch
 from torch import nn
 
+from ..body.body_mass import cubic_in_betas
 from ..errors import ShapeMoveError
 
 HEAD_KINDS = ("mlp", "text")
@@ -121,12 +123,11 @@ class TextBetaHead(nn.Module):
     SIZE_BUFFERS = ("size_y0", "size_yd", "mass_c", "mass_l", "mass_q", "mass_k", "meet_dirs")
 
     def _size_buffers(self, n: int, size_model: dict | None) -> None:
-        """``size_model`` (``beta_head_refit.head_size_model``): rest-vertex heights y0 (V,) + yd (V, n)
-        @ betas in metres, the mass polynomial (kg: c + l.b + b'qb + k[b,b,b]) and the betas of one
-        slider range of height and of weight (2, n); zeros until ``load_state_dict`` without it."""
+        """``size_model`` (``Readback.size_model``): rest-vertex heights y0 (V,) + yd (V, n) @ betas in
+        metres, the mass polynomial (kg: c + l.b + b'qb + k[b,b,b]) and the betas of one slider range
+        of height and of weight (2, n); zeros (one vertex) until ``load_state_dict`` without it."""
         if size_model is None:
-            V = 1
-            size_model = {"size_y0": torch.zeros(V), "size_yd": torch.zeros(V, n), "mass_c": torch.zeros(1),
+            size_model = {"size_y0": torch.zeros(1), "size_yd": torch.zeros(1, n), "mass_c": torch.zeros(1),
                           "mass_l": torch.zeros(n), "mass_q": torch.zeros(n, n), "mass_k": torch.zeros(n, n, n),
                           "meet_dirs": torch.zeros(2, n)}
         for k in self.SIZE_BUFFERS:
@@ -146,8 +147,7 @@ class TextBetaHead(nn.Module):
         height = 100.0 * (ys.gather(1, top[:, None]) - ys.gather(1, bottom[:, None]))[:, 0]
         g_height = 100.0 * (self.size_yd[top] - self.size_yd[bottom])
         k = self.mass_k
-        six = (self.mass_c + betas @ self.mass_l + torch.einsum("bp,pq,bq->b", betas, self.mass_q, betas)
-               + torch.einsum("bp,bq,br,pqr->b", betas, betas, betas, k))
+        six = cubic_in_betas(betas, self.mass_c, self.mass_l, self.mass_q, k)
         ksym = k + k.permute(1, 0, 2) + k.permute(2, 0, 1)
         g_six = self.mass_l + betas @ (self.mass_q + self.mass_q.T) + torch.einsum("pjk,bj,bk->bp", ksym, betas, betas)
         sign = torch.where(six < 0, -1.0, 1.0)

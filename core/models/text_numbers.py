@@ -25,8 +25,8 @@ FEATURES = 6
 
 
 def value_features(v: float) -> list[float]:
-    """A number's value in scales a small network can use: a flag, the value over 1, 10, 100 and
-    1,000 (squashed past those), and its logarithm."""
+    """A number's value in scales a small network can use: a flag, the value over 10 and over 100
+    squashed (tanh), over 100 plain (10 from 1,000 up), over 1,000 squashed, and its logarithm."""
     return [1.0, math.tanh(v / 10.0), math.tanh(v / 100.0), v / 100.0 if v < 1000 else 10.0,
             math.tanh(v / 1000.0), math.log10(1.0 + v) / 3.0]
 

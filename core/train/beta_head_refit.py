@@ -245,7 +245,7 @@ class Readback:
                                           for x in (poly.c, poly.l, poly.q, poly.k))
 
     def size_model(self) -> dict:
-        """What ``TextBetaHead(meets=1)`` measures a body with (its buffers): the rest vertices'
+        """What a ``TextBetaHead`` with ``meets`` measures a body with (its buffers): the rest vertices'
         heights (m) as y0 + yd @ betas, this mass polynomial (kg) and the betas of one slider range
         of height and of weight."""
         names = list(self.names)
@@ -264,10 +264,9 @@ class Readback:
 
     def mass(self, betas: torch.Tensor) -> torch.Tensor:
         """(B, 10) -> (B,) kg (``fast_mass``'s number)."""
-        b = betas
-        six = (self.c + b @ self.l + torch.einsum("bp,pq,bq->b", b, self.q, b)
-               + torch.einsum("bp,bq,br,pqr->b", b, b, b, self.k))
-        return six.abs()
+        from ..body.body_mass import cubic_in_betas
+
+        return cubic_in_betas(betas, self.c, self.l, self.q, self.k).abs()
 
     def loss(self, pred: torch.Tensor, phenotype: torch.Tensor, betas: torch.Tensor, slider_weight: float,
              mass_weight: float) -> tuple:

@@ -172,10 +172,13 @@ def build_features(t5, reader, examples, readback, c: HeadTrainConfig, progress:
         hs.append(t5.beta_state(t5.inputs_for(cache, m, sh)))
         bar.update(len(m))
     bar.close()
+    said = [str(sh) for sh in shapes if sh and str(sh).strip()]
+    values = iter(number_features(cache.encoder.tokenizer, said))   # one per said text, in order
     for sh in shapes:
-        said = bool(sh and str(sh).strip())
-        x = cache.states_of[str(sh)] if said else torch.zeros(0, cache.encoder.dim, dtype=torch.float16)
-        f = number_features(cache.encoder.tokenizer, [str(sh)])[0] if said else torch.zeros(0, FEATURES)
+        if sh and str(sh).strip():
+            x, f = cache.states_of[str(sh)], next(values)
+        else:
+            x, f = torch.zeros(0, cache.encoder.dim, dtype=torch.float16), torch.zeros(0, FEATURES)
         if len(f) != len(x):
             raise ShapeMoveError(f"shape text {sh!r}: {len(x)} token states but {len(f)} tokens")
         blocks.append(x)
@@ -184,8 +187,7 @@ def build_features(t5, reader, examples, readback, c: HeadTrainConfig, progress:
     offsets = torch.zeros(len(lens) + 1, dtype=torch.long)
     offsets[1:] = torch.as_tensor(lens).cumsum(0)
     return {"h": torch.cat(hs), "states": torch.cat(blocks), "numbers": torch.cat(numbers), "offsets": offsets,
-            "betas": betas,
-            "pheno": pheno, "pool": torch.as_tensor(pool), "texts": [s or "" for s in shapes], "motions": motions}
+            "betas": betas, "pheno": pheno, "pool": torch.as_tensor(pool), "texts": [s or "" for s in shapes], "motions": motions}
 
 
 def _stamp(model_dir: Path, data: Path, c: HeadTrainConfig) -> str:
