@@ -57,7 +57,8 @@ train-default: setup
 		--out $(RUNS)/t5 --resume $(if $(BASE_T5),--base-model $(BASE_T5),)
 	$(PY) tools/export_default.py --vae $(RUNS)/vae_res_more --t5 $(RUNS)/t5 --tma $(RUNS)/tma --out weights/default --card configs/model_card.json
 	$(PY) -m shapemove train head --model weights/default --data $(BUILT) --out $(RUNS)/head --resume
-	rm -rf weights/default && cp -r $(RUNS)/head/model weights/default
+	$(PY) -m shapemove train head --model $(RUNS)/head/model --data $(BUILT) --config configs/default_head_units.json --out $(RUNS)/head_units --resume
+	rm -rf weights/default && cp -r $(RUNS)/head_units/model weights/default
 	$(PY) tools/build_motion_memory.py --model weights/default --data $(BUILT)
 
 # Evaluation tables of docs/evaluation.md (needs $(BUILT) from train-default); the 1-step SA-VAE is the untrained baseline.

@@ -300,6 +300,11 @@ def test_stated_texts_say_an_age_with_any_noun():
     assert any(any(n in t for n in adult_nouns) for t in said), said[:10]
     assert any("in her teens" in t for t in texts)
     assert not any(" he " in f" {t} " or "his " in t for t in texts)   # her, never his
+    # and in years, in the forms the parser reads, the number its own: "16 years old", "aged 16"
+    years = [t for t in texts if any(f in t for f in ("16 years old", "aged 16", "16 yo"))]
+    assert 40 <= len(years) <= 200 and all("in her 10s" not in t for t in texts)
+    adult = {**teen, "age": 47.0}
+    assert any("in her 40s" in stated_text(adult, {"height_cm": 160.0}, f"k{i}") for i in range(200))
 
 
 def test_a_head_that_meets_its_sizes_lands_the_mesh_on_them(openbody):

@@ -28,7 +28,10 @@ a folder without that key holds the first kind, as every model saved before it d
   height and weight sliders until its rest mesh measures exactly those (``meet``: a few Newton
   steps on the mesh height, linear in the betas, and the mesh mass, an exact cubic; the arrays ride
   along as buffers). The head's reading of "188 cm, 92 kg" then decides the body's size, not how
-  closely 10 betas can be regressed.
+  closely 10 betas can be regressed. With ``meets`` = 3 the numbers are read by ``number_units``
+  instead: each number's unit (cm, m, ft, in, kg, lb, st or none) chosen from the words around it,
+  the scales the units' own. ``number_tokens`` = 0 gives the values to that reader only (the
+  token states stay the words'), so a trained head without numbers can take it on unchanged.
 """
 from __future__ import annotations
 
@@ -71,7 +74,7 @@ class TextBetaHead(nn.Module):
 
     def __init__(self, d_model: int, num_betas: int = 10, hidden: int = 256, text_dim: int = 384, width: int = 128,
                  queries: int = 4, heads: int = 4, sliders: int = 0, phenotype_map=None, numbers: int = 0,
-                 meets: int = 0, size_model: dict | None = None):
+                 meets: int = 0, size_model: dict | None = None, number_tokens: int = 1):
         super().__init__()
         if width % heads:
             raise ShapeMoveError(f"beta head: width {width} is not a multiple of heads {heads}")
@@ -82,15 +85,23 @@ class TextBetaHead(nn.Module):
             self._slider_buffers(int(sliders), num_betas, phenotype_map)
         if numbers:
             self.sizes["numbers"] = int(numbers)
-            self.number_in = nn.Sequential(nn.Linear(int(numbers), width), nn.GELU(), nn.Linear(width, width))
+            if number_tokens:
+                self.number_in = nn.Sequential(nn.Linear(int(numbers), width), nn.GELU(), nn.Linear(width, width))
+            else:   # the values go to the unit reader (meets 3) only: the tokens are the words' alone
+                self.sizes["number_tokens"] = 0
         if meets:
             if not sliders:
                 raise ShapeMoveError("beta head: meets needs sliders (it moves the height and weight sliders)")
             self.sizes["meets"] = int(meets)
             self._size_buffers(num_betas, size_model)
+            if int(meets) not in (1, 2, 3):
+                raise ShapeMoveError(f"beta head: meets must be 1, 2 or 3, got {meets!r}")
+            if int(meets) >= 2 and not numbers:
+                raise ShapeMoveError(f"beta head: meets {int(meets)} reads the numbers of the text; it needs numbers")
+            if int(meets) == 3:
+                from .number_units import NumberUnits
+                self.units = NumberUnits(text_dim, features=int(numbers))
             if int(meets) == 2:
-                if not numbers:
-                    raise ShapeMoveError("beta head: meets 2 points at numbers; it needs numbers")
                 self.pointer = nn.Linear(width, 4)   # per token: height and mass gate, log of the scale
                 with torch.no_grad():
                     self.pointer.weight.mul_(0.1)
@@ -190,7 +201,8 @@ class TextBetaHead(nn.Module):
             if numbers is None or tuple(numbers.shape[:2]) != (B, L):
                 raise ShapeMoveError("this [BETA] head reads the values of the numbers in the shape text: "
                                      "give it number features for every text token")
-            tokens = tokens + self.number_in(numbers.to(tokens.dtype))
+            if hasattr(self, "number_in"):
+                tokens = tokens + self.number_in(numbers.to(tokens.dtype))
         x = torch.cat([self.none.expand(B, 1, -1), tokens], 1)
         keep = torch.cat([torch.ones(B, 1, dtype=torch.bool, device=x.device), text_mask.bool()], 1)
         x = self.mix(x, src_key_padding_mask=~keep)
@@ -204,15 +216,15 @@ class TextBetaHead(nn.Module):
         betas = self.map_intercept + sliders @ self.map_matrix + out[:, P:P + n] @ self.map_null
         if not self.sizes.get("meets"):
             return betas
-        if self.sizes["meets"] == 2:   # the numbers pointed at; the body's own size where none is stated
+        if self.sizes["meets"] >= 2:   # the numbers read; the body's own size where none is stated
             height, mass, _, _ = self.height_mass(betas)
-            said = self._point(torch.stack([height, mass], 1), x[:, 1:], numbers)
+            guess = torch.stack([height, mass], 1)
+            said = self._point(guess, x[:, 1:], numbers) if self.sizes["meets"] == 2 else self.units(guess, text * text_mask[..., None], numbers)
         else:
             said = torch.stack([170.0 + 20.0 * out[:, P + n], 70.0 + 20.0 * out[:, P + n + 1]], 1)   # cm, kg
-        said = torch.stack([said[:, 0].clamp(*MEET_CM), said[:, 1].clamp(*MEET_KG)], 1)
-        if self.reading_sizes:
+        if self.reading_sizes:   # training reads the sizes unclamped: a clamped one has no gradient
             return betas, said
-        return self.meet(betas, said)
+        return self.meet(betas, torch.stack([said[:, 0].clamp(*MEET_CM), said[:, 1].clamp(*MEET_KG)], 1))
 
     reading_sizes = False   # training: forward gives (betas before ``meet``, the height and mass read)
 
@@ -222,10 +234,9 @@ class TextBetaHead(nn.Module):
         "6 ft 2", ~ 2.54 for its "2"; ~ 0.454 for "200" in "200 lb"), the sum of those standing in for
         ``guess`` (the body's own size: ``meet`` then leaves a body described in words alone as it is)
         as far as the gates add up to 1."""
-        flag, value = numbers[..., 0], numbers[..., 3] * 100.0
-        prev_flag = torch.cat([torch.zeros_like(flag[:, :1]), flag[:, :-1]], 1)
-        prev_value = torch.cat([torch.zeros_like(value[:, :1]), value[:, :-1]], 1)
-        start = (flag > 0) & ~((prev_flag > 0) & (prev_value == value))    # a number's first word piece
+        from .number_units import number_starts
+
+        start, value = number_starts(numbers)    # a number's first word piece, and its value
         g = self.pointer(tokens)
         gate = torch.sigmoid(g[..., :2]) * start[..., None]
         scale = torch.exp(g[..., 2:].clamp(-4.0, 6.0))

@@ -29,14 +29,16 @@ MEASURES = ("height_cm", "waist_cm")
 
 
 def head_loss(head, states: torch.Tensor, betas: torch.Tensor, measure, weight: float, text=None, text_mask=None,
-              extra=None, l1_target=None, numbers=None, mass=None, mass_weight: float = 0.0) -> tuple:
+              extra=None, l1_target=None, numbers=None, mass=None, mass_weight: float = 0.0, units=None) -> tuple:
     """(loss, L1 of the betas, mean |height error| + |waist error| in cm). ``measure``: (B,10) -> (B,2) cm.
     ``text``/``text_mask``/``numbers``: the shape text's MiniLM states and its numbers' value
     features for a head that reads them; ``extra``:
     (B,10) predicted betas -> a further loss term (``Readback.loss``); ``l1_target``: the betas the
     L1 reads instead of ``betas`` (which the measurements still read). A head that meets the sizes it
     reads (``TextBetaHead`` with ``meets``) is trained on its betas before ``meet`` and, beside them,
-    on the height (x ``weight``) and mass (``mass``: (B,10) -> (B,) kg, x ``mass_weight``) it reads."""
+    on the height (x ``weight``) and mass (``mass``: (B,10) -> (B,) kg, x ``mass_weight``) it reads;
+    one that reads the numbers' units (meets 3) on ``units`` instead: (B, L) the unit of each
+    number's first word piece (``number_units.unit_labels``; -100 elsewhere), by cross-entropy."""
     args = (states, text, text_mask, *((numbers,) if getattr(head, "reads_numbers", False) else ()))
     said = None
     if getattr(head, "sizes", {}).get("meets"):
@@ -52,7 +54,13 @@ def head_loss(head, states: torch.Tensor, betas: torch.Tensor, measure, weight: 
         true = measure(betas)
     cm = (measure(pred) - true).abs().mean(0).sum()
     loss = l1 + weight * cm
-    if said is not None:
+    if units is not None:
+        logits, start, _ = head.units.logits(text, numbers)
+        labels = units[:, :logits.shape[1]]
+        keep = start & (labels >= 0)
+        if keep.any():
+            loss = loss + torch.nn.functional.cross_entropy(logits[keep], labels[keep])
+    elif said is not None:
         with torch.no_grad():
             true_kg = mass(betas)
         loss = loss + weight * (said[:, 0] - true[:, 0]).abs().mean() + mass_weight * (said[:, 1] - true_kg).abs().mean()
@@ -131,8 +139,9 @@ MORE_BUILD = {"muscle": ["beefy", "muscle-bound", "heavily muscled", "strong", "
 
 def stated_text(phenotype: dict, measures: dict, key: str) -> str:
     """One description of a body as people type it: a noun for its gender and age with a few build
-    and age words (some from ``MORE_*``), and its height and/or weight in cm, m, feet and inches,
-    kg, lb or stones, in varied sentence shapes. Deterministic for a ``key``."""
+    and age words (some from ``MORE_*``), sometimes its age in years ("35 years old", "aged 35"), and
+    its height and/or weight in cm, m, feet and inches, kg, lb or stones, in varied sentence shapes.
+    Deterministic for a ``key``."""
     import random
 
     from ..data.phenotype_captions import FEMALE, MALE, age_words, decade_words, phenotype_texts
@@ -166,6 +175,12 @@ def stated_text(phenotype: dict, measures: dict, key: str) -> str:
             desc += f" in {'his' if sex == 'male' else 'her'} {decade_words(age)}"
     else:
         desc = ""
+    if desc and "year" not in desc and rng.random() < 0.3:   # an age in years, as the parser's forms write it
+        a = int(age)
+        forms = [f", {a} years old", f", aged {a}", f" aged {a}", f", {a} yo"]
+        if sex != "person" and a >= 20:
+            forms.append(f" in {'his' if sex == 'male' else 'her'} {a // 10 * 10}s")
+        desc += rng.choice(forms)
     h, kg = measures.get("height_cm"), measures.get("mass_kg")
     H = _said_height(h, rng) if h is not None else None
     M = _said_mass(kg, rng) if kg is not None else None

@@ -43,7 +43,7 @@ from ..errors import ShapeMoveError
 
 KIND = "shapemove-head"
 FEATURE_KEYS = ("seed", "dataset_examples", "pool", "stated_share", "no_shape_average", "teen_share", "height_margin")
-FEATURES_FORMAT = 3   # 3: the shape texts' number features beside their states
+FEATURES_FORMAT = 4   # 3: the shape texts' number features beside their states; 4: stated ages in years
 
 
 @dataclass
@@ -69,6 +69,8 @@ class HeadTrainConfig:
     teen_weight: float = 4.0         # pool bodies under 20 drawn this many times as often (3 % of the ages drawn)
     teen_share: float = 0.0          # share of the pool drawn as teenagers, 14-19 (phenotype_sample.TEEN_AGES)
     height_margin: float = 0.0       # the pool's height slider drawn this fraction of its range past each end
+    start_from_source: bool = False  # the new head starts from the source model's own head (every weight it has)
+    train_only: list = field(default_factory=list)   # names of the parts that learn (e.g. ["units"]); [] = all
     log_every: int = 100
     ckpt_every: int = 500
 
@@ -97,6 +99,8 @@ class HeadTrainConfig:
             raise ShapeMoveError("head config: height_margin must be in [0, 0.5]")
         if self.lr <= 0 or min(self.measure_weight, self.slider_weight, self.mass_weight) < 0 or self.teen_weight <= 0:
             raise ShapeMoveError("head config: lr > 0, non-negative loss weights and teen_weight > 0 are required")
+        if not isinstance(self.train_only, list) or not all(isinstance(t, str) and t for t in self.train_only):
+            raise ShapeMoveError(f"head config: train_only must be a list of part names, got {self.train_only!r}")
         if not isinstance(self.head, dict) or self.head.get("kind") not in ("mlp", "text"):
             raise ShapeMoveError(f"head config: head must be {{\"kind\": \"text\" | \"mlp\", ...sizes}}, got {self.head!r}")
 
@@ -242,6 +246,50 @@ def export_model(src: Path, dst: Path, head, meta: dict) -> Path:
 
 
 # -- training --------------------------------------------------------------------------------------
+def start_from(head, source, where) -> None:
+    """``head`` takes every weight of ``source`` (the model's own head); its parts that ``source``
+    lacks (a unit reader, say) keep their new values. Refused where a shared weight's shape differs."""
+    own, theirs = head.state_dict(), source.state_dict()
+    wrong = [k for k in theirs if k not in own or own[k].shape != theirs[k].shape]
+    if wrong:
+        raise ShapeMoveError(f"start_from_source: the head of {where} does not fit the new head's sizes "
+                             f"({', '.join(wrong[:4])}{' ...' if len(wrong) > 4 else ''}); match its sizes in \"head\"")
+    head.load_state_dict({**own, **theirs})
+
+
+def label_units(feats: Features, measure, mass) -> torch.Tensor:
+    """(N, L) the unit index of each number's first word piece in every example's shape text
+    (``number_units.unit_labels``, from the example's own height and mass), -100 elsewhere."""
+    from ..models.number_units import number_starts, unit_labels
+
+    labels = torch.full(feats.padded_numbers.shape[:2], -100, dtype=torch.long)
+    with torch.no_grad():
+        height = torch.cat([measure(b)[:, 0] for b in feats.betas.split(4096)]).tolist()
+        kg = torch.cat([mass(b) for b in feats.betas.split(4096)]).tolist()
+    for i in torch.nonzero(feats.numbers).flatten().tolist():
+        start, value = number_starts(feats.padded_numbers[i:i + 1, :int(feats.lens[i])].float())
+        where = torch.nonzero(start[0]).flatten()
+        if len(where):
+            labels[i, where] = torch.tensor(unit_labels(value[0, where].tolist(), height[i], kg[i]))
+    return labels
+
+
+def trainable(head, parts: list) -> list:
+    """The parameters that learn: all, or those of the named parts (``head.<part>``); the rest frozen."""
+    if not parts:
+        return list(head.parameters())
+    names = dict(head.named_children())
+    missing = [p for p in parts if p not in names]
+    if missing:
+        raise ShapeMoveError(f"train_only: the head has no part {', '.join(missing)} (it has {', '.join(names)})")
+    for p in head.parameters():
+        p.requires_grad_(False)
+    learn = [p for part in parts for p in names[part].parameters()]
+    for p in learn:
+        p.requires_grad_(True)
+    return learn
+
+
 def _metrics(head, feats: Features, idx, readback, measure) -> dict:
     """Held-out pool bodies: betas L1, height/waist/mass errors, slider errors, gender right."""
     with torch.no_grad():
@@ -307,6 +355,9 @@ def train_head(model_dir, data, out, config: HeadTrainConfig | None = None, resu
     torch.manual_seed(c.seed)
     head = build_head(c.head, t5.d_model, getattr(examples.body, "phenotype_map", None),
                       readback.size_model() if c.head.get("meets") else None)
+    if c.start_from_source:
+        start_from(head, t5.beta_head, t5_dir)
+    learn = trainable(head, c.train_only)
     feats = load_features(out, _stamp(model_dir, data, c),
                           lambda: build_features(t5, reader, examples, readback, c, verbose))
     n = len(feats)
@@ -315,7 +366,8 @@ def train_head(model_dir, data, out, config: HeadTrainConfig | None = None, resu
     val_idx = pool_idx[len(pool_idx) - n_val:] if n_val else pool_idx[:0]
     train_idx = torch.as_tensor(sorted(set(range(n)) - set(val_idx.tolist())), dtype=torch.long)
 
-    optimizer = torch.optim.AdamW(head.parameters(), lr=c.lr, weight_decay=c.weight_decay)
+    units = label_units(feats, examples.measure, readback.mass) if c.head.get("meets") == 3 else None
+    optimizer = torch.optim.AdamW(learn, lr=c.lr, weight_decay=c.weight_decay)
     scheduler = torch.optim.lr_scheduler.LambdaLR(optimizer, lambda s: lr_at(s, c))
     step, rng = 0, random.Random(c.seed + 1)
     last = out / "last.pt"
@@ -367,8 +419,12 @@ def train_head(model_dir, data, out, config: HeadTrainConfig | None = None, resu
             target = torch.where(words[:, None], readback.to_betas(pheno), betas)
         loss, l1, cm = head_loss(head, h, betas, examples.measure, c.measure_weight, text, mask,
                                  extra=lambda pred: extra(pred, pheno, betas), l1_target=target, numbers=numbers,
-                                 mass=readback.mass, mass_weight=c.mass_weight)
-        optimizer_step(loss, optimizer, scheduler, head.parameters(), c.grad_clip)
+                                 mass=readback.mass, mass_weight=c.mass_weight,
+                                 units=None if units is None else units[pick])
+        if loss.requires_grad:   # a batch of words alone has nothing for a unit reader trained alone
+            optimizer_step(loss, optimizer, scheduler, learn, c.grad_clip)
+        else:
+            scheduler.step()
         step += 1
         log.bar.update(1)
         if step % c.log_every == 0 or step == c.steps:
