@@ -165,3 +165,21 @@ def test_the_default_head_meets_stated_sizes_and_leaves_words_alone(openbody):
         assert abs(gh - h) < 0.3 and abs(gkg - kg) < 0.3, (h, kg, gh, gkg)
     assert torch.allclose(betas[3:], old[3:], atol=1e-5)
     assert not torch.allclose(betas[:3], old[:3], atol=1e-2)
+
+
+def test_the_default_head_refuses_sizes_no_body_has():
+    """Sizes the head reads that it cannot make, or no living body has, are a clear error naming
+    them, never a body clamped to something else; a heavy but possible body is made."""
+    from shapemove.core.models.shapemove_t5 import ShapeMoveT5
+
+    t5, reader = ShapeMoveT5.load("weights/default/t5")
+
+    def betas(text):
+        with torch.no_grad():
+            return t5.predict_betas(t5.inputs_for(reader, ["a person walks."], [text]))
+
+    for text, said in [("a man who weighs 900 kg", "weight of 900 kg"), ("a woman, 120 cm", "height of 120 cm"),
+                       ("an obese 2 m, 40 kg man", "BMI of 10.0")]:
+        with pytest.raises(ShapeMoveError, match=said):
+            betas(text)
+    assert betas("a woman, 150 cm, 150 kg").shape == (1, 10)

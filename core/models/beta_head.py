@@ -224,9 +224,12 @@ class TextBetaHead(nn.Module):
             said = torch.stack([170.0 + 20.0 * out[:, P + n], 70.0 + 20.0 * out[:, P + n + 1]], 1)   # cm, kg
         if self.reading_sizes:   # training reads the sizes unclamped: a clamped one has no gradient
             return betas, said
+        if self.sizes["meets"] >= 2 and self.refusing:
+            refuse_impossible(said, guess)
         return self.meet(betas, torch.stack([said[:, 0].clamp(*MEET_CM), said[:, 1].clamp(*MEET_KG)], 1))
 
     reading_sizes = False   # training: forward gives (betas before ``meet``, the height and mass read)
+    refusing = True         # sizes no body has are an error (``refuse_impossible``); off while a head learns
 
     def _point(self, guess: torch.Tensor, tokens: torch.Tensor, numbers: torch.Tensor) -> torch.Tensor:
         """(B, 2) height and mass: each number of the text (its first token) may count towards either,
@@ -246,6 +249,29 @@ class TextBetaHead(nn.Module):
 
     def config(self) -> dict:
         return {"kind": self.kind, **self.sizes}
+
+
+def refuse_impossible(said: torch.Tensor, guess: torch.Tensor) -> None:
+    """A clear error where the sizes a head read in the text ((B, 2) cm, kg; ``guess``: the body's
+    own, where the text states none) are no body it can make: a height or mass outside
+    ``MEET_CM`` / ``MEET_KG``, or the two a BMI no living body has (``shape_words.PERSON_RANGES``),
+    never a body clamped to something else."""
+    from ..text.shape_words import PERSON_RANGES
+
+    stated = (said - guess).abs() > 1e-3
+    bmi = said[:, 1] / (said[:, 0] / 100.0).clamp(min=0.1) ** 2
+    lo, hi = PERSON_RANGES["bmi"]
+    for b in torch.nonzero(stated.any(1)).flatten().tolist():
+        h, kg = float(said[b, 0]), float(said[b, 1])
+        if stated[b, 0] and not MEET_CM[0] <= h <= MEET_CM[1]:
+            raise ShapeMoveError(f"the shape text states a height of {h:.0f} cm (as the [BETA] head reads it): "
+                                 f"it makes bodies of {MEET_CM[0]:.0f}-{MEET_CM[1]:.0f} cm")
+        if stated[b, 1] and not MEET_KG[0] <= kg <= MEET_KG[1]:
+            raise ShapeMoveError(f"the shape text states a weight of {kg:.0f} kg (as the [BETA] head reads it): "
+                                 f"it makes bodies of {MEET_KG[0]:.0f}-{MEET_KG[1]:.0f} kg")
+        if stated[b].all() and not lo <= float(bmi[b]) <= hi:
+            raise ShapeMoveError(f"{h:.0f} cm and {kg:.0f} kg make a BMI of {float(bmi[b]):.1f}: no living body "
+                                 f"has that (BMI {lo:g}-{hi:g})")
 
 
 def build_head(config: dict | None, d_model: int, phenotype_map=None, size_model: dict | None = None) -> nn.Module:

@@ -294,7 +294,11 @@ def _metrics(head, feats: Features, idx, readback, measure) -> dict:
     """Held-out pool bodies: betas L1, height/waist/mass errors, slider errors, gender right."""
     with torch.no_grad():
         h, text, mask, numbers, betas, pheno = feats.batch(idx)
-        pred = head(h, text, mask, *((numbers,) if getattr(head, "reads_numbers", False) else ()))
+        head.refusing = False   # a head still learning may read impossible sizes: measured, not refused
+        try:
+            pred = head(h, text, mask, *((numbers,) if getattr(head, "reads_numbers", False) else ()))
+        finally:
+            head.refusing = True
         dm = (measure(pred) - measure(betas)).abs().mean(0)
         kg = (readback.mass(pred) - readback.mass(betas)).abs().mean()
         sl = readback.sliders(pred)
