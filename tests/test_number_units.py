@@ -183,3 +183,18 @@ def test_the_default_head_refuses_sizes_no_body_has():
         with pytest.raises(ShapeMoveError, match=said):
             betas(text)
     assert betas("a woman, 150 cm, 150 kg").shape == (1, 10)
+
+
+def test_generate_refuses_an_impossible_head_reading_before_any_motion():
+    """A batch whose second request's shape text the head reads as no body stops before the first
+    is generated (every text is checked first), with the head's message."""
+    from shapemove.core.generation.generate import Generator, Request
+
+    gen = Generator(None)
+    calls = []
+    gen.tokens_for = lambda reqs: calls.append(reqs) or (_ for _ in ()).throw(AssertionError("generated"))
+    reqs = [Request("a person walks forward", "a man, 180 cm", seconds=2, shape_from="head"),
+            Request("a person waves", "a man who weighs 900 kg", seconds=2, shape_from="head")]
+    with pytest.raises(ShapeMoveError, match="weight of 900 kg"):
+        gen.generate_batch(reqs, progress=None)
+    assert calls == []

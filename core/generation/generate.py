@@ -329,6 +329,9 @@ class Generator:
                 from ..body.shape_from_measurements import betas_for_shape_text
 
                 betas_for_shape_text(self.body, r.shape_text)  # contradictions, impossible bodies: refused first
+            elif r.shape_text and r.betas is None and self.t5 is not None:   # the head's reading, refused first too
+                with one_torch_thread(), torch.no_grad():
+                    self.t5.predict_betas(self.t5.inputs_for(self.tok, [r.prompt], [r.shape_text]))
         out = []
         for i, (r, check) in enumerate(zip(reqs, checks)):
             if cancel is not None and cancel():

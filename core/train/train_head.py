@@ -23,6 +23,10 @@ the model folder is copied as it is and only ``t5/beta_head.safetensors`` and ``
      weight, height read back through OpenBody's map, as ``eval shape-words`` reads them; the drawn
      age in whole years, as the words say it; dataset bodies: their own betas' read-back)
    + ``mass_weight`` * |mass error| (kg, the mesh volume's exact cubic in the betas);
+   a head with a unit reader (``"meets": 3``) learns it by cross-entropy on ``label_units``'s labels
+   (the units that make each text's numbers add up to its body's own height and mass);
+   ``start_from_source`` starts from the source model's head, ``train_only`` names the parts that
+   learn (the shipped head's unit reader: ``configs/default_head_units.json``, the rest kept);
 4. ``out/last.pt`` every ``ckpt_every`` steps (atomic; ``--resume`` continues from it with the same
    batches); at the end ``out/model/``: the source model folder with the new head and a new manifest.
 """
