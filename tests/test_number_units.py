@@ -3,6 +3,7 @@ labels come from the bodies' own sizes, its choice sums the numbers in the units
 `train head` can teach it alone on top of a trained head that stays as it was."""
 import json
 
+import numpy as np
 import pytest
 import torch
 
@@ -68,6 +69,22 @@ def test_the_chosen_units_sum_the_numbers_and_the_guess_stands_in():
     # in training the choice is the softmax's mixture, with a gradient
     units.train()
     assert torch.allclose(units(guess, text, three), torch.tensor([[188.0, 80.0]]), atol=1e-3)
+
+
+def test_a_reader_without_values_chooses_from_the_words_around_the_number_alone():
+    """values=False: neither the number's value nor its own word pieces change the choice, the
+    words around it do."""
+    torch.manual_seed(0)
+    units = NumberUnits(text_dim=8, width=4, hidden=8, values=False).eval()
+    text = torch.randn(1, 6, 8)
+    a, b = _numbers({2: 9.0}, 6), _numbers({2: 20.0}, 6)
+    other = text.clone()
+    other[0, 2] = torch.randn(8)            # another number's word piece in its place
+    la = units.logits(text, a)[0][0, 2]
+    assert torch.allclose(la, units.logits(other, b)[0][0, 2])
+    moved = text.clone()
+    moved[0, 3] = torch.randn(8)            # the word after it
+    assert not torch.allclose(la, units.logits(moved, a)[0][0, 2])
 
 
 def test_a_fresh_reader_reads_every_number_as_none():
@@ -198,3 +215,16 @@ def test_generate_refuses_an_impossible_head_reading_before_any_motion():
     with pytest.raises(ShapeMoveError, match="weight of 900 kg"):
         gen.generate_batch(reqs, progress=None)
     assert calls == []
+
+
+def test_the_evaluation_counts_a_text_the_head_refuses_as_refused():
+    from shapemove.core.eval.shape_eval import head_betas, head_readings
+    from shapemove.core.models.shapemove_t5 import ShapeMoveT5
+
+    t5, reader = ShapeMoveT5.load("weights/default/t5")
+    texts = ["a man, 180 cm", "a man who weighs 900 kg", "an elderly woman"]
+    betas, refused = head_readings(t5, reader, ["a person walks."] * 3, texts)
+    assert np.isnan(betas[1]).all() and not np.isnan(betas[[0, 2]]).any()
+    assert refused == [(texts[1], refused[0][1])] and "900 kg" in refused[0][1]
+    alone = head_betas(t5, reader, ["a person walks."] * 2, [texts[0], texts[2]])
+    assert np.allclose(betas[[0, 2]], alone, atol=1e-5)

@@ -56,6 +56,21 @@ def head_betas(t5, reader, motion_texts: list[str], shape_texts: list[str], batc
     return np.concatenate(out) if out else np.zeros((0, 10), np.float32)
 
 
+def head_readings(t5, reader, motion_texts: list[str], shape_texts: list[str]) -> tuple:
+    """``head_betas``, with the texts the head refuses (a size it reads that no body has:
+    ``beta_head.refuse_impossible``) as NaN rows: ((N, 10) betas, [(text, message)] refused)."""
+    try:
+        return head_betas(t5, reader, motion_texts, shape_texts), []
+    except ShapeMoveError:   # some text of a batch refused: read them one by one
+        out, refused = np.full((len(shape_texts), 10), np.nan, np.float32), []
+        for i, (m, s) in enumerate(zip(motion_texts, shape_texts)):
+            try:
+                out[i] = head_betas(t5, reader, [m], [s])[0]
+            except ShapeMoveError as exc:
+                refused.append((s, str(exc)))
+        return out, refused
+
+
 def eval_shape(model_dir=None, bodies: int = 200, seed: int = 0, progress: bool = True) -> dict:
     from tqdm import tqdm
 

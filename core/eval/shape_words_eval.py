@@ -236,7 +236,7 @@ class _Reader:
         self.body = load_body_model(None)
         self._t5 = None
         self.free = 0          # texts the parser left to the head
-        self.refused: list = []  # (text, message) the parser refused
+        self.refused: list = []  # (text, message) the parser (or on the head path, the head) refused
 
     def t5(self):
         if self._t5 is None:
@@ -250,18 +250,22 @@ class _Reader:
         return self._t5
 
     def head(self, texts: list[str | None], captions=None) -> np.ndarray:
-        from .shape_eval import head_betas
+        """The head's betas; NaN rows for texts it refuses (recorded in ``refused``)."""
+        from .shape_eval import head_readings
 
         t5, reader = self.t5()
         caps = list(captions) if captions is not None else [MOTION[i % len(MOTION)] for i in range(len(texts))]
-        return head_betas(t5, reader, caps, list(texts))
+        betas, refused = head_readings(t5, reader, caps, list(texts))
+        self.refused += refused
+        return betas
 
     def betas(self, texts: list[str]) -> tuple[np.ndarray, np.ndarray]:
-        """(N,10) betas and (N,) bool: read (False: refused by the parser, betas NaN)."""
+        """(N,10) betas and (N,) bool: read (False: refused by the parser or the head, betas NaN)."""
         from ..body.shape_from_measurements import betas_for_shape_text
 
         if self.path == "head":
-            return self.head(texts), np.ones(len(texts), bool)
+            b = self.head(texts)
+            return b, ~np.isnan(b).any(1)
         out = np.full((len(texts), self.body.num_betas), np.nan)
         ok = np.ones(len(texts), bool)
         free = []
@@ -279,7 +283,7 @@ class _Reader:
         if free:
             self.free += len(free)
             out[free] = self.head([texts[i] for i in free])
-        return out, ok
+        return out, ok & ~np.isnan(out).any(1)
 
 
 def _readback(body, betas: np.ndarray) -> np.ndarray:
@@ -419,7 +423,7 @@ def format_results(res: dict) -> str:
              f"height within 1 cm and weight within 2 kg: {n['both_met_pct']:.1f} %  (mean error {n['height_err_cm_mean']:.2f} cm, "
              f"{n['mass_err_kg_mean']:.2f} kg; max {n['height_err_cm_max']:.2f} cm, {n['mass_err_kg_max']:.2f} kg; "
              f"refused {n['refused']})",
-             f"texts refused by the parser: {res['refused_total']}; left to the [BETA] head: {res['left_to_head']}"]
+             f"texts refused (parser, or the head on its path): {res['refused_total']}; left to the [BETA] head: {res['left_to_head']}"]
     ns = res["no_shape"]
     if "prompts" in ns:
         av = ns["average"]

@@ -31,7 +31,8 @@ a folder without that key holds the first kind, as every model saved before it d
   closely 10 betas can be regressed. With ``meets`` = 3 the numbers are read by ``number_units``
   instead: each number's unit (cm, m, ft, in, kg, lb, st or none) chosen from the words around it,
   the scales the units' own. ``number_tokens`` = 0 gives the values to that reader only (the
-  token states stay the words'), so a trained head without numbers can take it on unchanged.
+  token states stay the words'), so a trained head without numbers can take it on unchanged;
+  ``unit_values`` = 0 lets the reader choose from the words around a number alone.
 """
 from __future__ import annotations
 
@@ -74,7 +75,7 @@ class TextBetaHead(nn.Module):
 
     def __init__(self, d_model: int, num_betas: int = 10, hidden: int = 256, text_dim: int = 384, width: int = 128,
                  queries: int = 4, heads: int = 4, sliders: int = 0, phenotype_map=None, numbers: int = 0,
-                 meets: int = 0, size_model: dict | None = None, number_tokens: int = 1):
+                 meets: int = 0, size_model: dict | None = None, number_tokens: int = 1, unit_values: int = 1):
         super().__init__()
         if width % heads:
             raise ShapeMoveError(f"beta head: width {width} is not a multiple of heads {heads}")
@@ -100,7 +101,9 @@ class TextBetaHead(nn.Module):
                 raise ShapeMoveError(f"beta head: meets {int(meets)} reads the numbers of the text; it needs numbers")
             if int(meets) == 3:
                 from .number_units import NumberUnits
-                self.units = NumberUnits(text_dim, features=int(numbers))
+                self.units = NumberUnits(text_dim, features=int(numbers), values=bool(unit_values))
+                if not unit_values:
+                    self.sizes["unit_values"] = 0
             if int(meets) == 2:
                 self.pointer = nn.Linear(width, 4)   # per token: height and mass gate, log of the scale
                 with torch.no_grad():

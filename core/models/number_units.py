@@ -11,6 +11,10 @@ height is the sum over numbers of value x the chosen height unit's scale, and th
     units = NumberUnits(text_dim=384)
     said = units(guess, text_states, numbers)   # (B, 2) cm, kg
 
+With ``values`` False (the shipped head's ``"unit_values": 0``) the choice never sees the number
+itself: its value is not an input and its digits' word pieces are hidden from the window, so "20
+stone" is read like "9 stone" although no training body weighed 20 stone.
+
 ``guess`` (B, 2) stands in as far as no number is read as a height (mass): a body described in
 words alone keeps its own size. In training the choice is a softmax; in use (``eval()``), the
 likeliest unit. It learns from labels (``unit_labels``: the units that make a text's
@@ -38,10 +42,12 @@ def number_starts(numbers: torch.Tensor) -> tuple:
 
 
 class NumberUnits(nn.Module):
-    def __init__(self, text_dim: int = 384, width: int = 64, hidden: int = 256, features: int = 6):
+    def __init__(self, text_dim: int = 384, width: int = 64, hidden: int = 256, features: int = 6,
+                 values: bool = True):
         super().__init__()
+        self.values = bool(values)   # False: the choice reads the words around a number, never the number
         self.read = nn.Sequential(nn.LayerNorm(text_dim), nn.Linear(text_dim, width))
-        self.choose = nn.Sequential(nn.Linear(len(WINDOW) * width + features, hidden), nn.GELU(),
+        self.choose = nn.Sequential(nn.Linear(len(WINDOW) * width + (features if values else 0), hidden), nn.GELU(),
                                     nn.Linear(hidden, len(UNITS)))
         with torch.no_grad():   # at first every number is read as none: the body keeps its size
             self.choose[-1].weight.mul_(0.1)
@@ -58,11 +64,13 @@ class NumberUnits(nn.Module):
         and the values (B, L)."""
         start, value = number_starts(numbers)
         x = self.read(text.to(self.read[1].weight.dtype))
+        if not self.values:   # the digits' own word pieces hidden: "20 stone" reads as "_ stone", whatever the size
+            x = x * (numbers[..., :1] <= 0).to(x.dtype)
         B, L, W = x.shape
         pad = x.new_zeros(B, max(-min(WINDOW), 0), W), x.new_zeros(B, max(WINDOW), W)
         xp = torch.cat([pad[0], x, pad[1]], 1)
         o = pad[0].shape[1]
-        window = torch.cat([xp[:, o + d:o + d + L] for d in WINDOW] + [numbers.to(x.dtype)], 2)
+        window = torch.cat([xp[:, o + d:o + d + L] for d in WINDOW] + ([numbers.to(x.dtype)] if self.values else []), 2)
         return self.choose(window), start, value
 
     def forward(self, guess: torch.Tensor, text: torch.Tensor, numbers: torch.Tensor) -> torch.Tensor:
