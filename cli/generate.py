@@ -121,4 +121,8 @@ def run(args) -> int:
     if motion.loop_advance is not None:
         print(f"loop: the root advances {float(np.linalg.norm(motion.loop_advance[[0, 2]])):.2f} m per cycle")
     print(f"body ({motion.shape_source or '[BETA] head'}): " + format_body(m))
+    if (motion.shape_source or "[BETA] head") == "[BETA] head":
+        said = gen.head_reading(args.prompt, args.shape_text)
+        if said:
+            print(f"  the [BETA] head read: {said}")
     return 0

@@ -228,3 +228,15 @@ def test_the_evaluation_counts_a_text_the_head_refuses_as_refused():
     assert refused == [(texts[1], refused[0][1])] and "900 kg" in refused[0][1]
     alone = head_betas(t5, reader, ["a person walks."] * 2, [texts[0], texts[2]])
     assert np.allclose(betas[[0, 2]], alone, atol=1e-5)
+
+
+def test_what_the_head_read_is_said_in_the_units_typed():
+    from shapemove.core.generation.generate import Generator
+    from shapemove.core.models.number_units import describe
+
+    assert describe([(6.0, "ft"), (2.0, "in"), (200.0, "lb"), (35.0, "none")]) == "6 ft 2 in = 188.0 cm; 200 lb = 90.7 kg"
+    assert describe([(35.0, "none")]) == ""
+    gen = Generator(None)
+    assert gen.head_reading("a person walks", "she is 1.62 m, 9 st 4 lb") == "1.62 m = 162.0 cm; 9 st 4 lb = 59.0 kg"
+    assert gen.head_reading("a person walks", "an elderly woman") is None
+    assert gen.head_reading("a person walks", None) is None

@@ -374,6 +374,19 @@ class Generator:
             return body_from_prompt(self.body, r.prompt)
         return np.asarray(predicted, np.float32), "[BETA] head"
 
+    def head_reading(self, prompt: str, shape_text: str | None) -> str | None:
+        """What the [BETA] head's unit reader made of the shape text's numbers ("6 ft 2 in = 188.0
+        cm; 200 lb = 90.7 kg"), None for a head without one or a text that states no size."""
+        units = getattr(getattr(self.t5, "beta_head", None), "units", None)
+        if units is None or not (shape_text and shape_text.strip()):
+            return None
+        from ..models.number_units import describe
+
+        with one_torch_thread(), torch.no_grad():
+            states, mask, numbers = self.t5.head_text(self.t5.inputs_for(self.tok, [prompt], [shape_text]))
+            said = describe(units.read_units(states * mask[..., None], numbers)[0])
+        return said or None
+
     def redecode(self, motion: Motion, betas) -> Motion:
         """The same tokens on another body (``decode.redecode``; a motion made by body part is
         composed and mirrored again, ``parts.redecode_parts``)."""

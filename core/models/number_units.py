@@ -132,3 +132,16 @@ def unit_labels(values: list[float], height: float, mass: float, tol_cm: float =
             if best is None or key < best:
                 best, pick = key, {**hu, **mu}
     return [pick.get(i, 0) for i in range(len(values))]
+
+
+def describe(read: list) -> str:
+    """"6 ft 2 in = 188.0 cm; 200 lb = 90.7 kg": one text's ``read_units`` as a user reads it ("" when
+    it states neither size)."""
+    kind = {u[0]: (u[1], u[2]) for u in UNITS}
+    parts = []
+    for size, unit in ((0, "cm"), (1, "kg")):
+        said = [(v, u) for v, u in read if kind[u][0] == size]
+        if said:
+            total = sum(v * kind[u][1] for v, u in said)
+            parts.append(" ".join(f"{v:g} {u}" for v, u in said) + f" = {total:.1f} {unit}")
+    return "; ".join(parts)
