@@ -11,8 +11,8 @@ height is the sum over numbers of value x the chosen height unit's scale, and th
     units = NumberUnits(text_dim=384)
     said = units(guess, text_states, numbers)   # (B, 2) cm, kg
 
-With ``values`` False (the shipped head's ``"unit_values": 0``) the choice never sees the number
-itself: its value is not an input and its digits' word pieces are hidden from the window, so "20
+With ``values`` False (a head's ``"unit_values": 0``; tried, the shipped head reads the values) the
+choice never sees the number itself: its value is not an input and its digits' word pieces are hidden from the window, so "20
 stone" is read like "9 stone" although no training body weighed 20 stone.
 
 ``guess`` (B, 2) stands in as far as no number is read as a height (mass): a body described in
@@ -25,10 +25,12 @@ from __future__ import annotations
 import torch
 from torch import nn
 
+from ..text.shape_words import INCH, LB, ST
+
 # (name, which size it states: 0 height cm / 1 mass kg / -1 none, scale to cm or kg)
 UNITS = (("none", -1, 0.0),
-         ("cm", 0, 1.0), ("m", 0, 100.0), ("mm", 0, 0.1), ("ft", 0, 30.48), ("in", 0, 2.54),
-         ("kg", 1, 1.0), ("lb", 1, 0.45359237), ("st", 1, 6.35029318))
+         ("cm", 0, 1.0), ("m", 0, 100.0), ("mm", 0, 0.1), ("ft", 0, 12 * INCH), ("in", 0, INCH),
+         ("kg", 1, 1.0), ("lb", 1, LB), ("st", 1, ST))
 WINDOW = (-2, -1, 0, 1, 2, 3)   # word pieces read around a number's first one ("1" "." "88" "m")
 
 

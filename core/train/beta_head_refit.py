@@ -55,7 +55,7 @@ def head_loss(head, states: torch.Tensor, betas: torch.Tensor, measure, weight: 
     cm = (measure(pred) - true).abs().mean(0).sum()
     loss = l1 + weight * cm
     if units is not None:
-        logits, start, _ = head.units.logits(text, numbers)
+        logits, start, _ = head.units.logits(text * text_mask[..., None], numbers)   # as ``forward`` reads it
         labels = units[:, :logits.shape[1]]
         keep = start & (labels >= 0)
         if keep.any():
