@@ -101,6 +101,38 @@ def test_pin_feet_puts_planted_joints_on_their_targets(body):
     assert 0 < np.linalg.norm(got[2, 7] - pos[2, 7]) < np.linalg.norm(got[3, 7] - pos[3, 7])
 
 
+def test_pin_feet_lands_a_nearly_straight_leg(body):
+    """A planted heel at 0.98 of the leg's length from the hip (a stance leg at heel strike) is
+    landed within a millimetre by the default soft reach (0.99); the old limit (0.97) stopped
+    1.2 mm short, which is how a planted foot slides as the hip moves. Past full length, the leg stops short of
+    straight instead of snapping."""
+    from shapemove.core.body.plant import SOFT_REACH, pin_feet
+    from shapemove.core.geometry.rotations import axis_angle_to_matrix
+
+    b = np.zeros(10, np.float32)
+    aa = np.zeros((3, 24, 3))
+    aa[:, 1, 0], aa[:, 4, 0] = -0.3, 0.6        # left hip flexed, knee bent
+    rot = axis_angle_to_matrix(aa)
+    transl = np.zeros((3, 3))
+    pos = _fk(body, b, rot, transl)
+    with torch.no_grad():
+        rest = body.rest_joints(torch.as_tensor(b)[None])[0].numpy()
+    leg = np.linalg.norm(rest[4] - rest[1]) + np.linalg.norm(rest[7] - rest[4])
+    down = np.array([0.0, -np.cos(0.3), np.sin(0.3)])   # down and forward from the hip
+    tgt = pos.copy()
+    tgt[:, 7] = pos[:, 1] + down * leg * np.array([0.98, 0.98, 1.05])[:, None]
+    w = np.zeros((3, 4))
+    w[:, 0] = 1.0                                # the left heel planted
+    assert SOFT_REACH == pytest.approx(0.99)
+    miss = lambda reach: np.linalg.norm(  # noqa: E731
+        _fk(body, b, pin_feet(rot, transl, rest, body.parents, tgt, w, reach), transl)[:, 7] - tgt[:, 7], axis=-1)
+    assert miss(SOFT_REACH)[:2].max() < 1e-3
+    # the old limit's soft IK by hand: 0.97 L + 0.03 L (1 - exp(-(0.98 - 0.97) / 0.03)) = 0.9785 L
+    assert miss(0.97)[:2] == pytest.approx(leg * (0.98 - 0.97 - 0.03 * (1 - np.exp(-1 / 3))), rel=0.02)
+    reached = np.linalg.norm(_fk(body, b, pin_feet(rot, transl, rest, body.parents, tgt, w), transl)[2, 7] - pos[2, 1])
+    assert 0.99 * leg < reached < leg
+
+
 def test_retargeted_walk_keeps_planted_feet_still(mocap_root, body):
     """A real walk through the shipped SA-VAE onto a short, slim body: where the source's feet are
     in contact, the retargeted heels and balls step < 1 mm per frame on average (the decoder's own

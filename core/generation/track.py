@@ -26,7 +26,6 @@ from ..motion.skeleton_ops import facing_directions, gaussian_smooth, heading_an
 from ..scene.motion_file import Motion, make_motion
 from .decode import decode_features
 
-SOFT_REACH = 0.99     # of the leg's length (plant.SOFT_REACH is 0.97): see ``plant``
 HEADING_SIGMA = 5.0   # frames: the body's heading without the hips' swing of each step
 CENTRE_SIGMA = 5.0    # frames: the root's path without its sway
 
@@ -67,10 +66,8 @@ def decoded_track(codes: list[int], vae, betas) -> tuple[Track, np.ndarray]:
 
 def plant(body, betas, track: Track, ik_refine_iters: int = 10, prompt: str | None = None, **extra) -> Motion:
     """A track -> Motion on ``body`` with its contacts planted (``plant.plant_motion``, as
-    ``decode.motion_from_joints`` with a straighter soft reach ``SOFT_REACH``: an edited stance
-    leg lands its foot instead of stopping short), then ``lock_stance``."""
-    planted = plant_motion(body, betas, track.joints, track.contacts, refine_iters=ik_refine_iters,
-                           soft_reach=SOFT_REACH)
+    ``decode.motion_from_joints``), then ``lock_stance``."""
+    planted = plant_motion(body, betas, track.joints, track.contacts, refine_iters=ik_refine_iters)
     m = make_motion(body, matrix_to_axis_angle(planted.rotations).astype(np.float32), planted.transl, betas,
                     fps=float(FPS), prompt=prompt, network_joints=track.joints.astype(np.float32),
                     contacts=planted.contacts, **extra)
