@@ -104,8 +104,8 @@ def test_pin_feet_puts_planted_joints_on_their_targets(body):
 def test_pin_feet_lands_a_nearly_straight_leg(body):
     """A planted heel at 0.98 of the leg's length from the hip (a stance leg at heel strike) is
     landed within a millimetre by the default soft reach (0.99); the old limit (0.97) stopped
-    1.2 mm short, which is how a planted foot slides as the hip moves. Past full length, the leg stops short of
-    straight instead of snapping."""
+    1.2 mm short, which is how a planted foot slides as the hip moves. Past full length, the leg
+    stops short of straight instead of snapping."""
     from shapemove.core.body.plant import SOFT_REACH, pin_feet
     from shapemove.core.geometry.rotations import axis_angle_to_matrix
 
@@ -124,13 +124,13 @@ def test_pin_feet_lands_a_nearly_straight_leg(body):
     w = np.zeros((3, 4))
     w[:, 0] = 1.0                                # the left heel planted
     assert SOFT_REACH == pytest.approx(0.99)
-    miss = lambda reach: np.linalg.norm(  # noqa: E731
-        _fk(body, b, pin_feet(rot, transl, rest, body.parents, tgt, w, reach), transl)[:, 7] - tgt[:, 7], axis=-1)
-    assert miss(SOFT_REACH)[:2].max() < 1e-3
+    heel = lambda reach: _fk(body, b, pin_feet(rot, transl, rest, body.parents, tgt, w, reach), transl)[:, 7]  # noqa: E731
+    landed = heel(SOFT_REACH)
+    assert np.linalg.norm(landed - tgt[:, 7], axis=-1)[:2].max() < 1e-3
     # the old limit's soft IK by hand: 0.97 L + 0.03 L (1 - exp(-(0.98 - 0.97) / 0.03)) = 0.9785 L
-    assert miss(0.97)[:2] == pytest.approx(leg * (0.98 - 0.97 - 0.03 * (1 - np.exp(-1 / 3))), rel=0.02)
-    reached = np.linalg.norm(_fk(body, b, pin_feet(rot, transl, rest, body.parents, tgt, w), transl)[2, 7] - pos[2, 1])
-    assert 0.99 * leg < reached < leg
+    assert np.linalg.norm(heel(0.97) - tgt[:, 7], axis=-1)[:2] == pytest.approx(
+        leg * (0.98 - 0.97 - 0.03 * (1 - np.exp(-1 / 3))), rel=0.02)
+    assert 0.99 * leg < np.linalg.norm(landed[2] - pos[2, 1]) < leg
 
 
 def test_retargeted_walk_keeps_planted_feet_still(mocap_root, body):
