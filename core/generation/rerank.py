@@ -7,6 +7,10 @@ with the SA-VAE and compares their TMA motion embeddings with the prompt's TMA t
 (cosine); the highest wins. The TMA is the model's own (``tma/`` of the model folder), so choosing
 costs one batched SA-VAE decode and one TMA pass (tens of milliseconds), not a second generator.
 
+Travel words come first: a candidate whose root travel goes against "forward", "backwards", "in
+place" or "steps to the left" is set aside before the TMA chooses (``travel_words``), since the
+TMA reads what the body does, not which way it goes.
+
 Bias to keep in mind: R-precision and the paraphrase classifier also read TMA embeddings, so
 ``eval generate`` scores the generator with one candidate, and ``eval paraphrase`` also reports a
 classifier that does not use the TMA (``action_classifier.FeatureEmbedder``).
@@ -15,6 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .travel_words import allowed
 
 
 class CandidatePicker:
@@ -30,5 +35,6 @@ class CandidatePicker:
         return embed_motions(self.model, feats, self.mean, self.std) @ text
 
     def pick(self, prompt: str, feats: list) -> int:
-        """Index of the candidate closest to ``prompt`` (the first on a tie)."""
-        return int(np.argmax(self.scores(prompt, feats)))
+        """Index of the candidate closest to ``prompt`` among those that obey its travel words (the
+        first on a tie)."""
+        return int(np.argmax(np.where(allowed(prompt, feats), self.scores(prompt, feats), -np.inf)))

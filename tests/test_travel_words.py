@@ -1,0 +1,85 @@
+"""Travel words: which way a prompt sends the body, and the candidates that go against it."""
+import numpy as np
+import pytest
+
+from shapemove.core.generation.travel_words import SLACK, Travel, allowed, obeys, root_travel, travel_of
+
+
+@pytest.mark.parametrize("prompt, expected", [
+    ("A tall heavy man trudges forward", Travel(forward=1)),
+    ("person strutting confidently toward the camera", Travel(forward=1)),
+    ("The hiker paces ahead at a steady clip", Travel(forward=1)),
+    ("A person backs up step by step", Travel(forward=-1)),
+    ("the character retreats, walking in reverse", Travel(forward=-1)),
+    ("walks forward and backward", Travel()),                      # both ways: no direction
+    ("A man shuffles to his left", Travel(side=1)),
+    ("crab walk sideways to the right", Travel(side=-1)),
+    ("the goalkeeper side-steps to the right along the line", Travel(side=-1)),
+    ("steps to the left, then steps to the right", Travel()),      # both sides: none
+    ("a man walks sideways", Travel(sideways=True)),
+    ("toy soldier marching in place", Travel(in_place=True)),
+    ("twirl around on the spot", Travel(in_place=True)),
+    ("waves to his left", Travel()),                               # a side, but no going
+    ("A golfer swings to the left", Travel()),
+    ("a person jumps and waves", Travel()),
+])
+def test_travel_of_reads_the_words(prompt, expected):
+    assert travel_of(prompt) == expected
+
+
+def _clip(forward_per_frame: float, left_per_frame: float, frames: int = 40) -> np.ndarray:
+    f = np.zeros((frames, 263), np.float32)
+    f[:, 2], f[:, 1] = forward_per_frame, left_per_frame
+    return f
+
+
+def test_root_travel_sums_each_frames_step():
+    fwd, left = root_travel(_clip(0.03, -0.01))
+    assert fwd == pytest.approx(1.2, abs=1e-5) and left == pytest.approx(-0.4, abs=1e-5)
+
+
+def test_a_word_rules_out_only_travel_against_it_beyond_the_slack():
+    assert SLACK == 0.5
+    forward = Travel(forward=1)
+    assert obeys(forward, _clip(0.0, 0.0))                  # a punch "forward" need not travel
+    assert obeys(forward, _clip(-0.012, 0.0))               # 0.48 m back: within the slack
+    assert not obeys(forward, _clip(-0.013, 0.0))           # 0.52 m back
+    assert not obeys(Travel(forward=-1), _clip(0.05, 0.0))  # 2 m forward for "backwards"
+    left = Travel(side=1)
+    assert obeys(left, _clip(0.0, 0.02))                    # 0.8 m to the body's left (+X)
+    assert not obeys(left, _clip(0.0, 0.01))                # 0.4 m: not enough to the left
+    assert not obeys(left, _clip(0.0, -0.02))               # to the right
+    sideways = Travel(sideways=True)
+    assert obeys(sideways, _clip(0.01, -0.02)) and not obeys(sideways, _clip(0.03, 0.02))
+    in_place = Travel(in_place=True)
+    assert obeys(in_place, _clip(0.02, 0.0)) and not obeys(in_place, _clip(0.02, 0.02))  # 0.8 m; 1.13 m
+
+
+def test_allowed_sets_aside_the_contrary_and_keeps_all_when_none_obey():
+    feats = [_clip(-0.09, 0.0), _clip(0.04, 0.0), _clip(0.0, 0.0)]
+    assert allowed("a man trudges forward", feats).tolist() == [False, True, True]
+    assert allowed("a man walks backwards", feats).tolist() == [True, False, True]
+    assert allowed("a man walks", feats).tolist() == [True, True, True]
+    assert allowed("a man steps to his left", feats).tolist() == [True, True, True]   # none goes left
+
+
+def test_the_picker_sets_aside_the_tmas_favourite_when_it_walks_backward():
+    """The blind paraphrase that showed it: the TMA alone chose a captured walk backward for
+    "a tall heavy man trudges forward". Here the shipped TMA scores the memory's walk backward
+    above its forward walk, and the picker takes the forward one."""
+    from shapemove.core.generation.decode import decode_features
+    from shapemove.core.generation.generate import Generator
+
+    gen = Generator("weights/default")
+    memory = gen.t5.memory
+    prompt = "A tall heavy man trudges forward"
+    back = [i for i, _ in memory.clips_of_action("walk backward")]
+    walks = [i for i, _ in memory.clips_of_action("walk")]
+    betas = np.zeros(10, np.float32)
+    feats = [decode_features(list(memory.clip_tokens[i]), gen.vae, betas).numpy() for i in back[:4] + walks[:4]]
+    scores = gen.picker.scores(prompt, feats)
+    fwd = np.array([root_travel(f)[0] for f in feats])
+    assert (fwd[:4] < -SLACK).all() and (fwd[4:] > SLACK).all(), fwd
+    assert int(np.argmax(scores)) < 4, "the TMA alone should prefer a walk backward here"
+    best = gen.picker.pick(prompt, feats)
+    assert best >= 4 and best == 4 + int(np.argmax(scores[4:]))
