@@ -7,9 +7,10 @@ with the SA-VAE and compares their TMA motion embeddings with the prompt's TMA t
 (cosine); the highest wins. The TMA is the model's own (``tma/`` of the model folder), so choosing
 costs one batched SA-VAE decode and one TMA pass (tens of milliseconds), not a second generator.
 
-Travel words come first: a candidate whose root travel goes against "forward", "backwards", "in
-place" or "steps to the left" is set aside before the TMA chooses (``travel_words``), since the
-TMA reads what the body does, not which way it goes.
+Travel and pace words come first: a candidate whose root travel goes against "forward",
+"backwards", "in place" or "steps to the left" is set aside before the TMA chooses
+(``travel_words``), and for "walks quickly" or "a brisk walk" only the fastest candidates
+compete (``pace_words``), since the TMA reads what the body does, not which way or how fast it goes.
 
 Bias to keep in mind: R-precision and the paraphrase classifier also read TMA embeddings, so
 ``eval generate`` scores the generator with one candidate, and ``eval paraphrase`` also reports a
@@ -19,6 +20,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .pace_words import asks_fast, fastest, gait_speed
 from .travel_words import allowed
 
 
@@ -35,6 +37,9 @@ class CandidatePicker:
         return embed_motions(self.model, feats, self.mean, self.std) @ text
 
     def pick(self, prompt: str, feats: list) -> int:
-        """Index of the candidate closest to ``prompt`` among those that obey its travel words (the
-        first on a tie)."""
-        return int(np.argmax(np.where(allowed(prompt, feats), self.scores(prompt, feats), -np.inf)))
+        """Index of the candidate closest to ``prompt`` among those that obey its travel and pace
+        words (the first on a tie)."""
+        keep = allowed(prompt, feats)
+        if asks_fast(prompt):
+            keep = fastest(np.array([gait_speed(f) for f in feats]), keep)
+        return int(np.argmax(np.where(keep, self.scores(prompt, feats), -np.inf)))

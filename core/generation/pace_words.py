@@ -1,0 +1,53 @@
+"""A fast pace the words ask of a gait: "walks quickly", "a brisk walk", "runs as fast as they can".
+
+The TMA that chooses among the candidates (``rerank.CandidatePicker``) hardly tells a brisk walk
+from a slow one, and the clips retrieved for "walks quickly" by caption can be slow ones: the
+default model gave "a person walks quickly" 0.51 m/s against 1.08 m/s for "a person walks"
+(``tools/pace_check.py``). So when a prompt names a gait (the legs actions of
+``part_prompts.LEGS``: walk, jog, run, march, sneak, ...) and a fast pace, only the fastest third
+of the candidates compete. Speed is the root's mean horizontal speed along its path, read from
+the features' root velocities.
+
+Slow words are read only to cancel a fast one ("slowly, then fast" names no single pace): the
+slower candidates were tried for them and not kept, since the slowest candidates of a walk are
+often limps and creeps (``docs/evaluation.md``, fifteenth session). A prompt without a gait
+("waves quickly") is left to the TMA, since its root speed says nothing of a hand's.
+"""
+from __future__ import annotations
+
+import re
+
+import numpy as np
+
+from ..data.actions import action_spans
+from .part_prompts import LEGS
+
+FPS = 20.0
+FAST_SHARE = 1 / 3  # the fastest third of the candidates compete for a fast pace
+
+_FAST = re.compile(r"\b(quick(?:ly)?|fast(?:er)?|brisk(?:ly)?|rapid(?:ly)?|swift(?:ly)?|hurried(?:ly)?|hurr(?:y|ies|ying)|"
+                   r"hast(?:y|ily)|speedy|full speed|top speed|flat out|as fast as)\b", re.I)
+_SLOW = re.compile(r"\b(slow(?:ly|er)?|leisurely|lazily|sluggish(?:ly)?|unhurried(?:ly)?|"
+                   r"(?:easy|gentle|relaxed|snail's|leisurely|slow) pace)\b", re.I)
+
+
+def asks_fast(prompt: str) -> bool:
+    """Whether the prompt asks a gait to go fast (and names no slow pace beside it)."""
+    return (bool(_FAST.search(prompt)) and not _SLOW.search(prompt)
+            and any(sp[2] in LEGS for sp in action_spans(prompt)))
+
+
+def gait_speed(features: np.ndarray) -> float:
+    """Mean horizontal root speed (m/s) along the path of a (T, 263) feature clip."""
+    f = np.asarray(features, dtype=np.float64)
+    return float(np.hypot(f[:, 1], f[:, 2]).mean() * FPS)
+
+
+def fastest(speeds: np.ndarray, among: np.ndarray) -> np.ndarray:
+    """(N,) bool: the fastest third (``FAST_SHARE``) of the candidates ``among`` (bool), at or above
+    the quantile's speed; ``among`` itself when it holds none."""
+    speeds = np.asarray(speeds, dtype=np.float64)
+    if not among.any():
+        return among
+    keep = among & (speeds >= np.quantile(speeds[among], 1 - FAST_SHARE))
+    return keep if keep.any() else among

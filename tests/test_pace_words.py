@@ -1,0 +1,99 @@
+"""Pace words: a gait asked to go fast, and the fastest candidates."""
+import numpy as np
+import pytest
+
+from shapemove.core.generation.pace_words import asks_fast, fastest, gait_speed
+
+
+@pytest.mark.parametrize("prompt, expected", [
+    ("a person walks quickly", True),
+    ("a man walks briskly down the road", True),
+    ("A quick sprint", True),
+    ("someone runs as fast as they can", True),
+    ("a soldier runs ahead at full speed", True),
+    ("a person walks slowly", False),                # slow words are not enforced
+    ("a person waves quickly", False),               # no gait: a hand's pace is not the root's
+    ("a man walks slowly, then runs fast", False),   # both paces: none
+    ("a person walks", False),
+    ("an old woman hurries forward", False),         # "hurries" names no gait the patterns read
+])
+def test_asks_fast_reads_a_gaits_fast_pace(prompt, expected):
+    assert asks_fast(prompt) == expected
+
+
+def test_gait_speed_is_the_mean_speed_along_the_path():
+    f = np.zeros((20, 263), np.float32)
+    f[:, 1], f[:, 2] = 0.03, 0.04          # 5 cm a frame at 20 fps: 1 m/s, whichever way it goes
+    assert gait_speed(f) == pytest.approx(1.0, abs=1e-5)
+    f[10:, 1:3] *= -1                     # half of it back again: still 1 m/s along the path
+    assert gait_speed(f) == pytest.approx(1.0, abs=1e-5)
+
+
+def test_fastest_keeps_the_fastest_third_of_the_allowed():
+    speeds = np.array([0.1, 0.6, 0.9, 1.2, 1.5, 1.8, 2.1])
+    everyone = np.ones(7, bool)
+    # at or above the 2/3 quantile of all seven (linear rule: position 6 x 2/3 = 4, i.e. 1.5)
+    assert np.flatnonzero(fastest(speeds, everyone)).tolist() == [4, 5, 6]
+    # only among the candidates the travel words allowed (0.6-1.5: position 2, i.e. 1.2)
+    among = np.array([False, True, True, True, True, False, False])
+    assert np.flatnonzero(fastest(speeds, among)).tolist() == [3, 4]
+    nobody = np.zeros(7, bool)
+    assert fastest(speeds, nobody).tolist() == nobody.tolist()
+
+
+def test_the_picker_takes_a_fast_walk_over_the_tmas_favourite():
+    """Six captured walks from the shipped memory, decoded on the mean body (0.56-1.35 m/s): the
+    TMA alone prefers a 0.65 m/s walk for "walks quickly"; for "walks slowly" the TMA chooses."""
+    from shapemove.core.generation.decode import decode_features
+    from shapemove.core.generation.generate import Generator
+
+    gen = Generator("weights/default")
+    memory = gen.t5.memory
+    walks = [i for i, _ in memory.clips_of_action("walk")][:12:2]
+    feats = [decode_features(list(memory.clip_tokens[i]), gen.vae, np.zeros(10, np.float32)).numpy() for i in walks]
+    speeds = np.array([gait_speed(f) for f in feats])
+    fits = speeds >= np.quantile(speeds, 2 / 3)
+    scores = gen.picker.scores("a person walks quickly", feats)
+    assert not fits[int(np.argmax(scores))], "the TMA alone should prefer a slower walk here"
+    best = gen.picker.pick("a person walks quickly", feats)
+    assert fits[best] and scores[best] == scores[fits].max() and speeds[best] > 1.0
+    slow = gen.picker.scores("a person walks slowly", feats)
+    assert gen.picker.pick("a person walks slowly", feats) == int(np.argmax(slow))
+
+
+def _pace_check():
+    import importlib.util
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    spec = importlib.util.spec_from_file_location("pace_check", root / "tools" / "pace_check.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod, root
+
+
+def test_pace_check_measures_the_pelvis_along_its_path():
+    mod, _ = _pace_check()
+    t = np.arange(41) / 20.0                                    # 2 s at 20 fps
+    joints = np.zeros((41, 22, 3))
+    joints[:, 0, 0] = np.where(t <= 1, 1.5 * t, 1.5 * (2 - t))  # 1.5 m/s out, 1.5 m/s back
+    joints[:, 0, 1] = 0.9 + 0.05 * np.sin(8 * t)                # bobbing does not count
+    assert mod.root_speed(joints, 20.0) == pytest.approx(1.5, abs=1e-9)
+
+
+def test_the_pace_sets_ask_one_gait_slow_plain_and_fast():
+    import json
+
+    from shapemove.core.data.actions import action_spans
+    from shapemove.core.generation.part_prompts import LEGS
+
+    _, root = _pace_check()
+    for name in ("tuning_pace.json", "heldout_pace_blind.json"):
+        rows = json.loads((root / "configs" / name).read_text())["rows"]
+        assert len(rows) >= 10
+        for row in rows:
+            assert len(row) == 3 and any(sp[2] in LEGS for sp in action_spans(row[1])), row
+            assert not asks_fast(row[0]) and not asks_fast(row[1]), row
+    # on the tuning set, every fast prompt reads fast but "hurries" (no gait word)
+    rows = json.loads((root / "configs" / "tuning_pace.json").read_text())["rows"]
+    assert [r[2] for r in rows if not asks_fast(r[2])] == ["an old woman hurries forward"]
