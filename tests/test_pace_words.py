@@ -97,3 +97,38 @@ def test_the_pace_sets_ask_one_gait_slow_plain_and_fast():
     # on the tuning set, every fast prompt reads fast but "hurries" (no gait word)
     rows = json.loads((root / "configs" / "tuning_pace.json").read_text())["rows"]
     assert [r[2] for r in rows if not asks_fast(r[2])] == ["an old woman hurries forward"]
+
+
+@pytest.mark.parametrize("prompt, expected", [
+    ("a person walks slowly", True),
+    ("the guard marches slowly", True),
+    ("a man strolls at a leisurely pace down the road", True),
+    ("a woman jogs slowly", False),              # a flight phase: not slowed
+    ("a person walks slowly, then runs", False),  # a gait with flight beside it
+    ("a person walks", False),
+    ("a person waves slowly", False),
+])
+def test_asks_slow_steps_reads_a_stepping_gaits_slow_pace(prompt, expected):
+    from shapemove.core.generation.pace_words import asks_slow_steps
+
+    assert asks_slow_steps(prompt) == expected
+
+
+def test_slow_motion_plays_a_walk_at_the_slow_speed_over_the_same_length():
+    from shapemove.core.generation.generate import Generator, Request
+    from shapemove.core.generation.pace_words import SLOW_SPEED, slow_motion
+
+    gen = Generator("weights/default")
+    walk = gen.generate_batch([Request("a person walks forward", seconds=4.0, seed=0)])[0]
+    assert slow_motion(walk, gen.body, "a person jogs slowly") is walk
+    slow = slow_motion(walk, gen.body, "a person walks forward slowly")
+    assert slow.num_frames == walk.num_frames and slow.tokens is None   # an edit: no tokens kept
+    # the slowed walk covers what the walk covered in its first SLOW_SPEED of the time
+    keep = int(round(walk.num_frames * SLOW_SPEED))
+    path = lambda j: np.linalg.norm(np.diff(j[:, 0, [0, 2]], axis=0), axis=1).sum()
+    assert path(slow.joints) == pytest.approx(path(walk.joints[:keep]), rel=0.03)
+    assert path(slow.joints) < 0.85 * path(walk.joints)
+    # planted again: the lowest foot joint stays on the walk's floor
+    feet = [7, 8, 10, 11]
+    assert abs(slow.joints[:, feet, 1].min() - walk.joints[:, feet, 1].min()) < 0.01
+    assert slow.features is not None and len(slow.features) == slow.num_frames - 1

@@ -31,6 +31,7 @@ from .action_clips import ACTION_CLIPS, UNASKED_SECONDS, action_clips
 from .circle_walk import CIRCLE, circle_motion, names_circle
 from .decode import decode_features, decode_tokens, redecode
 from .model_bundle import model_files, part_warnings, resolve_model_dir
+from .pace_words import slow_motion
 from .parts import CLAUSE_NEAR, generate_by_parts, is_by_parts, redecode_parts
 from .prompts import check_prompt
 from .rerank import CandidatePicker
@@ -347,6 +348,7 @@ class Generator:
                     motion = (circle_motion(motion, self.body, r.prompt, self.ik_refine_iters)   # circle_walk.py
                               if self.asks_circle(r.prompt, check) else
                               turn_motion(motion, self.body, r.prompt, self.ik_refine_iters))    # turn_words.py
+                    motion = slow_motion(motion, self.body, r.prompt, self.ik_refine_iters)      # pace_words.py
             motion.warnings = [check.warning] if check is not None and check.warning else []
             if r.candidates > 1 and r.temperature > 0:  # best-of-N wanted: say when the model cannot pick
                 motion.warnings += part_warnings(self.model_dir)

@@ -1,4 +1,5 @@
-"""A fast pace the words ask of a gait: "walks quickly", "a brisk walk", "runs as fast as they can".
+"""The pace the words ask of a gait: "walks quickly", "a brisk walk", "runs as fast as they can",
+"walks slowly".
 
 The TMA that chooses among the candidates (``rerank.CandidatePicker``) hardly tells a brisk walk
 from a slow one, and the clips retrieved for "walks quickly" by caption can be slow ones: the
@@ -8,10 +9,14 @@ default model gave "a person walks quickly" 0.51 m/s against 1.08 m/s for "a per
 of the candidates compete. Speed is the root's mean horizontal speed along its path, read from
 the features' root velocities.
 
-Slow words are read only to cancel a fast one ("slowly, then fast" names no single pace): the
-slower candidates were tried for them and not kept, since the slowest candidates of a walk are
-often limps and creeps (``docs/evaluation.md``, fifteenth session). A prompt without a gait
-("waves quickly") is left to the TMA, since its root speed says nothing of a hand's.
+A slow pace is not chosen among the candidates: the slowest candidates of a walk are often limps
+and creeps, so choosing them cost the gait (``docs/evaluation.md``, fifteenth session). Instead the
+chosen motion of a stepping gait (a walk, march, sneak, limp, ...: no flight phase) is played at
+``SLOW_SPEED`` over the same length (``slow_motion``: its first ``SLOW_SPEED`` share resampled to
+the whole length, feet planted again; an edit, like a turn the words name, so it keeps no
+tokens). A jog or a run is left as it is: slowed down, its flights would hang in the air. Both
+paces named ("slowly, then fast") is no pace; a prompt without a gait ("waves quickly") is left to
+the TMA, since its root speed says nothing of a hand's.
 """
 from __future__ import annotations
 
@@ -24,6 +29,8 @@ from .part_prompts import LEGS
 
 FPS = 20.0
 FAST_SHARE = 1 / 3  # the fastest third of the candidates compete for a fast pace
+SLOW_SPEED = 0.8    # a stepping gait asked slowly is played at this speed
+STEPPING = LEGS - {"jog", "run", "sprint"}   # gaits without a flight phase
 
 _FAST = re.compile(r"\b(quick(?:ly)?|fast(?:er)?|brisk(?:ly)?|rapid(?:ly)?|swift(?:ly)?|hurried(?:ly)?|hurr(?:y|ies|ying)|"
                    r"hast(?:y|ily)|speedy|full speed|top speed|flat out|as fast as)\b", re.I)
@@ -31,10 +38,19 @@ _SLOW = re.compile(r"\b(slow(?:ly|er)?|leisurely|lazily|sluggish(?:ly)?|unhurrie
                    r"(?:easy|gentle|relaxed|snail's|leisurely|slow) pace)\b", re.I)
 
 
+def _gaits(prompt: str) -> set:
+    return {sp[2] for sp in action_spans(prompt) if sp[2] in LEGS}
+
+
 def asks_fast(prompt: str) -> bool:
     """Whether the prompt asks a gait to go fast (and names no slow pace beside it)."""
-    return (bool(_FAST.search(prompt)) and not _SLOW.search(prompt)
-            and any(sp[2] in LEGS for sp in action_spans(prompt)))
+    return bool(_FAST.search(prompt)) and not _SLOW.search(prompt) and bool(_gaits(prompt))
+
+
+def asks_slow_steps(prompt: str) -> bool:
+    """Whether the prompt asks a stepping gait (and no other gait) to go slowly, naming no fast pace."""
+    gaits = _gaits(prompt)
+    return bool(_SLOW.search(prompt)) and not _FAST.search(prompt) and bool(gaits) and gaits <= STEPPING
 
 
 def gait_speed(features: np.ndarray) -> float:
@@ -51,3 +67,17 @@ def fastest(speeds: np.ndarray, among: np.ndarray) -> np.ndarray:
         return among
     keep = among & (speeds >= np.quantile(speeds[among], 1 - FAST_SHARE))
     return keep if keep.any() else among
+
+
+def slow_motion(motion, body, prompt: str, ik_refine_iters: int = 10):
+    """``motion`` played at ``SLOW_SPEED`` over its own length when ``prompt`` asks a stepping gait
+    to go slowly (``asks_slow_steps``); the motion itself otherwise."""
+    from .time_warp import resample
+    from .track import Track, replanted, track_of
+
+    if not asks_slow_steps(prompt) or motion.num_frames < 4:
+        return motion
+    track = track_of(motion)
+    n = len(track.joints)
+    keep = max(2, int(round(n * SLOW_SPEED)))
+    return replanted(motion, body, resample(Track(track.joints[:keep], track.contacts[:keep]), n), ik_refine_iters)
