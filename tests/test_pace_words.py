@@ -116,7 +116,8 @@ def test_asks_slow_steps_reads_a_stepping_gaits_slow_pace(prompt, expected):
 
 def test_slow_motion_plays_a_walk_at_the_slow_speed_over_the_same_length():
     from shapemove.core.generation.generate import Generator, Request
-    from shapemove.core.generation.pace_words import SLOW_SPEED, slow_motion
+    from shapemove.core.generation.pace_words import SLOW_SPEED
+    from shapemove.core.generation.slow_steps import slow_motion
 
     gen = Generator("weights/default")
     walk = gen.generate_batch([Request("a person walks forward", seconds=4.0, seed=0)])[0]

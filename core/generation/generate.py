@@ -31,7 +31,6 @@ from .action_clips import ACTION_CLIPS, UNASKED_SECONDS, action_clips
 from .circle_walk import CIRCLE, circle_motion, names_circle
 from .decode import decode_features, decode_tokens, redecode
 from .model_bundle import model_files, part_warnings, resolve_model_dir
-from .pace_words import slow_motion
 from .parts import CLAUSE_NEAR, generate_by_parts, is_by_parts, redecode_parts
 from .prompts import check_prompt
 from .rerank import CandidatePicker
@@ -40,6 +39,7 @@ from .retrieved_candidates import retrieved_codes
 from .sampling_params import (DEFAULT_CANDIDATES, DEFAULT_GUIDANCE, DEFAULT_RETRIEVAL_FIRST, DEFAULT_RETRIEVAL_PREFIX,
                               DEFAULT_RETRIEVED, check_candidates, check_guidance, check_retrieval_first,
                               check_retrieval_prefix, check_retrieved, check_sampling)
+from .slow_steps import slow_motion
 from .turn_words import turn_motion
 
 
@@ -348,7 +348,7 @@ class Generator:
                     motion = (circle_motion(motion, self.body, r.prompt, self.ik_refine_iters)   # circle_walk.py
                               if self.asks_circle(r.prompt, check) else
                               turn_motion(motion, self.body, r.prompt, self.ik_refine_iters))    # turn_words.py
-                    motion = slow_motion(motion, self.body, r.prompt, self.ik_refine_iters)      # pace_words.py
+                    motion = slow_motion(motion, self.body, r.prompt, self.ik_refine_iters)      # slow_steps.py
             motion.warnings = [check.warning] if check is not None and check.warning else []
             if r.candidates > 1 and r.temperature > 0:  # best-of-N wanted: say when the model cannot pick
                 motion.warnings += part_warnings(self.model_dir)

@@ -12,9 +12,8 @@ the features' root velocities.
 A slow pace is not chosen among the candidates: the slowest candidates of a walk are often limps
 and creeps, so choosing them cost the gait (``docs/evaluation.md``, fifteenth session). Instead the
 chosen motion of a stepping gait (a walk, march, sneak, limp, ...: no flight phase) is played at
-``SLOW_SPEED`` over the same length (``slow_motion``: its first ``SLOW_SPEED`` share resampled to
-the whole length, feet planted again; an edit, like a turn the words name, so it keeps no
-tokens). A jog or a run is left as it is: slowed down, its flights would hang in the air. Both
+``SLOW_SPEED`` over the same length (``slow_steps.slow_motion``: an edit, like a turn the words
+name). A jog or a run is left as it is: slowed down, its flights would hang in the air. Both
 paces named ("slowly, then fast") is no pace; a prompt without a gait ("waves quickly") is left to
 the TMA, since its root speed says nothing of a hand's.
 """
@@ -68,16 +67,3 @@ def fastest(speeds: np.ndarray, among: np.ndarray) -> np.ndarray:
     keep = among & (speeds >= np.quantile(speeds[among], 1 - FAST_SHARE))
     return keep if keep.any() else among
 
-
-def slow_motion(motion, body, prompt: str, ik_refine_iters: int = 10):
-    """``motion`` played at ``SLOW_SPEED`` over its own length when ``prompt`` asks a stepping gait
-    to go slowly (``asks_slow_steps``); the motion itself otherwise."""
-    from .time_warp import resample
-    from .track import Track, replanted, track_of
-
-    if not asks_slow_steps(prompt) or motion.num_frames < 4:
-        return motion
-    track = track_of(motion)
-    n = len(track.joints)
-    keep = max(2, int(round(n * SLOW_SPEED)))
-    return replanted(motion, body, resample(Track(track.joints[:keep], track.contacts[:keep]), n), ik_refine_iters)

@@ -14,7 +14,7 @@ import numpy as np
 from ..constants import FPS
 from ..errors import ShapeMoveError
 from ..scene.motion_file import Motion
-from .track import Track, plant, track_of
+from .track import plant, resample, track_of
 
 MIN_SPEED, MAX_SPEED = 0.5, 2.0
 MIN_SECONDS, MAX_SECONDS = 0.4, 120.0
@@ -46,27 +46,6 @@ def warped_length(num_frames: int, speed: float | None = None, seconds: float | 
         raise ShapeMoveError("give either a speed or a duration to time-warp to, not both")
     n = num_frames / check_speed(speed) if speed is not None else check_seconds(seconds) * fps
     return max(2, int(round(n)))
-
-
-def resample(track: Track, n: int, advance=None) -> Track:
-    """``track`` resampled to ``n`` frames. Open: frame 0 and the last frame stay where they are.
-    A loop (``advance`` (3,)): the ``n`` frames sample one cycle of ``len(track)`` frames, frame
-    ``len(track)`` being frame 0 moved by ``advance``."""
-    J, C = track.joints, track.contacts
-    T = len(J)
-    if advance is not None:
-        J = np.concatenate([J, J[:1] + np.asarray(advance, np.float64)], 0)
-        C = np.concatenate([C, C[:1]], 0)
-        t = np.arange(n) * T / n
-    else:
-        t = np.linspace(0.0, T - 1, n)
-    i0 = np.minimum(np.floor(t).astype(int), len(J) - 2)
-    w = (t - i0)[:, None, None]
-    joints = (1 - w) * J[i0] + w * J[i0 + 1]
-    contacts = C[np.minimum(np.round(t).astype(int), len(C) - 1)]
-    if advance is not None:
-        contacts = C[np.round(t).astype(int) % T]
-    return Track(joints, contacts)
 
 
 def time_warp(motion: Motion, body, speed: float | None = None, seconds: float | None = None,

@@ -64,6 +64,27 @@ def decoded_track(codes: list[int], vae, betas) -> tuple[Track, np.ndarray]:
     return Track(joints, contacts_from_features(f)), f
 
 
+def resample(track: Track, n: int, advance=None) -> Track:
+    """``track`` resampled to ``n`` frames. Open: frame 0 and the last frame stay where they are.
+    A loop (``advance`` (3,)): the ``n`` frames sample one cycle of ``len(track)`` frames, frame
+    ``len(track)`` being frame 0 moved by ``advance``."""
+    J, C = track.joints, track.contacts
+    T = len(J)
+    if advance is not None:
+        J = np.concatenate([J, J[:1] + np.asarray(advance, np.float64)], 0)
+        C = np.concatenate([C, C[:1]], 0)
+        t = np.arange(n) * T / n
+    else:
+        t = np.linspace(0.0, T - 1, n)
+    i0 = np.minimum(np.floor(t).astype(int), len(J) - 2)
+    w = (t - i0)[:, None, None]
+    joints = (1 - w) * J[i0] + w * J[i0 + 1]
+    contacts = C[np.minimum(np.round(t).astype(int), len(C) - 1)]
+    if advance is not None:
+        contacts = C[np.round(t).astype(int) % T]
+    return Track(joints, contacts)
+
+
 def plant(body, betas, track: Track, ik_refine_iters: int = 10, prompt: str | None = None, **extra) -> Motion:
     """A track -> Motion on ``body`` with its contacts planted (``plant.plant_motion``, as
     ``decode.motion_from_joints``), then ``lock_stance``."""
