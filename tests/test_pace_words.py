@@ -61,33 +61,24 @@ def test_the_picker_takes_a_fast_walk_over_the_tmas_favourite():
     assert gen.picker.pick("a person walks slowly", feats) == int(np.argmax(slow))
 
 
-def _pace_check():
-    import importlib.util
-    from pathlib import Path
+def test_pace_checks_speed_is_the_pelvis_along_its_path():
+    from shapemove.core.eval.gait import mean_speed
 
-    root = Path(__file__).resolve().parents[1]
-    spec = importlib.util.spec_from_file_location("pace_check", root / "tools" / "pace_check.py")
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod, root
-
-
-def test_pace_check_measures_the_pelvis_along_its_path():
-    mod, _ = _pace_check()
     t = np.arange(41) / 20.0                                    # 2 s at 20 fps
     joints = np.zeros((41, 22, 3))
     joints[:, 0, 0] = np.where(t <= 1, 1.5 * t, 1.5 * (2 - t))  # 1.5 m/s out, 1.5 m/s back
     joints[:, 0, 1] = 0.9 + 0.05 * np.sin(8 * t)                # bobbing does not count
-    assert mod.root_speed(joints, 20.0) == pytest.approx(1.5, abs=1e-9)
+    assert mean_speed(joints, 20.0) == pytest.approx(1.5, abs=1e-9)
 
 
 def test_the_pace_sets_ask_one_gait_slow_plain_and_fast():
     import json
+    from pathlib import Path
 
     from shapemove.core.data.actions import action_spans
     from shapemove.core.generation.part_prompts import LEGS
 
-    _, root = _pace_check()
+    root = Path(__file__).resolve().parents[1]
     for name in ("tuning_pace.json", "heldout_pace_blind.json"):
         rows = json.loads((root / "configs" / name).read_text())["rows"]
         assert len(rows) >= 10

@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from shapemove.core.generation.travel_words import SLACK, Travel, allowed, obeys, root_travel, travel_of
+from shapemove.core.generation.travel_words import SLACK, Travel, allowed, body_frame_travel, obeys, travel_of
 
 
 @pytest.mark.parametrize("prompt, expected", [
@@ -33,8 +33,8 @@ def _clip(forward_per_frame: float, left_per_frame: float, frames: int = 40) -> 
     return f
 
 
-def test_root_travel_sums_each_frames_step():
-    fwd, left = root_travel(_clip(0.03, -0.01))
+def test_body_frame_travel_sums_each_frames_step():
+    fwd, left = body_frame_travel(_clip(0.03, -0.01))
     assert fwd == pytest.approx(1.2, abs=1e-5) and left == pytest.approx(-0.4, abs=1e-5)
 
 
@@ -78,7 +78,7 @@ def test_the_picker_sets_aside_the_tmas_favourite_when_it_walks_backward():
     betas = np.zeros(10, np.float32)
     feats = [decode_features(list(memory.clip_tokens[i]), gen.vae, betas).numpy() for i in back[:4] + walks[:4]]
     scores = gen.picker.scores(prompt, feats)
-    fwd = np.array([root_travel(f)[0] for f in feats])
+    fwd = np.array([body_frame_travel(f)[0] for f in feats])
     assert (fwd[:4] < -SLACK).all() and (fwd[4:] > SLACK).all(), fwd
     assert int(np.argmax(scores)) < 4, "the TMA alone should prefer a walk backward here"
     best = gen.picker.pick(prompt, feats)

@@ -1,8 +1,8 @@
 """Do pace words change the pace? Each row of a pace set (``configs/tuning_pace.json``; its blind
 twin ``configs/heldout_pace_blind.json``) asks one gait slow, plain and fast; every prompt is
 generated on several seeds and the chosen motion's root speed is measured on the final joints
-(the pelvis's horizontal path over the motion's length: the same number a user would read off
-the rig, not the features the generator chose by).
+(``gait.mean_speed``: the pelvis's horizontal path over the motion's length, the same number a
+user would read off the rig, not the features the generator chose by).
 
     python tools/pace_check.py --model weights/default [--seeds 4] [--json out/pace.json] [--data data/built]
 
@@ -19,12 +19,6 @@ import json
 from pathlib import Path
 
 import numpy as np
-
-
-def root_speed(joints: np.ndarray, fps: float) -> float:
-    """Mean horizontal speed (m/s) of the pelvis along its path."""
-    step = np.diff(joints[:, 0, [0, 2]], axis=0)
-    return float(np.linalg.norm(step, axis=1).sum() / max(1e-9, (len(joints) - 1) / fps))
 
 
 def _judges(gen, data) -> dict:
@@ -49,6 +43,7 @@ def main(argv=None) -> int:
     ap.add_argument("--data", type=Path, default=None, help="built dataset: also judge each motion's action")
     args = ap.parse_args(argv)
     from shapemove.core.data.actions import action_spans
+    from shapemove.core.eval.gait import mean_speed
     from shapemove.core.generation.generate import Generator, Request
     from shapemove.core.generation.part_prompts import LEGS
 
@@ -62,7 +57,7 @@ def main(argv=None) -> int:
         speeds, reads = [], {name: [] for name in judges}
         for prompt in row:
             made = gen.generate_batch([Request(prompt, seconds=args.seconds, seed=s) for s in range(args.seeds)])
-            speeds.append(float(np.mean([root_speed(m.joints, m.fps) for m in made])))
+            speeds.append(float(np.mean([mean_speed(m.joints, m.fps) for m in made])))
             for name, judge in judges.items():
                 got = judge.classify([m.features for m in made], exclude=[list(m.retrieved_clips) for m in made])
                 reads[name].append(got)

@@ -23,10 +23,10 @@ import re
 
 import numpy as np
 
+from ..constants import FPS
 from ..data.actions import action_spans
 from .part_prompts import LEGS
 
-FPS = 20.0
 FAST_SHARE = 1 / 3  # the fastest third of the candidates compete for a fast pace
 SLOW_SPEED = 0.8    # a stepping gait asked slowly is played at this speed
 STEPPING = LEGS - {"jog", "run", "sprint"}   # gaits without a flight phase
@@ -66,4 +66,3 @@ def fastest(speeds: np.ndarray, among: np.ndarray) -> np.ndarray:
         return among
     keep = among & (speeds >= np.quantile(speeds[among], 1 - FAST_SHARE))
     return keep if keep.any() else among
-

@@ -53,7 +53,7 @@ def travel_of(prompt: str) -> Travel:
                   in_place=bool(_IN_PLACE.search(prompt)))
 
 
-def root_travel(features: np.ndarray) -> tuple[float, float]:
+def body_frame_travel(features: np.ndarray) -> tuple[float, float]:
     """(forward, left) metres the root goes over a (T, 263) feature clip, each frame's step in its
     own root frame."""
     f = np.asarray(features, dtype=np.float64)
@@ -62,7 +62,7 @@ def root_travel(features: np.ndarray) -> tuple[float, float]:
 
 def obeys(travel: Travel, features: np.ndarray, slack: float = SLACK) -> bool:
     """False where the clip's root travel goes against ``travel`` by more than ``slack`` metres."""
-    fwd, left = root_travel(features)
+    fwd, left = body_frame_travel(features)
     if travel.forward and travel.forward * fwd < -slack:
         return False
     if travel.side and travel.side * left < slack:
