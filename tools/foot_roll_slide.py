@@ -1,6 +1,6 @@
 """Stance slide, penetrate and float of planted walks on one or more model folders (issue #24: the
 foot roll in ``body/plant.py``). For each model and seed: "a person walks forward", 4 s; that walk
-along an S-curve (``tests/test_animation.py``'s path: 3 m long, +-0.6 m, not cropped); that walk at
+along an S-curve (3 m long, +-0.6 m, not cropped); that walk at
 double speed (``time_warp``); optionally the walk loop.
 
     python tools/foot_roll_slide.py --model weights/default --model /tmp/m_ft2 [--seeds 0 1 2 3] [--loop] [--json out.json]

@@ -8,9 +8,10 @@ user would read off the rig, not the features the generator chose by).
 
 Prints each row's mean speeds (slow / plain / fast, m/s), whether they are in order, and over all
 rows the speed ratios slow/plain and fast/plain. With ``--data`` (the built dataset), each motion
-is also judged as ``eval paraphrase`` judges (the TMA's and the raw features' 5 nearest training
-clips, a retrieved clip judged without its take): a pace must not cost the gait, so the share of
-motions still read as the row's gait (the plain prompt's, by the action patterns) is printed.
+is also judged as ``eval paraphrase`` judges (what the rig plays, ``motion_features``: the TMA's and
+the raw features' 5 nearest training clips, a retrieved clip judged without its take): a pace must
+not cost the gait, so the share of motions still read as the row's gait (the plain prompt's, by the
+action patterns) is printed.
 """
 from __future__ import annotations
 
@@ -44,6 +45,7 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     from shapemove.core.data.actions import action_spans
     from shapemove.core.eval.gait import mean_speed
+    from shapemove.core.motion.features import motion_features
     from shapemove.core.generation.generate import Generator, Request
     from shapemove.core.generation.part_prompts import LEGS
 
@@ -59,7 +61,7 @@ def main(argv=None) -> int:
             made = gen.generate_batch([Request(prompt, seconds=args.seconds, seed=s) for s in range(args.seeds)])
             speeds.append(float(np.mean([mean_speed(m.joints, m.fps) for m in made])))
             for name, judge in judges.items():
-                got = judge.classify([m.features for m in made], exclude=[list(m.retrieved_clips) for m in made])
+                got = judge.classify([motion_features(m) for m in made], exclude=[list(m.retrieved_clips) for m in made])
                 reads[name].append(got)
                 kept[name][0] += sum(a == gait for a in got)
                 kept[name][1] += len(got)

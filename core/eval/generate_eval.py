@@ -8,7 +8,8 @@ For every clip the prompt is one of its captions (chosen with ``seed``) and its 
 ``max_codes``). The result holds the ``KEYS`` of the generated motions and, under
 "ground_truth", the same keys for the real clips (as ``eval recon`` does):
 
-- r_precision_top1/top3, matching_score: TMA embeddings of the motion features (T,263) against
+- r_precision_top1/top3, matching_score: TMA embeddings of the features of what the rig plays
+  (``motion_features``; the real clips' own features) against
   the caption embeddings (groups of 32, ``retrieval.r_precision``);
 - fid: Fréchet distance between the generated and the real motion embeddings (the real column
   is the real set against itself: 0 up to round-off, clipped at 0);
@@ -31,6 +32,7 @@ from ..errors import ShapeMoveError
 from ..generation.generate import Generator, Request
 from ..generation.model_bundle import model_files
 from ..geometry.rotations import axis_angle_to_matrix
+from ..motion.features import motion_features
 from ..train.motion_dataset import read_split
 from ..train.t5_dataset import read_lines
 from .evaluate import evaluate_motion
@@ -149,7 +151,7 @@ def eval_generate(data, split: str = "test", model_dir=None, tma=None, max_clips
     texts = [c["caption"] for c in clips]
     real, real_emb = score(tma, texts, [c["features"] for c in clips], None, real_phys)
     h, w = shape_errors(gen.body, np.stack([m.betas for m in motions]), np.stack([c["betas"] for c in clips]))
-    generated, _ = score(tma, texts, [m.features for m in motions], real_emb, gen_phys, h, w)
+    generated, _ = score(tma, texts, [motion_features(m) for m in motions], real_emb, gen_phys, h, w)
     return {**generated, "ground_truth": real}
 
 

@@ -4,7 +4,10 @@
     res["motion"]["accuracy"], res["motion"]["per_action"]["walk"], res["classifier"]["ceiling"]["accuracy"]
 
 For each held-out prompt ({"text", "action", "also"?}, written by hand, never trained or tuned on)
-the model generates a motion, and its action is read three ways:
+the model generates a motion, and its action is read three ways, each from the features of what the
+rig plays (``motion_features`` of the planted Motion, computed as the dataset builder computes a
+clip's; before the sixteenth session a plain prompt was read from its decoded features, whose
+rotations the rig did not play):
 
 - ``motion`` (the target: >= 80 % right): the generated motion's TMA motion embedding among the
   training clips' motion embeddings of the built dataset ``data``: the majority action of its 5
@@ -110,6 +113,7 @@ def eval_paraphrase(model_dir=None, prompts=None, tma=None, seed: int = 0, secon
     "unknown_action", "actions", "rows", ...}."""
     from ..generation.generate import Generator, Request
     from ..generation.model_bundle import model_files
+    from ..motion.features import motion_features
     from ..generation.sampling_params import (DEFAULT_CANDIDATES, DEFAULT_RETRIEVAL_FIRST, DEFAULT_RETRIEVAL_PREFIX,
                                               DEFAULT_RETRIEVED)
     from .action_classifier import ActionClassifier, FeatureEmbedder, default_built_dir
@@ -154,9 +158,10 @@ def eval_paraphrase(model_dir=None, prompts=None, tma=None, seed: int = 0, secon
         m = gen.generate_batch([Request(it["text"], seconds=seconds, seed=seed + i, candidates=candidates,
                                         retrieval_prefix=retrieval_prefix, retrieved=retrieved if retrieval else 0,
                                         retrieval_first=retrieval_first, by_parts=by_parts)])[0]
-        motion_emb = embed_motions(model, [m.features], mean, std)[0]
+        played = motion_features(m)   # what the rig plays (a plain prompt's decoded features differ)
+        motion_emb = embed_motions(model, [played], mean, std)[0]
         embs.append(motion_emb)
-        feats.append(m.features)
+        feats.append(played)
         rows.append({**it, "motion_proto_pred": actions[int(np.argmax(A @ motion_emb))],
                      "warned": bool(m.warnings), "kept_clips": list(m.retrieved_clips),
                      "parts": list(m.part_prompts) if m.part_prompts else None,

@@ -11,6 +11,7 @@ from ..errors import ShapeMoveError
 from ..geometry.rotations import matrix_to_axis_angle
 from ..motion.features import joints_from_features
 from ..scene.motion_file import Motion, make_motion
+from .decoded_joints import decoded_joints
 
 
 
@@ -34,23 +35,27 @@ def decode_features(codes: list[int], vae, betas) -> torch.Tensor:
 def decode_tokens(codes: list[int], vae, body, betas, ik_refine_iters: int = 10, prompt: str | None = None,
                   contacts=None) -> Motion:
     """Motion tokens + betas (10,) -> Motion on ``body``: SA-VAE ``decode_long`` with the body's
-    shape, joints from the features, then ``plant.plant_motion``: the feet the decoder's contact
-    channels mark are planted (one fixed point per contact run, soles on y = 0), IK onto the body,
-    and the posed mesh grounded frame by frame on its soles. The Motion's ``joints`` are FK of its
-    pose (what the rig plays); the decoder's own joints are kept as ``network_joints``.
-    ``contacts`` (>= T,4) known foot contacts (retargeting: the source motion's) are planted
-    instead of the decoder's channels, as measured contacts (no gating, flights kept)."""
+    shape; the joints of the decoded rotations posed on the body (``decoded_joints``: they carry
+    the asked-for action better than the decoded positions); then ``plant.plant_motion``: the feet
+    the decoder's contact channels mark are planted (one fixed point per contact run, soles on
+    y = 0), IK onto the body, and the posed mesh grounded frame by frame on its soles. The
+    Motion's ``joints`` are FK of its pose (what the rig plays); the joints it was planted from
+    are kept as ``network_joints``. ``contacts`` (>= T,4) known foot contacts (retargeting: the
+    source motion's) are planted instead of the decoder's channels, as measured contacts (no
+    gating, flights kept); a retargeted take is played from the decoded joint positions, the
+    channel its codes were searched against (``code_search``)."""
     betas = check_betas(betas)
     feats = decode_features(codes, vae, betas)
-    with torch.no_grad():
-        joints = joints_from_features(feats.double()).float().numpy()
     known = contacts is not None
     if known:
+        with torch.no_grad():
+            joints = joints_from_features(feats.double()).float().numpy()
         contacts = np.asarray(contacts)
         if contacts.ndim != 2 or contacts.shape[1] != 4 or len(contacts) < len(joints):
             raise ShapeMoveError(f"known contacts must be (>= {len(joints)}, 4), got shape {contacts.shape}")
         contacts = contacts[:len(joints)]
     else:
+        joints = decoded_joints(feats, body, betas).astype(np.float32)
         contacts = contacts_from_features(feats.numpy())
     return motion_from_joints(body, betas, joints, contacts, ik_refine_iters, prompt=prompt, known_contacts=known,
                               tokens=np.asarray(codes, np.int32), features=feats.numpy().astype(np.float32))

@@ -196,7 +196,7 @@ def generate_loop(gen, req, progress=None, cancel=None) -> Motion:
     for codes in cands:
         if cancel is not None and cancel():
             raise ShapeMoveError("cancelled")
-        track, _ = decoded_track(codes, gen.vae, betas)
+        track, _ = decoded_track(codes, gen.vae, gen.body, betas)
         try:
             found.append((track, best_cut(track.joints, FPS, period)))
         except ShapeMoveError:

@@ -38,14 +38,14 @@ def _mirrored(track: Track) -> Track:
     return Track(*mirror_track(track.joints, track.contacts))
 
 
-def _track(codes, vae, betas, mirrored: bool) -> Track:
-    track, _ = decoded_track([int(c) for c in codes], vae, betas)
+def _track(codes, vae, body, betas, mirrored: bool) -> Track:
+    track, _ = decoded_track([int(c) for c in codes], vae, body, betas)
     return _mirrored(track) if mirrored else track
 
 
-def _side_fixed(codes, vae, betas, side: tuple[str, str] | None) -> tuple[Track, bool]:
+def _side_fixed(codes, vae, body, betas, side: tuple[str, str] | None) -> tuple[Track, bool]:
     """The decoded track, mirrored when it names a side that moves less than the other."""
-    track = _track(codes, vae, betas, False)
+    track = _track(codes, vae, body, betas, False)
     if side is not None and needs_mirror(track.joints, *side):
         return _mirrored(track), True
     return track, False
@@ -97,7 +97,7 @@ def generate_by_parts(gen, r) -> Motion | None:
         betas, source = gen.body_shape(r, pred[0].numpy())
         m = gen.decode_motion(codes[0], betas, prompt=r.prompt)
         if needs_mirror(m.joints, *side):
-            m = assemble(gen.body, betas, _track(codes[0], gen.vae, betas, True), None, r.prompt, gen.ik_refine_iters,
+            m = assemble(gen.body, betas, _track(codes[0], gen.vae, gen.body, betas, True), None, r.prompt, gen.ik_refine_iters,
                          tokens=np.asarray(codes[0], np.int32), mirrored=True)
         m.shape_source = source
         m.retrieved_clips = [c for c in kept if c]
@@ -109,8 +109,8 @@ def generate_by_parts(gen, r) -> Motion | None:
     arms_codes, _, arms_kept = gen.tokens_for([arms_req])
     retrieved = [c for c in kept + arms_kept if c]
     betas, source = gen.body_shape(r, pred[0].numpy())
-    legs = _track(codes[0], gen.vae, betas, False)
-    arms, arms_mirrored = _side_fixed(arms_codes[0], gen.vae, betas, plan.arms_side)
+    legs = _track(codes[0], gen.vae, gen.body, betas, False)
+    arms, arms_mirrored = _side_fixed(arms_codes[0], gen.vae, gen.body, betas, plan.arms_side)
     tokens = dict(tokens=np.asarray(codes[0], np.int32), arms_tokens=np.asarray(arms_codes[0], np.int32),
                   arms_mirrored=arms_mirrored)
     if plan.legs_action == CIRCLE:  # the codec does not carry turning: the words' circle is walked (circle_walk.py)
@@ -128,8 +128,8 @@ def is_by_parts(motion: Motion) -> bool:
 
 def redecode_parts(motion: Motion, vae, body, betas, ik_refine_iters: int = 10) -> Motion:
     """A by-part motion's tokens decoded for another body: the same composition and mirrors."""
-    legs = _track(motion.tokens, vae, betas, motion.mirrored)
-    arms = _track(motion.arms_tokens, vae, betas, motion.arms_mirrored) if motion.arms_tokens is not None else None
+    legs = _track(motion.tokens, vae, body, betas, motion.mirrored)
+    arms = _track(motion.arms_tokens, vae, body, betas, motion.arms_mirrored) if motion.arms_tokens is not None else None
     if arms is not None and len(arms) != len(legs):
         raise ShapeMoveError(f"this motion's arms have {len(arms)} frames and its legs {len(legs)}; "
                              "it cannot be re-decoded (generate it again)")

@@ -147,13 +147,13 @@ def _timeline_track(gen, codes_per_segment, betas, arms_per_segment=None) -> tup
     """The decoded (and, with arms of their own, composed) track of a timeline's codes; its
     decoded features (None when composed) and the Motion fields that go with it."""
     codes = [c for seg in codes_per_segment for c in seg]
-    track, feats = decoded_track(codes, gen.vae, betas)
+    track, feats = decoded_track(codes, gen.vae, gen.body, betas)
     extra = {"tokens": np.asarray(codes, np.int32)}
     if arms_per_segment is not None and any(a is not None for a in arms_per_segment):
         from .part_compose import compose_arms
 
         arms = _arms_stream(codes_per_segment, arms_per_segment)
-        arms_track, _ = decoded_track(arms, gen.vae, betas)
+        arms_track, _ = decoded_track(arms, gen.vae, gen.body, betas)
         track = Track(compose_arms(track.joints, arms_track.joints), track.contacts)
         extra["arms_tokens"], feats = np.asarray(arms, np.int32), None
     return track, feats, extra

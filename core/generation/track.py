@@ -1,7 +1,8 @@
 """The decoder's joint track of a motion: what loop, path and speed edits work on before the feet
 are planted again.
 
-A generated Motion keeps the SA-VAE's joints (``network_joints``, Y up, before IK and grounding)
+A generated Motion keeps the joints it was planted from (``network_joints``, Y up, before IK and
+grounding: the decoded rotations posed on the body, ``decoded_joints``)
 and the contacts it planted. The animation edits (``loop``, ``path_follow``, ``time_warp``,
 ``sequence``) change those joints and contacts and hand them to ``decode.motion_from_joints``
 (``body/plant.py``: one fixed point per contact run, IK, grounding on the mesh soles), so every
@@ -21,10 +22,10 @@ from ..constants import FPS
 from ..geometry.rotations import matrix_to_axis_angle
 from ..errors import ShapeMoveError
 from ..motion.contacts import CONTACT_IDS, detect_contacts, runs
-from ..motion.features import joints_from_features
 from ..motion.skeleton_ops import facing_directions, gaussian_smooth, heading_angles, smooth_directions
 from ..scene.motion_file import Motion, make_motion
 from .decode import decode_features
+from .decoded_joints import decoded_joints
 
 HEADING_SIGMA = 5.0   # frames: the body's heading without the hips' swing of each step
 CENTRE_SIGMA = 5.0    # frames: the root's path without its sway
@@ -56,10 +57,11 @@ def track_of(motion: Motion) -> Track:
 
 
 @torch.no_grad()
-def decoded_track(codes: list[int], vae, betas) -> tuple[Track, np.ndarray]:
-    """Motion codes + betas -> (the SA-VAE's joint track, its (T,263) features)."""
+def decoded_track(codes: list[int], vae, body, betas) -> tuple[Track, np.ndarray]:
+    """Motion codes + betas -> (the SA-VAE's joint track on ``body``: its decoded rotations posed
+    (``decoded_joints``), its (T,263) features)."""
     feats = decode_features(codes, vae, betas)
-    joints = joints_from_features(feats.double()).numpy()
+    joints = decoded_joints(feats, body, betas)
     f = feats.numpy().astype(np.float32)
     return Track(joints, contacts_from_features(f)), f
 
