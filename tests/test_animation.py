@@ -105,8 +105,8 @@ def test_path_follow_s_curve(gen, walk):
     from shapemove.core.generation.path_follow import follow_path, path_report
 
     t = np.linspace(0, 1, 40)
-    path = np.stack([0.6 * np.sin(2 * np.pi * t), 4.5 * t], 1)   # longer than the walk's ~4.3 m: not
-    m = follow_path(walk, gen.body, path, crop=False)               # cropped, it ends on the path
+    path = np.stack([0.6 * np.sin(2 * np.pi * t), 3.0 * t], 1)
+    m = follow_path(walk, gen.body, path, crop=False)
     r = path_report(m, path)
     assert r["root_mean_m"] <= 0.05 and r["root_max_m"] <= 0.15, r
     assert r["facing_max_deg"] <= 20, r
@@ -119,9 +119,7 @@ def test_speed_exact_duration_and_planted(gen, walk):
     for speed, frames in ((0.5, 2 * walk.num_frames), (2.0, walk.num_frames // 2)):
         m = time_warp(walk, gen.body, speed=speed)
         assert m.num_frames == frames
-        # posed from the decoded rotations, whose legs step a little further than the decoded
-        # pelvis travels: 0.50 mm a frame at double speed (0.35 when posed from the positions)
-        assert _slide(m) <= 0.6, speed
+        assert _slide(m) <= 0.5, speed
     assert time_warp(walk, gen.body, seconds=3.0).num_frames == 60
     with pytest.raises(ShapeMoveError, match="between 0.5 and 2"):
         time_warp(walk, gen.body, speed=3.0)
@@ -192,8 +190,8 @@ def test_timeline_segment_of_two_things_is_made_by_part(gen):
     m = generate_sequence(gen, segs, seed=0)
     own = segment_codes(m, arms=True)
     assert own[0] is None and own[2] is None and len(own[1]) == len(segment_codes(m)[1]) == 20
-    # the sitting segment lifts its arms to shoulder height as it gets up again (posed from the
-    # decoded rotations, a wrist passes the shoulder for 15 % of it): the wave does not leak there
+    # the sitting segment spreads its arms to shoulder height as it gets up again (the decoded
+    # positions just under the shoulders, the decoded rotations just over them for 15 % of it)
     assert hand_up(m, 1) >= 0.9 and hand_up(m, 0) <= 0.1 and hand_up(m, 2) <= 0.2
     assert boundary_report(m)["jump_ratio"] <= 2.0
     whole = generate_sequence(gen, segs, seed=0, by_parts=False)

@@ -36,15 +36,18 @@ def test_consistent_features_give_their_joints_back(openbody):
     assert np.abs(got - want).max() < 2e-3   # metres: the body, its root fit and its path agree
 
 
-def test_the_pose_comes_from_the_rotations_not_the_positions(openbody):
+def test_the_upper_body_comes_from_the_rotations_the_legs_from_the_positions(openbody):
     f = _features(openbody)
     moved = f.copy()
     ric = moved[:, feature_slices["ric"]].reshape(T - 1, 21, 3)
     ric[:, [19, 20], 1] += 0.2     # the decoded wrists 20 cm higher (ric holds joints 1..21)
+    ric[:, [6, 7], 2] += 0.1       # the decoded ankles 10 cm forward
     moved[:, feature_slices["ric"]] = ric.reshape(T - 1, -1)
-    assert np.abs(joints_from_features(moved.astype(np.float64))[:, 20:22, 1]
-                  - joints_from_features(f.astype(np.float64))[:, 20:22, 1]).min() > 0.19
-    np.testing.assert_allclose(decoded_joints(moved, openbody, BETAS), decoded_joints(f, openbody, BETAS), atol=1e-3)
+    was, now = joints_from_features(f.astype(np.float64)), joints_from_features(moved.astype(np.float64))
+    assert np.abs(now[:, 20:22, 1] - was[:, 20:22, 1]).min() > 0.19
+    got, before = decoded_joints(moved, openbody, BETAS), decoded_joints(f, openbody, BETAS)
+    np.testing.assert_allclose(got[:, 12:], before[:, 12:], atol=1e-3)       # neck, head, collars, arms: rotations
+    np.testing.assert_allclose(got[:, [7, 8]], now[:, [7, 8]], atol=1e-9)    # ankles: where the positions put them
 
 
 def test_the_path_is_the_decoded_pelvis(openbody):

@@ -207,7 +207,7 @@ def ground_shift(per_foot, lowest_all, contacts, max_flight: int | None = None) 
 
 
 GATE_HEIGHT = 0.08   # m: a predicted contact whose sole is higher than this is not planted
-BODY_SMOOTH = 1.5    # frames (Gaussian sigma) of ``smooth_body`` when the contacts are known
+BODY_SMOOTH = 1.5    # frames (Gaussian sigma) of ``smooth_body`` for a decoded motion (``decode.motion_from_joints``)
 
 
 def smooth_body(joints, sigma: float = BODY_SMOOTH) -> np.ndarray:

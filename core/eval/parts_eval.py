@@ -15,7 +15,8 @@ training caption: ``tests/test_heldout_parts.py``):
   arms right when the judged gesture is; both right when both are.
 
 One generated motion per prompt (seed ``seed + i`` for the i-th prompt of each set; the product's
-best-of-N TMA choice among token samples unless ``candidates`` says otherwise), judged by
+best-of-N TMA choice among token samples unless ``candidates`` says otherwise), its features
+computed from what the rig plays (``motion_features`` of the planted Motion), judged by
 ``part_judge.PartJudge`` built from the real training clips of the built dataset ``data``;
 ``judge_real`` is the judge's own accuracy on the real test clips (``part_judge_accuracy``), the
 most a generator can be credited with. ``reachable`` is what copying real performances could
@@ -108,6 +109,7 @@ def eval_parts(model_dir=None, data=None, sides=None, two_things=None, seed: int
     from ..generation.generate import Generator, Request
     from ..generation.sampling_params import DEFAULT_CANDIDATES, DEFAULT_RETRIEVAL_FIRST, DEFAULT_RETRIEVED
     from ..models.motion_memory import take_of
+    from ..motion.features import motion_features
     from .action_classifier import default_built_dir
     from .part_judge import PartJudge, arms_right, legs_right
     from .part_judge_accuracy import leave_one_out, real_accuracy
@@ -138,7 +140,8 @@ def eval_parts(model_dir=None, data=None, sides=None, two_things=None, seed: int
             progress(done / total, text)
         how = {"part_prompts": list(m.part_prompts) if m.part_prompts else None,
                "mirrored": bool(m.mirrored or m.arms_mirrored), "retrieved_clips": list(m.retrieved_clips)}
-        return judge.judge([m.features], [{take_of(c) for c in m.retrieved_clips}])[0], bool(m.warnings), how
+        played = motion_features(m)   # what the rig plays (a plain prompt's decoded features differ)
+        return judge.judge([played], [{take_of(c) for c in m.retrieved_clips}])[0], bool(m.warnings), how
 
     side_rows, two_rows = [], []
     for i, it in enumerate(side_items):

@@ -35,8 +35,9 @@ def decode_features(codes: list[int], vae, betas) -> torch.Tensor:
 def decode_tokens(codes: list[int], vae, body, betas, ik_refine_iters: int = 10, prompt: str | None = None,
                   contacts=None) -> Motion:
     """Motion tokens + betas (10,) -> Motion on ``body``: SA-VAE ``decode_long`` with the body's
-    shape; the joints of the decoded rotations posed on the body (``decoded_joints``: they carry
-    the asked-for action better than the decoded positions); then ``plant.plant_motion``: the feet
+    shape; its joints: the decoded positions of the legs, the upper body posed from the decoded
+    rotations (``decoded_joints``: they carry the asked-for action better than the decoded
+    positions); then ``plant.plant_motion``: the feet
     the decoder's contact channels mark are planted (one fixed point per contact run, soles on
     y = 0), IK onto the body, and the posed mesh grounded frame by frame on its soles. The
     Motion's ``joints`` are FK of its pose (what the rig plays); the joints it was planted from
@@ -75,11 +76,13 @@ def redecode(motion: Motion, vae, body, betas, ik_refine_iters: int = 10) -> Mot
 def motion_from_joints(body, betas, joints, contacts, ik_refine_iters: int = 10, prompt: str | None = None,
                        known_contacts: bool = False, **extra) -> Motion:
     """(T,22,3) joint positions + (T,4) foot contacts of joints 7, 8, 10, 11 -> self-consistent
-    Motion on ``body`` with ``betas``: contacts planted, mesh grounded (``plant.plant_motion``);
-    ``known_contacts``: ``contacts`` are measured (not predicted): planted without gating, long
-    flights kept, the decoded body smoothed (``plant.smooth_body``); ``extra``: tokens, features."""
-    planted = plant_motion(body, betas, joints, contacts, refine_iters=ik_refine_iters, **(
-        {"gate": False, "max_flight": None, "smooth": BODY_SMOOTH} if known_contacts else {}))
+    Motion on ``body`` with ``betas``: the body but the feet smoothed over ``BODY_SMOOTH`` frames
+    against decoder jitter (``plant.smooth_body``: the zero-moment point follows the centre of mass's
+    acceleration), contacts planted, mesh grounded (``plant.plant_motion``); ``known_contacts``:
+    ``contacts`` are measured (not predicted): planted without gating, long flights kept;
+    ``extra``: tokens, features."""
+    planted = plant_motion(body, betas, joints, contacts, refine_iters=ik_refine_iters, smooth=BODY_SMOOTH, **(
+        {"gate": False, "max_flight": None} if known_contacts else {}))
     poses = matrix_to_axis_angle(planted.rotations).astype(np.float32)
     m = make_motion(body, poses, planted.transl, betas, fps=float(FPS), prompt=prompt,
                     network_joints=np.asarray(joints, np.float32), contacts=planted.contacts,

@@ -1,22 +1,25 @@
-"""The joints a decoded motion is played from: the decoder's rotations posed on the body.
+"""The joints a generated motion is played from: the decoder's rotations posed on the body.
 
 The SA-VAE writes each frame twice: as joint positions (the ``ric`` block, read by
 ``joints_from_features``) and as the local rotations of joints 1..21 (the ``rot6d`` block). The two
 do not agree exactly (posed on the body, the rotations put the wrists and ankles 5-20 cm from the
-decoded positions), and they do not carry the action equally: played from the positions (IK, so
-the rotations follow the positions as they do in the training clips), the default model's motions
-for the blind held-out paraphrases read as the asked action 50 % of the time on the frequent
-actions (TMA judge), against 70.5 % posed from the decoded rotations (docs/evaluation.md, the
-sixteenth session). So the rig is posed from the rotations: ``decoded_joints`` turns the features
-into the joints of that pose: forward kinematics of the decoded rotations on the body, the root's
-orientation fitted to the decoded pelvis, hips and spine, the pelvis on its decoded path. Planting
-(``plant.plant_motion``) then lands the feet from these joints, and its IK returns rotations within
-a few degrees of the decoded ones, as it does for a captured clip's.
+decoded positions), and they do not carry the action equally: played from the positions alone (IK,
+so the rotations follow the positions as they do in the training clips), the default model's
+motions for the blind held-out paraphrases read as the asked action 50 % of the time on the
+frequent actions (TMA judge); with the upper body posed from the decoded rotations, 68 % (70 %
+lenient; docs/evaluation.md, the sixteenth session).
 
-The path stays the decoded positions': they travel as fast as the real clips of the same action
-(generated walk 1.005x) and their stride follows the leg length. Travel re-derived from the feet
-of the posed legs (``motion.root_from_feet``) made a walk 13 % faster (1.07 -> 1.21 m/s) and a tall
-body's stride 13-19 % longer than its legs explain, so it was not kept.
+The legs and the path stay the positions': they were trained with the foot and stability losses,
+travel as fast as real clips of the same action and stride with the leg length. Posed from the
+rotations too, the legs left the feet skating more (foot-vertex skate 32.9 -> 41.4 % on `eval
+generate`) and the body less often dynamically stable (71.9 -> 47.1 %); the rotations' upper body
+jitters more than the positions' (``plant.smooth_body`` takes it out: ``decode.motion_from_joints``).
+
+``decoded_joints``: the pelvis, hips, knees, ankles, feet and spine1 where the positions put them;
+spine2 and everything above it (spine, neck, head, collars, arms) posed with the decoded rotations
+on the body (forward kinematics, the root turned as the rigid fit of the decoded pelvis, hips and
+spine1), hung from the decoded spine1. Planting (``plant.plant_motion``) then lands the feet and
+solves the rig's rotations from these joints.
 """
 from __future__ import annotations
 
@@ -29,14 +32,16 @@ from ..geometry.torch_ops import forward_kinematics
 from ..motion.features import FEATURE_DIM, feature_slices, joints_from_features
 
 BODY_JOINTS = 22
+SPINE1 = 3
+UPPER = [6, 9, 12, 13, 14, 15, 16, 17, 18, 19, 20, 21]   # spine2 and every joint above it
 
 
 def decoded_joints(features, body, betas) -> np.ndarray:
     """(T, 263) de-normalized features decoded for ``betas`` -> (T, 22, 3) float64 joints (metres,
-    Y up, the features' canonical frame): the body ``body`` with ``betas`` posed with the decoded
-    local rotations of joints 1..21 (hands straight), its root turned as the rigid fit of the
-    decoded pelvis, hips and spine1 (``ik.solve_ik``'s root fit) and its pelvis on the decoded
-    pelvis. Bone lengths are the body's own."""
+    Y up, the features' canonical frame): the decoded positions of the pelvis, legs and spine1;
+    above spine1, the body ``body`` with ``betas`` posed with the decoded local rotations (its
+    root turned as the rigid fit of the decoded pelvis, hips and spine1, ``ik.solve_ik``'s root
+    fit), moved so that its spine1 is the decoded one. The upper body's bones are the body's own."""
     from ..body.ik import solve_ik
 
     f = features.double().numpy() if isinstance(features, torch.Tensor) else np.asarray(features, np.float64)
@@ -54,4 +59,6 @@ def decoded_joints(features, body, betas) -> np.ndarray:
     with torch.no_grad():
         posed, _ = forward_kinematics(torch.as_tensor(rot), rest[None].expand(len(f), -1, -1), body.parents)
     posed = posed[:, :BODY_JOINTS].numpy()
-    return posed - posed[:, :1] + positions[:, :1]
+    out = positions.copy()
+    out[:, UPPER] = posed[:, UPPER] - posed[:, [SPINE1]] + positions[:, [SPINE1]]
+    return out

@@ -6,8 +6,8 @@
 
 Steps: prompt checks -> T5 writes [BETA] + motion tokens (constrained decoding, length control)
 -> betas from the [BETA] head unless given -> SA-VAE decodes the tokens for those betas ->
-the decoded rotations posed on the body (``decoded_joints``) -> feet planted, IK onto the body
-with those betas -> ``Motion``.
+joints: the decoded positions' legs, the upper body posed from the decoded rotations
+(``decoded_joints``) -> feet planted, IK onto the body with those betas -> ``Motion``.
 ``redecode(motion, betas)`` re-decodes the same tokens for another body (the shape sliders).
 """
 from __future__ import annotations

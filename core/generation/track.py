@@ -2,7 +2,7 @@
 are planted again.
 
 A generated Motion keeps the joints it was planted from (``network_joints``, Y up, before IK and
-grounding: the decoded rotations posed on the body, ``decoded_joints``)
+grounding: ``decoded_joints``, the upper body posed from the decoded rotations)
 and the contacts it planted. The animation edits (``loop``, ``path_follow``, ``time_warp``,
 ``sequence``) change those joints and contacts and hand them to ``decode.motion_from_joints``
 (``body/plant.py``: one fixed point per contact run, IK, grounding on the mesh soles), so every
@@ -58,8 +58,8 @@ def track_of(motion: Motion) -> Track:
 
 @torch.no_grad()
 def decoded_track(codes: list[int], vae, body, betas) -> tuple[Track, np.ndarray]:
-    """Motion codes + betas -> (the SA-VAE's joint track on ``body``: its decoded rotations posed
-    (``decoded_joints``), its (T,263) features)."""
+    """Motion codes + betas -> (the SA-VAE's joint track on ``body``: decoded positions for the legs,
+    the upper body posed from the decoded rotations (``decoded_joints``); its (T,263) features)."""
     feats = decode_features(codes, vae, betas)
     joints = decoded_joints(feats, body, betas)
     f = feats.numpy().astype(np.float32)

@@ -4,8 +4,8 @@ Keys: ``joints`` (T,22,3) metres Y-up, ``betas`` (10,), ``poses`` (T,24,3) axis-
 rotations (SMPL convention, relative to the body's rest pose), ``transl`` (T,3) root offset as in
 ``BodyModel.forward`` (posed joints = FK(rest joints) + transl), ``fps``, ``body_model`` (id such as
 "openbody-v1"); optional ``prompt`` (str), ``tokens`` and ``features`` (arrays), ``network_joints``
-(T,22,3: the joints it was planted from, before IK and grounding: a generated motion's decoded
-rotations posed on the body, a retargeted take's decoded positions) and ``contacts`` (T,4 uint8: foot
+(T,22,3: the joints it was planted from, before IK and grounding: for a generated motion, its
+upper body posed from the decoded rotations; for a retargeted take, the decoded positions) and ``contacts`` (T,4 uint8: foot
 contacts of joints 7, 8, 10, 11 that were planted), with ``contacts_measured`` (uint8 1) when those
 came from the source mocap (retargeting) rather than the decoder: re-decoding plants them again.
 Animation extras (``core/generation``, docs/animation.md): ``loop_advance`` (3,) float32, the root's
