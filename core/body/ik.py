@@ -198,6 +198,19 @@ def _tree(parents: tuple):
     return kids, tuple(groups)
 
 
+def fit_root(target: torch.Tensor, rest: torch.Tensor, parents) -> tuple[torch.Tensor, torch.Tensor]:
+    """The root's world rotation (T,3,3) and position (T,3): a rigid fit (rotation + translation)
+    of the pelvis and its children (hips, spine1; ``ROOT_WEIGHTS``) of ``rest`` (24,3) onto
+    ``target`` (T,22,3), float64. With another body's pelvis layout this shares the mismatch
+    instead of piling it onto the hips."""
+    group = [0] + list(_tree(tuple(int(p) for p in parents))[0][0])
+    w = torch.tensor(ROOT_WEIGHTS, dtype=target.dtype)[:, None]
+    c_rest = (rest[group] * w).sum(0) / w.sum()
+    c_tgt = (target[:, group] * w).sum(1) / w.sum()
+    rot = _kabsch(rest[group] - c_rest, target[:, group] - c_tgt[:, None], w[:, 0])
+    return rot, c_tgt + rot @ (rest[0] - c_rest)
+
+
 def analytic_ik(target: torch.Tensor, rest: torch.Tensor, parents, max_turn_deg: float = 30.0):
     """target (T,22,3), rest (24,3) float64 -> local rotations (T,24,3,3), transl (T,3)."""
     T = target.shape[0]
@@ -213,14 +226,7 @@ def analytic_ik(target: torch.Tensor, rest: torch.Tensor, parents, max_turn_deg:
 
     G = [None] * NUM_JOINTS  # world rotations (T,3,3)
     P = [None] * NUM_JOINTS  # FK positions (T,3)
-    # root: rigid fit (rotation + translation) of the pelvis and its children; with another
-    # body's pelvis layout this shares the mismatch instead of piling it onto the hips
-    group = [0] + list(kids[0])
-    w = torch.tensor(ROOT_WEIGHTS, dtype=dt)[:, None]
-    c_rest = (rest[group] * w).sum(0) / w.sum()
-    c_tgt = (target[:, group] * w).sum(1) / w.sum()
-    G[0] = _kabsch(rest[group] - c_rest, target[:, group] - c_tgt[:, None], w[:, 0])
-    P[0] = c_tgt + G[0] @ (rest[0] - c_rest)
+    G[0], P[0] = fit_root(target, rest, parents)
     # a group (e.g. the left and right knee) is solved as one batch of 2T frames: the same arithmetic, fewer calls
     cat = lambda xs: xs[0] if len(xs) == 1 else torch.cat(xs, 0)  # noqa: E731
     per = lambda x: x.expand(T, *x.shape)  # noqa: E731  a per-joint constant, one row per frame

@@ -26,23 +26,33 @@ from __future__ import annotations
 import numpy as np
 import torch
 
+from ..body.skeleton import JOINT_INDEX, NUM_BODY_JOINTS, PARENTS
 from ..errors import ShapeMoveError
 from ..geometry.rotations import rot6d_to_matrix
 from ..geometry.torch_ops import forward_kinematics
 from ..motion.features import FEATURE_DIM, feature_slices, joints_from_features
 
-BODY_JOINTS = 22
-SPINE1 = 3
-UPPER = [6, 9, 12, 13, 14, 15, 16, 17, 18, 19, 20, 21]   # spine2 and every joint above it
+SPINE1 = JOINT_INDEX["spine1"]
+
+
+def _below(joint: int, ancestor: int) -> bool:
+    while joint >= 0:
+        if joint == ancestor:
+            return True
+        joint = int(PARENTS[joint])
+    return False
+
+
+UPPER = [j for j in range(NUM_BODY_JOINTS) if _below(j, JOINT_INDEX["spine2"])]   # spine2 and all above it
 
 
 def decoded_joints(features, body, betas) -> np.ndarray:
     """(T, 263) de-normalized features decoded for ``betas`` -> (T, 22, 3) float64 joints (metres,
     Y up, the features' canonical frame): the decoded positions of the pelvis, legs and spine1;
     above spine1, the body ``body`` with ``betas`` posed with the decoded local rotations (its
-    root turned as the rigid fit of the decoded pelvis, hips and spine1, ``ik.solve_ik``'s root
-    fit), moved so that its spine1 is the decoded one. The upper body's bones are the body's own."""
-    from ..body.ik import solve_ik
+    root turned as the rigid fit of the decoded pelvis, hips and spine1, ``ik.fit_root``), moved
+    so that its spine1 is the decoded one. The upper body's bones are the body's own."""
+    from ..body.ik import fit_root
 
     f = features.double().numpy() if isinstance(features, torch.Tensor) else np.asarray(features, np.float64)
     if f.ndim != 2 or f.shape[1] != FEATURE_DIM or len(f) < 1 or not np.isfinite(f).all():
@@ -51,14 +61,14 @@ def decoded_joints(features, body, betas) -> np.ndarray:
     b = torch.as_tensor(np.asarray(betas, np.float32).reshape(1, -1))
     with torch.no_grad():
         rest = body.rest_joints(b)[0].double()
-    root = solve_ik(positions, rest.numpy(), refine_iters=0).rotations[:, 0]
-    local = rot6d_to_matrix(f[:, feature_slices["rot6d"]].reshape(len(f), BODY_JOINTS - 1, 6))
+        root, _ = fit_root(torch.as_tensor(positions), rest, PARENTS)
+    local = rot6d_to_matrix(f[:, feature_slices["rot6d"]].reshape(len(f), NUM_BODY_JOINTS - 1, 6))
     rot = np.tile(np.eye(3), (len(f), rest.shape[0], 1, 1))
-    rot[:, 0] = root
-    rot[:, 1:BODY_JOINTS] = local
+    rot[:, 0] = root.numpy()
+    rot[:, 1:NUM_BODY_JOINTS] = local
     with torch.no_grad():
         posed, _ = forward_kinematics(torch.as_tensor(rot), rest[None].expand(len(f), -1, -1), body.parents)
-    posed = posed[:, :BODY_JOINTS].numpy()
+    posed = posed[:, :NUM_BODY_JOINTS].numpy()
     out = positions.copy()
     out[:, UPPER] = posed[:, UPPER] - posed[:, [SPINE1]] + positions[:, [SPINE1]]
     return out
