@@ -54,7 +54,7 @@ def test_action_balanced_clip_sampling():
     """action_balance 1 draws each main action equally often, 0 each clip."""
     import numpy as np
 
-    from shapemove.core.train.t5_dataset import clip_weights
+    from shapemove.core.train.action_balance import clip_weights
 
     ids = [f"w{i}" for i in range(90)] + ["c0", "c1"] + [f"r{i}" for i in range(8)]
     labels = {c: {"actions": [{"w": "walk", "c": "cartwheel", "r": "run"}[c[0]]]} for c in ids}

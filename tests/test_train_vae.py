@@ -113,6 +113,33 @@ def test_batch_stream_is_a_function_of_the_step(data_dir):
     assert sorted(k[0] for k in r0 + r1) == [0, 1, 2, 3]                # ranks split an epoch
 
 
+def test_batch_stream_draws_by_weight_and_resumes(data_dir):
+    """Action balance (``train.action_balance``): epochs drawn in proportion to the clips' weights,
+    the same items from any start step, and a clip of weight 0 never drawn."""
+    from shapemove.core.train.action_balance import clip_weights
+
+    ds = MotionClips(data_dir, "train", window=64)
+    w = [6.0, 2.0, 0.0, 0.0]
+    it = iter(BatchStream(ds, batch=4, seed=3, weights=w))
+    first = [next(it) for _ in range(500)]
+    drawn = np.bincount([k[0] for b in first for k in b], minlength=4)
+    assert drawn[2] == drawn[3] == 0 and drawn.sum() == 2000
+    assert drawn[0] / drawn.sum() == pytest.approx(0.75, abs=0.03)     # 6 / (6 + 2)
+    it2 = iter(BatchStream(ds, batch=4, seed=3, start_step=250, weights=w))
+    assert [next(it2) for _ in range(3)] == first[250:253]
+    with pytest.raises(ShapeMoveError, match="sampling weights"):
+        BatchStream(ds, batch=4, weights=[0.0] * 4)
+    with pytest.raises(ShapeMoveError, match="sampling weights"):
+        BatchStream(ds, batch=4, weights=[1.0] * 3)
+    # three walks and one sneak: balance 1 gives the sneak the walks' share together, 0 its clip's share
+    labels = {"a": {"actions": ["walk"]}, "b": {"actions": ["walk"]}, "c": {"actions": ["walk"]},
+              "d": {"actions": ["sneak"]}}
+    assert clip_weights(list("abcd"), labels, 1.0).tolist() == pytest.approx([1 / 3] * 3 + [1.0])
+    assert clip_weights(list("abcd"), labels, 0.0).tolist() == [1.0] * 4
+    with pytest.raises(ShapeMoveError, match="action_balance"):
+        SAVAEConfig.from_dict({"train": {"action_balance": 1.5}}).validate()
+
+
 def test_lr_schedule():
     t = TrainSettings(warmup_steps=100, decay="step", milestones=(0.5, 0.8), gamma=0.1)
     assert lr_factor(0, t, 1000) == pytest.approx(0.01) and lr_factor(99, t, 1000) == 1.0

@@ -69,6 +69,7 @@ class TrainSettings:
     num_workers: int = 0
     init_from: str = ""          # start from this trained savae.pt (its weights and its Mean/Std)
     freeze: tuple = ()           # parts left as they are: "encoder", "quantizer", "shape_embedding", "decoder"
+    action_balance: float = 0.0  # clip sampling weight 1 / (clips of its main action) ** this (1 = actions equally)
 
 
 PARTS = ("encoder", "quantizer", "shape_embedding", "decoder", "residual_encoder", "residual_decoder",
@@ -175,6 +176,8 @@ class SAVAEConfig:
         if self.residual_levels and math.prod(self.residual_levels) > math.prod(self.levels):
             raise ShapeMoveError("residual_levels: the residual codebook may not be larger than the base one "
                                  f"({math.prod(self.levels)} codes), so a token holds both (motion_codes.py)")
+        if not 0 <= self.train.action_balance <= 1:
+            raise ShapeMoveError(f"train.action_balance must be in [0, 1], got {self.train.action_balance!r}")
         if not 0 <= self.residual_dropout <= 1:
             raise ShapeMoveError(f"residual_dropout must be in [0, 1], got {self.residual_dropout!r}")
 

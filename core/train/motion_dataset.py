@@ -107,17 +107,34 @@ class BatchStream:
 
     Epoch e is ``DistributedSampler(shuffle, seed).set_epoch(e)`` over the clips (each rank gets
     its share); batches run across epoch boundaries, so step s always holds items
-    [s*batch, (s+1)*batch) of this rank's stream, whatever step training (re)started at."""
+    [s*batch, (s+1)*batch) of this rank's stream, whatever step training (re)started at. With
+    ``weights`` (one per clip, ``action_balance.clip_weights``: an action's share of training not
+    following its clip count) epoch e is as many clips drawn with replacement in proportion to
+    them, from a generator seeded by (seed, e), each rank taking every ``world_size``-th."""
 
     def __init__(self, dataset: MotionClips, batch: int, rank: int = 0, world_size: int = 1, seed: int = 0,
-                 start_step: int = 0):
+                 start_step: int = 0, weights=None):
         if len(dataset) == 0:
             raise ShapeMoveError(f"{dataset.root}: no clips of at least {dataset.window} frames in this split")
         self.sampler = DistributedSampler(dataset, num_replicas=world_size, rank=rank, shuffle=True, seed=seed)
         self.batch, self.start_step = batch, start_step
+        self.rank, self.world_size, self.seed = rank, world_size, seed
+        self.p = None
+        if weights is not None:
+            w = np.asarray(weights, dtype=np.float64)
+            if w.shape != (len(dataset),) or not np.isfinite(w).all() or (w < 0).any() or w.sum() <= 0:
+                raise ShapeMoveError(f"sampling weights must be {len(dataset)} finite values >= 0, not all 0")
+            self.p = w / w.sum()
+
+    def _epoch(self, e: int) -> list[int]:
+        if self.p is None:
+            self.sampler.set_epoch(e)
+            return list(self.sampler)
+        drawn = np.random.default_rng([self.seed, e]).choice(len(self.p), size=len(self.p), p=self.p)
+        return [int(i) for i in drawn[self.rank::self.world_size]]
 
     def __iter__(self):
-        per_epoch = len(self.sampler)
+        per_epoch = len(self.sampler) if self.p is None else len(range(self.rank, len(self.p), self.world_size))
         j = self.start_step * self.batch
         epoch, order = -1, []
         while True:
@@ -125,8 +142,7 @@ class BatchStream:
             for _ in range(self.batch):
                 e, pos = divmod(j, per_epoch)
                 if e != epoch:
-                    self.sampler.set_epoch(e)
-                    epoch, order = e, list(self.sampler)
+                    epoch, order = e, self._epoch(e)
                 keys.append((order[pos], e))
                 j += 1
             yield keys

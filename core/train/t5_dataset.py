@@ -21,6 +21,7 @@ from ..data.paraphrase_bank import BANK_SHARE, training_caption
 from ..errors import ShapeMoveError
 from ..models.shapemove_t5 import NULL_PROMPT, shapemove_prompt
 from ..models.tokenizer import EOM, SOM
+from .action_balance import clip_weights
 from .motion_dataset import read_split
 
 
@@ -69,17 +70,6 @@ def body_words(meta: dict, betas: np.ndarray, key: str, n: int = 3) -> list[str]
             return []
         pheno = dict(zip(pmap.names, pmap.from_betas(betas)))
     return phenotype_texts(pheno, meta.get("measure") or {}, key, n)
-
-
-def clip_weights(ids: list[str], labels: dict, balance: float) -> np.ndarray:
-    """Sampling weight per clip: 1 / (clips sharing its main action) ** ``balance``. 0 draws every
-    clip equally (common actions dominate: thousands of Bandai hand raises against five
-    cartwheels); 1 draws every action equally, then a clip of it."""
-    main = [((labels.get(c) or {}).get("actions") or [""])[0] for c in ids]
-    count: dict[str, int] = {}
-    for a in main:
-        count[a] = count.get(a, 0) + 1
-    return np.array([count[a] ** -float(balance) for a in main], dtype=np.float64)
 
 
 class T2MExamples:

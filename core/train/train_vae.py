@@ -27,6 +27,7 @@ from ..models.fsq import codebook_usage
 from ..models.savae import SAVAE, SAVAEConfig, TrainSettings, add_residual, load_savae
 from ..models.vae_losses import bone_lengths, vae_losses
 from . import distributed
+from .action_balance import dataset_weights
 from .checkpoint_cadence import finish, save_if_due
 from .run_log import StepLog
 from .checkpoint import config_differences, load_checkpoint, make_metadata, save_checkpoint, stats_hash
@@ -193,8 +194,10 @@ def _train(data, out, cfg, t, resume, body, dist, progress, cancel, verbose) -> 
 
     if dist.is_main:
         atomic_write_json(out / "config.json", cfg.to_dict())
+    weights = dataset_weights(train_set.root, train_set.ids, t.action_balance) if t.action_balance > 0 else None
     batches = DataLoader(train_set, batch_sampler=BatchStream(train_set, t.batch_size // dist.world_size, dist.rank,
-                                                              dist.world_size, t.seed, start_step=step),
+                                                              dist.world_size, t.seed, start_step=step,
+                                                              weights=weights),
                          num_workers=t.num_workers, pin_memory=dist.device.type == "cuda")
     batch_iter = iter(batches)
     log = StepLog(out, t.steps, step, dist, progress, "train vae", verbose)
