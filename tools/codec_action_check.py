@@ -55,11 +55,11 @@ def main(argv=None) -> int:
     import torch
     from tqdm import tqdm
 
-    from shapemove.core.eval.action_classifier import ActionClassifier, FeatureEmbedder
-    from shapemove.core.eval.tma_embed import embed_motions, load_tma
+    from shapemove.core.eval.action_classifier import ActionClassifier
+    from shapemove.core.eval.tma_embed import load_tma
     from shapemove.core.generation.decode import decode_features
     from shapemove.core.generation.model_bundle import model_files, resolve_model_dir
-    from shapemove.core.generation.retarget import encode_windowed
+    from shapemove.core.generation.retarget import encode_take
     from shapemove.core.models.known_texts import read_known
     from shapemove.core.models.motion_codes import base_of
     from shapemove.core.models.savae import load_savae
@@ -67,13 +67,10 @@ def main(argv=None) -> int:
 
     model_dir = resolve_model_dir(a.model)
     tma = load_tma(model_files(model_dir)["tma"])
-    model, _, mean, std = tma
     actions = read_known(model_dir / "t5").action_names
     vae = load_savae(a.checkpoint)
-    vae = vae[0] if isinstance(vae, tuple) else vae
     judges = {"tma": ActionClassifier.from_data(tma, a.data, actions, progress=False),
-              "raw": ActionClassifier.from_data(None, a.data, actions, embed=FeatureEmbedder.from_data(a.data),
-                                                progress=False)}
+              "raw": ActionClassifier.from_features(a.data, actions, progress=False)}
     ways = ["base"] + (["both"] if vae.has_residual else [])
     rows = []
     with one_torch_thread():
@@ -85,14 +82,12 @@ def main(argv=None) -> int:
             shaped = np.load(a.data / "new_joint_vecs" / f"{cid}.npy")[:n]
             betas = np.load(a.data / "betas" / f"{cid}.npy").astype(np.float32)
             with torch.no_grad():
-                tokens = [int(t) for t in encode_windowed(vae, vae.normalize(torch.as_tensor(canon[:n], dtype=torch.float32)))]
+                tokens = encode_take(vae, canon, search=False)   # the encoders' codes, as retargeting without search
             feats = [shaped] + [decode_features(base_of(tokens, vae.quantizer.codebook_size) if w == "base" else tokens,
                                                 vae, betas).numpy() for w in ways]
             row = {"clip": cid, "action": action}
             for name, judge in judges.items():
-                preds = (judge.classify_embeddings(embed_motions(model, feats, mean, std), exclude=[[cid]] * len(feats))
-                         if name == "tma" else judge.classify(feats, exclude=[[cid]] * len(feats)))
-                row[name] = dict(zip(["capture"] + ways, preds))
+                row[name] = dict(zip(["capture"] + ways, judge.classify(feats, exclude=[[cid]] * len(feats))))
             rows.append(row)
     per: dict[str, dict] = {}
     for r in rows:

@@ -24,14 +24,13 @@ import numpy as np
 
 def _judges(gen, data) -> dict:
     """The two judges of ``eval paraphrase``: 5 nearest training clips by TMA embedding and by raw features."""
-    from shapemove.core.eval.action_classifier import ActionClassifier, FeatureEmbedder
+    from shapemove.core.eval.action_classifier import ActionClassifier
     from shapemove.core.generation.model_bundle import model_files
     from shapemove.core.eval.tma_embed import load_tma
 
     tma = load_tma(model_files(gen.model_dir)["tma"])
     return {"TMA": ActionClassifier.from_data(tma, data, gen.known_actions, progress=False),
-            "raw-feature": ActionClassifier.from_data(None, data, gen.known_actions,
-                                                      embed=FeatureEmbedder.from_data(data), progress=False)}
+            "raw-feature": ActionClassifier.from_features(data, gen.known_actions, progress=False)}
 
 
 def main(argv=None) -> int:

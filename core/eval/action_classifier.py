@@ -257,6 +257,14 @@ class ActionClassifier:
         out.ids = ids  # the reference clips' ids (their captions: the nearest-caption baseline)
         return out
 
+    @classmethod
+    def from_features(cls, data, actions, split: str = "train", progress: bool = True) -> "ActionClassifier":
+        """The judge without a learned model: ``from_data`` on ``FeatureEmbedder`` vectors of the raw
+        features (the dataset's Mean/Std), so a choice made by the TMA cannot flatter it."""
+        out = cls.from_data(None, data, actions, split, embed=FeatureEmbedder.from_data(data), progress=progress)
+        out.info["kind"] = f"{out.k}-nearest training clips in pooled raw-feature space (no TMA)"
+        return out
+
     def classify_embeddings(self, emb: np.ndarray, chunk: int = 1024, exclude: list | None = None) -> list[str]:
         """Action of each embedding. ``exclude[i]``: a clip id or clip ids whose captured takes (each clip, its
         mirror image and shape-augmented copies) row i must not find among the references (a

@@ -116,7 +116,7 @@ def eval_paraphrase(model_dir=None, prompts=None, tma=None, seed: int = 0, secon
     from ..motion.features import motion_features
     from ..generation.sampling_params import (DEFAULT_CANDIDATES, DEFAULT_RETRIEVAL_FIRST, DEFAULT_RETRIEVAL_PREFIX,
                                               DEFAULT_RETRIEVED)
-    from .action_classifier import ActionClassifier, FeatureEmbedder, default_built_dir
+    from .action_classifier import ActionClassifier, default_built_dir
     from .tma_embed import embed_motions, embed_texts, load_tma
 
     items = load_prompts(prompts)
@@ -148,9 +148,7 @@ def eval_paraphrase(model_dir=None, prompts=None, tma=None, seed: int = 0, secon
     else:
         ceiling = classifier.ceiling(data, "test", max_clips=ceiling_clips, progress=show_progress) if data else None
     if feature_classifier is None and data is not None:
-        feature_classifier = ActionClassifier.from_data(None, data, actions, embed=FeatureEmbedder.from_data(data),
-                                                        progress=show_progress)
-        feature_classifier.info["kind"] = "5-nearest training clips in pooled raw-feature space (no TMA)"
+        feature_classifier = ActionClassifier.from_features(data, actions, progress=show_progress)
     A = action_embeddings(tma, actions)
     known = [it for it in items if it["action"] in actions]
     rows, embs, feats = [], [], []
