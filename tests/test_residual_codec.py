@@ -73,9 +73,13 @@ def test_config_refuses_bad_residual_settings():
         SAVAEConfig.from_dict({"base": "tiny", "residual_levels": [8, 8, 8, 8]})
     with pytest.raises(ShapeMoveError, match="residual parts need residual_levels"):
         tiny(init_from="x.pt", freeze=("residual_encoder",)).validate()
+    everything = ("encoder", "quantizer", "shape_embedding", "decoder", "residual_encoder", "residual_decoder",
+                  "residual_shape_embedding")
     with pytest.raises(ShapeMoveError, match="leaves nothing to train"):
-        tiny([8, 5, 5, 5], init_from="x.pt", freeze=("residual_encoder", "residual_decoder",
-                                                     "residual_shape_embedding")).validate()
+        tiny([8, 5, 5, 5], init_from="x.pt", freeze=everything).validate()
+    assert tiny([8, 5, 5, 5], init_from="x.pt", freeze=everything[4:]).trains_base
+    assert not tiny([8, 5, 5, 5], init_from="x.pt", freeze=everything[:4]).trains_base
+    assert tiny().trains_base
     assert tiny([8, 5, 5, 5]).residual_input_dim == 9
 
 
@@ -114,6 +118,39 @@ def test_residual_training_keeps_every_base_token(tiny_dataset, tmp_path):
     with pytest.raises(ShapeMoveError, match="another network.*residual_levels"):
         train_vae(tiny_dataset, tmp_path / "other", tiny([5, 5, 5], steps=2, init_from=str(tmp_path / "res" / "savae.pt")),
                   device="cpu", verbose=False)
+
+
+def test_base_decoder_fine_tuned_under_a_residual_branch(tiny_dataset, tmp_path):
+    """Every residual part frozen, the encoder and quantizer too: training goes through the base
+    path, so the base decoder learns while every token and the residual branch (what captured motion
+    decodes through) stay bit for bit."""
+    from shapemove.core.train.motion_dataset import MotionClips
+    from shapemove.core.train.train_vae import train_vae
+
+    train_vae(tiny_dataset, tmp_path / "src", tiny(steps=20, lr=3e-3), device="cpu", verbose=False)
+    res_cfg = tiny([8, 5, 5, 5], steps=10, lr=3e-3, init_from=str(tmp_path / "src" / "savae.pt"),
+                   freeze=("encoder", "quantizer", "decoder", "shape_embedding"), val_every=1000)
+    train_vae(tiny_dataset, tmp_path / "res", res_cfg, device="cpu", verbose=False)
+    frozen = ("encoder", "quantizer", "residual_encoder", "residual_decoder", "residual_shape_embedding")
+    cfg = tiny([8, 5, 5, 5], steps=10, lr=3e-3, init_from=str(tmp_path / "res" / "savae.pt"), freeze=frozen,
+               val_every=5)
+    assert cfg.trains_base
+    train_vae(tiny_dataset, tmp_path / "dec", cfg, device="cpu", verbose=False)
+    res, dec = load_savae(tmp_path / "res" / "savae.pt"), load_savae(tmp_path / "dec" / "savae.pt")
+    before, after = res.state_dict(), dec.state_dict()
+    for name, v in before.items():
+        if name.startswith(("decoder.", "shape_embedding.")):
+            continue
+        assert torch.equal(v, after[name]), name                  # encoders and residual branch as they were
+    assert not torch.equal(before["decoder.lift.weight"], after["decoder.lift.weight"])   # the base decoder learnt
+    item = MotionClips(tiny_dataset, "train", 32)[(0, 0)]
+    x, b = item["x"][None], item["betas"][None]
+    with torch.no_grad():
+        tokens = dec.encode_tokens(x)
+        assert torch.equal(tokens, res.encode_tokens(x))
+        assert torch.equal(dec.decode_tokens_long(tokens, b), res.decode_tokens_long(tokens, b))
+        base = base_of(tokens, 1000)
+        assert not torch.allclose(dec.decode_tokens_long(base, b), res.decode_tokens_long(base, b), atol=1e-4)
 
 
 def test_the_t5_reads_base_codes_only():

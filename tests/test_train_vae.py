@@ -260,6 +260,36 @@ def test_decoder_fine_tune_keeps_every_token(data_dir, body, tmp_path):
         tiny_config(init_from="x.pt", freeze=("encodr",)).validate()
 
 
+def test_wider_decoder_refit_on_frozen_codes(data_dir, body, tmp_path):
+    """A base decoder of another width (``decoder_width``) trained anew on a codec's frozen codes:
+    every token and the shape embedding come from the source, the decoder has the new width and
+    decodes; widening a frozen decoder is refused by name."""
+    train_vae(data_dir, tmp_path / "src", tiny_config(), body=body, device="cpu", verbose=False)
+    src_path = str(tmp_path / "src" / "savae.pt")
+    src = load_savae(src_path)
+    cfg = tiny_config(steps=2, init_from=src_path, freeze=("encoder", "quantizer", "shape_embedding"))
+    cfg.decoder_width = 24
+    train_vae(data_dir, tmp_path / "wide", cfg, body=body, device="cpu", verbose=False)
+    wide = load_savae(tmp_path / "wide" / "savae.pt")
+    assert wide.cfg.width == 16 and wide.cfg.base_decoder_width == 24 and src.cfg.base_decoder_width == 16
+    assert wide.decoder.net[0].out_channels == 24 and src.decoder.net[0].out_channels == 16
+    for part in ("encoder", "shape_embedding"):
+        for name, v in getattr(src, part).state_dict().items():
+            assert torch.equal(v, getattr(wide, part).state_dict()[name]), (part, name)
+    clips = MotionClips(data_dir, "train", 64)
+    x = src.normalize(torch.from_numpy(np.load(data_dir / "norm_joint_vecs" / f"{clips.ids[0]}.npy")[None, :64]))
+    with torch.no_grad():
+        codes, idx = wide.encode(x)
+        assert torch.equal(idx, src.encode(x)[1])
+        assert wide.decode(codes, torch.zeros(1, 10)).shape == (1, 64, 263)
+    frozen = tiny_config(steps=1, init_from=src_path, freeze=("encoder", "quantizer", "decoder"))
+    frozen.decoder_width = 24
+    with pytest.raises(ShapeMoveError, match="another network.*decoder_width"):
+        train_vae(data_dir, tmp_path / "frozen", frozen, body=body, device="cpu", verbose=False)
+    with pytest.raises(ShapeMoveError, match="decoder_width must be >= 0"):
+        SAVAEConfig(decoder_width=-1).validate()
+
+
 def test_cli_train_vae(data_dir, tmp_path):
     from shapemove.cli import main
 

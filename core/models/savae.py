@@ -88,6 +88,7 @@ class SAVAEConfig:
     down_t: int = 2
     shape_hidden: int = 256
     shape_token_dim: int = 0     # width of the decoder's time stream: 0 = `width`; len(levels) = raw codes
+    decoder_width: int = 0       # channels of the base decoder: 0 = `width` (a wider one can be fitted to frozen codes)
     residual_levels: tuple = ()  # FSQ levels of a residual code beside the base one; () = none
     residual_dropout: float = 0.5  # training: share of clips the residual branch decodes from base codes
     loss: LossWeights = field(default_factory=LossWeights)
@@ -113,6 +114,10 @@ class SAVAEConfig:
     @property
     def token_dim(self) -> int:
         return self.shape_token_dim or self.width
+
+    @property
+    def base_decoder_width(self) -> int:
+        return self.decoder_width or self.width
 
     @property
     def downsample(self) -> int:
@@ -167,8 +172,7 @@ class SAVAEConfig:
             raise ShapeMoveError(f"train.freeze: unknown part(s) {', '.join(map(repr, unknown))}; parts are {', '.join(PARTS)}")
         if self.train.freeze and not self.train.init_from:
             raise ShapeMoveError("train.freeze needs train.init_from: freezing untrained weights keeps them random")
-        # a residual codec trains its residual branch (the base one is not in its forward pass)
-        trainable = set(RESIDUAL_PARTS) if self.residual_levels else {"encoder", "shape_embedding", "decoder"}
+        trainable = {"encoder", "shape_embedding", "decoder"} if self.trains_base else set(RESIDUAL_PARTS)
         if set(self.train.freeze) >= trainable:
             raise ShapeMoveError("train.freeze leaves nothing to train")
         if set(self.train.freeze) & set(RESIDUAL_PARTS) and not self.residual_levels:
@@ -178,8 +182,18 @@ class SAVAEConfig:
                                  f"({math.prod(self.levels)} codes), so a token holds both (motion_codes.py)")
         if not 0 <= self.train.action_balance <= 1:
             raise ShapeMoveError(f"train.action_balance must be in [0, 1], got {self.train.action_balance!r}")
+        if self.decoder_width < 0:
+            raise ShapeMoveError(f"decoder_width must be >= 0, got {self.decoder_width!r}")
         if not 0 <= self.residual_dropout <= 1:
             raise ShapeMoveError(f"residual_dropout must be in [0, 1], got {self.residual_dropout!r}")
+
+    @property
+    def trains_base(self) -> bool:
+        """Whether training decodes through the base path. A residual codec trains its residual
+        branch (the base decoder is not in that forward pass) unless every residual part is frozen:
+        then its base decoder is the one fine-tuned (the T5's codes decode through it), and the
+        residual branch stays as it was."""
+        return not self.residual_levels or set(RESIDUAL_PARTS) <= set(self.train.freeze)
 
     @property
     def residual_input_dim(self) -> int:
@@ -197,7 +211,8 @@ class SAVAE(nn.Module):
         self.encoder = Encoder(cfg.feature_dim, c, cfg.width, cfg.depth, cfg.dilation_growth, cfg.down_t)
         self.quantizer = FSQ(cfg.levels)
         self.shape_embedding = ShapeEmbedding(cfg.num_betas, cfg.shape_hidden, cfg.token_dim)
-        self.decoder = Decoder(c, cfg.token_dim, cfg.feature_dim, cfg.width, cfg.depth, cfg.dilation_growth, cfg.down_t)
+        self.decoder = Decoder(c, cfg.token_dim, cfg.feature_dim, cfg.base_decoder_width, cfg.depth, cfg.dilation_growth,
+                               cfg.down_t)
         if cfg.residual_levels:
             r = len(cfg.residual_levels)
             self.residual_encoder = Encoder(cfg.feature_dim, r, cfg.width, cfg.depth, cfg.dilation_growth, cfg.down_t)
@@ -293,9 +308,11 @@ class SAVAE(nn.Module):
             raise ShapeMoveError(f"residual code out of range [0, {self.residual_quantizer.codebook_size})")
         return self.decode_long(codes, betas, residual=self.residual_quantizer.indices_to_codes(res))
 
-    def forward(self, x: torch.Tensor, betas: torch.Tensor) -> dict:
+    def forward(self, x: torch.Tensor, betas: torch.Tensor, base: bool = False) -> dict:
+        """Training's pass: encode, decode. ``base`` decodes the base codes by the base decoder even
+        in a residual codec (``SAVAEConfig.trains_base``)."""
         codes, indices = self.encode(x)
-        if not self.has_residual:
+        if not self.has_residual or base:
             return {"recon": self.decode(codes, betas), "codes": codes, "indices": indices}
         residual, _ = self.encode_residual(x)
         present = None

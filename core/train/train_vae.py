@@ -86,7 +86,9 @@ def start_from(cfg: SAVAEConfig, body_name: str) -> SAVAE:
     theirs, mine = src.cfg.to_dict(), cfg.to_dict()
     # a residual code may be added to a codec that has none (savae.add_residual)
     adds = ("residual_levels", "residual_dropout") if cfg.residual_levels and not src.has_residual else ()
-    diff = config_differences(theirs, mine, ignore=("loss", "train") + adds)
+    # a base decoder of another width is trained anew on the source's (frozen or not) codes
+    refit = ("decoder_width",) if "decoder" not in cfg.train.freeze else ()
+    diff = config_differences(theirs, mine, ignore=("loss", "train") + adds + refit)
     if diff:
         shown = "; ".join(f"{k}: {theirs.get(k)!r} there, {mine.get(k)!r} here" for k in diff)
         raise ShapeMoveError(f"train.init_from {cfg.train.init_from}: another network ({shown})")
@@ -115,7 +117,7 @@ def evaluate(model: SAVAE, dataset: MotionClips, cfg: SAVAEConfig, device, body=
     for k in range(0, len(keys), bs):
         items = [dataset[key] for key in keys[k:k + bs]]
         b = _to({name: torch.stack([it[name] for it in items]) for name in items[0]}, device)
-        out = model(b["x"], b["betas"])
+        out = model(b["x"], b["betas"], base=cfg.trains_base)
         losses = batch_losses(out, b, model, cfg, body)
         for name, v in losses.items():
             sums[name] = sums.get(name, 0.0) + float(v) * len(items)
@@ -164,6 +166,9 @@ def _train(data, out, cfg, t, resume, body, dist, progress, cancel, verbose) -> 
     model = SAVAE(cfg, mean, std)
     if source is not None and model.has_residual and not source.has_residual:
         add_residual(model, source)
+    elif source is not None and source.cfg.base_decoder_width != cfg.base_decoder_width:
+        kept = {k: v for k, v in source.state_dict().items() if not k.startswith("decoder.")}
+        model.load_state_dict(kept, strict=False)   # every part but the base decoder, which starts anew
     elif source is not None:
         model.load_state_dict(source.state_dict())
     freeze(model, t.freeze)
@@ -207,7 +212,7 @@ def _train(data, out, cfg, t, resume, body, dist, progress, cancel, verbose) -> 
         if distributed.broadcast_flag(bool(cancel and dist.is_main and cancel()), dist):
             break
         b = _to(next(batch_iter), dist.device)
-        result = model(b["x"], b["betas"])
+        result = model(b["x"], b["betas"], base=cfg.trains_base)
         losses = batch_losses(result, b, raw, cfg, body)
         optimizer_step(losses["total"], optimizer, scheduler, trained, t.grad_clip)
         step += 1
