@@ -140,6 +140,25 @@ def test_penetration_floating_sliding(clip):
     assert L.foot_slide_loss(slide, torch.zeros(1, T, 4)) == 0
 
 
+def test_squared_reconstruction_counts_a_far_pose_in_full():
+    """``recon_mse``: the mean squared error of the normalized features, off unless weighted. One
+    feature 4 std off in one of 4 x 263 values: squared 16 / 1052, where smooth L1 gives (4 - 0.5) /
+    1052, so the far pose weighs 4.6x more against the same error spread thin (0.1 everywhere:
+    0.01 squared against 0.005)."""
+    target = torch.zeros(1, 4, 263)
+    far = target.clone()
+    far[0, 2, 7] = 4.0
+    thin = target + 0.1
+    w = SAVAEConfig().loss
+    assert w.recon_mse == 0 and "recon_mse" not in L.vae_losses(far, target, torch.zeros(263), torch.ones(263), w)
+    w.recon_mse, w.recon = 1.0, 0.0
+    out = L.vae_losses(far, target, torch.zeros(263), torch.ones(263), w)
+    assert float(out["recon_mse"]) == pytest.approx(16 / 1052, rel=1e-6)
+    assert float(out["recon"]) == pytest.approx(3.5 / 1052, rel=1e-6)
+    assert float(L.vae_losses(thin, target, torch.zeros(263), torch.ones(263), w)["recon_mse"]) == pytest.approx(0.01, rel=1e-4)
+    assert float(out["total"]) == pytest.approx(sum(getattr(w, k) * float(v) for k, v in out.items() if k != "total"), rel=1e-6)
+
+
 def test_vae_losses_through_features(clip):
     """End to end on features: a prediction equal to the target has zero reconstruction losses,
     the same motion sunk 10 cm (root height and ric heights lowered) penetrates."""

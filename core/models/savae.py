@@ -38,6 +38,7 @@ from .shape_embedding import ShapeEmbedding
 @dataclass
 class LossWeights:
     recon: float = 1.0        # smooth L1 on normalized features
+    recon_mse: float = 0.0    # squared error on normalized features: a rare, far-off pose counts in full
     vel: float = 0.5          # smooth L1 on their temporal differences
     bone: float = 1.0         # |bone length - target body's bone length| (m)
     floating: float = 0.5     # lowest foot joint above the target's, on contact frames (m)

@@ -151,6 +151,8 @@ def vae_losses(pred: torch.Tensor, target: torch.Tensor, mean: torch.Tensor, std
     target's contact channels. Returns a dict of scalar tensors with the weighted sum in 'total'.
     """
     out = {"recon": F.smooth_l1_loss(pred, target), "vel": velocity_loss(pred, target)}
+    if getattr(weights, "recon_mse", 0.0):
+        out["recon_mse"] = F.mse_loss(pred, target)
     stability = getattr(weights, "dyn_stability", 0.0)
     physical = stability or any(getattr(weights, k, 0.0) for k in ("bone", "floating", "slide", "penetrate", "root"))
     if physical:
