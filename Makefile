@@ -52,11 +52,10 @@ train-default: setup
 	$(PY) -m shapemove train vae --data $(BUILT) --config configs/default_vae_decoder_feet.json --init-from $(RUNS)/vae_decoder/savae.pt --out $(RUNS)/vae_feet --resume
 	$(PY) -m shapemove train vae --data $(BUILT) --config configs/default_vae_residual.json --init-from $(RUNS)/vae_feet/savae.pt --out $(RUNS)/vae_res --resume
 	$(PY) -m shapemove train vae --data $(BUILT) --config configs/default_vae_residual_more.json --init-from $(RUNS)/vae_res/savae.pt --out $(RUNS)/vae_res_more --resume
-	$(PY) -m shapemove train vae --data $(BUILT) --config configs/default_vae_base.json --init-from $(RUNS)/vae_res_more/savae.pt --out $(RUNS)/vae_base --resume
 	$(PY) -m shapemove train tma --data $(BUILT) --config configs/default_tma.json --out $(RUNS)/tma --resume
 	$(PY) -m shapemove train t5 --data $(BUILT) --config configs/default_t5.json --vae $(RUNS)/vae/savae.pt \
 		--out $(RUNS)/t5 --resume $(if $(BASE_T5),--base-model $(BASE_T5),)
-	$(PY) tools/export_default.py --vae $(RUNS)/vae_base --t5 $(RUNS)/t5 --tma $(RUNS)/tma --out weights/default --card configs/model_card.json
+	$(PY) tools/export_default.py --vae $(RUNS)/vae_res_more --t5 $(RUNS)/t5 --tma $(RUNS)/tma --out weights/default --card configs/model_card.json
 	$(PY) -m shapemove train head --model weights/default --data $(BUILT) --out $(RUNS)/head --resume
 	$(PY) -m shapemove train head --model $(RUNS)/head/model --data $(BUILT) --config configs/default_head_units.json --out $(RUNS)/head_units --resume
 	rm -rf weights/default && cp -r $(RUNS)/head_units/model weights/default
