@@ -7,7 +7,7 @@ import torch
 
 from shapemove.core.errors import ShapeMoveError
 from shapemove.core.models.motion_codes import base_of, pack, unpack
-from shapemove.core.models.savae import SAVAE, SAVAEConfig, TrainSettings, add_residual, load_savae
+from shapemove.core.models.savae import PARTS, SAVAE, SAVAEConfig, TrainSettings, add_residual, load_savae
 
 pytestmark = pytest.mark.usefixtures("one_thread")
 
@@ -73,8 +73,7 @@ def test_config_refuses_bad_residual_settings():
         SAVAEConfig.from_dict({"base": "tiny", "residual_levels": [8, 8, 8, 8]})
     with pytest.raises(ShapeMoveError, match="residual parts need residual_levels"):
         tiny(init_from="x.pt", freeze=("residual_encoder",)).validate()
-    everything = ("encoder", "quantizer", "shape_embedding", "decoder", "residual_encoder", "residual_decoder",
-                  "residual_shape_embedding")
+    everything = PARTS
     with pytest.raises(ShapeMoveError, match="leaves nothing to train"):
         tiny([8, 5, 5, 5], init_from="x.pt", freeze=everything).validate()
     assert tiny([8, 5, 5, 5], init_from="x.pt", freeze=everything[4:]).trains_base

@@ -286,6 +286,10 @@ def test_wider_decoder_refit_on_frozen_codes(data_dir, body, tmp_path):
     frozen.decoder_width = 24
     with pytest.raises(ShapeMoveError, match="another network.*decoder_width"):
         train_vae(data_dir, tmp_path / "frozen", frozen, body=body, device="cpu", verbose=False)
+    widened = tiny_config(steps=1, init_from=src_path, freeze=("encoder", "quantizer"))
+    widened.decoder_width, widened.residual_levels = 24, (8, 5, 5, 5)   # a residual branch copies the old decoder
+    with pytest.raises(ShapeMoveError, match="another network.*decoder_width"):
+        train_vae(data_dir, tmp_path / "both", widened, body=body, device="cpu", verbose=False)
     with pytest.raises(ShapeMoveError, match="decoder_width must be >= 0"):
         SAVAEConfig(decoder_width=-1).validate()
 

@@ -87,7 +87,8 @@ def start_from(cfg: SAVAEConfig, body_name: str) -> SAVAE:
     # a residual code may be added to a codec that has none (savae.add_residual)
     adds = ("residual_levels", "residual_dropout") if cfg.residual_levels and not src.has_residual else ()
     # a base decoder of another width is trained anew on the source's (frozen or not) codes
-    refit = ("decoder_width",) if "decoder" not in cfg.train.freeze else ()
+    # (not while a residual branch is added: it starts as a copy of the source's base decoder)
+    refit = ("decoder_width",) if "decoder" not in cfg.train.freeze and not adds else ()
     diff = config_differences(theirs, mine, ignore=("loss", "train") + adds + refit)
     if diff:
         shown = "; ".join(f"{k}: {theirs.get(k)!r} there, {mine.get(k)!r} here" for k in diff)
@@ -168,7 +169,8 @@ def _train(data, out, cfg, t, resume, body, dist, progress, cancel, verbose) -> 
         add_residual(model, source)
     elif source is not None and source.cfg.base_decoder_width != cfg.base_decoder_width:
         kept = {k: v for k, v in source.state_dict().items() if not k.startswith("decoder.")}
-        model.load_state_dict(kept, strict=False)   # every part but the base decoder, which starts anew
+        missing = model.load_state_dict(kept, strict=False).missing_keys   # the base decoder starts anew
+        assert all(k.startswith("decoder.") for k in missing), missing
     elif source is not None:
         model.load_state_dict(source.state_dict())
     freeze(model, t.freeze)
