@@ -5,7 +5,10 @@ The body: explicit betas, or a shape text - a measured sentence ("A person stand
 with a waist circumference of 100 cm") or adjectives ("a tall, heavy-set man") - turned into
 betas by matching the body's measurements (``core/body/shape_from_measurements.py``).
 Default: through the SA-VAE (``core/generation/retarget.py``; the output keeps its motion tokens,
-so it can be re-decoded for other bodies); ``--naive`` copies the rotations instead.
+so it can be re-decoded for other bodies), unless its codes miss the take (decoded on the subject's
+own body, more than ``take_fidelity.LOST_TAKE_MM`` off in the worst second: a fast kick the codec
+flattens): then the take's own rotations with its feet planted, and a note says so
+(``--no-fallback`` keeps the SA-VAE's motion anyway); ``--naive`` copies the rotations instead.
 """
 from __future__ import annotations
 
@@ -23,6 +26,9 @@ def add_arguments(p):
                    help="SA-VAE run folder or .pt (default: the embedded model's savae.pt)")
     p.add_argument("--out", type=Path, required=True, help="output motion file (.npz)")
     p.add_argument("--naive", action="store_true", help="copy the rotations instead of going through the SA-VAE")
+    p.add_argument("--no-fallback", action="store_true",
+                   help="keep the SA-VAE's motion even when its codes miss the take (default: the take's own "
+                        "rotations, feet planted, when they do)")
     p.add_argument("--no-search", action="store_true",
                    help="the SA-VAE's encoders' codes, not searched for on the subject's body (faster, less faithful)")
     p.add_argument("--body-model", default=None, help="openbody (default) or an SMPL-family file")
@@ -57,6 +63,7 @@ def run(args) -> int:
     from ..core.body.load import load_body_model
     from ..core.body.measure import format_body, measure
     from ..core.generation.retarget import load_vae, naive_retarget, retarget
+    from ..core.generation.take_fidelity import LOST_TAKE_MM
 
     if args.out.suffix.lower() != ".npz":
         raise ShapeMoveError(f"--out must end in .npz, got {args.out}")
@@ -74,8 +81,10 @@ def run(args) -> int:
         search = not getattr(args, "no_search", False)
         with tqdm(total=100, desc="searching codes", unit="%", disable=not search) as bar:
             motion = retarget(args.motion, load_vae(args.checkpoint, body), body, betas, read=read,
-                              search=search, progress=lambda f: bar.update(round(100 * f) - bar.n))
-        how = f"SA-VAE, {len(motion.tokens)} tokens"
+                              search=search, progress=lambda f: bar.update(round(100 * f) - bar.n),
+                              fallback_mm=None if args.no_fallback else LOST_TAKE_MM)
+        how = (f"SA-VAE, {len(motion.tokens)} tokens" if motion.tokens is not None
+               else "the take's own rotations, feet planted: " + "; ".join(motion.warnings))
     save_motion(args.out, motion)
     m = measure(body, motion.betas)
     print(f"wrote {args.out}: {motion.num_frames} frames ({motion.num_frames / motion.fps:.1f} s), {how}")

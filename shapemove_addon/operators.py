@@ -24,7 +24,7 @@ from .export import FORMATS, export_rig
 from .jobs import report_error
 from .preferences import body_spec, preferences, setting
 from .redecode import HAS_TOKENS_KEY, MOTION_FILE_KEY
-from .rig_state import PHYSICS_KEY, current_betas, rig_body_spec, rig_of
+from .rig_state import PHYSICS_KEY, RETARGET_NOTE_KEY, current_betas, rig_body_spec, rig_of
 from .animation_rig import ROOT_MOTION_ITEMS, build_animated_rig
 from .scene_build import SLIDER_RANGE
 
@@ -318,8 +318,12 @@ def _retarget_job(context, source: str, target_rig, name: str, read: dict | None
         params["betas"] = current_betas(target_rig).tolist()
 
     def done(msg):
-        if not msg.get("cancelled"):
-            build_rig_from_file(msg["result"]["path"], name)
+        if msg.get("cancelled"):
+            return
+        rig = build_rig_from_file(msg["result"]["path"], name)
+        notes = [str(w) for w in msg["result"].get("warnings") or []]
+        if rig is not None and notes:   # e.g. the codec missed the take: its own rotations were used
+            rig[RETARGET_NOTE_KEY] = notes[:2]
 
     job_submit.submit_job("retarget", params, kind="retarget", label=f"retarget {Path(source).name}", on_result=done)
 

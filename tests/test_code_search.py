@@ -159,3 +159,37 @@ def test_the_retarget_job_shows_the_search_and_cancels_during_it(mocap_root, tmp
                                 lambda: any("searching codes" in m for _, m in seen))
     assert [m for _, m in seen if "searching codes" in m] and not out.exists()
     assert all(0.3 <= f <= 0.9 for f, m in seen if "searching codes" in m)
+
+
+def test_the_retarget_job_keeps_a_kick_the_codec_flattens(mocap_root, tmp_path):
+    """The panel's Retarget ("auto") checks the searched codes on the subject's own body first. A
+    captured front kick (the right foot 1.0 m above its lowest point) comes back from the shipped
+    codec at under 0.4 m: auto moves the take by its own rotations instead, feet planted, and says
+    why; a walk stays on the SA-VAE (tokens, no note). "savae" keeps the codec's motion anyway."""
+    if not SAVAE.is_file():
+        pytest.skip(f"{SAVAE} missing")
+    from shapemove.core.body.load import load_body_model
+    from shapemove.core.generation.retarget import source_joints
+    from shapemove.core.scene.motion_file import load_motion
+    from shapemove.core.worker import jobs_shapemove
+
+    data = mocap_root / "bandai" / "dataset-1" / "data"
+    kick = data / "dataset-1_kick_normal_001.bvh"
+
+    def job(source, method):
+        out = tmp_path / f"{source.stem}_{method}.npz"
+        r = jobs_shapemove.retarget({"source": str(source), "betas": [1.0] + [0.0] * 9, "method": method,
+                                     "out": str(out)}, lambda f, m: None, lambda: False)
+        return r, load_motion(out)
+
+    src = source_joints(kick, load_body_model(None))[0][:, 8, 1]
+    lift = lambda y: float(y.max() - y.min())  # noqa: E731   (the right ankle's rise)
+    assert lift(src) > 0.9
+    r, m = job(kick, "auto")
+    assert r["method"] == "planted" and r["tokens"] == 0 and m.tokens is None and len(src) == m.num_frames
+    assert len(r["warnings"]) == 1 and "worst second" in r["warnings"][0]
+    assert lift(m.joints[:, 8, 1]) > 0.95 * lift(src)        # the kick is kept (on a taller body)
+    r, m = job(kick, "savae")
+    assert r["method"] == "savae" and not r["warnings"] and lift(m.joints[:, 8, 1]) < 0.5 * lift(src)
+    r, m = job(data / f"{WALK}.bvh", "auto")
+    assert r["method"] == "savae" and r["tokens"] == len(m.tokens) > 0 and not r["warnings"]

@@ -53,6 +53,23 @@ def test_paraphrase_eval_on_a_tiny_model(tiny_bundle, tmp_path, capsys):  # noqa
     fr = res["frequent"]
     assert set(fr["reachable"]) == set(res["reachable"]) and all(v is None or 0 <= v <= 1 for v in fr["reachable"].values())
     assert (fr["reachable"]["motion"] is None) == (fr["motion"]["prompts"] == 0)
+    assert res["seeds"] == [0] and all(r["seed"] == 0 for r in rows)
+
+    # two seeds: every prompt generated once per seed, seed 0's generations as in the one-seed run,
+    # and the accuracies counted over all the generations
+    assert main(["eval", "paraphrase", "--model", str(model), "--prompts", str(tmp_path / "p.json"), "--seconds", "1",
+                 "--data", str(data), "--json", str(tmp_path / "r2.json"), "--quiet", "--seed", "0", "3"]) == 0
+    two = json.loads((tmp_path / "r2.json").read_text())
+    assert two["seeds"] == [0, 3] and [r["seed"] for r in two["rows"]] == [0] * len(rows) + [3] * len(rows)
+    assert [r["text"] for r in two["rows"]] == [r["text"] for r in rows] * 2
+    keys = ("motion_pred", "motion_features_pred", "text_pred", "nearest_caption_pred", "kept_clips")
+    assert [[r[k] for k in keys] for r in two["rows"][:len(rows)]] == [[r[k] for k in keys] for r in rows]
+    right = sum(r["motion_pred"] == r["action"] for r in two["rows"])
+    assert two["motion"]["prompts"] == 2 * len(rows) and two["motion"]["accuracy"] == pytest.approx(right / (2 * len(rows)))
+    assert f"each generated on 2 seeds (0, 3), every column counts {2 * len(rows)} generations" in capsys.readouterr().out
+    with pytest.raises(ShapeMoveError, match="distinct seeds"):
+        from shapemove.core.eval.paraphrase_eval import eval_paraphrase
+        eval_paraphrase(model, tmp_path / "p.json", seed=[1, 1], data=data)
 
 
 def test_bad_prompt_files(tmp_path):
@@ -108,3 +125,7 @@ def test_eval_report_writes_the_paraphrase_table(tmp_path):
     plain.write_text("no paraphrase block\n")
     assert rep.main(none + ["--paraphrase", str(tmp_path / "p.json"), "--page", str(plain)]) == 0
     assert plain.read_text() == "no paraphrase block\n"
+    two = dict(_para_result(0.6, 0.949, 0.3, 0.08, 282), seeds=[0, 1])   # 141 prompts on two seeds
+    (tmp_path / "p2.json").write_text(json.dumps(two))
+    assert rep.main(none + ["--paraphrase", str(tmp_path / "p2.json"), "--page", str(readme)]) == 0
+    assert "held-out paraphrases (141 prompts x 2 seeds)" in readme.read_text()

@@ -216,6 +216,72 @@ def test_redecoding_a_retargeted_motion_plants_the_source_contacts(run_bvh, vae,
     assert not r.contacts_measured and not np.array_equal(r.contacts, m.contacts)
 
 
+def test_take_error_is_the_root_aligned_joint_distance(run_bvh, vae, body):
+    """take_fidelity: the codes' decoded joints against the take's, root-aligned, in mm; the worst
+    second is the largest one-second mean. Hand-derived: one joint of 22 moved 10 cm up in every
+    frame is 100 / 22 mm per frame; a window's mean."""
+    from shapemove.core.generation.decode import decode_features
+    from shapemove.core.generation.retarget import encode_take, processor, source_joints
+    from shapemove.core.generation.take_fidelity import take_error_mm, worst_second_mm
+
+    arrays = processor(body).process(source_joints(run_bvh, body)[0])
+    codes = encode_take(vae, arrays["norm_joint_vecs"], search=False)
+    with torch.no_grad():
+        own = decode_features(codes, vae, arrays["betas"]).numpy()
+        assert np.abs(take_error_mm(codes, vae, arrays["betas"], own)).max() < 1e-3     # the decoding itself: 0
+        moved = own.copy()
+        moved[:, 4 + 1] += 0.1       # ric data (joints 1..21, x y z from column 4): joint 1 (left hip) 10 cm up
+        np.testing.assert_allclose(take_error_mm(codes, vae, arrays["betas"], moved), 100 / 22, rtol=1e-4)
+        real = take_error_mm(codes, vae, arrays["betas"], arrays["new_joint_vecs"])
+    assert real.shape == (4 * len(codes),) and real.mean() > 10   # 20 training steps: far from the take
+    err = np.r_[np.zeros(10), np.full(20, 30.0), np.zeros(10)]
+    assert worst_second_mm(err, frames=20) == pytest.approx(30.0)
+    assert worst_second_mm(err, frames=40) == pytest.approx(15.0) == worst_second_mm(err, frames=100)
+    assert worst_second_mm(err, frames=30) == pytest.approx(20.0)
+    with pytest.raises(ShapeMoveError, match="take's features"):
+        take_error_mm(codes, vae, arrays["betas"], own[:10])
+
+
+def test_retarget_falls_back_to_the_takes_rotations_when_the_codes_miss_it(run_bvh, vae, body):
+    """With ``fallback_mm`` the codes are checked on the subject's own body first: under the
+    threshold the SA-VAE's motion (tokens); over it the take's own rotations on the new body, its
+    feet planted on the source's contacts, the bones the new body's, and a warning."""
+    from shapemove.core.body.shape_from_measurements import betas_from_shape_text
+    from shapemove.core.eval.bones import bone_lengths, target_bone_lengths
+    from shapemove.core.generation.retarget import (encode_take, naive_retarget, processor, retarget, source_contacts,
+                                                    source_joints)
+    from shapemove.core.generation.take_fidelity import take_error_mm, worst_second_mm
+    from shapemove.core.motion.contacts import runs
+
+    b = betas_from_shape_text(body, "A person standing 190 cm tall")
+    joints = source_joints(run_bvh, body)[0]
+    arrays = processor(body).process(joints)
+    codes = encode_take(vae, arrays["norm_joint_vecs"], arrays["betas"], arrays["new_joint_vecs"])
+    with torch.no_grad():
+        worst = worst_second_mm(take_error_mm(codes, vae, arrays["betas"], arrays["new_joint_vecs"]))
+    kept = retarget(run_bvh, vae, body, b, fallback_mm=worst + 1)
+    assert np.array_equal(kept.tokens, codes) and not kept.warnings
+    m = retarget(run_bvh, vae, body, b, fallback_mm=worst - 1)
+    assert m.tokens is None and m.num_frames == len(joints) and np.array_equal(m.betas, b)
+    assert len(m.warnings) == 1 and f"{worst:.0f} mm" in m.warnings[0]
+    src = source_contacts(joints)       # planted; a heel the foot rolls off where the leg cannot reach is released
+    assert m.contacts_measured and not (m.contacts > src).any() and (m.contacts == src).mean() > 0.9
+    with torch.no_grad():
+        fk = body.forward(torch.as_tensor(b)[None], torch.as_tensor(m.poses), torch.as_tensor(m.transl)).joints
+    fk = fk[:, :22].double().numpy()
+    assert np.abs(bone_lengths(fk) - target_bone_lengths(body, torch.as_tensor(b)[None])).max() < 1e-4
+    steps = np.concatenate([np.linalg.norm(np.diff(fk[s:e, jid][:, [0, 2]], axis=0), axis=1)
+                            for k, jid in enumerate((7, 8, 10, 11)) for s, e in runs(m.contacts[:, k])])
+    assert np.median(steps) < 1e-3                                   # planted feet stay put
+    # the pose is the take's: root-aligned within 2 cm of the naive retarget (the same rotations on
+    # the same body), where the tiny codec's decoding is much further off
+    rel = lambda j: j - j[:, :1]  # noqa: E731
+    naive = naive_retarget(run_bvh, body, b)
+    assert np.linalg.norm(rel(fk) - rel(naive.joints), axis=-1).mean() < 0.02
+    n = kept.num_frames
+    assert np.linalg.norm(rel(kept.joints) - rel(naive.joints[:n]), axis=-1).mean() > 0.05
+
+
 def test_naive_retarget_keeps_the_rotations_on_the_new_bones(run_bvh, tiny_dataset, body):
     from shapemove.core.body.skeleton import PARENTS
     from shapemove.core.eval.bones import bone_lengths, target_bone_lengths
@@ -295,9 +361,14 @@ def test_cli_retarget(run_bvh, vae_run, body, tmp_path, capsys):
 
     out = tmp_path / "tall.npz"
     assert main(["retarget", "--motion", str(run_bvh), "--shape-text", "A person standing 190 cm tall",
-                 "--checkpoint", str(vae_run), "--out", str(out)]) == 0
+                 "--checkpoint", str(vae_run), "--out", str(out), "--no-fallback"]) == 0
     m = load_motion(out)
     assert m.tokens is not None and abs(_height(body, m.betas) - 190) < 1.0
+    capsys.readouterr()
+    # the 20-step codec misses the take by far more than LOST_TAKE_MM: by default its own rotations
+    assert main(["retarget", "--motion", str(run_bvh), "--shape-text", "A person standing 190 cm tall",
+                 "--checkpoint", str(vae_run), "--out", str(out)]) == 0
+    assert load_motion(out).tokens is None and "the take's own rotations, feet planted" in capsys.readouterr().out
     assert main(["retarget", "--motion", str(run_bvh), "--betas", "1,0.5", "--naive", "--out", str(tmp_path / "n.npz")]) == 0
     assert np.allclose(load_motion(tmp_path / "n.npz").betas[:3], [1, 0.5, 0])
     capsys.readouterr()
@@ -306,7 +377,7 @@ def test_cli_retarget(run_bvh, vae_run, body, tmp_path, capsys):
         import argparse
 
         base = dict(motion=run_bvh, betas=None, shape_text=None, checkpoint=vae_run, out=tmp_path / "x.npz",
-                    naive=False, body_model=None)
+                    naive=False, body_model=None, no_fallback=False)
         return argparse.Namespace(**{**base, **kw})
 
     other = save_checkpoint(tmp_path / "t5.pt", {"model": {}},    # a checkpoint of another kind

@@ -106,7 +106,9 @@ def _paraphrase_cell(res: dict | None, key: str, metric: str) -> str:
 def paraphrase_table(held: dict, blind: dict | None = None) -> str:
     """Right-action rates of `eval paraphrase` (held-out set, and the blind set when given); target 80 %."""
     def name(res, default):
-        return f"{default} ({res['motion']['prompts']} prompts)"
+        seeds = res.get("seeds") or [0]
+        n = res["motion"]["prompts"] // len(seeds)
+        return f"{default} ({n} prompts" + (f" x {len(seeds)} seeds)" if len(seeds) > 1 else ")")
 
     head = ["right action", name(held, "held-out paraphrases")] + ([name(blind, "blind held-out set")] if blind else [])
     lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]

@@ -201,7 +201,7 @@ class ClipProcessor:
         return {
             "new_joints": shaped, "new_joint_vecs": self.features(shaped, rot, contacts),
             "norm_joints": normal, "norm_joint_vecs": self.features(normal, rot, contacts),
-            "betas": target, "contacts": contacts,
+            "betas": target, "contacts": contacts, "rotations": rot, "root": root, "rest": sol["rest"],
             "poses": matrix_to_axis_angle(rot).astype(np.float32),
             "transl": shaped[:, 0] - rest_t[0],  # BodyModel.forward(target, poses, transl) -> shaped
             "ik_error_cm": sol["ik_error_cm"], "ik_target_error_cm": sol["ik_target_error_cm"],

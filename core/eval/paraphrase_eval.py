@@ -27,6 +27,11 @@ rotations the rig did not play):
 mean over the prompts of their action's leave-one-take-out accuracy on the training clips
 (``ActionClassifier.reachable``; 0 for an action that is no clip's main action).
 
+``seed`` may be several seeds: every prompt is generated once per seed (prompt i on seed ``s + i``,
+as a single seed does) and each generation counts as one row, so the accuracies are the sums over
+the seeds; one seed moves a 150-prompt set by about 5 prompts (docs/evaluation.md), so compare
+models on two or more.
+
 Each strict (the expected action) and lenient (also one of "also"), per action and overall, over
 the prompts whose action the model was trained on; prompts of actions it does not know are
 counted apart (``unknown_action``). The TMA was trained on the training captions only, so it
@@ -98,7 +103,7 @@ def _tally(rows: list[dict], key: str) -> dict:
             "prompts": n}
 
 
-def eval_paraphrase(model_dir=None, prompts=None, tma=None, seed: int = 0, seconds: float | None = 4.0,
+def eval_paraphrase(model_dir=None, prompts=None, tma=None, seed: int | list[int] = 0, seconds: float | None = 4.0,
                     progress=None, generator=None, data=None, classifier=None, ceiling_clips: int | None = None,
                     show_progress: bool = True, candidates: int | None = None, feature_classifier=None,
                     retrieval: bool = True, frequent: int = 20, retrieval_prefix: int | None = None,
@@ -120,6 +125,9 @@ def eval_paraphrase(model_dir=None, prompts=None, tma=None, seed: int = 0, secon
     from .tma_embed import embed_motions, embed_texts, load_tma
 
     items = load_prompts(prompts)
+    seeds = [int(seed)] if isinstance(seed, (int, np.integer)) else [int(s) for s in seed]
+    if not seeds or len(set(seeds)) != len(seeds):
+        raise ShapeMoveError(f"eval paraphrase needs one or more distinct seeds, got {list(seeds)}")
     candidates = DEFAULT_CANDIDATES if candidates is None else candidates
     retrieval_prefix = DEFAULT_RETRIEVAL_PREFIX if retrieval_prefix is None else retrieval_prefix
     retrieved = DEFAULT_RETRIEVED if retrieved is None else retrieved
@@ -152,20 +160,21 @@ def eval_paraphrase(model_dir=None, prompts=None, tma=None, seed: int = 0, secon
     A = action_embeddings(tma, actions)
     known = [it for it in items if it["action"] in actions]
     rows, embs, feats = [], [], []
-    for i, it in enumerate(known):
-        m = gen.generate_batch([Request(it["text"], seconds=seconds, seed=seed + i, candidates=candidates,
+    runs = [(s, i, it) for s in seeds for i, it in enumerate(known)]
+    for n, (s, i, it) in enumerate(runs):
+        m = gen.generate_batch([Request(it["text"], seconds=seconds, seed=s + i, candidates=candidates,
                                         retrieval_prefix=retrieval_prefix, retrieved=retrieved if retrieval else 0,
                                         retrieval_first=retrieval_first, by_parts=by_parts)])[0]
         played = motion_features(m)   # what the rig plays (a plain prompt's decoded features differ)
         motion_emb = embed_motions(model, [played], mean, std)[0]
         embs.append(motion_emb)
         feats.append(played)
-        rows.append({**it, "motion_proto_pred": actions[int(np.argmax(A @ motion_emb))],
+        rows.append({**it, "seed": s, "motion_proto_pred": actions[int(np.argmax(A @ motion_emb))],
                      "warned": bool(m.warnings), "kept_clips": list(m.retrieved_clips),
                      "parts": list(m.part_prompts) if m.part_prompts else None,
                      "mirrored": bool(m.mirrored or m.arms_mirrored)})
         if progress is not None:
-            progress((i + 1) / len(known), it["text"])
+            progress((n + 1) / len(runs), it["text"])
     kept = [r["kept_clips"] for r in rows]  # retrieved clips are judged without their own takes
     for r, p in zip(rows, classifier.classify_embeddings(np.stack(embs), exclude=kept) if embs else []):
         r["motion_pred"] = p
@@ -196,7 +205,7 @@ def eval_paraphrase(model_dir=None, prompts=None, tma=None, seed: int = 0, secon
             "candidates": candidates,
             "retrieval_prefix": retrieval_prefix if retrieval and gen.reads_memory else 0,
             "retrieved": retrieved if retrieval else 0, "retrieval_first": retrieval_first,
-            "kept_retrieved": sum(bool(r["kept_clips"]) for r in rows), "by_parts": by_parts,
+            "kept_retrieved": sum(bool(r["kept_clips"]) for r in rows), "by_parts": by_parts, "seeds": seeds,
             "composed": sum(bool(r["parts"]) for r in rows), "mirrored": sum(r["mirrored"] for r in rows),
             "classifier": {**classifier.info, "ceiling": ceiling},
             "feature_classifier": dict(feature_classifier.info) if feature_classifier is not None else None,
@@ -250,9 +259,12 @@ def format_results(res: dict) -> str:
     ceil = (res.get("classifier") or {}).get("ceiling") or {}
     real = ceil.get("per_action") or {}
     w = max([len(a) for a in m["per_action"]] + [7])
-    lines = [f"Held-out paraphrases ({Path(res.get('prompts_file', '')).name}): {m['prompts']} prompts of "
+    seeds = res.get("seeds") or [0]
+    lines = [f"Held-out paraphrases ({Path(res.get('prompts_file', '')).name}): {m['prompts'] // len(seeds)} prompts of "
              f"{len(m['per_action'])} known actions ({res['unknown_prompts']} prompts of actions the model does "
-             f"not know: {', '.join(res['unknown_action']) or 'none'})",
+             f"not know: {', '.join(res['unknown_action']) or 'none'})"
+             + (f"; each generated on {len(seeds)} seeds ({', '.join(map(str, seeds))}), every column counts "
+                f"{m['prompts']} generations" if len(seeds) > 1 else ""),
              "motion: generated motion, 5 nearest training clips in TMA motion space; real: the same classifier "
              "on real test clips of the action; text: the prompt's TMA text vs action text prototypes; "
              "m-vs-t: generated motion vs those text prototypes",
@@ -310,7 +322,9 @@ def add_arguments(p) -> None:
                         "(default $SHAPEMOVE_BUILT, else data/built)")
     p.add_argument("--tma", type=Path, default=None, help="TMA whose embeddings are compared (default: the model's tma/)")
     p.add_argument("--seconds", type=float, default=4.0, help="length of each generated motion")
-    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--seed", type=int, nargs="+", default=[0], metavar="SEED",
+                   help="one or more seeds: each prompt is generated once per seed and the accuracies sum them "
+                        "(one seed moves a 150-prompt set by about 5 prompts: compare models on two or more)")
     p.add_argument("--candidates", type=int, default=None,
                    help="token samples per prompt, the TMA keeps the closest (default: the product's, 8; 1 = none)")
     p.add_argument("--json", type=Path, default=None, help="write the results here")

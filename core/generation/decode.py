@@ -74,14 +74,15 @@ def redecode(motion: Motion, vae, body, betas, ik_refine_iters: int = 10) -> Mot
 
 
 def motion_from_joints(body, betas, joints, contacts, ik_refine_iters: int = 10, prompt: str | None = None,
-                       known_contacts: bool = False, **extra) -> Motion:
+                       known_contacts: bool = False, smooth: float = BODY_SMOOTH, **extra) -> Motion:
     """(T,22,3) joint positions + (T,4) foot contacts of joints 7, 8, 10, 11 -> self-consistent
     Motion on ``body`` with ``betas``: the body but the feet smoothed over ``BODY_SMOOTH`` frames
     against decoder jitter (``plant.smooth_body``: the zero-moment point follows the centre of mass's
     acceleration), contacts planted, mesh grounded (``plant.plant_motion``); ``known_contacts``:
     ``contacts`` are measured (not predicted): planted without gating, long flights kept;
+    ``smooth``: that smoothing's sigma (0 for captured joints, which carry no decoder jitter);
     ``extra``: tokens, features."""
-    planted = plant_motion(body, betas, joints, contacts, refine_iters=ik_refine_iters, smooth=BODY_SMOOTH, **(
+    planted = plant_motion(body, betas, joints, contacts, refine_iters=ik_refine_iters, smooth=smooth, **(
         {"gate": False, "max_flight": None} if known_contacts else {}))
     poses = matrix_to_axis_angle(planted.rotations).astype(np.float32)
     m = make_motion(body, poses, planted.transl, betas, fps=float(FPS), prompt=prompt,

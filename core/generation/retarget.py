@@ -14,6 +14,12 @@
      on the captured joints, which are known here), not the ones the decoder predicts: a
      retargeted foot stays put exactly where the captured one did. The Motion keeps its tokens:
      ``Generator.redecode`` moves it to yet another body (with the decoder's contacts).
+  4. with ``fallback_mm`` (the product's "auto": ``take_fidelity.LOST_TAKE_MM``), first check
+     that the codes carry the take: decoded on the subject's own body, their joints within that
+     many mm of the take's in its worst second. Where they are not (a fast kick the codec
+     flattens), the take is moved by ``planted_retarget`` instead and the Motion says so.
+``planted_retarget(arrays, body, betas)``: the subject's rotations on the new body, stride scaled by
+leg length, the source's contacts planted and the mesh grounded (no tokens).
 ``naive_retarget(motion, body, betas)``: the subject's local rotations copied onto the new body,
 the root trajectory scaled by the leg-length (pelvis height) ratio, the clip's lowest mesh point put
 on the floor (one offset, no contacts). Bones are the new body's, but feet slide, sink and float
@@ -184,18 +190,54 @@ def source_contacts(joints) -> np.ndarray:
 
 
 def retarget(motion, vae, body, betas, ik_refine_iters: int = 10, plant_source_contacts: bool = True,
-             read: dict | None = None, search: bool = True, progress=None) -> Motion:
+             read: dict | None = None, search: bool = True, progress=None, fallback_mm: float | None = None) -> Motion:
     """``motion`` (mocap file path or Motion22) performed by the body ``betas`` (10,), through the
     SA-VAE ``vae`` (trained for ``body``). Returns a validated Motion with tokens: 4*((T-1)//4)
     frames at 20 fps. ``plant_source_contacts``: plant the source's contacts (default) rather
     than the decoder's predicted ones. ``read``: see ``source_joints``. ``search``: the codes
     searched for on the subject's body (``encode_take``; else the encoders'); ``progress(fraction)``
-    during the search."""
+    during the search. ``fallback_mm`` (e.g. ``take_fidelity.LOST_TAKE_MM``): when the codes,
+    decoded on the subject's own body, miss the take by more than this in its worst second (the
+    codec cannot carry it: a fast kick), the take is moved by ``planted_retarget`` instead (T
+    frames, no tokens, a warning saying why); None never falls back."""
+    from .take_fidelity import take_error_mm, worst_second_mm
+
     betas = check_betas(betas)
     joints, _ = source_joints(motion, body, read)
-    codes = encode_source(joints, vae, body, ik_refine_iters, search, progress)
+    arrays = processor(body, ik_refine_iters).process(joints)
+    codes = encode_take(vae, arrays["norm_joint_vecs"], arrays["betas"], arrays["new_joint_vecs"], search, progress)
+    if fallback_mm is not None:
+        with torch.no_grad():
+            worst = worst_second_mm(take_error_mm(codes, vae, arrays["betas"], arrays["new_joint_vecs"]))
+        if worst > fallback_mm:
+            out = planted_retarget(arrays, body, betas, ik_refine_iters)
+            out.warnings.append(f"the SA-VAE's codes miss this take by {worst:.0f} mm in its worst second (more than "
+                                f"{fallback_mm:g} mm): moved by its own rotations, feet planted, and not "
+                                "re-decodable from tokens")
+            return out
     out = decode_tokens(codes, vae, body, betas, ik_refine_iters,
                         contacts=source_contacts(joints) if plant_source_contacts else None)
+    validate(out)
+    return out
+
+
+def planted_retarget(arrays: dict, body, betas, ik_refine_iters: int = 10) -> Motion:
+    """The subject's own rotations on the body ``betas`` with the take's contacts planted: the
+    builder's arrays of the take (``ClipProcessor.process`` on the subject's body: its rotations,
+    root and rest joints, its measured contacts) posed on the new body with the stride scaled by
+    leg length and grounded on the contacts (``pose_on``), then the feet in contact pinned to one
+    point per contact run and IK onto the body (``motion_from_joints``, measured contacts, no
+    smoothing: captured joints carry no decoder jitter). T frames, no tokens. Unlike
+    ``naive_retarget`` (one offset for the whole clip) no foot slides or floats where the
+    proportions differ; unlike the SA-VAE it never loses what the codec cannot carry."""
+    from .decode import motion_from_joints
+
+    betas = check_betas(betas)
+    proc = processor(body, ik_refine_iters)
+    contacts = np.asarray(arrays["contacts"], np.uint8)
+    shaped = proc.pose_on(arrays["rotations"], arrays["root"], betas, proc.stride_scale(arrays["rest"], betas),
+                          contacts)
+    out = motion_from_joints(body, betas, shaped, contacts, ik_refine_iters, known_contacts=True, smooth=0.0)
     validate(out)
     return out
 

@@ -162,12 +162,16 @@ def retarget(params, progress, cancel) -> dict:
     """params {"source" (BVH / ASF+AMC / AMASS .npz), "body", "betas" (10, optional: else the
     source subject's own shape, fitted to its bone lengths), "source_fps" / "angle_unit" (optional
     overrides of what the file declares: ``io.mocap.reader_options``), "method" ("auto" | "savae" | "naive";
-    auto = through the SA-VAE when a model has one, else naive), "search" (optional, default true:
+    auto = through the SA-VAE when a model has one and its codes carry the take
+    (``take_fidelity.LOST_TAKE_MM``), else the take's own rotations with its feet planted
+    (``planted_retarget``), or naive without a model; "savae" = through the SA-VAE whatever it
+    loses), "search" (optional, default true:
     the SA-VAE's codes searched for on the subject's body), "model", "out"} -> the motion on
     the body, written to ``out``."""
     from ..body.fit import bone_lengths, fit_betas_to_bone_lengths
     from ..body.load import load_body_model
     from ..generation.retarget import load_vae, naive_retarget, retarget as savae_retarget, source_joints
+    from ..generation.take_fidelity import LOST_TAKE_MM
 
     op = "retarget"
     out = _out_path(params, op)
@@ -202,11 +206,12 @@ def retarget(params, progress, cancel) -> dict:
         progress(0.3 + 0.6 * fraction, "retargeting through the SA-VAE: searching codes")
 
     motion = (savae_retarget(source, vae, body, betas, read=read, search=param(params, op, "search", bool, True),
-                             progress=searching) if vae is not None
-              else naive_retarget(source, body, betas, read=read))
+                             progress=searching, fallback_mm=LOST_TAKE_MM if method == "auto" else None)
+              if vae is not None else naive_retarget(source, body, betas, read=read))
     motion.prompt = motion.prompt or (source.subject if not isinstance(source, Path) else source.stem)
     save_motion(out, motion)
-    return {**_motion_facts(out, motion), "method": "savae" if vae is not None else "naive"}
+    used = "naive" if vae is None else ("planted" if motion.tokens is None else "savae")
+    return {**_motion_facts(out, motion), "method": used, "warnings": list(motion.warnings)}
 
 
 def _library_clip(path: Path):
