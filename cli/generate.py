@@ -106,6 +106,8 @@ def run(args) -> int:
     save_motion(args.out, motion)
     import sys
 
+    for n in motion.notes:  # a library clip played as captured
+        print(f"note: {n}")
     for w in motion.warnings:  # a prompt far from the training captions
         print(f"warning: {w}", file=sys.stderr)
     m = measure(gen.body, motion.betas)
@@ -117,7 +119,7 @@ def run(args) -> int:
     elif motion.mirrored:
         print("mirrored: the named side now moves most")
     if motion.retrieved_clips:
-        print(f"kept a retrieved training clip: {', '.join(motion.retrieved_clips)}")
+        print(f"kept a retrieved clip: {', '.join(motion.retrieved_clips)}")
     if motion.loop_advance is not None:
         print(f"loop: the root advances {float(np.linalg.norm(motion.loop_advance[[0, 2]])):.2f} m per cycle")
     print(f"body ({motion.shape_source or '[BETA] head'}): " + format_body(m))

@@ -84,7 +84,7 @@ def run(args) -> int:
                               search=search, progress=lambda f: bar.update(round(100 * f) - bar.n),
                               fallback_mm=None if args.no_fallback else LOST_TAKE_MM)
         how = (f"SA-VAE, {len(motion.tokens)} tokens" if motion.tokens is not None
-               else "the take's own rotations, feet planted: " + "; ".join(motion.warnings))
+               else "the take's own rotations, feet planted: " + "; ".join(motion.notes))
     save_motion(args.out, motion)
     m = measure(body, motion.betas)
     print(f"wrote {args.out}: {motion.num_frames} frames ({motion.num_frames / motion.fps:.1f} s), {how}")

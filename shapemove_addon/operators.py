@@ -24,7 +24,7 @@ from .export import FORMATS, export_rig
 from .jobs import report_error
 from .preferences import body_spec, preferences, setting
 from .redecode import HAS_TOKENS_KEY, MOTION_FILE_KEY
-from .rig_state import PHYSICS_KEY, RETARGET_NOTE_KEY, current_betas, rig_body_spec, rig_of
+from .rig_state import PHYSICS_KEY, TAKE_NOTES_KEY, current_betas, rig_body_spec, rig_of
 from .animation_rig import ROOT_MOTION_ITEMS, build_animated_rig
 from .scene_build import SLIDER_RANGE
 
@@ -93,6 +93,8 @@ def on_generated(name: str, msg: dict):
         rig["shapemove_model_warnings"] = model
     if rig is not None and r.get("parts"):
         rig["shapemove_parts"] = [str(p) for p in r["parts"]][:2]  # two things at once, a side mirrored
+    if rig is not None and r.get("notes"):
+        rig[TAKE_NOTES_KEY] = [str(n) for n in r["notes"]][:2]   # a library clip played as captured
     return rig
 
 
@@ -190,6 +192,8 @@ class SHAPEMOVE_OT_generate(JobOperator, bpy.types.Operator):
         prompt = scene_prompt(context)
         params = {**generation_params(context, prompt), "prompt": prompt,
                   "seconds": s.seconds if s.use_seconds else None}
+        if s.use_library and s.library_folder:   # the user's own motions join the candidates
+            params["library"] = existing_path(s.library_folder, "library folder", folder=True)
         name = paths.slug(prompt, 24)
 
         job_submit.submit_job("generate", params, kind=self.job, label="generate",
@@ -321,9 +325,9 @@ def _retarget_job(context, source: str, target_rig, name: str, read: dict | None
         if msg.get("cancelled"):
             return
         rig = build_rig_from_file(msg["result"]["path"], name)
-        notes = [str(w) for w in msg["result"].get("warnings") or []]
-        if rig is not None and notes:   # e.g. the codec missed the take: its own rotations were used
-            rig[RETARGET_NOTE_KEY] = notes[:2]
+        notes = [str(w) for w in msg["result"].get("notes") or []]
+        if rig is not None and notes:   # the codec missed the take: its own rotations were used
+            rig[TAKE_NOTES_KEY] = notes[:2]
 
     job_submit.submit_job("retarget", params, kind="retarget", label=f"retarget {Path(source).name}", on_result=done)
 

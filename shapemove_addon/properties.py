@@ -102,6 +102,10 @@ class ShapeMoveSceneSettings(bpy.types.PropertyGroup):
     by_parts: BoolProperty(name="By body part", default=True,
                            description="Two things at once ('jogs, waving') are generated as legs and arms and put "
                                        "together; a named left or right is made the side that moves most")
+    use_library: BoolProperty(name="Use Library motions", default=False,
+                              description="The Library folder's captioned motions join the candidates for the "
+                                          "prompt; one the model's codes cannot carry (a fast kick) is played as "
+                                          "captured")
     # shape
     shape_from_text: StringProperty(name="Shape text", default="",
                                     description="e.g. 'a man with a height of 185 cm and a waist circumference of 90 cm'")

@@ -15,7 +15,7 @@ from .scene_build import RIG_MARK
 
 
 PHYSICS_KEY = "shapemove_physics"  # a generated motion's physics figures (the generate job's, stored by the operator)
-RETARGET_NOTE_KEY = "shapemove_retarget_notes"  # how the retarget job moved a take when not as asked (the codec missed it)
+TAKE_NOTES_KEY = "shapemove_take_notes"  # a take played from its own rotations, and why (retarget, a library clip)
 
 
 def rig_of(obj):

@@ -187,9 +187,9 @@ def test_the_retarget_job_keeps_a_kick_the_codec_flattens(mocap_root, tmp_path):
     assert lift(src) > 0.9
     r, m = job(kick, "auto")
     assert r["method"] == "planted" and r["tokens"] == 0 and m.tokens is None and len(src) == m.num_frames
-    assert len(r["warnings"]) == 1 and "worst second" in r["warnings"][0]
+    assert len(r["notes"]) == 1 and "worst second" in r["notes"][0]
     assert lift(m.joints[:, 8, 1]) > 0.95 * lift(src)        # the kick is kept (on a taller body)
     r, m = job(kick, "savae")
-    assert r["method"] == "savae" and not r["warnings"] and lift(m.joints[:, 8, 1]) < 0.5 * lift(src)
+    assert r["method"] == "savae" and not r["notes"] and lift(m.joints[:, 8, 1]) < 0.5 * lift(src)
     r, m = job(data / f"{WALK}.bvh", "auto")
-    assert r["method"] == "savae" and r["tokens"] == len(m.tokens) > 0 and not r["warnings"]
+    assert r["method"] == "savae" and r["tokens"] == len(m.tokens) > 0 and not r["notes"]

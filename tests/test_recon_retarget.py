@@ -260,10 +260,10 @@ def test_retarget_falls_back_to_the_takes_rotations_when_the_codes_miss_it(run_b
     with torch.no_grad():
         worst = worst_second_mm(take_error_mm(codes, vae, arrays["betas"], arrays["new_joint_vecs"]))
     kept = retarget(run_bvh, vae, body, b, fallback_mm=worst + 1)
-    assert np.array_equal(kept.tokens, codes) and not kept.warnings
+    assert np.array_equal(kept.tokens, codes) and not kept.notes
     m = retarget(run_bvh, vae, body, b, fallback_mm=worst - 1)
     assert m.tokens is None and m.num_frames == len(joints) and np.array_equal(m.betas, b)
-    assert len(m.warnings) == 1 and f"{worst:.0f} mm" in m.warnings[0]
+    assert len(m.notes) == 1 and f"{worst:.0f} mm" in m.notes[0]
     src = source_contacts(joints)       # planted; a heel the foot rolls off where the leg cannot reach is released
     assert m.contacts_measured and not (m.contacts > src).any() and (m.contacts == src).mean() > 0.9
     with torch.no_grad():

@@ -113,9 +113,59 @@ def test_a_users_library_becomes_retrieved_candidates(gen, tmp_path):
     out = own.generate_batch([Request("someone does jumping jacks on a purple trampoline", seconds=4, seed=0,
                                       retrieval_first=0.0)])[0]
     assert out.retrieved_clips and out.retrieved_clips[0].startswith("library:")
+    assert out.tokens is not None and not out.notes      # its codes carry it: decoded as any candidate
     (tmp_path / "empty").mkdir()
     with pytest.raises(ShapeMoveError, match="no motion with a caption"):
         own.add_library(tmp_path / "empty")
+
+
+def test_a_library_kick_the_codec_flattens_is_played_as_captured(mocap_root, openbody, tmp_path):
+    """A user's captured front kick in the library: kept for its own caption, its codes would
+    bring the right ankle's 1.0 m rise down to under half (retargeted through the SA-VAE,
+    tests/test_code_search.py), so the window kept is played from the file by its own rotations,
+    feet planted, starting at the origin facing +Z like a decoded motion, with a note; the worker's
+    generate job does the same with "library" (the Generate panel's "Use Library motions")."""
+    import shutil
+
+    import torch
+
+    from shapemove.core.generation.generate import Generator, Request
+    from shapemove.core.generation.library_takes import window_start
+    from shapemove.core.generation.retarget import source_joints
+    from shapemove.core.scene.motion_file import load_motion
+    from shapemove.core.worker import jobs_shapemove
+
+    assert window_start([5, 6, 7, 8, 6, 7], [6, 7]) == 1 and window_start([5, 6], [6, 5]) is None
+    assert window_start([1, 2], [1, 2, 3]) is None and window_start([1, 2], []) is None
+    lib = tmp_path / "library"
+    lib.mkdir()
+    kick = mocap_root / "bandai" / "dataset-1" / "data" / "dataset-1_kick_normal_001.bvh"
+    shutil.copy(kick, lib / "kick.bvh")
+    caption = "a person performs a zorblax front kick"     # no training caption is nearer than its own
+    (lib / "kick.txt").write_text(caption + "\n")
+    src = source_joints(kick, openbody)[0][:, 8, 1]
+    own = Generator(None)
+    assert own.add_library(lib) == 1
+    m = own.generate_batch([Request(caption, seconds=4, seed=0, retrieval_first=0.0)])[0]
+    assert m.retrieved_clips == ["library:kick"] and m.tokens is None and m.num_frames == 80
+    assert len(m.notes) == 1 and "kick.bvh" in m.notes[0] and not m.warnings
+    lift = lambda y: float(y.max() - y.min())  # noqa: E731   (the right ankle's rise)
+    assert lift(src) > 0.9 and lift(m.joints[:, 8, 1]) > 0.9 * lift(src)
+    j = m.joints
+    across = (j[0, 1] - j[0, 2]) + (j[0, 16] - j[0, 17])
+    facing = np.cross(across, [0.0, 1.0, 0.0])
+    assert np.abs(j[0, 0, [0, 2]]).max() < 0.01 and abs(np.degrees(np.arctan2(facing[0], facing[2]))) < 3
+    with torch.no_grad():                                  # the mesh stands on the floor in every frame
+        v = openbody(torch.as_tensor(m.betas)[None].expand(m.num_frames, -1), torch.as_tensor(m.poses),
+                     torch.as_tensor(m.transl)).vertices
+    assert np.abs(v[..., 1].min(1).values.numpy()).max() < 0.005
+    r = jobs_shapemove.generate({"prompt": caption, "seconds": 4, "library": str(lib), "out": str(tmp_path / "g.npz")},
+                                lambda *a: None, lambda: False)
+    assert r["tokens"] == 0 and len(r["notes"]) == 1 and "kick.bvh" in r["notes"][0] and not r["warnings"]
+    assert lift(load_motion(tmp_path / "g.npz").joints[:, 8, 1]) > 0.9 * lift(src)
+    with pytest.raises(ShapeMoveError, match="library folder not found"):
+        jobs_shapemove.generate({"prompt": caption, "library": str(tmp_path / "nowhere"), "out": str(tmp_path / "x.npz")},
+                                lambda *a: None, lambda: False)
 
 
 def test_a_model_folder_with_a_memory_retrieves_from_it(gen, tmp_path):

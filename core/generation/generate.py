@@ -13,6 +13,7 @@ joints: the decoded positions' legs, the upper body posed from the decoded rotat
 from __future__ import annotations
 
 from dataclasses import dataclass
+from pathlib import Path
 from typing import NamedTuple
 
 import numpy as np
@@ -31,6 +32,7 @@ from ..torch_threads import one_torch_thread
 from .action_clips import ACTION_CLIPS, UNASKED_SECONDS, action_clips
 from .circle_walk import CIRCLE, circle_motion, names_circle
 from .decode import decode_features, decode_tokens, redecode
+from .library_takes import captured_window, read_take, window_fit
 from .model_bundle import model_files, part_warnings, resolve_model_dir
 from .parts import CLAUSE_NEAR, generate_by_parts, is_by_parts, redecode_parts
 from .prompts import check_prompt
@@ -42,6 +44,9 @@ from .sampling_params import (DEFAULT_CANDIDATES, DEFAULT_GUIDANCE, DEFAULT_RETR
                               check_retrieval_prefix, check_retrieved, check_sampling)
 from .slow_steps import slow_motion
 from .turn_words import turn_motion
+
+
+LIBRARY_TAKES = 8   # library clips kept read as captured at once (Generator._library_window)
 
 
 class Chosen(NamedTuple):
@@ -131,6 +136,8 @@ class Generator:
         self.default_guidance = DEFAULT_GUIDANCE if trained_null > 0 else 0.0  # a model without a null prompt: none
         self._tma_file = files.get("tma")
         self._picker = None
+        self.library_files: dict[str, Path] = {}   # memory clip id -> the user's file (add_library)
+        self._library_takes: dict[str, dict | None] = {}  # library clips read as captured (library_takes.read_take)
 
     @property
     def picker(self) -> CandidatePicker | None:
@@ -152,9 +159,11 @@ class Generator:
         return n, n
 
     @torch.no_grad()
-    def tokens_for(self, reqs: list[Request]) -> Chosen:
+    def tokens_for(self, reqs: list[Request], library_as_captured: bool = False) -> Chosen:
         """Each request's chosen motion tokens, the [BETA] head's betas (B, 10) and the memory clip
-        whose tokens were kept (None for a T5 sample)."""
+        whose tokens were kept (None for a T5 sample). ``library_as_captured``: a user's library
+        window its codes cannot carry is judged by its captured frames, as ``library_take`` would
+        play it (the caller plays it so)."""
         if self.t5 is None:
             raise ShapeMoveError(f"{self.model_dir} has no t5/ model: text-to-motion needs one (train t5)")
         codes, betas, kept = [], [], []
@@ -167,7 +176,11 @@ class Generator:
                                         else self._sampled(r, lo, hi, g))
                 best = 0
                 if len(cands) > 1 and self.picker is not None:
-                    feats = [decode_features(c, self.vae, beta.numpy()).numpy() for c in cands]
+                    feats = []
+                    for c, src in zip(cands, sources):
+                        fit = self._library_window(src, c) if library_as_captured else None
+                        feats.append(decode_features(c, self.vae, beta.numpy()).numpy() if fit is None
+                                     else np.asarray(self._library_takes[src]["new_joint_vecs"][fit.lo:fit.hi]))
                     best = self.picker.pick(r.prompt, feats)
                 codes.append(cands[best])
                 betas.append(beta)
@@ -267,7 +280,7 @@ class Generator:
             from ..models.motion_memory import MotionMemory
 
             self.t5.memory = MotionMemory.empty()
-        ids, captions, feats = library_clips(folder, progress=progress)
+        ids, captions, feats, files = library_clips(folder, progress=progress)
         tokens = []
         down = self.vae.cfg.downsample
         with torch.no_grad(), one_torch_thread():
@@ -276,7 +289,41 @@ class Generator:
                 idx = self.vae.encode_tokens(self.vae.normalize(torch.as_tensor(f[:n], dtype=torch.float32)[None]))
                 tokens.append(idx[0].numpy())
         self.t5.memory.add_clips([f"library:{i}" for i in ids], [[c] for c in captions], tokens, self.tok)
+        self._library_takes.clear()
+        self.library_files.update({f"library:{i}": Path(f) for i, f in zip(ids, files)})
         return len(ids)
+
+    def _library_window(self, clip: str | None, codes: list[int]):
+        """``library_takes.window_fit`` of a window of the user's library clip ``clip`` (its file read
+        once and kept, ``LIBRARY_TAKES`` at a time); None for a clip not of the library or a window
+        its codes carry."""
+        path = self.library_files.get(clip) if clip else None
+        if path is None or self.t5 is None or self.t5.memory is None or clip not in self.t5.memory.clip_ids:
+            return None
+        if clip not in self._library_takes:
+            if len(self._library_takes) >= LIBRARY_TAKES:
+                self._library_takes.pop(next(iter(self._library_takes)))
+            try:
+                self._library_takes[clip] = read_take(path, self.body, self.ik_refine_iters)
+            except ShapeMoveError:   # a file whose joints the builder cannot read: its codes are played
+                self._library_takes[clip] = None
+        if self._library_takes[clip] is None:
+            return None
+        clip_codes = self.t5.memory.clip_tokens[self.t5.memory.clip_ids.index(clip)]
+        return window_fit(self._library_takes[clip], clip_codes, codes, self.vae)
+
+    def library_take(self, clip: str | None, codes: list[int], betas, prompt: str | None = None) -> Motion | None:
+        """The user's library clip ``clip`` kept for a prompt (its window ``codes``), played from its
+        own file when its codes cannot carry it (``library_takes.captured_window``); None for
+        anything else (the decoded codes are played)."""
+        with one_torch_thread():
+            fit = self._library_window(clip, codes)
+            if fit is None:
+                return None
+            motion = captured_window(self._library_takes[clip], fit, self.body, betas, self.library_files[clip].name,
+                                     self.ik_refine_iters)
+        motion.prompt = prompt
+        return motion
 
     def _text_encoder(self):
         if self.t5 is not None and self.t5.encoder_kind == "minilm":
@@ -340,9 +387,10 @@ class Generator:
                 break
             motion = generate_by_parts(self, r) if r.by_parts else None
             if motion is None:  # one action, no side named: the motion as the model writes it
-                codes, pred, kept = self.tokens_for([r])
+                codes, pred, kept = self.tokens_for([r], library_as_captured=True)
                 betas, source = self.body_shape(r, pred[0].numpy())
-                motion = self.decode_motion(codes[0], betas, prompt=r.prompt)
+                motion = (self.library_take(kept[0], codes[0], betas, r.prompt)   # a library clip as captured
+                          or self.decode_motion(codes[0], betas, prompt=r.prompt))
                 motion.shape_source = source
                 motion.retrieved_clips = [c for c in kept if c]
                 if r.by_parts:  # the codec does not carry turning: a circle or a turn the words name, given back

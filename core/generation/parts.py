@@ -93,8 +93,12 @@ def generate_by_parts(gen, r) -> Motion | None:
     if plan is None and side is None:
         return None
     if plan is None:  # one action, a named side: judged on the planted motion, the one the user sees
-        codes, pred, kept = gen.tokens_for([r])   # (planting, the foot roll above all, changes how far a foot travels)
-        betas, source = gen.body_shape(r, pred[0].numpy())
+        codes, pred, kept = gen.tokens_for([r], library_as_captured=True)   # (planting, the foot roll above all,
+        betas, source = gen.body_shape(r, pred[0].numpy())                  # changes how far a foot travels)
+        m = gen.library_take(kept[0], codes[0], betas, r.prompt)   # a library clip the codes miss, as captured
+        if m is not None and not needs_mirror(m.joints, *side):
+            m.shape_source, m.retrieved_clips = source, [c for c in kept if c]
+            return m
         m = gen.decode_motion(codes[0], betas, prompt=r.prompt)
         if needs_mirror(m.joints, *side):
             m = assemble(gen.body, betas, _track(codes[0], gen.vae, gen.body, betas, True), None, r.prompt, gen.ik_refine_iters,

@@ -199,7 +199,7 @@ def retarget(motion, vae, body, betas, ik_refine_iters: int = 10, plant_source_c
     during the search. ``fallback_mm`` (e.g. ``take_fidelity.LOST_TAKE_MM``): when the codes,
     decoded on the subject's own body, miss the take by more than this in its worst second (the
     codec cannot carry it: a fast kick), the take is moved by ``planted_retarget`` instead (T
-    frames, no tokens, a warning saying why); None never falls back."""
+    frames, no tokens, a note saying why: ``Motion.notes``); None never falls back."""
     from .take_fidelity import take_error_mm, worst_second_mm
 
     betas = check_betas(betas)
@@ -211,7 +211,7 @@ def retarget(motion, vae, body, betas, ik_refine_iters: int = 10, plant_source_c
             worst = worst_second_mm(take_error_mm(codes, vae, arrays["betas"], arrays["new_joint_vecs"]))
         if worst > fallback_mm:
             out = planted_retarget(arrays, body, betas, ik_refine_iters)
-            out.warnings.append(f"the SA-VAE's codes miss this take by {worst:.0f} mm in its worst second (more than "
+            out.notes.append(f"the SA-VAE's codes miss this take by {worst:.0f} mm in its worst second (more than "
                                 f"{fallback_mm:g} mm): moved by its own rotations, feet planted, and not "
                                 "re-decodable from tokens")
             return out
@@ -229,17 +229,38 @@ def planted_retarget(arrays: dict, body, betas, ik_refine_iters: int = 10) -> Mo
     point per contact run and IK onto the body (``motion_from_joints``, measured contacts, no
     smoothing: captured joints carry no decoder jitter). T frames, no tokens. Unlike
     ``naive_retarget`` (one offset for the whole clip) no foot slides or floats where the
-    proportions differ; unlike the SA-VAE it never loses what the codec cannot carry."""
+    proportions differ; unlike the SA-VAE it never loses what the codec cannot carry. Like a
+    decoded take it starts with the root over the origin, facing +Z (``start_at_origin``)."""
     from .decode import motion_from_joints
 
     betas = check_betas(betas)
     proc = processor(body, ik_refine_iters)
     contacts = np.asarray(arrays["contacts"], np.uint8)
-    shaped = proc.pose_on(arrays["rotations"], arrays["root"], betas, proc.stride_scale(arrays["rest"], betas),
-                          contacts)
+    rotations, root = start_at_origin(arrays["rotations"], arrays["root"], arrays["rest"])
+    shaped = proc.pose_on(rotations, root, betas, proc.stride_scale(arrays["rest"], betas), contacts)
     out = motion_from_joints(body, betas, shaped, contacts, ik_refine_iters, known_contacts=True, smooth=0.0)
     validate(out)
     return out
+
+
+def start_at_origin(rotations: np.ndarray, root: np.ndarray, rest: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Local rotations (T,24,3,3) and root path (T,3) of a take turned about the vertical and moved
+    so that at frame 0 the root is over the origin and the body faces +Z, as every decoded take
+    starts (HumanML3D features are relative to the first frame's heading): the facing is read from
+    the hips and shoulders across (left minus right) of frame 0 posed on the rest joints ``rest``."""
+    from ..body.skeleton import PARENTS
+    from ..geometry.fk import forward_kinematics
+
+    rotations = np.asarray(rotations, np.float64)
+    posed = forward_kinematics(rotations[:1], np.asarray(rest, np.float64), PARENTS)[0][0]
+    across = (posed[1] - posed[2]) + (posed[16] - posed[17])
+    forward = np.cross(across, [0.0, 1.0, 0.0])
+    a = -np.arctan2(forward[0], forward[2])            # the turn that brings the facing to +Z
+    yaw = np.array([[np.cos(a), 0.0, np.sin(a)], [0.0, 1.0, 0.0], [-np.sin(a), 0.0, np.cos(a)]])
+    out = rotations.copy()
+    out[:, 0] = yaw @ rotations[:, 0]
+    moved = np.asarray(root, np.float64) - [root[0][0], 0.0, root[0][2]]
+    return out.astype(np.float32), (moved @ yaw.T).astype(np.float32)
 
 
 def swap_betas_retarget(motion, body, betas, ik_refine_iters: int = 10) -> Motion:

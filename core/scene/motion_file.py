@@ -55,6 +55,7 @@ class Motion:
     ik_error_cm: float | None = None        # decode: mean IK error of the planted joints
     shape_source: str | None = None         # generate: "[BETA] head", "measurements" or "given"
     warnings: list[str] = field(default_factory=list)  # generate: the prompt check's warnings
+    notes: list[str] = field(default_factory=list)     # a take played from its own rotations, and why (retarget, library)
     part_prompts: tuple | None = None       # generate by parts: the (legs, arms) prompts
     retrieved_clips: list[str] = field(default_factory=list)  # generate: memory clips whose tokens were kept
     prompt_check: object | None = None      # generate: generation.prompts' check of the prompt

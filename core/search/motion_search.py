@@ -119,13 +119,48 @@ def load_motion_features(path: Path) -> tuple[np.ndarray, str]:
     raise ShapeMoveError(f"{path}: not a motion file (.npz, .bvh, .amc)")
 
 
-def library_clips(folder, progress=None, min_frames: int = 8) -> tuple[list[str], list[str], list[np.ndarray]]:
-    """(ids, captions, features (T,263)) of the library files that have a caption and at least
-    ``min_frames`` frames (what the retrieval memory can use); files without are left out."""
+def library_clip(path: Path):
+    """A library's clip that is not a mocap file -> Motion22: a dataset's ``new_joint_vecs/ID.npy``
+    (HumanML3D features, 20 fps) or a ``.npz`` that is not an AMASS file (no ``trans``) with
+    ``joints`` (T,22,3; a ShapeMove motion file's, at its ``fps``) or ``features`` (T,263). Mocap
+    files (.bvh, .amc, AMASS .npz) are returned unchanged (``generation.retarget.source_joints``
+    reads them)."""
+    from ..io.mocap import Motion22
+    from ..motion.features import joints_from_features
+
+    path = Path(path)
+    joints, fps = None, float(FPS)
+    if path.suffix.lower() == ".npy":
+        try:
+            joints = joints_from_features(np.load(path, allow_pickle=False).astype(np.float32))
+        except (OSError, ValueError) as exc:
+            raise ShapeMoveError(f"{path}: not a HumanML3D feature file ({exc})") from None
+    elif path.suffix.lower() == ".npz":
+        try:
+            with np.load(path, allow_pickle=False) as z:
+                if "trans" not in z.files:  # not an AMASS file
+                    if "joints" in z.files:
+                        joints = z["joints"].astype(np.float32)[:, :22]
+                        fps = float(z["fps"]) if "fps" in z.files else fps
+                    elif "features" in z.files:
+                        joints = joints_from_features(z["features"].astype(np.float32))
+        except (OSError, ValueError) as exc:
+            raise ShapeMoveError(f"{path}: unreadable ({exc})") from None
+    if joints is None:
+        return path
+    if not (np.isfinite(fps) and 1.0 <= fps <= 1000.0):
+        raise ShapeMoveError(f"{path}: frame rate {fps} is not a frame rate")
+    return Motion22(joints=np.asarray(joints, np.float64), fps=fps, source=str(path), subject=path.stem,
+                    offsets=np.zeros((22, 3)))
+
+
+def library_clips(folder, progress=None, min_frames: int = 8) -> tuple[list[str], list[str], list[np.ndarray], list[Path]]:
+    """(ids, captions, features (T,263), files) of the library files that have a caption and at
+    least ``min_frames`` frames (what the retrieval memory can use); files without are left out."""
     folder = Path(folder)
     if not folder.is_dir():
         raise ShapeMoveError(f"library folder not found: {folder}")
-    ids, captions, feats = [], [], []
+    ids, captions, feats, files = [], [], [], []
     entries = list_library(folder)
     for i, (cid, path, _) in enumerate(entries):
         try:
@@ -136,12 +171,13 @@ def library_clips(folder, progress=None, min_frames: int = 8) -> tuple[list[str]
             ids.append(cid)
             captions.append(caption.strip())
             feats.append(np.asarray(x, np.float32))
+            files.append(path)
         if progress is not None:
             progress((i + 1) / max(1, len(entries)), cid)
     if not ids:
         raise ShapeMoveError(f"{folder}: no motion with a caption to add to the memory (a caption is the "
                              "file's prompt or the first line of a same-name .txt)")
-    return ids, captions, feats
+    return ids, captions, feats, files
 
 
 def resolve_tma(tma):

@@ -14,12 +14,10 @@ from pathlib import Path
 
 import numpy as np
 
-from ..constants import FPS
 from ..errors import ShapeMoveError
 from ..generation.model_bundle import part_warnings, resolve_model_dir
-from ..io.mocap import Motion22
 from ..scene.motion_file import load_motion, save_motion
-from ..search.motion_search import check_query, index_library, search as _search
+from ..search.motion_search import check_query, index_library, library_clip, search as _search
 from .op_support import JobCancelled, param
 
 TRAIN_KINDS = ("vae", "t5", "tma")
@@ -47,16 +45,29 @@ def _betas(params: dict, op: str, name: str = "betas", default=None):
     return b
 
 
-def _generator(model, body):
-    """A cached Generator for (model folder or None = default, body spec)."""
+def _generator(model, body, library=None):
+    """A cached Generator for (model folder or None = default, body spec, library folder or None:
+    the user's captioned motions added to its memory, ``Generator.add_library``). A changed model
+    or library file loads it again."""
     from ..generation.generate import Generator
+    from ..search.motion_search import list_library
 
     d = resolve_model_dir(model or None)
     stamp = max((p.stat().st_mtime_ns for p in d.rglob("*") if p.is_file()), default=0)
-    key = (str(d.resolve()), body or "openbody", stamp)
+    lib = None
+    if library:
+        folder = Path(library)
+        if not folder.is_dir():
+            raise ShapeMoveError(f"library folder not found: {folder}")
+        files = [f for _, _, deps in list_library(folder) for f in deps if f.is_file()]
+        lib = (str(folder.resolve()), len(files), max((f.stat().st_mtime_ns for f in files), default=0))
+    key = (str(d.resolve()), body or "openbody", stamp, lib)
     if key not in _GENERATORS:
         _GENERATORS.clear()  # one loaded model set at a time
-        _GENERATORS[key] = Generator(d, body=body or None)
+        gen = Generator(d, body=body or None)
+        if lib is not None:
+            gen.add_library(lib[0])
+        _GENERATORS[key] = gen
     return _GENERATORS[key]
 
 
@@ -94,8 +105,10 @@ def _motion_facts(path: Path, motion) -> dict:
 def generate(params, progress, cancel) -> dict:
     """params {"prompt", "shape_text", "betas" (10, optional), "seconds" (optional), "seed",
     "temperature", "top_k", "by_parts" (optional, default true), "model" (folder, optional), "body",
-    "out" (.npz)} -> the motion file written, its facts, the body's measurements (cm) and what
-    generation by body part did ("parts")."""
+    "library" (optional: a folder of the user's captioned motions added to the retrieval memory; a
+    clip of it kept whose codes miss it is played as captured, ``library_takes.py``), "out" (.npz)}
+    -> the motion file written, its facts, the body's measurements (cm) and what generation by body
+    part did ("parts")."""
     from ..generation.generate import Request
 
     op = "generate"
@@ -111,7 +124,8 @@ def generate(params, progress, cancel) -> dict:
         req.guidance = float(param(params, op, "guidance", (int, float)))
     req.by_parts = bool(param(params, op, "by_parts", bool, True))
     progress(0.05, "loading models")
-    gen = _generator(param(params, op, "model", str, None), param(params, op, "body", str, None))
+    gen = _generator(param(params, op, "model", str, None), param(params, op, "body", str, None),
+                     param(params, op, "library", str, None))
     if cancel():
         raise JobCancelled
     progress(0.2, "writing motion tokens")
@@ -128,7 +142,7 @@ def generate(params, progress, cancel) -> dict:
             "warnings": list(motions[0].warnings),
             "model_warnings": [w for w in motions[0].warnings if w in part_warnings(gen.model_dir)],
             "nearest_actions": list(check.nearest_actions) if check is not None else [],
-            "parts": _parts(motions[0])}
+            "parts": _parts(motions[0]), "notes": list(motions[0].notes)}
 
 
 def _parts(motion) -> list[str]:
@@ -183,7 +197,7 @@ def retarget(params, progress, cancel) -> dict:
         raise ShapeMoveError(f"op 'retarget': method must be auto, savae or naive, got {method!r}")
     body = load_body_model(param(params, op, "body", str, None))
     progress(0.1, f"reading {source.name}")
-    source = _library_clip(source)
+    source = library_clip(source)
     read = {k: v for k, v in (("source_fps", param(params, op, "source_fps", (int, float), None)),
                               ("angle_unit", param(params, op, "angle_unit", str, None))) if v is not None}
     joints, _ = source_joints(source, body, read)
@@ -211,35 +225,7 @@ def retarget(params, progress, cancel) -> dict:
     motion.prompt = motion.prompt or (source.subject if not isinstance(source, Path) else source.stem)
     save_motion(out, motion)
     used = "naive" if vae is None else ("planted" if motion.tokens is None else "savae")
-    return {**_motion_facts(out, motion), "method": used, "warnings": list(motion.warnings)}
-
-
-def _library_clip(path: Path):
-    """A search library's clip that is not a mocap file -> Motion22 (20 fps): a dataset's
-    ``new_joint_vecs/ID.npy`` (HumanML3D features) or a ``.npz`` with ``joints`` (T,22,3) or
-    ``features`` (T,263). Mocap files (.bvh, .amc, AMASS .npz) are returned unchanged."""
-    from ..motion.features import joints_from_features
-
-    joints = None
-    if path.suffix.lower() == ".npy":
-        try:
-            joints = joints_from_features(np.load(path, allow_pickle=False).astype(np.float32))
-        except (OSError, ValueError) as exc:
-            raise ShapeMoveError(f"{path}: not a HumanML3D feature file ({exc})") from None
-    elif path.suffix.lower() == ".npz":
-        try:
-            with np.load(path, allow_pickle=False) as z:
-                if "poses" not in z.files and "trans" not in z.files:  # not a motion/AMASS file
-                    if "joints" in z.files:
-                        joints = z["joints"].astype(np.float32)
-                    elif "features" in z.files:
-                        joints = joints_from_features(z["features"].astype(np.float32))
-        except (OSError, ValueError) as exc:
-            raise ShapeMoveError(f"{path}: unreadable ({exc})") from None
-    if joints is None:
-        return path
-    return Motion22(joints=np.asarray(joints, np.float64), fps=float(FPS), source=str(path), subject=path.stem,
-                    offsets=np.zeros((22, 3)))
+    return {**_motion_facts(out, motion), "method": used, "notes": list(motion.notes)}
 
 
 def search(params, progress, cancel) -> dict:
