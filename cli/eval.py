@@ -173,12 +173,13 @@ def run_retarget(args) -> int:
     result["bodies"] = list(RETARGET_BODIES)
     atomic_write_json(args.json, result, nan_to_null=True)
     src = result.get("source")  # the capture on its own fitted body, for reference
-    cols = [("SA-VAE", "savae"), ("naive", "naive"), ("naive/fr", "naive_frame"), ("swap", "swap")] + (
+    cols = [("SA-VAE", "savae"), ("auto", "auto"), ("naive", "naive"), ("naive/fr", "naive_frame"), ("swap", "swap")] + (
         [("source", "source")] if src else [])
     print(f"{'metric':<20}" + "".join(f"{label:>10}" for label, _ in cols))
     for k in KEYS:
         print(f"{k:<20}" + "".join(f"{result[name][k]:>10.2f}" for _, name in cols))
-    print("naive/fr: naive with each frame's lowest point on the floor (no hovering)")
+    print("naive/fr: naive with each frame's lowest point on the floor (no hovering); auto: the product's Retarget "
+          f"(the take's own rotations, feet planted, for the {result['auto']['fallbacks']} clips the codes miss)")
     print(f"{len(clips)} clips x {len(bodies)} bodies; wrote {args.json}")
     return 0
 

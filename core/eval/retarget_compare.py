@@ -17,6 +17,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+import torch
 
 from ..constants import FPS
 from ..errors import ShapeMoveError
@@ -83,8 +84,10 @@ def source_score(body, data, clip):
 
 
 def compare_retargeting(data, checkpoint, clips, target_betas_list, body=None, ik_refine_iters: int = 10,
-                        progress=None, plant_source_contacts: bool = True, search: bool = True) -> dict:
-    """{"savae": metrics, "naive": metrics, "naive_frame": metrics, "swap": metrics, "source": metrics}
+                        progress=None, plant_source_contacts: bool = True, search: bool = True,
+                        fallback_mm: float | None = None) -> dict:
+    """{"savae": metrics, "auto": metrics, "naive": metrics, "naive_frame": metrics, "swap": metrics,
+    "source": metrics}
     (``KEYS`` + "clips", "bodies"; "naive_frame": ``ground_each_frame`` of naive, each frame's
     lowest point on the floor: naive without its hovering, which hides slides from the 5 cm contact
     line of ``skate``; "swap": ``swap_betas_retarget``, rotations and translation copied, betas swapped;
@@ -93,27 +96,41 @@ def compare_retargeting(data, checkpoint, clips, target_betas_list, body=None, i
     ((10,) betas each). ``checkpoint``: SA-VAE run folder or .pt. progress(fraction, clip).
     The SA-VAE side is decoded as ``generation.retarget.retarget`` does (the source's contacts
     planted unless ``plant_source_contacts`` is False: the decoder's own contacts; the codes searched
-    for on the subject's body unless ``search`` is False: the encoders' codes)."""
-    from ..generation.retarget import (check_betas, decode_tokens, encode_source, ground_each_frame, load_vae,
-                                       naive_retarget, source_contacts, source_joints, swap_betas_retarget)
+    for on the subject's body unless ``search`` is False: the encoders' codes). "auto" is what the
+    product's Retarget gives: the SA-VAE's motion, or for a clip whose codes miss it by more than
+    ``fallback_mm`` (default ``take_fidelity.LOST_TAKE_MM``) in its worst second the take's own
+    rotations with its feet planted (``retarget.planted_retarget``); its "fallbacks" counts those clips."""
+    from ..generation.retarget import (check_betas, decode_tokens, encode_take, ground_each_frame, load_vae,
+                                       naive_retarget, planted_retarget, processor, source_contacts, source_joints,
+                                       swap_betas_retarget)
+    from ..generation.take_fidelity import LOST_TAKE_MM, take_error_mm, worst_second_mm
     from ..io.mocap import Motion22
     from .recon import _body
+
+    fallback_mm = LOST_TAKE_MM if fallback_mm is None else float(fallback_mm)
 
     clips, targets = list(clips), [check_betas(b) for b in target_betas_list]
     if not clips or not targets:
         raise ShapeMoveError("compare_retargeting needs at least one clip and one target body")
     body = _body(body)
     vae = load_vae(checkpoint, body)
-    rows = {"savae": [], "naive": [], "naive_frame": [], "swap": [], "source": []}
+    rows = {"savae": [], "auto": [], "naive": [], "naive_frame": [], "swap": [], "source": []}
+    fallbacks = 0
     for i, clip in enumerate(clips):
         joints, name = source_joints(source_motion(data, clip), body)
         src = Motion22(joints=joints, fps=float(FPS), source=name, subject="", offsets=np.zeros((22, 3)))  # read once
-        codes = encode_source(joints, vae, body, ik_refine_iters, search)
+        arrays = processor(body, ik_refine_iters).process(joints)
+        codes = encode_take(vae, arrays["norm_joint_vecs"], arrays["betas"], arrays["new_joint_vecs"], search)
+        with torch.no_grad():
+            lost = worst_second_mm(take_error_mm(codes, vae, arrays["betas"], arrays["new_joint_vecs"])) > fallback_mm
+        fallbacks += lost
         known = source_contacts(joints)        # also where the slide of planted feet is measured
         contacts = known if plant_source_contacts else None
         for betas in targets:
-            rows["savae"].append(_score(body, decode_tokens(codes, vae, body, betas, ik_refine_iters, contacts=contacts),
-                                        betas, known))
+            savae = _score(body, decode_tokens(codes, vae, body, betas, ik_refine_iters, contacts=contacts), betas, known)
+            rows["savae"].append(savae)
+            rows["auto"].append(_score(body, planted_retarget(arrays, body, betas, ik_refine_iters), betas, known)
+                                if lost else savae)
             naive = naive_retarget(src, body, betas, ik_refine_iters)
             rows["naive"].append(_score(body, naive, betas, known))
             rows["naive_frame"].append(_score(body, ground_each_frame(naive, body), betas, known))
@@ -132,4 +149,5 @@ def compare_retargeting(data, checkpoint, clips, target_betas_list, body=None, i
             agg[k] = sum(row[k] * row["n_stance"] for row in r) / n if n else 0.0
         out[name] = {**{k: float(agg[k]) for k in KEYS}, "clips": len(r) if name == "source" else len(clips),
                      "bodies": 1 if name == "source" else len(targets)}
+    out["auto"]["fallbacks"] = int(fallbacks)
     return out

@@ -172,15 +172,6 @@ def encode_take(vae, norm_feats, betas=None, shaped_feats=None, search: bool = T
                                           progress=progress)]
 
 
-def encode_source(joints: np.ndarray, vae, body, ik_refine_iters: int = 10, search: bool = True,
-                  progress=None) -> list[int]:
-    """(T,22,3) source joints -> motion tokens: the builder's canonical features and the subject's
-    own (its fitted body), encoded by ``encode_take`` (searched, unless ``search`` is False).
-    T-1 feature rows are cut to a multiple of the VAE's downsampling (4): (T-1)//4 tokens."""
-    arrays = processor(body, ik_refine_iters).process(joints)
-    return encode_take(vae, arrays["norm_joint_vecs"], arrays["betas"], arrays["new_joint_vecs"], search, progress)
-
-
 def source_contacts(joints) -> np.ndarray:
     """(T,22,3) source joints at 20 fps -> (T,4) uint8 foot contacts of joints 7, 8, 10, 11
     (``motion.contacts.detect_contacts``, as the dataset builder labels its clips)."""
