@@ -119,6 +119,27 @@ def test_a_users_library_becomes_retrieved_candidates(gen, tmp_path):
         own.add_library(tmp_path / "empty")
 
 
+def test_library_clip_reads_motion_files_as_takes_and_refuses_bad_ones(tmp_path):
+    """``motion_search.library_clip``: a ShapeMove motion file (joints at its own fps) or a features
+    file is a take (Motion22); a mocap or AMASS file is left for the mocap readers; bad arrays and
+    pickles are refused by name, sizes bounded before anything is read."""
+    from shapemove.core.search.motion_search import library_clip
+
+    joints = np.random.default_rng(0).normal(size=(30, 24, 3)).astype(np.float32)
+    np.savez(tmp_path / "m.npz", joints=joints, poses=np.zeros((30, 24, 3)), transl=np.zeros((30, 3)), fps=30.0)
+    m = library_clip(tmp_path / "m.npz")
+    assert m.fps == 30.0 and m.joints.shape == (30, 22, 3) and np.allclose(m.joints, joints[:, :22])
+    np.savez(tmp_path / "amass.npz", poses=np.zeros((5, 66)), trans=np.zeros((5, 3)))
+    assert library_clip(tmp_path / "amass.npz") == tmp_path / "amass.npz"
+    assert library_clip(tmp_path / "walk.bvh") == tmp_path / "walk.bvh"
+    np.savez(tmp_path / "f.npz", features=np.zeros((10, 12)))
+    with pytest.raises(ShapeMoveError, match=r"features must be \(T, 263\)"):
+        library_clip(tmp_path / "f.npz")
+    np.savez(tmp_path / "p.npz", joints=np.array([{"a": 1}], dtype=object))
+    with pytest.raises(ShapeMoveError, match="pickled"):
+        library_clip(tmp_path / "p.npz")
+
+
 def test_a_library_kick_the_codec_flattens_is_played_as_captured(mocap_root, openbody, tmp_path):
     """A user's captured front kick in the library: kept for its own caption, its codes would
     bring the right ankle's 1.0 m rise down to under half (retargeted through the SA-VAE,

@@ -119,33 +119,40 @@ def load_motion_features(path: Path) -> tuple[np.ndarray, str]:
     raise ShapeMoveError(f"{path}: not a motion file (.npz, .bvh, .amc)")
 
 
+LIBRARY_CLIP_BYTES = 256 * 2**20   # the most a library clip's arrays may take (a motion, not a dataset)
+
+
 def library_clip(path: Path):
     """A library's clip that is not a mocap file -> Motion22: a dataset's ``new_joint_vecs/ID.npy``
     (HumanML3D features, 20 fps) or a ``.npz`` that is not an AMASS file (no ``trans``) with
     ``joints`` (T,22,3; a ShapeMove motion file's, at its ``fps``) or ``features`` (T,263). Mocap
     files (.bvh, .amc, AMASS .npz) are returned unchanged (``generation.retarget.source_joints``
     reads them)."""
+    from ..io.limits import check_file_size
     from ..io.mocap import Motion22
+    from ..io.npz_read import read_npz
     from ..motion.features import joints_from_features
 
     path = Path(path)
     joints, fps = None, float(FPS)
     if path.suffix.lower() == ".npy":
+        check_file_size(path, LIBRARY_CLIP_BYTES, "library feature file")
         try:
             joints = joints_from_features(np.load(path, allow_pickle=False).astype(np.float32))
         except (OSError, ValueError) as exc:
             raise ShapeMoveError(f"{path}: not a HumanML3D feature file ({exc})") from None
     elif path.suffix.lower() == ".npz":
-        try:
-            with np.load(path, allow_pickle=False) as z:
-                if "trans" not in z.files:  # not an AMASS file
-                    if "joints" in z.files:
-                        joints = z["joints"].astype(np.float32)[:, :22]
-                        fps = float(z["fps"]) if "fps" in z.files else fps
-                    elif "features" in z.files:
-                        joints = joints_from_features(z["features"].astype(np.float32))
-        except (OSError, ValueError) as exc:
-            raise ShapeMoveError(f"{path}: unreadable ({exc})") from None
+        z = read_npz(path, ("trans", "joints", "fps", "features"), max_bytes=LIBRARY_CLIP_BYTES, what="library motion")
+        if "trans" not in z:  # not an AMASS file
+            j = z.get("joints")
+            if j is not None and j.ndim == 3 and j.shape[1] >= 22 and j.shape[2] == 3:
+                joints = j.astype(np.float32)[:, :22]
+                fps = float(z["fps"]) if "fps" in z and z["fps"].size == 1 else fps
+            elif "features" in z:
+                f = np.asarray(z["features"], np.float32)
+                if f.ndim != 2 or f.shape[1] != 263:
+                    raise ShapeMoveError(f"{path}: features must be (T, 263), got {f.shape}")
+                joints = joints_from_features(f)
     if joints is None:
         return path
     if not (np.isfinite(fps) and 1.0 <= fps <= 1000.0):
