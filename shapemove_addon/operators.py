@@ -154,7 +154,7 @@ class SHAPEMOVE_OT_build_from_motion(ReportingOperator, bpy.types.Operator, Impo
         rig = build_animated_rig(context, motion, load_body(motion.body_model, model_file), name=self.rig_name,
                                  collection=context.collection, root_motion=self.root_motion)
         rig.armature[MOTION_FILE_KEY] = os.path.abspath(self.filepath)
-        rig.armature[HAS_TOKENS_KEY] = motion.tokens is not None and len(motion.tokens) > 0
+        rig.armature[HAS_TOKENS_KEY] = motion.remakeable   # tokens to decode again, or a take to plant again
         for obj in context.view_layer.objects:
             obj.select_set(False)
         rig.armature.select_set(True)

@@ -1,7 +1,8 @@
 """Re-decode a generated rig's motion for its new body after a shape change (debounced).
 
-A rig built from a motion file with motion tokens ("shapemove_motion_file", "shapemove_has_tokens")
-gets a "redecode" job DEBOUNCE seconds after the last shape change (``shape_sync.on_betas_changed``
+A rig built from a motion file that can be made again for another body ("shapemove_motion_file",
+"shapemove_has_tokens": motion tokens, or a take played by its own rotations, which is planted
+again, ``Motion.remakeable``) gets a "redecode" job DEBOUNCE seconds after the last shape change (``shape_sync.on_betas_changed``
 calls ``schedule``). When the job returns and the rig still has the betas the job was made for,
 the rig's action is replaced by the re-decoded motion (``apply_motion``); a stale answer (the
 sliders moved again meanwhile) schedules a new job instead.
@@ -22,7 +23,7 @@ from .rig_state import current_betas, rig_body_spec
 
 DEBOUNCE = 0.6  # s of quiet after the last slider move before a job starts
 MOTION_FILE_KEY = "shapemove_motion_file"
-HAS_TOKENS_KEY = "shapemove_has_tokens"
+HAS_TOKENS_KEY = "shapemove_has_tokens"   # the rig's motion can be made again for a new body (Motion.remakeable)
 
 _scheduled: set[str] = set()
 _inflight: dict[str, tuple] = {}  # rig name -> (job id, betas the job decodes for)

@@ -18,12 +18,15 @@ pytestmark = pytest.mark.blender
 
 
 def test_panel_says_a_take_was_moved_by_its_rotations(addon, openbody, tmp_path, monkeypatch):  # noqa: F811
-    from shapemove.shapemove_addon import job_submit, operators, panels
+    from shapemove.shapemove_addon import job_submit, operators, panels, redecode
     from shapemove.shapemove_addon.rig_state import TAKE_NOTES_KEY
 
     T = 12
     transl = np.stack([0.02 * np.arange(T), np.zeros(T), np.zeros(T)], -1)
-    save_motion(tmp_path / "m.npz", make_motion(openbody, np.zeros((T, 24, 3)), transl, np.zeros(10), fps=20))
+    contacts = np.ones((T, 4), np.uint8)     # a take played by its own rotations: measured contacts, no tokens
+    save_motion(tmp_path / "m.npz", make_motion(openbody, np.zeros((T, 24, 3)), transl, np.zeros(10), fps=20,
+                                                contacts=contacts, contacts_measured=True))
+    save_motion(tmp_path / "plain.npz", make_motion(openbody, np.zeros((T, 24, 3)), transl, np.zeros(10), fps=20))
     jobs = []
     monkeypatch.setattr(job_submit, "submit_job", lambda op, params, **kw: jobs.append((op, params, kw)) or "j1")
     operators._retarget_job(bpy.context, str(tmp_path / "kick.bvh"), None, "Kicker")
@@ -34,11 +37,13 @@ def test_panel_says_a_take_was_moved_by_its_rotations(addon, openbody, tmp_path,
     rig = operators.active_rig(bpy.context)
     assert rig is not None and list(rig[TAKE_NOTES_KEY]) == [note]
     assert note in _draw(panels.SHAPEMOVE_PT_generate, bpy.context)
-    # a take the codes carry leaves no note
-    kw["on_result"]({"result": {"path": str(tmp_path / "m.npz"), "method": "savae", "notes": []}})
+    assert redecode.wants_redecode(rig)     # a shape change plants it again (the redecode job: retarget.replant)
+    # a take the codes carry leaves no note; a motion with neither tokens nor measured contacts is not remade
+    kw["on_result"]({"result": {"path": str(tmp_path / "plain.npz"), "method": "savae", "notes": []}})
     rig = operators.active_rig(bpy.context)
     assert TAKE_NOTES_KEY not in rig and not any("SA-VAE" in s for s in _draw(panels.SHAPEMOVE_PT_generate,
                                                                                  bpy.context))
+    assert not redecode.wants_redecode(rig)
 
 
 def test_generate_uses_the_library_when_asked_and_notes_a_captured_take(addon, openbody, tmp_path,  # noqa: F811

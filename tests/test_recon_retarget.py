@@ -287,6 +287,43 @@ def test_retarget_falls_back_to_the_takes_rotations_when_the_codes_miss_it(run_b
     j = m.joints      # ... and it starts as a decoded take does: the root over the origin, facing +Z
     facing = np.cross((j[0, 1] - j[0, 2]) + (j[0, 16] - j[0, 17]), [0.0, 1.0, 0.0])
     assert np.abs(j[0, 0, [0, 2]]).max() < 0.01 and abs(np.degrees(np.arctan2(facing[0], facing[2]))) < 3
+    assert m.remakeable and kept.remakeable
+
+
+def test_a_planted_take_is_planted_again_for_a_new_body(run_bvh, vae, body):
+    """A body-shape change on a take played by its own rotations (no tokens to decode) plants it
+    again (``replant``): the new body's bones, the stride scaled by the new leg length, the planted
+    feet still; the same rotations on the new bones alone (what a slider does without it) slide."""
+    from shapemove.core.body.shape_from_measurements import betas_from_shape_text
+    from shapemove.core.eval.bones import bone_lengths, target_bone_lengths
+    from shapemove.core.generation.retarget import ground_each_frame, replant, retarget
+    from shapemove.core.motion.contacts import runs
+    from shapemove.core.scene.motion_file import make_motion
+
+    tall, short = (betas_from_shape_text(body, f"A person standing {h} cm tall") for h in (190, 150))
+    m = retarget(run_bvh, vae, body, tall, fallback_mm=0.0)          # always by its own rotations
+    assert m.tokens is None and m.remakeable
+
+    def fk(x):
+        with torch.no_grad():
+            return body.forward(torch.as_tensor(x.betas)[None], torch.as_tensor(x.poses),
+                                torch.as_tensor(x.transl)).joints[:, :22].double().numpy()
+
+    def slide(x, contacts):
+        j = fk(x)
+        return np.median(np.concatenate([np.linalg.norm(np.diff(j[s:e, jid][:, [0, 2]], axis=0), axis=1)
+                                         for k, jid in enumerate((7, 8, 10, 11)) for s, e in runs(contacts[:, k])]))
+
+    again = replant(m, body, short)
+    assert again.tokens is None and again.contacts_measured and again.num_frames == m.num_frames
+    assert np.array_equal(again.betas, short) and slide(again, again.contacts) < 1e-3
+    assert np.abs(bone_lengths(fk(again)) - target_bone_lengths(body, torch.as_tensor(short)[None])).max() < 1e-4
+    path = lambda x: np.linalg.norm(np.diff(fk(x)[:, 0, [0, 2]], axis=0), axis=1).sum()  # noqa: E731
+    assert path(again) < 0.9 * path(m)                                 # a shorter body takes shorter strides
+    rebased = ground_each_frame(make_motion(body, m.poses, m.transl, short, fps=20.0), body)
+    assert slide(rebased, m.contacts) > 3 * max(slide(again, again.contacts), 1e-4)
+    with pytest.raises(ShapeMoveError, match="re-planted"):
+        replant(retarget(run_bvh, vae, body, tall), body, short)      # tokens: decoded again instead
 
 
 def test_naive_retarget_keeps_the_rotations_on_the_new_bones(run_bvh, tiny_dataset, body):

@@ -184,6 +184,13 @@ def test_a_library_kick_the_codec_flattens_is_played_as_captured(mocap_root, ope
                                 lambda *a: None, lambda: False)
     assert r["tokens"] == 0 and len(r["notes"]) == 1 and "kick.bvh" in r["notes"][0] and not r["warnings"]
     assert lift(load_motion(tmp_path / "g.npz").joints[:, 8, 1]) > 0.9 * lift(src)
+    # a body-shape change plants the take again on the new body (the panel's re-decode job)
+    short = [-1.5] + [0.0] * 9
+    again = jobs_shapemove.redecode({"motion": str(tmp_path / "g.npz"), "betas": short, "out": str(tmp_path / "s.npz")},
+                                    lambda *a: None, lambda: False)
+    s = load_motion(again["path"])
+    assert again["tokens"] == 0 and np.allclose(s.betas, short) and s.contacts_measured and s.num_frames == 80
+    assert lift(s.joints[:, 8, 1]) > 0.8 * lift(src)       # still a kick, on a shorter body
     with pytest.raises(ShapeMoveError, match="library folder not found"):
         jobs_shapemove.generate({"prompt": caption, "library": str(tmp_path / "nowhere"), "out": str(tmp_path / "x.npz")},
                                 lambda *a: None, lambda: False)

@@ -440,7 +440,12 @@ class Generator:
 
     def redecode(self, motion: Motion, betas) -> Motion:
         """The same tokens on another body (``decode.redecode``; a motion made by body part is
-        composed and mirrored again, ``parts.redecode_parts``)."""
+        composed and mirrored again, ``parts.redecode_parts``); a take played by its own rotations
+        (no tokens, measured contacts) is planted again on the new body (``retarget.replant``)."""
+        if (motion.tokens is None or not len(motion.tokens)) and motion.contacts_measured:
+            from .retarget import replant
+
+            return replant(motion, self.body, betas, self.ik_refine_iters)
         if is_by_parts(motion):
             return redecode_parts(motion, self.vae, self.body, betas, self.ik_refine_iters)
         return redecode(motion, self.vae, self.body, betas, self.ik_refine_iters)

@@ -234,6 +234,28 @@ def planted_retarget(arrays: dict, body, betas, ik_refine_iters: int = 10) -> Mo
     return out
 
 
+def replant(motion: Motion, body, betas, ik_refine_iters: int = 10) -> Motion:
+    """A take played by its own rotations (``planted_retarget``'s Motion: measured contacts, no
+    tokens) moved onto the body ``betas`` the same way, from what the Motion holds: its local
+    rotations, its root path and the rest joints of the body it is on, its planted contacts. The
+    stride is scaled by leg length again and the feet planted again, where a body-shape slider alone
+    would keep the old stride (the planted feet then slide: 4.1 against 0.5 mm per frame for a
+    captured kick moved to a shorter body)."""
+    from ..geometry.rotations import axis_angle_to_matrix
+
+    if (motion.tokens is not None and len(motion.tokens)) or not motion.contacts_measured or motion.contacts is None:
+        raise ShapeMoveError("only a take played by its own rotations (measured contacts, no motion tokens) is "
+                             "re-planted; a motion with tokens is decoded again")
+    with torch.no_grad():
+        rest = body.rest_joints(torch.as_tensor(np.asarray(motion.betas, np.float32))[None])[0].numpy()
+    take = {"rotations": axis_angle_to_matrix(np.asarray(motion.poses, np.float32)),
+            "root": np.asarray(motion.transl, np.float32) + rest[0], "rest": rest,
+            "contacts": np.asarray(motion.contacts, np.uint8)}
+    out = planted_retarget(take, body, betas, ik_refine_iters)
+    out.prompt, out.notes = motion.prompt, list(motion.notes)
+    return out
+
+
 def start_at_origin(rotations: np.ndarray, root: np.ndarray, rest: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Local rotations (T,24,3,3) and root path (T,3) of a take turned about the vertical and moved
     so that at frame 0 the root is over the origin and the body faces +Z, as every decoded take

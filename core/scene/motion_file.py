@@ -64,6 +64,14 @@ class Motion:
     def num_frames(self) -> int:
         return int(self.poses.shape[0])
 
+    @property
+    def remakeable(self) -> bool:
+        """Whether the motion can be made again for another body: it has motion tokens (decoded
+        again), or it is a take played by its own rotations with its measured contacts (a retarget
+        the codes missed, a library clip: ``generation.retarget.replant``)."""
+        has_tokens = self.tokens is not None and len(self.tokens) > 0
+        return has_tokens or (self.contacts_measured and self.contacts is not None)
+
 
 def make_motion(body, poses, transl, betas, fps: float = 20.0, prompt: str | None = None, **extra) -> Motion:
     """Motion for ``body`` (a BodyModel): joints computed with ``body.forward``.

@@ -156,8 +156,9 @@ def _parts(motion) -> list[str]:
 
 
 def redecode(params, progress, cancel) -> dict:
-    """params {"motion" (.npz with tokens), "betas" (10), "model", "body", "out"} -> the same tokens
-    decoded for the new body, written to ``out``."""
+    """params {"motion" (.npz with tokens, or a take played by its own rotations), "betas" (10), "model",
+    "body", "out"} -> the same tokens decoded for the new body (a take: planted again on it,
+    ``retarget.replant``), written to ``out``."""
 
     op = "redecode"
     out = _out_path(params, op)
