@@ -7,7 +7,9 @@ animation options (docs/animation.md) "loop", "in_place", "path" ([[x, z], ...] 
 file next to the prompts file), "speed", "stretch", "root_motion" (PELVIS, OBJECT, ROOT_BONE, NONE);
 an object with "sequence": [{"prompt", "seconds"}, ...] instead of "prompt" is a timeline (one
 rig, one NLA strip per prompt). ``--loop``/``--in-place``/``--speed``/``--stretch``/``--root-motion``
-set defaults for every line. A prompt that fails is reported with its reason and skipped; the rest go on.
+set defaults for every line. ``--library DIR`` adds your own captioned motions to what the model
+retrieves (as ``generate --library``). A prompt that fails is reported with its reason and skipped;
+the rest go on.
 """
 from __future__ import annotations
 
@@ -24,6 +26,9 @@ def add_arguments(p):
     p.add_argument("--out", type=Path, required=True)
     p.add_argument("--video", action="store_true", help="also render an MP4 of every frame (slower)")
     p.add_argument("--model", type=Path, default=None)
+    p.add_argument("--library", type=Path, default=None,
+                   help="a folder of your own captioned motions that compete with the model's samples (as "
+                        "`generate --library`; one the model's codes cannot carry is played as captured)")
     p.add_argument("--frames", type=int, default=4, help="frames in each preview strip")
     p.add_argument("--resolution", type=int, nargs=2, default=(320, 320), metavar=("W", "H"))
     g = p.add_argument_group("animation defaults (a .jsonl line's own keys win)")
@@ -111,12 +116,16 @@ def run(args) -> int:
         except ShapeMoveError as exc:
             raise ShapeMoveError(f"{args.prompts} item {i + 1}: {exc}") from None
     gen = Generator(args.model)
+    if args.library is not None:
+        print(f"retrieval memory: {gen.add_library(args.library)} motions added from {args.library}")
     failed = []
     for i, it in enumerate(tqdm(items, desc="render", unit="prompt")):
         label = it.get("prompt") or " then ".join(str(s.get("prompt", "")) for s in it.get("sequence") or [])
         stem = args.out / f"{i:03d}_{slug(str(label))}"
         try:
             motion = _generate_item(gen, it, i, args, args.prompts.parent)
+            for note in motion.notes:   # a library clip played as captured
+                tqdm.write(f"prompt {i}: {note}")
             save_motion(stem.with_suffix(".npz"), motion)
             build_scene_file(motion, gen.body, stem.with_suffix(".blend"), stem.with_suffix(".png"),
                              frames=args.frames, resolution=tuple(args.resolution),
