@@ -93,9 +93,16 @@ def on_generated(name: str, msg: dict):
         rig["shapemove_model_warnings"] = model
     if rig is not None and r.get("parts"):
         rig["shapemove_parts"] = [str(p) for p in r["parts"]][:2]  # two things at once, a side mirrored
-    if rig is not None and r.get("notes"):
-        rig[TAKE_NOTES_KEY] = [str(n) for n in r["notes"]][:2]   # a library clip played as captured
+    keep_notes(rig, r)   # a library clip played as captured
     return rig
+
+
+def keep_notes(rig, result: dict) -> None:
+    """A job's notes (a take played by its own rotations, and why) kept on the rig it built, for the
+    panel (at most two lines)."""
+    notes = [str(n) for n in result.get("notes") or []]
+    if rig is not None and notes:
+        rig[TAKE_NOTES_KEY] = notes[:2]
 
 
 class ReportingOperator:
@@ -324,10 +331,7 @@ def _retarget_job(context, source: str, target_rig, name: str, read: dict | None
     def done(msg):
         if msg.get("cancelled"):
             return
-        rig = build_rig_from_file(msg["result"]["path"], name)
-        notes = [str(w) for w in msg["result"].get("notes") or []]
-        if rig is not None and notes:   # the codec missed the take: its own rotations were used
-            rig[TAKE_NOTES_KEY] = notes[:2]
+        keep_notes(build_rig_from_file(msg["result"]["path"], name), msg["result"])   # the codec missed the take
 
     job_submit.submit_job("retarget", params, kind="retarget", label=f"retarget {Path(source).name}", on_result=done)
 

@@ -17,7 +17,6 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-import torch
 
 from ..constants import FPS
 from ..errors import ShapeMoveError
@@ -101,9 +100,8 @@ def compare_retargeting(data, checkpoint, clips, target_betas_list, body=None, i
     ``fallback_mm`` (default ``take_fidelity.LOST_TAKE_MM``) in its worst second the take's own
     rotations with its feet planted (``retarget.planted_retarget``); its "fallbacks" counts those clips."""
     from ..generation.retarget import (check_betas, decode_tokens, encode_take, ground_each_frame, load_vae,
-                                       naive_retarget, planted_retarget, processor, source_contacts, source_joints,
-                                       swap_betas_retarget)
-    from ..generation.take_fidelity import LOST_TAKE_MM, take_error_mm, worst_second_mm
+                                       naive_retarget, planted_retarget, processor, source_joints, swap_betas_retarget)
+    from ..generation.take_fidelity import LOST_TAKE_MM, worst_take_error_mm
     from ..io.mocap import Motion22
     from .recon import _body
 
@@ -121,10 +119,9 @@ def compare_retargeting(data, checkpoint, clips, target_betas_list, body=None, i
         src = Motion22(joints=joints, fps=float(FPS), source=name, subject="", offsets=np.zeros((22, 3)))  # read once
         arrays = processor(body, ik_refine_iters).process(joints)
         codes = encode_take(vae, arrays["norm_joint_vecs"], arrays["betas"], arrays["new_joint_vecs"], search)
-        with torch.no_grad():
-            lost = worst_second_mm(take_error_mm(codes, vae, arrays["betas"], arrays["new_joint_vecs"])) > fallback_mm
+        lost = worst_take_error_mm(codes, vae, arrays["betas"], arrays["new_joint_vecs"]) > fallback_mm
         fallbacks += lost
-        known = source_contacts(joints)        # also where the slide of planted feet is measured
+        known = arrays["contacts"]   # source_contacts of the joints; also where the slide of planted feet is measured
         contacts = known if plant_source_contacts else None
         for betas in targets:
             savae = _score(body, decode_tokens(codes, vae, body, betas, ik_refine_iters, contacts=contacts), betas, known)

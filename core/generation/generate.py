@@ -442,7 +442,7 @@ class Generator:
         """The same tokens on another body (``decode.redecode``; a motion made by body part is
         composed and mirrored again, ``parts.redecode_parts``); a take played by its own rotations
         (no tokens, measured contacts) is planted again on the new body (``retarget.replant``)."""
-        if (motion.tokens is None or not len(motion.tokens)) and motion.contacts_measured:
+        if motion.planted_take:
             from .retarget import replant
 
             return replant(motion, self.body, betas, self.ik_refine_iters)

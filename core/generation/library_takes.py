@@ -23,10 +23,9 @@ from pathlib import Path
 from typing import NamedTuple
 
 import numpy as np
-import torch
 
 from ..scene.motion_file import Motion
-from .take_fidelity import LOST_TAKE_MM, take_error_mm, worst_second_mm
+from .take_fidelity import LOST_TAKE_MM, worst_take_error_mm
 
 
 class WindowFit(NamedTuple):
@@ -70,8 +69,7 @@ def window_fit(take: dict, clip_codes, window, vae, fallback_mm: float = LOST_TA
     lo, hi = start * down, (start + len(window)) * down
     if hi > len(take["new_joint_vecs"]):
         return None
-    with torch.no_grad():
-        worst = worst_second_mm(take_error_mm(window, vae, take["betas"], take["new_joint_vecs"][lo:hi]))
+    worst = worst_take_error_mm(window, vae, take["betas"], take["new_joint_vecs"][lo:hi])
     return WindowFit(lo, hi, worst) if worst > fallback_mm else None
 
 

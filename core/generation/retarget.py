@@ -191,23 +191,22 @@ def retarget(motion, vae, body, betas, ik_refine_iters: int = 10, plant_source_c
     decoded on the subject's own body, miss the take by more than this in its worst second (the
     codec cannot carry it: a fast kick), the take is moved by ``planted_retarget`` instead (T
     frames, no tokens, a note saying why: ``Motion.notes``); None never falls back."""
-    from .take_fidelity import take_error_mm, worst_second_mm
+    from .take_fidelity import worst_take_error_mm
 
     betas = check_betas(betas)
     joints, _ = source_joints(motion, body, read)
     arrays = processor(body, ik_refine_iters).process(joints)
     codes = encode_take(vae, arrays["norm_joint_vecs"], arrays["betas"], arrays["new_joint_vecs"], search, progress)
     if fallback_mm is not None:
-        with torch.no_grad():
-            worst = worst_second_mm(take_error_mm(codes, vae, arrays["betas"], arrays["new_joint_vecs"]))
+        worst = worst_take_error_mm(codes, vae, arrays["betas"], arrays["new_joint_vecs"])
         if worst > fallback_mm:
             out = planted_retarget(arrays, body, betas, ik_refine_iters)
             out.notes.append(f"the SA-VAE's codes miss this take by {worst:.0f} mm in its worst second (more than "
                                 f"{fallback_mm:g} mm): moved by its own rotations, feet planted, and not "
                                 "re-decodable from tokens")
             return out
-    out = decode_tokens(codes, vae, body, betas, ik_refine_iters,
-                        contacts=source_contacts(joints) if plant_source_contacts else None)
+    out = decode_tokens(codes, vae, body, betas, ik_refine_iters,   # the builder's contacts: source_contacts'
+                        contacts=arrays["contacts"] if plant_source_contacts else None)
     validate(out)
     return out
 
@@ -243,7 +242,7 @@ def replant(motion: Motion, body, betas, ik_refine_iters: int = 10) -> Motion:
     captured kick moved to a shorter body)."""
     from ..geometry.rotations import axis_angle_to_matrix
 
-    if (motion.tokens is not None and len(motion.tokens)) or not motion.contacts_measured or motion.contacts is None:
+    if not motion.planted_take:
         raise ShapeMoveError("only a take played by its own rotations (measured contacts, no motion tokens) is "
                              "re-planted; a motion with tokens is decoded again")
     with torch.no_grad():

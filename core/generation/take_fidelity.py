@@ -9,6 +9,7 @@ compares them) against the take's own (read from its shape-aware features the sa
 
     err = take_error_mm(codes, vae, betas, shaped_feats)   # (T,) mm, root-aligned, per frame
     worst_second_mm(err)                                  # the worst second's mean
+    worst_take_error_mm(codes, vae, betas, shaped_feats)  # both, what the fallbacks compare with LOST_TAKE_MM
 
 An action lasts about a second, so a short kick in a long walk is judged by its own second, not
 diluted by the walk. ``LOST_TAKE_MM`` is where the decoded action stops being the captured one
@@ -43,6 +44,12 @@ def take_error_mm(codes, vae, betas, shaped_feats) -> np.ndarray:
         tgt = joints_from_features(torch.as_tensor(shaped[:len(feats)], dtype=torch.float64)).numpy()
     aligned = (dec - dec[:, :1]) - (tgt - tgt[:, :1])
     return np.linalg.norm(aligned, axis=-1).mean(1) * 1000.0
+
+
+@torch.no_grad()
+def worst_take_error_mm(codes, vae, betas, shaped_feats) -> float:
+    """``worst_second_mm`` of ``take_error_mm``: how far the codes miss the take in its worst second."""
+    return worst_second_mm(take_error_mm(codes, vae, betas, shaped_feats))
 
 
 def worst_second_mm(err: np.ndarray, frames: int = SECOND) -> float:

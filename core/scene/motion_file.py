@@ -65,12 +65,18 @@ class Motion:
         return int(self.poses.shape[0])
 
     @property
+    def planted_take(self) -> bool:
+        """A take played by its own rotations with its measured contacts and no motion tokens (a
+        retarget the codes missed, a library clip): made again for another body by
+        ``generation.retarget.replant``."""
+        has_tokens = self.tokens is not None and len(self.tokens) > 0
+        return not has_tokens and self.contacts_measured and self.contacts is not None
+
+    @property
     def remakeable(self) -> bool:
         """Whether the motion can be made again for another body: it has motion tokens (decoded
-        again), or it is a take played by its own rotations with its measured contacts (a retarget
-        the codes missed, a library clip: ``generation.retarget.replant``)."""
-        has_tokens = self.tokens is not None and len(self.tokens) > 0
-        return has_tokens or (self.contacts_measured and self.contacts is not None)
+        again) or it is a ``planted_take`` (planted again)."""
+        return (self.tokens is not None and len(self.tokens) > 0) or self.planted_take
 
 
 def make_motion(body, poses, transl, betas, fps: float = 20.0, prompt: str | None = None, **extra) -> Motion:
