@@ -21,7 +21,8 @@ from ..core.errors import ShapeMoveError
 from ..core.scene.axes import points_to_y_up
 from . import job_submit, paths
 from .animation_rig import ROOT_MOTION_ITEMS, SEGMENTS_KEY, TRACK_NAME
-from .operators import JobOperator, ReportingOperator, build_rig_from_file, generation_params, scene_prompt
+from .operators import (JobOperator, ReportingOperator, build_rig_from_file, generation_params, keep_notes,
+                        library_param, scene_prompt)
 from .panels import _SettingsPanel, draw_job, draw_optional
 from .redecode import MOTION_FILE_KEY
 from .rig_state import rig_of
@@ -109,6 +110,7 @@ def _on_built(name: str, root_motion: str, replace=None, keep_strips=None):
             report_error(str(exc).replace("Error: ", "").strip())
             return None
         rig = rig_of(bpy.context.active_object)
+        keep_notes(rig, r)   # a library clip played as captured
         if rig is not None and keep_strips:
             retime_strips(rig, keep_strips)
         if rig is not None and replace is not None and replace.name in bpy.data.objects:
@@ -156,7 +158,7 @@ class SHAPEMOVE_OT_animate(JobOperator, bpy.types.Operator):
                   "seconds": s.seconds if s.use_seconds else None,
                   "loop": a.loop, "in_place": a.root_motion == "NONE",
                   "speed": a.speed if abs(a.speed - 1.0) > 1e-6 else None,
-                  "stretch": a.stretch if a.use_stretch else None}
+                  "stretch": a.stretch if a.use_stretch else None, **library_param(context)}
         if a.path_curve is not None:
             params["path"] = curve_path(a.path_curve, context)
         job_submit.submit_job("animate", params, kind=self.job, label="animate",

@@ -187,6 +187,15 @@ def generation_params(context, label: str) -> dict:
             "out": str(paths.new_motion_path(label))}
 
 
+def library_param(context) -> dict:
+    """{"library": folder} when the Generate panel's "Use Library motions" is on and a Library folder
+    is set (the user's own motions join the candidates; the folder must exist), else {}."""
+    s = context.scene.shapemove
+    if s.use_library and s.library_folder:
+        return {"library": existing_path(s.library_folder, "library folder", folder=True)}
+    return {}
+
+
 class SHAPEMOVE_OT_generate(JobOperator, bpy.types.Operator):
     """Generate a body shape and a motion from the prompt (runs in the background)"""
 
@@ -198,9 +207,7 @@ class SHAPEMOVE_OT_generate(JobOperator, bpy.types.Operator):
         s = context.scene.shapemove
         prompt = scene_prompt(context)
         params = {**generation_params(context, prompt), "prompt": prompt,
-                  "seconds": s.seconds if s.use_seconds else None}
-        if s.use_library and s.library_folder:   # the user's own motions join the candidates
-            params["library"] = existing_path(s.library_folder, "library folder", folder=True)
+                  "seconds": s.seconds if s.use_seconds else None, **library_param(context)}
         name = paths.slug(prompt, 24)
 
         job_submit.submit_job("generate", params, kind=self.job, label="generate",

@@ -75,3 +75,34 @@ def test_generate_uses_the_library_when_asked_and_notes_a_captured_take(addon, o
     assert list(rig[TAKE_NOTES_KEY]) == [note]
     shown = _draw(panels.SHAPEMOVE_PT_generate, bpy.context)
     assert note in shown and not any(line.startswith("Prompt unlike") for line in shown)
+
+
+def test_generate_animated_uses_the_library_and_keeps_the_note(addon, openbody, tmp_path, monkeypatch):  # noqa: F811
+    """Loop, root motion, path and speed ("Generate Animated") take the Library as Generate does, and
+    the rig they build keeps the job's note."""
+    from shapemove.shapemove_addon import job_submit, operators, panels
+    from shapemove.shapemove_addon.rig_state import TAKE_NOTES_KEY
+
+    jobs = []
+    monkeypatch.setattr(job_submit, "submit_job", lambda op, params, **kw: jobs.append((op, params, kw)) or "j1")
+    s, a = bpy.context.scene.shapemove, bpy.context.scene.shapemove_animation
+    s.prompt = "someone kicks high in front of them"
+    lib = tmp_path / "library"
+    lib.mkdir()
+    s.library_folder, s.use_library, a.loop = str(lib), False, True
+    assert "FINISHED" in bpy.ops.shapemove.animate()
+    assert jobs[-1][0] == "animate" and jobs[-1][1]["loop"] and "library" not in jobs[-1][1]
+    s.use_library = True
+    assert "FINISHED" in bpy.ops.shapemove.animate()
+    assert jobs[-1][1]["library"] == str(lib)
+    s.library_folder = str(tmp_path / "nowhere")
+    with pytest.raises(RuntimeError, match="library folder not found"):
+        bpy.ops.shapemove.animate()
+    T = 12
+    transl = np.stack([0.02 * np.arange(T), np.zeros(T), np.zeros(T)], -1)
+    save_motion(tmp_path / "m.npz", make_motion(openbody, np.zeros((T, 24, 3)), transl, np.zeros(10), fps=20))
+    note = "played as captured from your library (kick.bvh): its codes miss it by 250 mm in its worst second"
+    jobs[-2][2]["on_result"]({"result": {"path": str(tmp_path / "m.npz"), "warnings": [], "notes": [note]}})
+    rig = operators.active_rig(bpy.context)
+    assert rig is not None and list(rig[TAKE_NOTES_KEY]) == [note]
+    assert note in _draw(panels.SHAPEMOVE_PT_generate, bpy.context)

@@ -196,6 +196,41 @@ def test_a_library_kick_the_codec_flattens_is_played_as_captured(mocap_root, ope
                                 lambda *a: None, lambda: False)
 
 
+def test_a_library_kick_loops_and_stays_in_place_as_captured(mocap_root, openbody, tmp_path):
+    """Generate Animated with the Library (the worker's animate job, "library"): a loop of a kept
+    library kick is cut from the captured take with the kick inside the cycle, and held in place it
+    keeps its rise; both carry the note. Without the library the same job loops the model's codes, which
+    flatten the kick."""
+    import shutil
+
+    from shapemove.core.generation.loop import seam_report
+    from shapemove.core.generation.retarget import source_joints
+    from shapemove.core.scene.motion_file import load_motion
+    from shapemove.core.worker import jobs_animation
+
+    lib = tmp_path / "library"
+    lib.mkdir()
+    kick = mocap_root / "bandai" / "dataset-1" / "data" / "dataset-1_kick_normal_001.bvh"
+    shutil.copy(kick, lib / "kick.bvh")
+    caption = "a person performs a zorblax front kick"
+    (lib / "kick.txt").write_text(caption + "\n")
+    lift = lambda y: float(y.max() - y.min())  # noqa: E731   (the right ankle's rise)
+    src = lift(source_joints(kick, openbody)[0][:, 8, 1])
+    job = lambda **p: jobs_animation.animate({"prompt": caption, "seed": 0, "out": str(tmp_path / "a.npz"), **p},  # noqa: E731
+                                             lambda *a: None, lambda: False)
+    r = job(loop=True, seconds=2.0, library=str(lib))
+    m = load_motion(r["path"])
+    assert r["tokens"] == 0 and len(r["notes"]) == 1 and "kick.bvh" in r["notes"][0] and "loop_advance" in r
+    assert 34 <= m.num_frames <= 46 and lift(m.joints[:, 8, 1]) > 0.85 * src    # a 2 s cycle holding the kick
+    assert seam_report(m)["jump_ratio"] < 3.0
+    r = job(in_place=True, seconds=4.0, library=str(lib))
+    m = load_motion(r["path"])
+    assert r["tokens"] == 0 and len(r["notes"]) == 1 and m.num_frames == 80
+    assert np.ptp(m.joints[:, 0, [0, 2]], axis=0).max() < 1e-4 and lift(m.joints[:, 8, 1]) > 0.85 * src
+    r = job(loop=True, seconds=2.0)                     # the codes' loop: the kick flattened
+    assert not r["notes"] and lift(load_motion(r["path"]).joints[:, 8, 1]) < 0.5 * src
+
+
 def test_a_model_folder_with_a_memory_retrieves_from_it(gen, tmp_path):
     """A memory written beside a T5 that does not read one (tools/build_motion_memory.py does this
     for a trained model) is loaded and retrieved from; one with codes the model lacks is refused."""

@@ -16,6 +16,9 @@ planting moves joints the decoder barely moves, legs under a wave, by more than 
 ``plant_loop`` plants the feet on three copies of the cycle in a row and keeps the middle one, so
 the contact runs that cross the seam are planted as one run. ``Motion.loop_advance`` is the
 root's travel per cycle: frame T continues as frame 0 moved by it.
+
+With a library (``Generator.add_library``), a clip of it that the prompt keeps and the codes cannot
+carry (``library_takes.py``) is looped as captured (``loop_motion`` of ``Generator.library_take``).
 """
 from __future__ import annotations
 
@@ -154,8 +157,31 @@ def loop_motion(motion: Motion, body, seconds: float | None = None, ik_refine_it
     """An existing motion made into a loop (its best cut, see the module doc)."""
     track = track_of(motion)
     period = None if seconds is None else (0.85 * seconds, 1.15 * seconds)
-    cycle, adv = make_cycle(track, best_cut(track.joints, motion.fps, period))
-    return plant_loop(body, motion.betas, cycle, adv, ik_refine_iters, prompt=motion.prompt)
+    cut = best_cut(track.joints, motion.fps, period)
+    cycle, adv = make_cycle(track, cut)
+    m = plant_loop(body, motion.betas, cycle, adv, ik_refine_iters, prompt=motion.prompt)
+    m.seam_cost = cut.cost
+    return m
+
+
+def _library_loop(gen, req, lo: int, hi: int):
+    """A loop of the user's library clip that ``req`` keeps among the samples when the codes cannot
+    carry it (``Generator.library_take``: played as captured, feet planted), cut where it loops
+    best; None without a library or when a sample or a window the codes carry wins (it is looped
+    from its codes as any sample)."""
+    from dataclasses import replace
+
+    if not gen.library_files:
+        return None
+    seconds = hi * gen.vae.cfg.downsample / FPS if lo == hi else None
+    chosen = gen.tokens_for([replace(req, seconds=seconds)], library_as_captured=True)
+    betas, source = body_for(gen, req.prompt, req.shape_text, req.betas, chosen.betas[0].numpy())
+    take = gen.library_take(chosen.kept[0], chosen.codes[0], betas, req.prompt)
+    if take is None:
+        return None
+    m = loop_motion(take, gen.body, req.seconds, gen.ik_refine_iters)
+    m.shape_source, m.notes, m.retrieved_clips = source, list(take.notes), [chosen.kept[0]]
+    return m
 
 
 def generate_loop(gen, req, progress=None, cancel=None) -> Motion:
@@ -189,6 +215,11 @@ def generate_loop(gen, req, progress=None, cancel=None) -> Motion:
             no_part_loop = True
     if progress is not None:
         progress(0.1, "sampling loop candidates")
+    m = _library_loop(gen, req, lo, hi)
+    if m is not None:   # the user's own clip, as captured
+        m.warnings = [check.warning] if check is not None and check.warning else []
+        m.prompt_check = check
+        return m
     cands, pred = sample_codes(gen, req.prompt, req.shape_text, n, lo, hi, req.seed, req.temperature, req.top_k,
                                req.guidance)
     betas, source = body_for(gen, req.prompt, req.shape_text, req.betas, pred)

@@ -116,11 +116,12 @@ class BatchStream:
                  start_step: int = 0, weights=None):
         if len(dataset) == 0:
             raise ShapeMoveError(f"{dataset.root}: no clips of at least {dataset.window} frames in this split")
-        self.sampler = DistributedSampler(dataset, num_replicas=world_size, rank=rank, shuffle=True, seed=seed)
         self.batch, self.start_step = batch, start_step
         self.rank, self.world_size, self.seed = rank, world_size, seed
-        self.p = None
-        if weights is not None:
+        self.p, self.sampler = None, None
+        if weights is None:
+            self.sampler = DistributedSampler(dataset, num_replicas=world_size, rank=rank, shuffle=True, seed=seed)
+        else:
             w = np.asarray(weights, dtype=np.float64)
             if w.shape != (len(dataset),) or not np.isfinite(w).all() or (w < 0).any() or w.sum() <= 0:
                 raise ShapeMoveError(f"sampling weights must be {len(dataset)} finite values >= 0, not all 0")

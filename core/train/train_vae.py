@@ -169,8 +169,11 @@ def _train(data, out, cfg, t, resume, body, dist, progress, cancel, verbose) -> 
         add_residual(model, source)
     elif source is not None and source.cfg.base_decoder_width != cfg.base_decoder_width:
         kept = {k: v for k, v in source.state_dict().items() if not k.startswith("decoder.")}
-        missing = model.load_state_dict(kept, strict=False).missing_keys   # the base decoder starts anew
-        assert all(k.startswith("decoder.") for k in missing), missing
+        loaded = model.load_state_dict(kept, strict=False)   # the base decoder starts anew
+        other = [k for k in loaded.missing_keys + loaded.unexpected_keys if not k.startswith("decoder.")]
+        if other:
+            raise ShapeMoveError(f"{t.init_from}: only the base decoder may change width, but these weights do "
+                                 f"not match the new codec: {', '.join(other[:5])}")
     elif source is not None:
         model.load_state_dict(source.state_dict())
     freeze(model, t.freeze)

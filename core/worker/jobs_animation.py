@@ -1,7 +1,8 @@
 """Worker ops of the animation features (docs/animation.md), for the Blender panel:
 
-- ``animate``: the ``generate`` op's params plus "loop", "in_place", "path" ([[x, z], ...] metres,
-  Y up), "speed", "stretch" -> the motion file written and its facts;
+- ``animate``: the ``generate`` op's params (with "library": the user's captioned motions compete,
+  one the codes cannot carry is played as captured) plus "loop", "in_place", "path" ([[x, z], ...]
+  metres, Y up), "speed", "stretch" -> the motion file written and its facts (with its "notes");
 - ``sequence``: {"segments": [{"prompt", "seconds"}, ...], "shape_text", "betas", "seed", "model",
   "body", "out"} -> a timeline motion; with "regenerate": K (0-based) and "motion" (a timeline
   file) segment K is sampled again with "seed" and the others are kept.
@@ -18,7 +19,8 @@ from .op_support import JobCancelled, param
 
 def _facts(out, motion, body) -> dict:
     facts = {**_motion_facts(out, motion), "measurements": _measurements(body, motion.betas),
-             "ik_error_cm": float(motion.ik_error_cm or 0.0), "warnings": list(motion.warnings)}
+             "ik_error_cm": float(motion.ik_error_cm or 0.0), "warnings": list(motion.warnings),
+             "notes": list(motion.notes)}
     if motion.loop_advance is not None:
         facts["loop_advance"] = [float(v) for v in motion.loop_advance]
     if motion.segment_bounds is not None:
@@ -58,7 +60,8 @@ def animate(params, progress, cancel) -> dict:
                   temperature=float(param(params, op, "temperature", (int, float), 1.0)),
                   top_k=param(params, op, "top_k", int, 50), by_parts=bool(param(params, op, "by_parts", bool, True)))
     progress(0.05, "loading models")
-    gen = _generator(param(params, op, "model", str, None), param(params, op, "body", str, None))
+    gen = _generator(param(params, op, "model", str, None), param(params, op, "body", str, None),
+                     param(params, op, "library", str, None))
     if cancel():
         raise JobCancelled
     with _cancellable(cancel):
