@@ -71,6 +71,22 @@ def test_paraphrase_eval_on_a_tiny_model(tiny_bundle, tmp_path, capsys):  # noqa
         from shapemove.core.eval.paraphrase_eval import eval_paraphrase
         eval_paraphrase(model, tmp_path / "p.json", seed=[1, 1], data=data)
 
+    # a user's library (--library): its clips join the memory; with only retrieved clips competing
+    # (--retrieval-first 0) every prompt keeps the library's one clip, and the result counts them
+    from shapemove.core.generation.generate import Generator, Request
+    from shapemove.core.scene.motion_file import save_motion
+
+    lib = tmp_path / "library"
+    lib.mkdir()
+    save_motion(lib / "stroll.npz", Generator(model).generate_batch([Request("Someone strolls down the street.",
+                                                                             seconds=3, seed=0)])[0])
+    assert main(["eval", "paraphrase", "--model", str(model), "--prompts", str(tmp_path / "p.json"), "--seconds", "1",
+                 "--data", str(data), "--json", str(tmp_path / "r3.json"), "--quiet", "--library", str(lib),
+                 "--retrieval-first", "0"]) == 0
+    three = json.loads((tmp_path / "r3.json").read_text())
+    assert three["library"] == str(lib) and three["kept_library"] == len(rows)
+    assert all(r["kept_clips"] == ["library:stroll"] for r in three["rows"])
+
 
 def test_bad_prompt_files(tmp_path):
     from shapemove.core.eval.paraphrase_eval import load_prompts

@@ -51,6 +51,34 @@ def test_retrieved_codes_are_the_nearest_captions_clips(gen, memory):
     assert retrieved_codes(None, gen._text_encoder(), "x", 2, 4, 50) == []
 
 
+def test_a_library_clip_competes_beside_nearer_training_captions(gen, memory):
+    """A user's library clip joins the candidates though training captions are nearer, when its own
+    caption is within ``LIBRARY_MARGIN`` of the nearest one's similarity (and at least
+    ``LIBRARY_FLOOR``); a clip far from the prompt, shorter than asked or already retrieved does not."""
+    from shapemove.core.generation.retrieved_candidates import LIBRARY_FLOOR, LIBRARY_MARGIN, library_codes
+
+    reader = gen._text_encoder()
+    kick = [int(x) for x in memory.clip_tokens[0]]      # any codes: the caption decides
+    memory.add_clips(["library:mine", "library:short"], [["a person punches with the left hand."],
+                                                         ["someone punches the air."]],
+                     [kick, kick[:8]], reader)
+    lib = {"library:mine", "library:short"}
+    prompt = "somebody punches"
+    found = retrieved_codes(memory, reader, prompt, 1, 10, 20)
+    assert {r[0] for r in found} == {"punch_1"}       # the training punch is the nearest caption
+    near, (c, sim) = found[0][1], memory.nearest_of(reader, prompt, [3, 4], 10)
+    assert memory.clip_ids[c] == "library:mine" and near - LIBRARY_MARGIN <= sim < near and sim >= LIBRARY_FLOOR
+    rows = library_codes(memory, reader, prompt, lib, found, 10, 20)
+    assert [r[0] for r in rows] == ["library:mine"] and rows[0][2] == kick[:20] and rows[0][1] == pytest.approx(sim)
+    assert library_codes(memory, reader, prompt, lib, found, 10, 20, margin=near - sim - 0.01) == []
+    # the short clip (8 codes) is nearer than "mine" once 4 codes will do, and is then the one offered
+    assert memory.clip_ids[memory.nearest_of(reader, prompt, [3, 4], 4)[0]] == "library:short"
+    assert library_codes(memory, reader, "a person walks forward", lib,   # far from every library caption
+                         retrieved_codes(memory, reader, "a person walks forward", 1, 10, 20), 10, 20) == []
+    assert library_codes(memory, reader, prompt, lib, found + rows, 10, 20) == []    # already a candidate
+    assert library_codes(memory, reader, prompt, set(), found, 10, 20) == []
+
+
 def test_generation_keeps_a_retrieved_clip_only_when_it_wins(gen, memory):
     from shapemove.core.generation.generate import Request
 
@@ -229,6 +257,37 @@ def test_a_library_kick_loops_and_stays_in_place_as_captured(mocap_root, openbod
     assert np.ptp(m.joints[:, 0, [0, 2]], axis=0).max() < 1e-4 and lift(m.joints[:, 8, 1]) > 0.85 * src
     r = job(loop=True, seconds=2.0)                     # the codes' loop: the kick flattened
     assert not r["notes"] and lift(load_motion(r["path"]).joints[:, 8, 1]) < 0.5 * src
+
+
+def test_a_library_kick_is_found_for_words_the_training_kicks_are_nearer_to(mocap_root, openbody, tmp_path,
+                                                                           monkeypatch):
+    """"a karate front kick" is nearer to the training set's kicks (0.73) than to the user's "a
+    person does a high front kick with the right leg" (0.67): without ``library_codes`` the user's
+    kick is never a candidate and the codes' kick barely lifts the ankle; with it, the library kick
+    competes, is kept and is played as captured. A walk or a punch is not given the kick."""
+    import shutil
+
+    from shapemove.core.generation import generate as generate_module
+    from shapemove.core.generation.generate import Generator, Request
+    from shapemove.core.generation.retarget import source_joints
+
+    lib = tmp_path / "library"
+    lib.mkdir()
+    kick = mocap_root / "bandai" / "dataset-1" / "data" / "dataset-1_kick_normal_001.bvh"
+    shutil.copy(kick, lib / "kick.bvh")
+    (lib / "kick.txt").write_text("a person does a high front kick with the right leg\n")
+    lift = lambda y: float(y.max() - y.min())  # noqa: E731   (the right ankle's rise)
+    src = lift(source_joints(kick, openbody)[0][:, 8, 1])
+    own = Generator(None)
+    own.add_library(lib)
+    run = lambda p: own.generate_batch([Request(p, seconds=4, seed=0)])[0]  # noqa: E731
+    m = run("a karate front kick")
+    assert m.retrieved_clips == ["library:kick"] and len(m.notes) == 1 and lift(m.joints[:, 8, 1]) > 0.9 * src
+    assert "library:kick" not in run("a person walks forward").retrieved_clips
+    assert "library:kick" not in run("a person punches").retrieved_clips
+    monkeypatch.setattr(generate_module, "library_codes", lambda *a, **k: [])
+    m = run("a karate front kick")
+    assert "library:kick" not in m.retrieved_clips and lift(m.joints[:, 8, 1]) < 0.3 * src
 
 
 def test_a_model_folder_with_a_memory_retrieves_from_it(gen, tmp_path):

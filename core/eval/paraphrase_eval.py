@@ -107,13 +107,15 @@ def eval_paraphrase(model_dir=None, prompts=None, tma=None, seed: int | list[int
                     progress=None, generator=None, data=None, classifier=None, ceiling_clips: int | None = None,
                     show_progress: bool = True, candidates: int | None = None, feature_classifier=None,
                     retrieval: bool = True, frequent: int = 20, retrieval_prefix: int | None = None,
-                    retrieved: int | None = None, retrieval_first: float | None = None, by_parts: bool = True) -> dict:
+                    retrieved: int | None = None, retrieval_first: float | None = None, by_parts: bool = True,
+                    library=None) -> dict:
     """Generate a motion per held-out prompt and classify it (module docstring). ``data``: the built
     dataset whose training clips the kNN classifier reads (default ``default_built_dir()``);
     ``classifier``: an ``ActionClassifier`` to use instead (``feature_classifier`` likewise for the
     TMA-free one); ``candidates``: best-of-N samples per prompt (default: the product's);
     ``retrieval_prefix``: codes of a retrieved clip the seeded candidates start from (default: the
-    product's; 0 none, ``retrieval_seeds.py``). Returns
+    product's; 0 none, ``retrieval_seeds.py``); ``library``: a folder of captioned motions added to the
+    memory first, as a user's Library (``Generator.add_library``). Returns
     {"motion", "text", "motion_vs_text_prototypes", "motion_features", "reachable", "classifier",
     "unknown_action", "actions", "rows", ...}."""
     from ..generation.generate import Generator, Request
@@ -140,6 +142,8 @@ def eval_paraphrase(model_dir=None, prompts=None, tma=None, seed: int | list[int
                                  "(or set SHAPEMOVE_BUILT; default data/built when it exists)")
     gen = generator if generator is not None else Generator(model_dir)
     gen.set_retrieval(retrieval)
+    if library is not None:
+        gen.add_library(library)
     actions = gen.known_actions
     if not actions:
         raise ShapeMoveError(f"{gen.model_dir}: its T5 lists no known actions (trained before known_texts.json); "
@@ -206,6 +210,8 @@ def eval_paraphrase(model_dir=None, prompts=None, tma=None, seed: int | list[int
             "retrieval_prefix": retrieval_prefix if retrieval and gen.reads_memory else 0,
             "retrieved": retrieved if retrieval else 0, "retrieval_first": retrieval_first,
             "kept_retrieved": sum(bool(r["kept_clips"]) for r in rows), "by_parts": by_parts, "seeds": seeds,
+            "library": str(library) if library is not None else None,
+            "kept_library": sum(any(str(c).startswith("library:") for c in r["kept_clips"]) for r in rows),
             "composed": sum(bool(r["parts"]) for r in rows), "mirrored": sum(r["mirrored"] for r in rows),
             "classifier": {**classifier.info, "ceiling": ceiling},
             "feature_classifier": dict(feature_classifier.info) if feature_classifier is not None else None,
@@ -336,6 +342,9 @@ def add_arguments(p) -> None:
                    help="real clips nearest by caption added to the candidates (default: the product's; 0: none)")
     p.add_argument("--retrieval-first", type=float, default=None, metavar="SIM",
                    help="caption similarity from which only retrieved clips compete (default: the product's)")
+    p.add_argument("--library", type=Path, default=None, metavar="DIR",
+                   help="a folder of captioned motions added to the memory, as the panel's Library "
+                        "(a kept clip of it is judged as what the rig plays)")
     p.add_argument("--no-parts", action="store_true",
                    help="generate each prompt whole: no composition by body part, no mirroring to a named side")
 
@@ -349,7 +358,7 @@ def from_cli(args) -> int:
                               show_progress=not args.quiet, candidates=args.candidates,
                               retrieval=not args.no_retrieval, retrieval_prefix=args.retrieval_prefix,
                               retrieved=args.retrieved, retrieval_first=args.retrieval_first,
-                              by_parts=not args.no_parts)
+                              by_parts=not args.no_parts, library=args.library)
     finally:
         progress.close()
     return show_result(format_results(res), res, args.json)

@@ -38,7 +38,8 @@ from .parts import CLAUSE_NEAR, generate_by_parts, is_by_parts, redecode_parts
 from .prompts import check_prompt
 from .rerank import CandidatePicker
 from .retrieval_seeds import seed_prefixes, seeded_count
-from .retrieved_candidates import retrieved_codes
+from .on_the_spot import on_the_spot
+from .retrieved_candidates import library_codes, retrieved_codes
 from .sampling_params import (DEFAULT_CANDIDATES, DEFAULT_GUIDANCE, DEFAULT_RETRIEVAL_FIRST, DEFAULT_RETRIEVAL_PREFIX,
                               DEFAULT_RETRIEVED, check_candidates, check_guidance, check_retrieval_first,
                               check_retrieval_prefix, check_retrieved, check_sampling)
@@ -232,7 +233,8 @@ class Generator:
         when the model folder has a memory and retrieval is on."""
         if not r.retrieved or self.t5.memory is None or not self.t5.memory_enabled:
             return []
-        return retrieved_codes(self.t5.memory, self._text_encoder(), r.prompt, r.retrieved, lo, hi)
+        found = retrieved_codes(self.t5.memory, self._text_encoder(), r.prompt, r.retrieved, lo, hi)
+        return found + library_codes(self.t5.memory, self._text_encoder(), r.prompt, self.library_files, found, lo, hi)
 
     def _retrieval_seeds(self, r: Request, n: int) -> list[list[int]]:
         """Prefixes for the seeded share of ``n`` candidates (``retrieval_seeds.py``): only for a model
@@ -398,6 +400,8 @@ class Generator:
                               if self.asks_circle(r.prompt, check) else
                               turn_motion(motion, self.body, r.prompt, self.ik_refine_iters))    # turn_words.py
                     motion = slow_motion(motion, self.body, r.prompt, self.ik_refine_iters)      # slow_steps.py
+            if r.by_parts:   # "jogs in place": the data's gaits all travel; stepped on the spot instead
+                motion = on_the_spot(motion, self.body, r.prompt, self.ik_refine_iters)        # on_the_spot.py
             motion.warnings = [check.warning] if check is not None and check.warning else []
             if r.candidates > 1 and r.temperature > 0:  # best-of-N wanted: say when the model cannot pick
                 motion.warnings += part_warnings(self.model_dir)

@@ -29,6 +29,7 @@ import numpy as np
 from ..constants import FPS
 from ..errors import ShapeMoveError
 from ..scene.motion_file import Motion, make_motion
+from .on_the_spot import LOOP_ALLOWED, spot_track
 from .prompts import check_prompt
 from .sampling_params import DEFAULT_CANDIDATES, check_candidates, check_sampling
 from .token_sampling import body_for, sample_codes
@@ -228,6 +229,7 @@ def generate_loop(gen, req, progress=None, cancel=None) -> Motion:
         if cancel is not None and cancel():
             raise ShapeMoveError("cancelled")
         track, _ = decoded_track(codes, gen.vae, gen.body, betas)
+        track = spot_track(track, req.prompt, LOOP_ALLOWED) or track   # "jogs in place": on the spot (on_the_spot.py)
         try:
             found.append((track, best_cut(track.joints, FPS, period)))
         except ShapeMoveError:

@@ -19,7 +19,11 @@ and its feet are planted as for any sample. A clip shorter than the requested le
 """
 from __future__ import annotations
 
+from ..models.motion_memory import sentence_vectors
+
 WINDOWS = 3   # windows of a clip longer than the requested length: its start, middle and end
+LIBRARY_MARGIN = 0.08   # a user's library clip competes when its caption is this near the nearest caption's
+LIBRARY_FLOOR = 0.4     # ... and at least this near the prompt (MiniLM cosine)
 
 
 def windows(codes, min_codes: int, max_codes: int) -> list[list[int]]:
@@ -46,3 +50,24 @@ def retrieved_codes(memory, reader, prompt: str, count: int, min_codes: int,
     for c, sim in memory.nearest_long(reader, prompt, count, min_codes, 4 * count):  # room for skipping short clips
         out += [(memory.clip_ids[c], float(sim), w) for w in windows(memory.clip_tokens[c], min_codes, max_codes)]
     return out
+
+
+def library_codes(memory, reader, prompt: str, library, found, min_codes: int, max_codes: int,
+                  margin: float = LIBRARY_MARGIN) -> list[tuple[str, float, list[int]]]:
+    """(clip id, caption similarity, codes) of the windows of the user's library clip (``library``:
+    its clip ids in ``memory``) nearest to ``prompt`` by caption, when ``found`` (what
+    ``retrieved_codes`` gave) lacks it and its similarity is at least ``LIBRARY_FLOOR`` and at least
+    the memory's nearest caption's (a clip of any length) less ``margin``: thousands of training
+    captions would otherwise keep a user's own clip out of the candidates ("a karate front kick"
+    finds the training kicks, not the user's "front kick with the right leg"). [] otherwise."""
+    if memory is None or not library:
+        return []
+    hit = memory.nearest_of(reader, prompt, [i for i, c in enumerate(memory.clip_ids) if c in library], min_codes)
+    if hit is None:
+        return []
+    c, sim = hit
+    cid = memory.clip_ids[c]
+    near = max(s for _, s in memory.nearest(sentence_vectors(reader, [prompt]), 1)[0])   # any length
+    if cid in {f[0] for f in found} or sim < max(LIBRARY_FLOOR, near - margin):
+        return []
+    return [(cid, float(sim), w) for w in windows(memory.clip_tokens[c], min_codes, max_codes)]

@@ -103,13 +103,13 @@ def replanted(motion: Motion, body, track: Track, ik_refine_iters: int = 10) -> 
     """A generated motion after an edit of its track (a circle walked, a turn given back): planted
     again (``plant``), its features computed as the dataset builder computes a clip's (what the
     judges and the TMA read), and what generation said of it kept (body source, retrieved clips,
-    part prompts, warnings). Like every edit, it keeps no tokens: a new body keeps the motion
+    part prompts, warnings, notes). Like every edit, it keeps no tokens: a new body keeps the motion
     rather than re-decoding it."""
     from ..motion.features import motion_features
 
     out = plant(body, motion.betas, track, ik_refine_iters, prompt=motion.prompt)
     out.features = motion_features(out)
-    for key in ("shape_source", "retrieved_clips", "part_prompts", "warnings"):
+    for key in ("shape_source", "retrieved_clips", "part_prompts", "warnings", "notes"):
         if hasattr(motion, key):
             setattr(out, key, getattr(motion, key))
     return out
