@@ -4,7 +4,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from shapemove.core.generation.on_the_spot import asks_on_the_spot, on_the_spot_track
+from shapemove.core.generation.on_the_spot import asks_on_the_spot
+from shapemove.core.generation.stride_scale import scaled_strides
 
 pytestmark = pytest.mark.usefixtures("one_thread")
 
@@ -39,7 +40,7 @@ def test_the_words_that_keep_a_gait_in_place():
 def test_stepping_on_the_spot_keeps_planted_feet_and_bone_lengths():
     J = _walker()
     s = 0.1
-    out = on_the_spot_track(J, s)
+    out = scaled_strides(J, s)
     # the root's path is scaled about its start (height kept)
     assert np.allclose(out[:, 0, [0, 2]], J[0, 0, [0, 2]] + s * (J[:, 0, [0, 2]] - J[0, 0, [0, 2]]), atol=1e-9)
     assert np.allclose(out[:, [0, 7, 8, 10, 11], 1], J[:, [0, 7, 8, 10, 11], 1], atol=1e-12)
@@ -57,7 +58,7 @@ def test_stepping_on_the_spot_keeps_planted_feet_and_bone_lengths():
     # the feet keep their direction from the ankle; the upper body is carried by the root
     assert np.allclose(out[:, 10] - out[:, 7], J[:, 10] - J[:, 7]) and np.allclose(out[:, 11] - out[:, 8], J[:, 11] - J[:, 8])
     assert np.allclose(out[:, 16] - out[:, 0], J[:, 16] - J[:, 0])
-    assert np.allclose(on_the_spot_track(J, 1.0), J)
+    assert np.allclose(scaled_strides(J, 1.0), J)
 
 
 def test_a_jog_asked_in_place_steps_on_the_spot(openbody):

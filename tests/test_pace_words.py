@@ -94,7 +94,7 @@ def test_the_pace_sets_ask_one_gait_slow_plain_and_fast():
     ("a person walks slowly", True),
     ("the guard marches slowly", True),
     ("a man strolls at a leisurely pace down the road", True),
-    ("a woman jogs slowly", False),              # a flight phase: not slowed
+    ("a woman jogs slowly", False),              # a flight phase: shorter strides instead
     ("a person walks slowly, then runs", False),  # a gait with flight beside it
     ("a person walks", False),
     ("a person waves slowly", False),
@@ -105,6 +105,21 @@ def test_asks_slow_steps_reads_a_stepping_gaits_slow_pace(prompt, expected):
     assert asks_slow_steps(prompt) == expected
 
 
+@pytest.mark.parametrize("prompt, expected", [
+    ("a woman jogs slowly", True),
+    ("a man jogs at an easy pace", True),
+    ("a person walks slowly, then runs", True),   # a flight phase among the gaits: strides, not time
+    ("a person walks slowly", False),             # played slower instead
+    ("a woman jogs", False),
+    ("a woman jogs slowly, then fast", False),    # both paces: no pace
+    ("someone waves slowly", False),
+])
+def test_asks_slow_flight_reads_a_jog_or_runs_slow_pace(prompt, expected):
+    from shapemove.core.generation.pace_words import asks_slow_flight
+
+    assert asks_slow_flight(prompt) == expected
+
+
 def test_slow_motion_plays_a_walk_at_the_slow_speed_over_the_same_length():
     from shapemove.core.generation.generate import Generator, Request
     from shapemove.core.generation.pace_words import SLOW_SPEED
@@ -112,7 +127,7 @@ def test_slow_motion_plays_a_walk_at_the_slow_speed_over_the_same_length():
 
     gen = Generator("weights/default")
     walk = gen.generate_batch([Request("a person walks forward", seconds=4.0, seed=0)])[0]
-    assert slow_motion(walk, gen.body, "a person jogs slowly") is walk
+    assert slow_motion(walk, gen.body, "a person walks forward") is walk
     slow = slow_motion(walk, gen.body, "a person walks forward slowly")
     assert slow.num_frames == walk.num_frames and slow.tokens is None   # an edit: no tokens kept
     # the slowed walk covers what the walk covered in its first SLOW_SPEED of the time
@@ -124,3 +139,27 @@ def test_slow_motion_plays_a_walk_at_the_slow_speed_over_the_same_length():
     feet = [7, 8, 10, 11]
     assert abs(slow.joints[:, feet, 1].min() - walk.joints[:, feet, 1].min()) < 0.01
     assert slow.features is not None and len(slow.features) == slow.num_frames - 1
+
+
+def test_slow_motion_gives_a_jog_shorter_strides_at_the_same_cadence():
+    """A jog asked slowly is not played slower (its flights would hang in the air): the same frames,
+    the same flights, strides SLOW_SPEED as long, the feet planted again."""
+    from shapemove.core.generation.generate import Generator, Request
+    from shapemove.core.generation.pace_words import SLOW_SPEED
+    from shapemove.core.generation.slow_steps import slow_motion
+
+    gen = Generator("weights/default")
+    jog = gen.generate_batch([Request("a person jogs forward", seconds=4.0, seed=0)])[0]
+    slow = slow_motion(jog, gen.body, "a person jogs forward slowly")
+    assert slow.num_frames == jog.num_frames and slow.tokens is None
+    path = lambda j: np.linalg.norm(np.diff(j[:, 0, [0, 2]], axis=0), axis=1).sum()  # noqa: E731
+    assert path(jog.joints) > 4.0 and path(slow.joints) == pytest.approx(SLOW_SPEED * path(jog.joints), rel=0.05)
+    # the flights stay where they were: the frames with no foot planted
+    flight = lambda m: ~m.contacts.astype(bool).any(1)  # noqa: E731
+    assert flight(jog).sum() >= 8 and (flight(slow) == flight(jog)).mean() > 0.9
+    slide = []
+    for k, j in ((2, 10), (3, 11)):   # the balls of the feet where planted
+        on = (slow.contacts[1:, k] > 0) & (slow.contacts[:-1, k] > 0)
+        slide += list(np.linalg.norm(np.diff(slow.joints[:, j, [0, 2]], axis=0), axis=1)[on])
+    assert len(slide) > 10 and np.mean(slide) < 0.002
+

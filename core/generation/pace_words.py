@@ -13,7 +13,8 @@ A slow pace is not chosen among the candidates: the slowest candidates of a walk
 and creeps, so choosing them cost the gait (``docs/evaluation.md``, fifteenth session). Instead the
 chosen motion of a stepping gait (a walk, march, sneak, limp, ...: no flight phase) is played at
 ``SLOW_SPEED`` over the same length (``slow_steps.slow_motion``: an edit, like a turn the words
-name). A jog or a run is left as it is: slowed down, its flights would hang in the air. Both
+name). A jog or a run asked slowly keeps its cadence and flights and takes ``SLOW_SPEED`` shorter
+strides (played slower, its flights would hang in the air). Both
 paces named ("slowly, then fast") is no pace; a prompt without a gait ("waves quickly") is left to
 the TMA, since its root speed says nothing of a hand's.
 """
@@ -50,6 +51,13 @@ def asks_slow_steps(prompt: str) -> bool:
     """Whether the prompt asks a stepping gait (and no other gait) to go slowly, naming no fast pace."""
     gaits = _gaits(prompt)
     return bool(_SLOW.search(prompt)) and not _FAST.search(prompt) and bool(gaits) and gaits <= STEPPING
+
+
+def asks_slow_flight(prompt: str) -> bool:
+    """Whether the prompt asks a gait with a flight phase (a jog, a run) to go slowly, naming no fast
+    pace: its strides are shortened instead (``slow_steps``)."""
+    gaits = _gaits(prompt)
+    return bool(_SLOW.search(prompt)) and not _FAST.search(prompt) and bool(gaits) and not gaits <= STEPPING
 
 
 def gait_speed(features: np.ndarray) -> float:
