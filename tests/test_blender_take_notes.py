@@ -46,6 +46,34 @@ def test_panel_says_a_take_was_moved_by_its_rotations(addon, openbody, tmp_path,
     assert not redecode.wants_redecode(rig)
 
 
+def _asks_for_the_library(run, op: str, jobs: list, tmp_path) -> None:
+    """The operator ``run`` sends no "library" until Use Library motions is on, then the Library
+    folder; a folder that is gone is refused by name."""
+    s = bpy.context.scene.shapemove
+    s.prompt = "someone kicks high in front of them"
+    lib = tmp_path / "library"
+    lib.mkdir()
+    s.library_folder, s.use_library = str(lib), False
+    assert "FINISHED" in run()
+    assert jobs[-1][0] == op and "library" not in jobs[-1][1]          # off by default
+    s.use_library = True
+    assert "FINISHED" in run()
+    assert jobs[-1][1]["library"] == str(lib)
+    s.library_folder = str(tmp_path / "nowhere")
+    with pytest.raises(RuntimeError, match="library folder not found"):
+        run()
+
+
+def _motion_file(openbody, tmp_path):
+    T = 12
+    transl = np.stack([0.02 * np.arange(T), np.zeros(T), np.zeros(T)], -1)
+    save_motion(tmp_path / "m.npz", make_motion(openbody, np.zeros((T, 24, 3)), transl, np.zeros(10), fps=20))
+    return str(tmp_path / "m.npz")
+
+
+NOTE = "played as captured from your library (kick.bvh): its codes miss it by 253 mm in its worst second"
+
+
 def test_generate_uses_the_library_when_asked_and_notes_a_captured_take(addon, openbody, tmp_path,  # noqa: F811
                                                                          monkeypatch):
     from shapemove.shapemove_addon import job_submit, operators, panels
@@ -53,28 +81,12 @@ def test_generate_uses_the_library_when_asked_and_notes_a_captured_take(addon, o
 
     jobs = []
     monkeypatch.setattr(job_submit, "submit_job", lambda op, params, **kw: jobs.append((op, params, kw)) or "j1")
-    s = bpy.context.scene.shapemove
-    s.prompt = "someone kicks high in front of them"
-    lib = tmp_path / "library"
-    lib.mkdir()
-    s.library_folder = str(lib)
-    assert "FINISHED" in bpy.ops.shapemove.generate()
-    assert jobs[-1][0] == "generate" and "library" not in jobs[-1][1]          # off by default
-    s.use_library = True
-    assert "FINISHED" in bpy.ops.shapemove.generate()
-    assert jobs[-1][1]["library"] == str(lib)
-    s.library_folder = str(tmp_path / "nowhere")
-    with pytest.raises(RuntimeError, match="library folder not found"):
-        bpy.ops.shapemove.generate()
-    T = 12
-    transl = np.stack([0.02 * np.arange(T), np.zeros(T), np.zeros(T)], -1)
-    save_motion(tmp_path / "m.npz", make_motion(openbody, np.zeros((T, 24, 3)), transl, np.zeros(10), fps=20))
-    note = "played as captured from your library (kick.bvh): its codes miss it by 253 mm in its worst second"
-    rig = operators.on_generated("Kicker", {"result": {"path": str(tmp_path / "m.npz"), "warnings": [],
-                                                      "notes": [note]}})
-    assert list(rig[TAKE_NOTES_KEY]) == [note]
+    _asks_for_the_library(bpy.ops.shapemove.generate, "generate", jobs, tmp_path)
+    rig = operators.on_generated("Kicker", {"result": {"path": _motion_file(openbody, tmp_path), "warnings": [],
+                                                      "notes": [NOTE]}})
+    assert list(rig[TAKE_NOTES_KEY]) == [NOTE]
     shown = _draw(panels.SHAPEMOVE_PT_generate, bpy.context)
-    assert note in shown and not any(line.startswith("Prompt unlike") for line in shown)
+    assert NOTE in shown and not any(line.startswith("Prompt unlike") for line in shown)
 
 
 def test_generate_animated_uses_the_library_and_keeps_the_note(addon, openbody, tmp_path, monkeypatch):  # noqa: F811
@@ -85,24 +97,10 @@ def test_generate_animated_uses_the_library_and_keeps_the_note(addon, openbody, 
 
     jobs = []
     monkeypatch.setattr(job_submit, "submit_job", lambda op, params, **kw: jobs.append((op, params, kw)) or "j1")
-    s, a = bpy.context.scene.shapemove, bpy.context.scene.shapemove_animation
-    s.prompt = "someone kicks high in front of them"
-    lib = tmp_path / "library"
-    lib.mkdir()
-    s.library_folder, s.use_library, a.loop = str(lib), False, True
-    assert "FINISHED" in bpy.ops.shapemove.animate()
-    assert jobs[-1][0] == "animate" and jobs[-1][1]["loop"] and "library" not in jobs[-1][1]
-    s.use_library = True
-    assert "FINISHED" in bpy.ops.shapemove.animate()
-    assert jobs[-1][1]["library"] == str(lib)
-    s.library_folder = str(tmp_path / "nowhere")
-    with pytest.raises(RuntimeError, match="library folder not found"):
-        bpy.ops.shapemove.animate()
-    T = 12
-    transl = np.stack([0.02 * np.arange(T), np.zeros(T), np.zeros(T)], -1)
-    save_motion(tmp_path / "m.npz", make_motion(openbody, np.zeros((T, 24, 3)), transl, np.zeros(10), fps=20))
-    note = "played as captured from your library (kick.bvh): its codes miss it by 250 mm in its worst second"
-    jobs[-2][2]["on_result"]({"result": {"path": str(tmp_path / "m.npz"), "warnings": [], "notes": [note]}})
+    bpy.context.scene.shapemove_animation.loop = True
+    _asks_for_the_library(bpy.ops.shapemove.animate, "animate", jobs, tmp_path)
+    assert jobs[-1][1]["loop"]
+    jobs[-1][2]["on_result"]({"result": {"path": _motion_file(openbody, tmp_path), "warnings": [], "notes": [NOTE]}})
     rig = operators.active_rig(bpy.context)
-    assert rig is not None and list(rig[TAKE_NOTES_KEY]) == [note]
-    assert note in _draw(panels.SHAPEMOVE_PT_generate, bpy.context)
+    assert rig is not None and list(rig[TAKE_NOTES_KEY]) == [NOTE]
+    assert NOTE in _draw(panels.SHAPEMOVE_PT_generate, bpy.context)
