@@ -7,6 +7,7 @@ import pytest
 
 from shapemove.core.errors import ShapeMoveError
 from shapemove.core.generation.retrieved_candidates import retrieved_codes, windows
+from shapemove.core.models.motion_memory import sentence_vectors
 
 pytestmark = pytest.mark.usefixtures("one_thread")
 
@@ -52,30 +53,35 @@ def test_retrieved_codes_are_the_nearest_captions_clips(gen, memory):
 
 
 def test_a_library_clip_competes_beside_nearer_training_captions(gen, memory):
-    """A user's library clip joins the candidates though training captions are nearer, when its own
-    caption is within ``LIBRARY_MARGIN`` of the nearest one's similarity (and at least
-    ``LIBRARY_FLOOR``); a clip far from the prompt, shorter than asked or already retrieved does not."""
+    """A user's library clip joins the candidates though training captions are nearer: the library
+    clip nearest to the prompt when its caption is within ``LIBRARY_MARGIN`` of the nearest caption's
+    similarity (and at least ``LIBRARY_FLOOR``), and the nearest library clip of an action the prompt
+    names. A clip shorter than asked, one already retrieved, or one of another action far from the
+    prompt is not offered."""
     from shapemove.core.generation.retrieved_candidates import LIBRARY_FLOOR, LIBRARY_MARGIN, library_codes
 
     reader = gen._text_encoder()
-    kick = [int(x) for x in memory.clip_tokens[0]]      # any codes: the caption decides
-    memory.add_clips(["library:mine", "library:short"], [["a person punches with the left hand."],
-                                                         ["someone punches the air."]],
-                     [kick, kick[:8]], reader)
-    lib = {"library:mine", "library:short"}
+    codes = [int(x) for x in memory.clip_tokens[0]]     # any codes: the captions decide
+    memory.add_clips(["library:mine", "library:short", "library:jab"],
+                     [["a person punches with the left hand."], ["someone punches the air."], ["a boxer jabs."]],
+                     [codes, codes[:8], codes], reader, actions=[[], [], ["punch"]])   # as if only the jab named one
+    lib = {"library:mine", "library:short", "library:jab"}
     prompt = "somebody punches"
     found = retrieved_codes(memory, reader, prompt, 1, 10, 20)
-    assert {r[0] for r in found} == {"punch_1"}       # the training punch is the nearest caption
-    near, (c, sim) = found[0][1], memory.nearest_of(reader, prompt, [3, 4], 10)
+    assert {r[0] for r in found} == {"punch_1"}       # the training punch is the nearest long caption
+    near = max(s for _, s in memory.nearest(sentence_vectors(reader, [prompt]), 1)[0])
+    c, sim = memory.nearest_of(reader, prompt, [3, 4, 5], 10)
     assert memory.clip_ids[c] == "library:mine" and near - LIBRARY_MARGIN <= sim < near and sim >= LIBRARY_FLOOR
     rows = library_codes(memory, reader, prompt, lib, found, 10, 20)
-    assert [r[0] for r in rows] == ["library:mine"] and rows[0][2] == kick[:20] and rows[0][1] == pytest.approx(sim)
-    assert library_codes(memory, reader, prompt, lib, found, 10, 20, margin=near - sim - 0.01) == []
-    # the short clip (8 codes) is nearer than "mine" once 4 codes will do, and is then the one offered
-    assert memory.clip_ids[memory.nearest_of(reader, prompt, [3, 4], 4)[0]] == "library:short"
-    assert library_codes(memory, reader, "a person walks forward", lib,   # far from every library caption
-                         retrieved_codes(memory, reader, "a person walks forward", 1, 10, 20), 10, 20) == []
-    assert library_codes(memory, reader, prompt, lib, found + rows, 10, 20) == []    # already a candidate
+    assert [r[0] for r in rows] == ["library:mine", "library:jab"] and rows[0][2] == codes[:20]
+    assert rows[0][1] == pytest.approx(sim) and rows[1][1] < near - LIBRARY_MARGIN   # the jab: by its action
+    assert [r[0] for r in library_codes(memory, reader, prompt, lib, found, 10, 20, margin=near - sim - 0.01)] == \
+        ["library:jab"]
+    # the short clip (8 codes) is nearer than "mine" once 4 codes will do
+    assert memory.clip_ids[memory.nearest_of(reader, prompt, [3, 4, 5], 4)[0]] == "library:short"
+    walk = "a person walks forward"                   # far from every library caption, no punch named
+    assert library_codes(memory, reader, walk, lib, retrieved_codes(memory, reader, walk, 1, 10, 20), 10, 20) == []
+    assert library_codes(memory, reader, prompt, lib, found + rows, 10, 20) == []    # already candidates
     assert library_codes(memory, reader, prompt, set(), found, 10, 20) == []
 
 
@@ -262,9 +268,10 @@ def test_a_library_kick_loops_and_stays_in_place_as_captured(mocap_root, openbod
 def test_a_library_kick_is_found_for_words_the_training_kicks_are_nearer_to(mocap_root, openbody, tmp_path,
                                                                            monkeypatch):
     """"a karate front kick" is nearer to the training set's kicks (0.73) than to the user's "a
-    person does a high front kick with the right leg" (0.67): without ``library_codes`` the user's
-    kick is never a candidate and the codes' kick barely lifts the ankle; with it, the library kick
-    competes, is kept and is played as captured. A walk or a punch is not given the kick."""
+    person does a high front kick with the right leg" (0.67), "a woman kicks" to "A person kicks."
+    (0.90 against 0.56): without ``library_codes`` the user's kick is never a candidate and the
+    codes' kick barely lifts the ankle; with it, the library kick competes (by its caption, by the
+    action named), is kept and is played as captured. A walk or a punch is not given the kick."""
     import shutil
 
     from shapemove.core.generation import generate as generate_module
@@ -283,6 +290,8 @@ def test_a_library_kick_is_found_for_words_the_training_kicks_are_nearer_to(moca
     run = lambda p: own.generate_batch([Request(p, seconds=4, seed=0)])[0]  # noqa: E731
     m = run("a karate front kick")
     assert m.retrieved_clips == ["library:kick"] and len(m.notes) == 1 and lift(m.joints[:, 8, 1]) > 0.9 * src
+    m = run("a woman kicks")                         # nearest "A person kicks." (0.90): the user's kick by its action
+    assert m.retrieved_clips == ["library:kick"] and lift(m.joints[:, 8, 1]) > 0.85 * src
     assert "library:kick" not in run("a person walks forward").retrieved_clips
     assert "library:kick" not in run("a person punches").retrieved_clips
     monkeypatch.setattr(generate_module, "library_codes", lambda *a, **k: [])

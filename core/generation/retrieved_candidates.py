@@ -54,20 +54,35 @@ def retrieved_codes(memory, reader, prompt: str, count: int, min_codes: int,
 
 def library_codes(memory, reader, prompt: str, library, found, min_codes: int, max_codes: int,
                   margin: float = LIBRARY_MARGIN) -> list[tuple[str, float, list[int]]]:
-    """(clip id, caption similarity, codes) of the windows of the user's library clip (``library``:
-    its clip ids in ``memory``) nearest to ``prompt`` by caption, when ``found`` (what
-    ``retrieved_codes`` gave) lacks it and its similarity is at least ``LIBRARY_FLOOR`` and at least
-    the memory's nearest caption's (a clip of any length) less ``margin``: thousands of training
-    captions would otherwise keep a user's own clip out of the candidates ("a karate front kick"
-    finds the training kicks, not the user's "front kick with the right leg"). [] otherwise."""
+    """(clip id, caption similarity, codes) of the windows of the user's library clips (``library``:
+    their clip ids in ``memory``) that compete beside ``found`` (what ``retrieved_codes`` gave):
+    the library clip nearest to ``prompt`` by caption when its similarity is at least
+    ``LIBRARY_FLOOR`` and at least the memory's nearest caption's (a clip of any length) less
+    ``margin``, and the nearest library clip of an action the prompt names (``data/actions.py``
+    patterns, read from its caption): thousands of training captions would otherwise keep a user's
+    own clip out of the candidates ("a karate front kick" finds the training kicks, not the user's
+    "front kick with the right leg"; "a woman kicks" finds "A person kicks."). Clips already in
+    ``found`` are not offered again; [] when none qualifies."""
+    from ..data.actions import action_spans
+
     if memory is None or not library:
         return []
-    hit = memory.nearest_of(reader, prompt, [i for i, c in enumerate(memory.clip_ids) if c in library], min_codes)
-    if hit is None:
-        return []
-    c, sim = hit
-    cid = memory.clip_ids[c]
-    near = max(s for _, s in memory.nearest(sentence_vectors(reader, [prompt]), 1)[0])   # any length
-    if cid in {f[0] for f in found} or sim < max(LIBRARY_FLOOR, near - margin):
-        return []
-    return [(cid, float(sim), w) for w in windows(memory.clip_tokens[c], min_codes, max_codes)]
+    mine = [i for i, c in enumerate(memory.clip_ids) if c in library]
+    taken = {f[0] for f in found}
+    offered = []
+    hit = memory.nearest_of(reader, prompt, mine, min_codes)
+    if hit is not None:
+        near = max(s for _, s in memory.nearest(sentence_vectors(reader, [prompt]), 1)[0])   # any length
+        if hit[1] >= max(LIBRARY_FLOOR, near - margin):
+            offered.append(hit)
+    named = {a for _, _, a in action_spans(prompt)}
+    hit = memory.nearest_of(reader, prompt, [i for i in mine if named & set(memory.clip_actions[i])], min_codes)
+    if hit is not None:
+        offered.append(hit)
+    out = []
+    for c, sim in offered:
+        cid = memory.clip_ids[c]
+        if cid not in taken:
+            taken.add(cid)
+            out += [(cid, float(sim), w) for w in windows(memory.clip_tokens[c], min_codes, max_codes)]
+    return out
