@@ -70,7 +70,7 @@ def test_a_library_clip_competes_beside_nearer_training_captions(gen, memory):
     found = retrieved_codes(memory, reader, prompt, 1, 10, 20)
     assert {r[0] for r in found} == {"punch_1"}       # the training punch is the nearest long caption
     near = max(s for _, s in memory.nearest(sentence_vectors(reader, [prompt]), 1)[0])
-    c, sim = memory.nearest_of(reader, prompt, [3, 4, 5], 10)
+    c, sim = memory.nearest_of(sentence_vectors(reader, [prompt])[0], [3, 4, 5], 10)
     assert memory.clip_ids[c] == "library:mine" and near - LIBRARY_MARGIN <= sim < near and sim >= LIBRARY_FLOOR
     rows = library_codes(memory, reader, prompt, lib, found, 10, 20)
     assert [r[0] for r in rows] == ["library:mine", "library:jab"] and rows[0][2] == codes[:20]
@@ -78,7 +78,7 @@ def test_a_library_clip_competes_beside_nearer_training_captions(gen, memory):
     assert [r[0] for r in library_codes(memory, reader, prompt, lib, found, 10, 20, margin=near - sim - 0.01)] == \
         ["library:jab"]
     # the short clip (8 codes) is nearer than "mine" once 4 codes will do
-    assert memory.clip_ids[memory.nearest_of(reader, prompt, [3, 4, 5], 4)[0]] == "library:short"
+    assert memory.clip_ids[memory.nearest_of(sentence_vectors(reader, [prompt])[0], [3, 4, 5], 4)[0]] == "library:short"
     walk = "a person walks forward"                   # far from every library caption, no punch named
     assert library_codes(memory, reader, walk, lib, retrieved_codes(memory, reader, walk, 1, 10, 20), 10, 20) == []
     assert library_codes(memory, reader, prompt, lib, found + rows, 10, 20) == []    # already candidates

@@ -14,6 +14,10 @@ for word), only the retrieved windows compete: the TMA rates a generated fallbac
 about as close to "throws punches" as a captured punch, so best-of-N alone would keep it. Either way the
 tokens are decoded by the SA-VAE for the requested body, so the motion has that body's proportions
 and its feet are planted as for any sample. A clip shorter than the requested length is skipped.
+A user's library (``Generator.add_library``) is in the same memory, where thousands of training
+captions can be nearer to a prompt than the user's own: ``library_codes`` offers the library's
+nearest clip beside them when its caption is nearly as near, and its nearest clip of an action the
+prompt names.
 
     rows = retrieved_codes(t5.memory, reader, "a man throws punches", count=2, min_codes=20, max_codes=20)
 """
@@ -70,13 +74,14 @@ def library_codes(memory, reader, prompt: str, library, found, min_codes: int, m
     mine = [i for i, c in enumerate(memory.clip_ids) if c in library]
     taken = {f[0] for f in found}
     offered = []
-    hit = memory.nearest_of(reader, prompt, mine, min_codes)
+    v = sentence_vectors(reader, [prompt])
+    hit = memory.nearest_of(v[0], mine, min_codes)
     if hit is not None:
-        near = max(s for _, s in memory.nearest(sentence_vectors(reader, [prompt]), 1)[0])   # any length
+        near = max((s for _, s in memory.nearest(v, 1)[0]), default=hit[1])   # the nearest caption, any length
         if hit[1] >= max(LIBRARY_FLOOR, near - margin):
             offered.append(hit)
     named = {a for _, _, a in action_spans(prompt)}
-    hit = memory.nearest_of(reader, prompt, [i for i in mine if named & set(memory.clip_actions[i])], min_codes)
+    hit = memory.nearest_of(v[0], [i for i in mine if named & set(memory.clip_actions[i])], min_codes)
     if hit is not None:
         offered.append(hit)
     out = []

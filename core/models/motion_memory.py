@@ -196,13 +196,14 @@ class MotionMemory:
         near = self.nearest(sentence_vectors(reader, [prompt]), room)[0]
         return [(c, s) for c, s in near if len(self.clip_tokens[c]) >= min_codes][:count]
 
-    def nearest_of(self, reader, prompt: str, clips, min_codes: int) -> tuple[int, float] | None:
-        """(clip index, similarity) of the clip of ``clips`` (indices) whose caption is nearest to
-        ``prompt``, among those with at least ``min_codes`` codes; None when there is none."""
+    def nearest_of(self, vector: torch.Tensor, clips, min_codes: int) -> tuple[int, float] | None:
+        """(clip index, similarity) of the clip of ``clips`` (indices) whose caption is nearest to the
+        unit sentence vector ``vector`` (384,), among those with at least ``min_codes`` codes; None
+        when there is none."""
         keep = {int(c) for c in clips if len(self.clip_tokens[int(c)]) >= min_codes}
         if not keep:
             return None
-        sims = (self.vectors @ sentence_vectors(reader, [prompt])[0].float()).tolist()
+        sims = (self.vectors @ vector.float()).tolist()
         best = None
         for t, cs in enumerate(self.text_clips):
             hit = next((c for c in cs if c in keep), None)
