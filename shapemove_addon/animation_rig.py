@@ -5,8 +5,9 @@ pelvis / the armature object / a root bone / none, and a timeline as NLA strips.
 ``core.scene.root_motion.rig_channels`` splits off, then
 - keys the travel on the armature object (``OBJECT``) or on a new ``root`` bone, the pelvis's
   parent, at the origin with an identity rest frame (``ROOT_BONE``);
-- for a loop: one key more (frame 0 moved by the advance) and a Cycles modifier in "Repeat with
-  Offset" mode on every F-Curve, so the action repeats for ever with the root advancing per cycle;
+- for a loop: one key more (frame 0 moved by the advance) and a Cycles modifier on every F-Curve,
+  "Repeat with Offset" on translations and "Repeat" on rotations, so the action repeats for ever
+  with the root advancing per cycle;
 - for a timeline (``segment_bounds``): one NLA track "ShapeMove timeline" with one strip per
   prompt, each playing its frames of the one action; strips can be moved and scaled.
 Keys are written per F-Curve with ``keyframe_points.add(n)`` + ``foreach_set``. A failure removes
@@ -78,10 +79,17 @@ def _add_root_bone(context, arm, pelvis: str) -> None:
     arm.pose.bones[ROOT_BONE].rotation_mode = "QUATERNION"
 
 
+ROTATION_PATHS = ("rotation_quaternion", "rotation_euler", "rotation_axis_angle")
+
+
 def _make_cycles(action, obj) -> None:
+    """A Cycles modifier on every F-Curve: translations repeat with their per-cycle offset (the
+    root advances), rotations repeat as they are. A rotation's closing key is its first rotation,
+    but continuous quaternion keys can end it as -q where they began at q (the same rotation, a
+    bone that turned past half a circle over the cycle): offset, every later cycle would add -2q."""
     for fc in action_fcurves(action, obj):
         mod = fc.modifiers.new("CYCLES")
-        mod.mode_before = mod.mode_after = "REPEAT_OFFSET"
+        mod.mode_before = mod.mode_after = "REPEAT" if fc.data_path.endswith(ROTATION_PATHS) else "REPEAT_OFFSET"
 
 
 def _add_strips(arm, action, motion) -> list:

@@ -50,6 +50,31 @@ def test_loop_cycles_with_root_advance(openbody, mode):
     assert ("root" in arm.data.bones) == (mode == "ROOT_BONE")
 
 
+def test_a_loop_whose_rotations_turn_over_repeats_them(openbody):
+    """A bone that turns a full circle over the cycle (a swung arm, a captured kick's hip) ends its
+    continuous quaternion keys at -q where it started at q: the same rotation. Repeated with an
+    offset, the next cycle would add -2q to every key of that bone and bend the limb anywhere; the
+    rotations repeat, the translation advances."""
+    from shapemove.shapemove_addon.animation_rig import build_animated_rig
+
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    t = np.arange(P)
+    poses = np.zeros((P, 24, 3))
+    poses[:, 16, 2] = 2 * np.pi * t / P                    # the left shoulder: one turn a cycle
+    transl = np.arange(P)[:, None] * ADV[None] / P + [0.0, 0.9, 0.0]
+    m = make_motion(openbody, poses, transl, np.zeros(10), fps=20, prompt="arm circles",
+                    loop_advance=ADV.astype(np.float32))
+    rig = build_animated_rig(bpy.context, m, openbody, name="Circles", root_motion="PELVIS")
+    arm = rig.armature
+    adv_z_up = np.array([ADV[0], -ADV[2], ADV[1]])
+    for f in (3, 9, 14):
+        bpy.context.scene.frame_set(f)
+        a = bone_heads_world(arm, ["left_wrist"])[0]
+        bpy.context.scene.frame_set(f + P)
+        b = bone_heads_world(arm, ["left_wrist"])[0]
+        np.testing.assert_allclose(b - a, adv_z_up, atol=1e-4)
+
+
 def test_timeline_nla_strips_play_the_segments(openbody):
     from shapemove.shapemove_addon.animation_rig import TRACK_NAME, build_animated_rig
 

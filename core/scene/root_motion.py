@@ -9,7 +9,8 @@ Modes (the panel's "Root motion", the export carries it):
 - ``NONE``: in place, the travel removed (facing and height kept).
 ``rig_channels`` also closes a loop: a looping motion (``loop_advance``) gets one frame more, frame
 0 moved by the advance, so the keys' last value minus their first is the per-cycle offset that a
-Cycles modifier in "Repeat with Offset" mode adds each cycle.
+Cycles modifier in "Repeat with Offset" mode adds each cycle to the translations (the rotations
+repeat as they are: ``shapemove_addon/animation_rig.py``).
 """
 from __future__ import annotations
 
