@@ -92,6 +92,27 @@ def _make_cycles(action, obj) -> None:
         mod.mode_before = mod.mode_after = "REPEAT" if fc.data_path.endswith(ROTATION_PATHS) else "REPEAT_OFFSET"
 
 
+def replay_strips(arm, action) -> bool:
+    """Point a timeline rig's strips at ``action`` (its motion decoded again for a new body: the same
+    frames), each strip keeping its timing (a strip the user moved or scaled stays where it is), and
+    let the strips play it rather than the active action. False for a rig without a timeline."""
+    anim = arm.animation_data
+    track = anim.nla_tracks.get(TRACK_NAME) if anim is not None else None
+    if track is None:
+        return False
+    slot = getattr(anim, "action_slot", None)
+    for strip in track.strips:
+        keep = (strip.action_frame_start, strip.action_frame_end, strip.scale, strip.repeat, strip.frame_start,
+                strip.frame_end)
+        strip.action = action
+        if slot is not None and hasattr(strip, "action_slot"):
+            strip.action_slot = slot
+        strip.action_frame_start, strip.action_frame_end, strip.scale, strip.repeat = keep[:4]
+        strip.frame_start, strip.frame_end = keep[4:]
+    anim.action = None
+    return True
+
+
 def _add_strips(arm, action, motion) -> list:
     anim = arm.animation_data
     slot = getattr(anim, "action_slot", None)
@@ -113,6 +134,21 @@ def _add_strips(arm, action, motion) -> list:
     return strips
 
 
+def key_travel(context, arm, action, travel, root_motion: str) -> None:
+    """Key ``travel`` ((T,3) Y up, ``rig_channels``' split-off travel; None: nothing to key) in
+    ``action`` on what carries it: the armature object (``OBJECT``) or its root bone (``ROOT_BONE``,
+    added as the pelvis's parent when the rig has none yet)."""
+    if travel is None:
+        return
+    new_curve = _curve_adder(action, arm)
+    if root_motion.upper() == "OBJECT":
+        _key_vectors(new_curve, "location", points_to_z_up(travel))
+        return
+    if ROOT_BONE not in arm.data.bones:
+        _add_root_bone(context, arm, arm["shapemove_joint_names"].split("\n")[0])
+    _key_vectors(new_curve, f'pose.bones["{ROOT_BONE}"].location', points_to_z_up(travel))
+
+
 def build_animated_rig(context, motion, body_model, name: str = "ShapeMove", collection=None,
                        root_motion: str = "PELVIS") -> BuiltRig:
     """The rig for ``motion`` with its loop, root-motion mode and timeline (see the module doc)."""
@@ -126,13 +162,7 @@ def build_animated_rig(context, motion, body_model, name: str = "ShapeMove", col
     rig = build_rig(context, flat, body_model, name=name, collection=collection)
     arm = rig.armature
     try:
-        names = arm["shapemove_joint_names"].split("\n")
-        new_curve = _curve_adder(rig.action, arm)
-        if ch.travel is not None and root_motion.upper() == "OBJECT":
-            _key_vectors(new_curve, "location", points_to_z_up(ch.travel))
-        elif ch.travel is not None:
-            _add_root_bone(context, arm, names[0])
-            _key_vectors(new_curve, f'pose.bones["{ROOT_BONE}"].location', points_to_z_up(ch.travel))
+        key_travel(context, arm, rig.action, ch.travel, root_motion)
         arm[ROOT_MOTION_KEY] = root_motion.upper()
         scene = context.scene
         if ch.cycle is not None:

@@ -101,15 +101,29 @@ def _answered(name, betas, msg) -> None:
 
 def apply_motion(rig, motion) -> bpy.types.Action:
     """Replace the rig's action with ``motion``'s keys (same action name; the old one is removed
-    when nothing else uses it). The bones must already sit on the rest joints of motion.betas.
-    (A decoded motion is already grounded on the body's mesh by core's decode.)"""
-    rotations, transl = motion_channels_z_up(motion.poses, motion.transl)
+    when nothing else uses it), the travel on what the rig was built to carry it with (its root
+    motion: the pelvis, the object, a root bone, or none for in place; ``animation_rig``); a timeline
+    rig's strips play the new action with their own timing (``animation_rig.replay_strips``). The
+    bones must already sit on the rest joints of motion.betas. (A decoded motion is already
+    grounded on the body's mesh by core's decode.)"""
+    from ..core.scene.root_motion import rig_channels
+    from .animation_rig import ROOT_MOTION_KEY, key_travel, replay_strips
+
+    mode = str(rig.get(ROOT_MOTION_KEY, "PELVIS"))
+    ch = rig_channels(motion, mode)
+    rotations, transl = motion_channels_z_up(ch.poses, ch.transl)
     names = rig["shapemove_joint_names"].split("\n")
     grounding.forget_contacts(rig)  # a new motion: its contacts are detected at the next shape change
     anim = rig.animation_data
     old = anim.action if anim is not None else None
     name = old.name if old is not None else f"{rig.name}_motion"
+    if old is None:   # a timeline's strips play its action: that is the one replaced
+        strips = [s for t in anim.nla_tracks for s in t.strips if s.action is not None] if anim is not None else []
+        old = strips[0].action if strips else None
+        name = old.name if old is not None else name
     action = write_pose_action(rig, rotations, transl, motion.fps, names, name + "_new")
+    key_travel(bpy.context, rig, action, ch.travel, mode)
+    replay_strips(rig, action)
     if old is not None and old.users == 0:
         bpy.data.actions.remove(old)
     action.name = name

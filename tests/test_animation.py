@@ -147,6 +147,10 @@ def test_timeline_boundaries_and_regenerate(gen):
     assert np.abs(rel(m2)[86:] - rel(m)[86:]).max() <= 5e-3               # the last segment kept (from its fade)
     assert boundary_report(m2)["jump_ratio"] <= 2.0
     assert np.abs(rel(m2)[50:70] - rel(m)[50:70]).max() > 0.1             # the middle one is new
+    # decoded again for another body (a Shape slider), the timeline keeps its segments
+    tall = gen.redecode(m, np.full(10, 0.8, np.float32))
+    assert tall.num_frames == m.num_frames and tall.segment_bounds.tolist() == m.segment_bounds.tolist()
+    assert tall.segment_prompts == m.segment_prompts and np.allclose(tall.betas, 0.8)
 
 
 def test_motion_file_round_trip(tmp_path, walk, gen):

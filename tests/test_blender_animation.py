@@ -75,6 +75,30 @@ def test_a_loop_whose_rotations_turn_over_repeats_them(openbody):
         np.testing.assert_allclose(b - a, adv_z_up, atol=1e-4)
 
 
+@pytest.mark.parametrize("mode", ["OBJECT", "ROOT_BONE", "NONE"])
+def test_a_redecoded_motion_keeps_the_rigs_root_motion(openbody, mode):
+    """A shape change re-decodes the motion (``redecode.apply_motion``): the new keys go where the
+    rig was built to carry the travel: on the object, on the root bone, or nowhere (in place), not
+    back on the pelvis."""
+    from shapemove.shapemove_addon.animation_rig import build_animated_rig
+    from shapemove.shapemove_addon.redecode import apply_motion
+
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    m = _loop(openbody)
+    m.loop_advance = None
+    rig = build_animated_rig(bpy.context, m, openbody, name="Walk", root_motion=mode)
+    arm = rig.armature
+    before = [(_pelvis(arm, f), bone_heads_world(arm, ["pelvis"])[0] - np.array(arm.matrix_world)[:3, 3])
+              for f in (1, 6, 12)]
+    apply_motion(arm, m)                                  # the same motion again: nothing may move
+    after = [(_pelvis(arm, f), bone_heads_world(arm, ["pelvis"])[0] - np.array(arm.matrix_world)[:3, 3])
+             for f in (1, 6, 12)]
+    for (w0, local0), (w1, local1) in zip(before, after):
+        np.testing.assert_allclose(w1, w0, atol=1e-4)        # the world motion
+        np.testing.assert_allclose(local1, local0, atol=1e-4)  # and what carries it
+    assert ("root" in arm.data.bones) == (mode == "ROOT_BONE")
+
+
 def test_timeline_nla_strips_play_the_segments(openbody):
     from shapemove.shapemove_addon.animation_rig import TRACK_NAME, build_animated_rig
 
@@ -92,6 +116,21 @@ def test_timeline_nla_strips_play_the_segments(openbody):
     strips[1].frame_start_ui = 30.0   # re-timed: the second segment now starts at frame 30
     j = m.joints[8, 0]
     np.testing.assert_allclose(_pelvis(rig.armature, 32), [j[0], -j[2], j[1]], atol=1e-4)
+    # a shape change decodes the timeline again (redecode.apply_motion): the strips play the new
+    # keys with the timing the user gave them, no active action plays over them, the old one is gone
+    from shapemove.shapemove_addon.redecode import apply_motion
+
+    old = strips[0].action
+    old_name = old.name
+    m.transl[:, 0] += 0.5                                   # the "new" motion: moved half a metre
+    apply_motion(rig.armature, m)
+    strips = rig.armature.animation_data.nla_tracks[TRACK_NAME].strips
+    assert rig.armature.animation_data.action is None and strips[0].action == strips[1].action
+    assert strips[0].action.name == old_name and len(bpy.data.actions) == 1      # replaced, same name
+    assert [s.frame_start for s in strips] == [1.0, 30.0]
+    for f, k in ((3, 2), (32, 8)):
+        j = m.joints[k, 0] + [0.5, 0.0, 0.0]
+        np.testing.assert_allclose(_pelvis(rig.armature, f), [j[0], -j[2], j[1]], atol=1e-4)
 
 
 @pytest.mark.parametrize("mode", ["OBJECT", "ROOT_BONE"])
