@@ -25,7 +25,7 @@ from .operators import (JobOperator, ReportingOperator, build_rig_from_file, gen
                         library_param, scene_prompt)
 from .panels import _SettingsPanel, draw_job, draw_optional
 from .redecode import MOTION_FILE_KEY
-from .rig_state import rig_of
+from .rig_state import current_betas, rig_of
 
 MAX_CURVE_POINTS = 20_000
 
@@ -243,7 +243,8 @@ class SHAPEMOVE_OT_regenerate_strip(ReportingOperator, bpy.types.Operator):
             raise ShapeMoveError("this rig does not know its motion file; generate the timeline again")
         timing = {i: t for i, t in enumerate(strip_timing(rig)) if i != k}
         params = {**generation_params(context, "timeline"), "regenerate": k, "motion": str(source),
-                  "seed": int(context.scene.shapemove.seed) + 1000 + k}
+                  "seed": int(context.scene.shapemove.seed) + 1000 + k,
+                  "betas": [float(b) for b in current_betas(rig)]}   # the body as the sliders left it
         context.scene.shapemove.seed += 1   # the next press samples another one
         job_submit.submit_job("sequence", params, kind="sequence", label="regenerate strip",
                               on_result=_on_built(rig.name, rig.get("shapemove_root_motion", "PELVIS"), replace=rig,

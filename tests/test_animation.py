@@ -265,5 +265,11 @@ def test_worker_ops_animate_and_sequence(tmp_path, gen):
     again = jobs_animation.sequence({"regenerate": 1, "motion": seq["path"], "seed": 4, "out": str(tmp_path / "t.npz")},
                                     lambda f, m: None, never)
     assert again["segments"] == seq["segments"] and again["path"].endswith("t.npz")
+    # Regenerate Strip after the Shape sliders moved: the timeline is made again for the rig's body
+    tall = [0.9] + [0.0] * 9
+    reshaped = jobs_animation.sequence({"regenerate": 0, "motion": seq["path"], "seed": 5, "betas": tall,
+                                        "out": str(tmp_path / "v.npz")}, lambda f, m: None, never)
+    assert np.allclose(reshaped["betas"], tall) and not np.allclose(again["betas"], tall)
+    assert reshaped["measurements"]["height_cm"] > again["measurements"]["height_cm"] + 3
     with pytest.raises(ShapeMoveError, match="segments"):
         jobs_animation.sequence({"segments": [{"prompt": "x"}], "out": str(tmp_path / "u.npz")}, lambda f, m: None, never)

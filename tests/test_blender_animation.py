@@ -212,3 +212,36 @@ def test_regenerated_timeline_keeps_the_other_strips_timing(openbody):
     assert got[0] == timing[0] and got[2] == timing[2]
     assert got[0][2] == 2.0 and got[2][0] >= 40.0                       # not the fresh 1.0 / 11.0
     assert got[1][2] == 1.0 and got[1][0] == got[0][1]                   # the new strip follows the slowed first
+
+
+def test_regenerate_strip_asks_for_the_rigs_body_now(openbody, tmp_path, monkeypatch):
+    """Regenerate Strip after the Shape sliders moved: the job is asked for the rig's body as the
+    sliders left it (the worker makes the timeline again for it), not the body in the motion file."""
+    import shapemove
+    from shapemove.core.scene.motion_file import save_motion
+    from shapemove.shapemove_addon import job_submit
+    from shapemove.shapemove_addon.animation_rig import build_animated_rig
+    from shapemove.shapemove_addon.redecode import MOTION_FILE_KEY
+    from shapemove.shapemove_addon.rig_state import body_of
+
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    shapemove.register()
+    try:
+        m = _loop(openbody)
+        m.loop_advance = None
+        m.segment_bounds, m.segment_prompts = np.array([[0, 8], [8, 16]]), ["walks", "waves"]
+        rig = build_animated_rig(bpy.context, m, openbody, name="Timeline")
+        rig.armature[MOTION_FILE_KEY] = str(save_motion(tmp_path / "t.npz", m))
+        body_of(rig.armature).data.shape_keys.key_blocks["beta_0"].value = 1.25   # a slider moved
+        bpy.context.view_layer.objects.active = rig.armature
+        bpy.context.scene.shapemove_animation.strip_index = 2
+        jobs = []
+        monkeypatch.setattr(job_submit, "submit_job", lambda op, params, **kw: jobs.append((op, params)) or "j1")
+        assert "FINISHED" in bpy.ops.shapemove.regenerate_strip()
+        (op, params), = jobs
+        assert op == "sequence" and params["regenerate"] == 1 and params["motion"].endswith("t.npz")
+        assert params["betas"][0] == pytest.approx(1.25) and params["betas"][1:] == [0.0] * 9
+    finally:
+        shapemove.unregister()
+        bpy.ops.wm.read_factory_settings(use_empty=True)
+

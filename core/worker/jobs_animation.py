@@ -5,7 +5,8 @@
   metres, Y up), "speed", "stretch" -> the motion file written and its facts (with its "notes");
 - ``sequence``: {"segments": [{"prompt", "seconds"}, ...], "shape_text", "betas", "seed", "model",
   "body", "out"} -> a timeline motion; with "regenerate": K (0-based) and "motion" (a timeline
-  file) segment K is sampled again with "seed" and the others are kept.
+  file) segment K is sampled again with "seed" and the others are kept, for the body "betas" (the
+  rig's now) or else the file's.
 """
 from __future__ import annotations
 
@@ -80,7 +81,11 @@ def sequence(params, progress, cancel) -> dict:
     progress(0.05, "loading models")
     gen = _generator(param(params, op, "model", str, None), param(params, op, "body", str, None))
     if regen is not None:
-        motion = regenerate_segment(gen, load_motion(param(params, op, "motion", str)), regen, seed,
+        timeline = load_motion(param(params, op, "motion", str))
+        betas = _betas(params, op)
+        if betas is not None:   # the rig's body now (Shape sliders moved since it was generated)
+            timeline.betas = betas
+        motion = regenerate_segment(gen, timeline, regen, seed,
                                     param(params, op, "prompt", str, None) or None,
                                     param(params, op, "seconds", (int, float), None), by_parts=by_parts)
     else:
