@@ -153,6 +153,37 @@ def test_timeline_boundaries_and_regenerate(gen):
     assert tall.segment_prompts == m.segment_prompts and np.allclose(tall.betas, 0.8)
 
 
+def test_timeline_segments_obey_their_pace_and_travel_words(gen):
+    """"jogs in place" steps on the spot and "walks slowly" takes shorter strides inside a timeline
+    too (``timeline_words.py``): the same codes as without the edits (the tokens are kept for
+    Regenerate Strip and re-decoding), the other segments as they were, no jump at the boundaries,
+    and decoded again for a new body the edits hold."""
+    from shapemove.core.generation.sequence import boundary_report, generate_sequence
+    from shapemove.core.generation.timeline_words import segment_scale, worded_joints
+
+    segs = [("a person walks forward", 2.0), ("a person jogs in place", 3.0), ("a person walks forward slowly", 2.0)]
+    plain = generate_sequence(gen, segs, seed=0, by_parts=False)    # no word edits
+    m = generate_sequence(gen, segs, seed=0)
+
+    def travel(x):
+        r = x.joints[:, 0, [0, 2]]
+        return [float(np.linalg.norm(np.diff(r[a:b], axis=0), axis=1).sum()) for a, b in x.segment_bounds]
+
+    assert np.array_equal(m.tokens, plain.tokens) and m.segment_bounds.tolist() == [[0, 40], [40, 100], [100, 140]]
+    t0, t = travel(plain), travel(m)
+    assert t0[1] > 3.0 and t[1] < 0.15 * t0[1]                      # the jog stays on the spot
+    assert 0.7 * t0[2] < t[2] < 0.9 * t0[2]                          # the slow walk: strides at 0.8
+    assert abs(t[0] - t0[0]) < 0.1 * t0[0]                           # the walk as it was
+    assert boundary_report(m)["jump_ratio"] <= 2.0
+    again = gen.redecode(m, np.full(10, 0.6, np.float32))
+    assert again.segment_prompts == m.segment_prompts and travel(again)[1] < 0.15 * t0[1]
+    # the scales the words ask: none for a plain walk (no edit at all), SLOW_SPEED, the spot's
+    assert segment_scale("a person walks forward", plain.joints[:40]) == 1.0
+    assert segment_scale("a person walks forward slowly", plain.joints[100:]) == 0.8
+    assert segment_scale("a person jogs in place", plain.joints[40:100]) == pytest.approx(0.5 / t0[1], rel=0.1)  # its path
+    assert worded_joints(plain.joints, [[0, 140]], ["a person walks forward"]) is None
+
+
 def test_motion_file_round_trip(tmp_path, walk, gen):
     from shapemove.core.generation.loop import loop_motion
     from shapemove.core.scene.motion_file import load_motion, save_motion

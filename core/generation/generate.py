@@ -444,17 +444,17 @@ class Generator:
 
     def redecode(self, motion: Motion, betas) -> Motion:
         """The same tokens on another body (``decode.redecode``; a motion made by body part is
-        composed and mirrored again, ``parts.redecode_parts``; a timeline keeps its segments); a take
-        played by its own rotations (no tokens, measured contacts) is planted again on the new body
-        (``retarget.replant``)."""
+        composed and mirrored again, ``parts.redecode_parts``; a timeline assembled again,
+        ``sequence.redecode_timeline``); a take played by its own rotations (no tokens, measured
+        contacts) is planted again on the new body (``retarget.replant``)."""
         if motion.planted_take:
             from .retarget import replant
 
             return replant(motion, self.body, betas, self.ik_refine_iters)
+        if motion.segment_bounds is not None and motion.tokens is not None:   # a timeline, assembled again
+            from .sequence import redecode_timeline
+
+            return redecode_timeline(self, motion, betas)
         if is_by_parts(motion):
-            out = redecode_parts(motion, self.vae, self.body, betas, self.ik_refine_iters)
-        else:
-            out = redecode(motion, self.vae, self.body, betas, self.ik_refine_iters)
-        if motion.segment_bounds is not None and out.num_frames == motion.num_frames:   # a timeline stays one
-            out.segment_bounds, out.segment_prompts = motion.segment_bounds, list(motion.segment_prompts)
-        return out
+            return redecode_parts(motion, self.vae, self.body, betas, self.ik_refine_iters)
+        return redecode(motion, self.vae, self.body, betas, self.ik_refine_iters)

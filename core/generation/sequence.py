@@ -159,22 +159,42 @@ def _timeline_track(gen, codes_per_segment, betas, arms_per_segment=None) -> tup
     return track, feats, extra
 
 
-def _planted(gen, track: Track, feats, extra: dict, codes_per_segment, prompts, betas) -> Motion:
+def _planted(gen, track: Track, feats, extra: dict, codes_per_segment, prompts, betas, words: bool = True) -> Motion:
+    """The timeline's track planted, with its segments; ``words``: each segment's pace and travel
+    words obeyed first (``timeline_words.py``)."""
+    down = len(track) // sum(len(c) for c in codes_per_segment)
+    ends = np.cumsum([len(c) for c in codes_per_segment]) * down
+    bounds = np.stack([np.r_[0, ends[:-1]], ends], axis=1).astype(np.int64)
+    if words:
+        from .timeline_words import worded_joints
+
+        worded = worded_joints(track.joints, bounds, prompts)
+        if worded is not None:
+            track, feats = Track(worded, track.contacts), None
     motion = plant(gen.body, betas, track, gen.ik_refine_iters, prompt=" -> ".join(prompts), features=feats, **extra)
-    if feats is None:  # composed or spliced: the planted motion's features, as parts.assemble computes them
+    if feats is None:  # composed, spliced or worded: the planted motion's features, as parts.assemble computes them
         from ..motion.features import motion_features
 
         motion.features = motion_features(motion)
-    down = len(track) // sum(len(c) for c in codes_per_segment)
-    ends = np.cumsum([len(c) for c in codes_per_segment]) * down
-    motion.segment_bounds = np.stack([np.r_[0, ends[:-1]], ends], axis=1).astype(np.int64)
+    motion.segment_bounds = bounds
     motion.segment_prompts = list(prompts)
     return motion
 
 
-def _assemble(gen, codes_per_segment, prompts, betas, arms_per_segment=None) -> Motion:
+def _assemble(gen, codes_per_segment, prompts, betas, arms_per_segment=None, words: bool = True) -> Motion:
     track, feats, extra = _timeline_track(gen, codes_per_segment, betas, arms_per_segment)
-    return _planted(gen, track, feats, extra, codes_per_segment, prompts, betas)
+    return _planted(gen, track, feats, extra, codes_per_segment, prompts, betas, words)
+
+
+def redecode_timeline(gen, motion: Motion, betas) -> Motion:
+    """A timeline's codes (and its arms' codes) decoded and planted again for the body ``betas``,
+    as generation assembles it (its segments' words obeyed), segments kept."""
+    from .decode import check_betas
+
+    arms = segment_codes(motion, arms=True) if motion.arms_tokens is not None else None
+    out = _assemble(gen, segment_codes(motion), list(motion.segment_prompts), check_betas(betas), arms)
+    out.shape_source = "given"
+    return out
 
 
 def splice(old: Track, new: Track, start: int, old_end: int, new_end: int, blend: int = SPLICE_BLEND) -> Track:
@@ -245,7 +265,7 @@ def generate_sequence(gen, segments, shape_text: str | None = None, betas=None, 
         arms.append(own_arms)
         if progress is not None:
             progress((i + 1) / (len(segs) + 1), f"segment {i + 1}/{len(segs)}: {s.prompt}")
-    motion = _assemble(gen, chosen, [s.prompt for s in segs], betas, arms)
+    motion = _assemble(gen, chosen, [s.prompt for s in segs], betas, arms, words=by_parts)
     motion.shape_source = source
     motion.warnings = warnings
     if progress is not None:
@@ -301,7 +321,7 @@ def regenerate_segment(gen, motion: Motion, index: int, seed: int, prompt: str |
     start = sum(len(c) for c in per[:index]) * down
     old_end = start + len(old_per[index]) * down
     track = splice(before, after, start, old_end, start + len(per[index]) * down)
-    out = _planted(gen, track, None, extra, per, prompts, motion.betas)
+    out = _planted(gen, track, None, extra, per, prompts, motion.betas, words=by_parts)
     out.shape_source = "given"
     return out
 

@@ -36,28 +36,33 @@ def _knee(hip: np.ndarray, ankle: np.ndarray, thigh: np.ndarray, shin: np.ndarra
     return hip + along[:, None] * u + side[:, None] * bend
 
 
-def scaled_strides(joints: np.ndarray, scale: float) -> np.ndarray:
+def scaled_strides(joints: np.ndarray, scale) -> np.ndarray:
     """(T,22,3) joints whose root path and ankle offsets (along the heading; square to it, about the
-    stance width) are ``scale`` times theirs (module doc); ``scale`` 1 gives the joints back."""
+    stance width) are ``scale`` times theirs (module doc): one factor, or one per frame (a timeline's
+    segments, eased in and out; the root's steps are scaled frame by frame). The knees are placed
+    again where the scale is under 1; a scale of 1 everywhere gives the joints back."""
     from .track import headings
 
     J = np.asarray(joints, np.float64)
-    if scale >= 1.0:
+    s = np.minimum(np.broadcast_to(np.asarray(scale, np.float64), (len(J),)), 1.0)
+    if (s >= 1.0).all():
         return J.copy()
     h = headings(J)
     fwd = np.stack([np.sin(h), np.zeros_like(h), np.cos(h)], axis=1)      # (T,3) the heading, level
     left = np.stack([np.cos(h), np.zeros_like(h), -np.sin(h)], axis=1)     # (T,3) square to it, level
     root = J[:, PELVIS] * [1.0, 0.0, 1.0]
-    moved = root[0] + scale * (root - root[0])                               # the root's path, scaled
+    steps = s[1:, None] * np.diff(root, axis=0)
+    moved = root[0] + np.concatenate([np.zeros((1, 3)), np.cumsum(steps, axis=0)])   # the root's path, scaled
     out = J + (moved - root)[:, None]                                       # the body carried by it
+    shrink = (1.0 - s)[:, None]
     for hip, knee, ankle, foot in LEGS_CHAINS:
         thigh = np.linalg.norm(J[:, knee] - J[:, hip], axis=1)
         shin = np.linalg.norm(J[:, ankle] - J[:, knee], axis=1)
         ahead = ((J[:, ankle] - root) * fwd).sum(1)                         # the ankle's offset along the heading
         aside = ((J[:, ankle] - root) * left).sum(1)                        # ... and square to it
-        new_ankle = (out[:, ankle] - (1.0 - scale) * ahead[:, None] * fwd
-                     - (1.0 - scale) * (aside - aside.mean())[:, None] * left)   # its stance width kept
+        new_ankle = (out[:, ankle] - shrink * ahead[:, None] * fwd
+                     - shrink * (aside - aside.mean())[:, None] * left)     # its stance width kept
         out[:, foot] += new_ankle - out[:, ankle]                           # the foot keeps its direction
         out[:, ankle] = new_ankle
-        out[:, knee] = _knee(out[:, hip], new_ankle, thigh, shin, fwd)
+        out[:, knee] = np.where((s < 1.0)[:, None], _knee(out[:, hip], new_ankle, thigh, shin, fwd), out[:, knee])
     return out
