@@ -12,7 +12,6 @@ joints: the decoded positions' legs, the upper body posed from the decoded rotat
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
 from pathlib import Path
 from typing import NamedTuple
 
@@ -40,9 +39,9 @@ from .rerank import CandidatePicker
 from .retrieval_seeds import seed_prefixes, seeded_count
 from .on_the_spot import on_the_spot
 from .retrieved_candidates import library_codes, retrieved_codes
-from .sampling_params import (DEFAULT_CANDIDATES, DEFAULT_GUIDANCE, DEFAULT_RETRIEVAL_FIRST, DEFAULT_RETRIEVAL_PREFIX,
-                              DEFAULT_RETRIEVED, check_candidates, check_guidance, check_retrieval_first,
+from .sampling_params import (DEFAULT_GUIDANCE, check_candidates, check_guidance, check_retrieval_first,
                               check_retrieval_prefix, check_retrieved, check_sampling)
+from .request import Request
 from .slow_steps import slow_motion
 from .turn_words import turn_motion
 
@@ -55,25 +54,6 @@ class Chosen(NamedTuple):
     codes: list[list[int]]        # motion tokens
     betas: torch.Tensor           # (B, 10) the [BETA] head's bodies
     kept: list[str | None]        # the memory clip whose tokens were kept, None for a T5 sample
-
-
-@dataclass
-class Request:
-    prompt: str
-    shape_text: str | None = None
-    betas: np.ndarray | None = None
-    seconds: float | None = None
-    seed: int = 0
-    temperature: float = 1.0
-    top_k: int | None = 50
-    shape_from: str = "auto"  # "auto": measurements stated in the shape text win; "head": the [BETA] head only
-    candidates: int = DEFAULT_CANDIDATES  # token samples drawn; the TMA keeps the one closest to the prompt
-    guidance: float | None = None  # classifier-free guidance scale; None: the model's default (0 without a null prompt)
-    retrieval_prefix: int = DEFAULT_RETRIEVAL_PREFIX  # codes of a retrieved clip half the candidates start from (0: none)
-    retrieved: int = DEFAULT_RETRIEVED  # real clips nearest by caption added to the candidates (0: none)
-    retrieval_first: float | None = DEFAULT_RETRIEVAL_FIRST  # caption similarity from which only retrieved clips compete
-    by_parts: bool = True  # two things at once composed by body part, a named side mirrored (parts.py)
-    action: str | None = None  # the action the prompt names (the planner's reading): its captured clips compete alone
 
 
 def _rows(inputs: tuple | None, a: int, b: int) -> tuple | None:

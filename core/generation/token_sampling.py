@@ -44,7 +44,7 @@ def body_for(gen, prompt: str, shape_text: str | None, betas, predicted) -> tupl
 
         return check_betas(betas), "given"
     if shape_text:
-        from .generate import Request
+        from .request import Request
 
         return gen.body_shape(Request(prompt, shape_text, None), np.asarray(predicted, np.float32))
     return np.asarray(predicted, np.float32), "[BETA] head"
