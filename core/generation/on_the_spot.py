@@ -27,18 +27,25 @@ def asks_on_the_spot(prompt: str) -> bool:
     return travel_of(prompt).in_place and any(sp[2] in LEGS for sp in action_spans(prompt))
 
 
+def spot_scale(joints, prompt: str, allowed: float = SLACK) -> float:
+    """The stride scale that keeps (T,22,3) ``joints`` within ``allowed`` metres of travel when
+    ``prompt`` keeps a gait in place and they travel further; 1 otherwise."""
+    from .track import travel
+
+    if not asks_on_the_spot(prompt) or len(joints) < 4:
+        return 1.0
+    went = float(travel(joints)[-1])
+    return allowed / went if went > allowed else 1.0
+
+
 def spot_track(track, prompt: str, allowed: float = SLACK):
     """``track`` (a ``track.Track``) stepping on the spot when ``prompt`` keeps a gait in place and
-    the track travels more than ``allowed`` metres, scaled to travel that far; None otherwise (a
-    loop allows ``LOOP_ALLOWED``: its advance repeats every cycle)."""
-    from .track import Track, travel
+    the track travels more than ``allowed`` metres, scaled to travel that far (``spot_scale``); None
+    otherwise (a loop allows ``LOOP_ALLOWED``: its advance repeats every cycle)."""
+    from .track import Track
 
-    if not asks_on_the_spot(prompt) or len(track.joints) < 4:
-        return None
-    went = float(travel(track.joints)[-1])
-    if went <= allowed:
-        return None
-    return Track(scaled_strides(track.joints, allowed / went), track.contacts)
+    scale = spot_scale(track.joints, prompt, allowed)
+    return None if scale >= 1.0 else Track(scaled_strides(track.joints, scale), track.contacts)
 
 
 def on_the_spot(motion, body, prompt: str, ik_refine_iters: int = 10):

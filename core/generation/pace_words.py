@@ -47,17 +47,22 @@ def asks_fast(prompt: str) -> bool:
     return bool(_FAST.search(prompt)) and not _SLOW.search(prompt) and bool(_gaits(prompt))
 
 
+def _slow_gaits(prompt: str) -> set:
+    """The gaits the prompt asks to go slowly (a slow pace named, no fast one); empty otherwise."""
+    return _gaits(prompt) if _SLOW.search(prompt) and not _FAST.search(prompt) else set()
+
+
 def asks_slow_steps(prompt: str) -> bool:
     """Whether the prompt asks a stepping gait (and no other gait) to go slowly, naming no fast pace."""
-    gaits = _gaits(prompt)
-    return bool(_SLOW.search(prompt)) and not _FAST.search(prompt) and bool(gaits) and gaits <= STEPPING
+    gaits = _slow_gaits(prompt)
+    return bool(gaits) and gaits <= STEPPING
 
 
 def asks_slow_flight(prompt: str) -> bool:
     """Whether the prompt asks a gait with a flight phase (a jog, a run) to go slowly, naming no fast
     pace: its strides are shortened instead (``slow_steps``)."""
-    gaits = _gaits(prompt)
-    return bool(_SLOW.search(prompt)) and not _FAST.search(prompt) and bool(gaits) and not gaits <= STEPPING
+    gaits = _slow_gaits(prompt)
+    return bool(gaits) and not gaits <= STEPPING
 
 
 def gait_speed(features: np.ndarray) -> float:

@@ -20,21 +20,17 @@ from __future__ import annotations
 
 import numpy as np
 
-from .on_the_spot import asks_on_the_spot
+from .on_the_spot import asks_on_the_spot, spot_scale
 from .pace_words import SLOW_SPEED, asks_slow_flight, asks_slow_steps
 from .stride_scale import scaled_strides
-from .travel_words import SLACK
 
 EASE = 8   # frames over which the stride scale moves from one segment's to the next
 
 
 def segment_scale(prompt: str, joints: np.ndarray) -> float:
     """The stride scale the words of one segment ask of its (T,22,3) joints (module doc)."""
-    from .track import travel
-
     if asks_on_the_spot(prompt):
-        went = float(travel(joints)[-1]) if len(joints) > 1 else 0.0
-        return SLACK / went if went > SLACK else 1.0
+        return spot_scale(joints, prompt)
     if asks_slow_steps(prompt) or asks_slow_flight(prompt):
         return SLOW_SPEED
     return 1.0
