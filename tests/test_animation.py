@@ -184,6 +184,68 @@ def test_timeline_segments_obey_their_pace_and_travel_words(gen):
     assert worded_joints(plain.joints, [[0, 140]], ["a person walks forward"]) is None
 
 
+def test_a_timeline_segment_that_turns_around_sends_the_next_one_back(gen):
+    """"walks forward" -> "turns around" -> "walks forward": the codec does not carry turning, so
+    before ``timeline_words.turn_profile`` the last walk went on the way the first went (seed 1:
+    cosine 1.00 between the two walks' directions). The turn segment now turns the body half a turn
+    and the last walk comes back; tokens kept, boundaries smooth, feet planted, and re-decoding for
+    a new body keeps the turn."""
+    from shapemove.core.generation.sequence import boundary_report, generate_sequence
+    from shapemove.core.generation.timeline_words import turn_profile
+    from shapemove.core.generation.track import headings
+
+    segs = [("a person walks forward", 2.0), ("a person turns around", 2.0), ("a person walks forward", 2.0)]
+    plain = generate_sequence(gen, segs, seed=1, by_parts=False)
+    m = generate_sequence(gen, segs, seed=1)
+
+    def walks_cos(x):
+        r = x.joints[:, 0, [0, 2]]
+        (a0, b0), _, (a2, b2) = x.segment_bounds
+        d0, d2 = r[b0 - 1] - r[a0], r[b2 - 1] - r[a2]
+        return float(d0 @ d2 / np.linalg.norm(d0) / np.linalg.norm(d2))
+
+    def turn(x):
+        h = np.unwrap(headings(x.joints))
+        return float(h[-1] - h[0])
+
+    assert np.array_equal(m.tokens, plain.tokens)
+    assert walks_cos(plain) > 0.5 and walks_cos(m) < -0.9             # the last walk comes back
+    assert abs(abs(turn(m)) - np.pi) < 0.35                             # half a turn, give or take 20 degrees
+    assert boundary_report(m)["jump_ratio"] <= 2.0
+    J, C = m.joints[:, [7, 8, 10, 11]][:, :, [0, 2]], m.contacts.astype(bool)
+    slide = np.linalg.norm(np.diff(J, axis=0), axis=2)[C[1:] & C[:-1]]
+    assert slide.mean() < 1e-3                                          # planted feet stay put (m/frame)
+    again = gen.redecode(m, np.full(10, 0.6, np.float32))
+    assert walks_cos(again) < -0.9
+    # the profile: 0 before the turn segment, the whole turn after it; None without a turn
+    phi = turn_profile(plain.joints, plain.segment_bounds, [p for p, _ in segs])
+    own = np.unwrap(headings(plain.joints))
+    assert phi[:40].tolist() == [0.0] * 40 and np.ptp(phi[80:]) == 0.0
+    assert phi[-1] == pytest.approx(np.pi - (own[79] - own[40]))       # "turns around": left, its own turn counted
+    assert turn_profile(plain.joints, plain.segment_bounds, ["a person walks forward"] * 3) is None
+
+
+def test_a_timeline_segment_that_walks_in_a_circle_goes_round_once(gen):
+    """A circle segment's course is bent once round (a whole turn at an even rate, left unless
+    the words say clockwise) and the walk after it goes on the way the walk before it went."""
+    from shapemove.core.generation.sequence import generate_sequence
+    from shapemove.core.generation.track import headings, travel
+
+    segs = [("a person walks forward", 2.0), ("a person walks around in a circle", 6.0),
+            ("a person walks forward", 2.0)]
+    plain = generate_sequence(gen, segs, seed=0, by_parts=False)
+    for words, sign in (("a person walks around in a circle", 1), ("a person walks in a circle clockwise", -1)):
+        m = generate_sequence(gen, [segs[0], (words, 6.0), segs[2]], seed=0)
+        (a0, b0), (a1, b1), (a2, b2) = m.segment_bounds
+        r, h = m.joints[:, 0, [0, 2]], np.unwrap(headings(m.joints))
+        assert sign * (h[b1 - 1] - h[a1]) == pytest.approx(2 * np.pi, abs=0.4)
+        assert np.linalg.norm(r[b1 - 1] - r[a1]) < 0.35 * travel(m.joints[a1:b1])[-1]   # back near its start
+        d0, d2 = r[b0 - 1] - r[a0], r[b2 - 1] - r[a2]
+        assert d0 @ d2 / np.linalg.norm(d0) / np.linalg.norm(d2) > 0.7
+    (a, b), r0 = plain.segment_bounds[1], plain.joints[:, 0, [0, 2]]
+    assert np.linalg.norm(r0[b - 1] - r0[a]) > 0.8 * travel(plain.joints[a:b])[-1]    # straight before
+
+
 def test_motion_file_round_trip(tmp_path, walk, gen):
     from shapemove.core.generation.loop import loop_motion
     from shapemove.core.scene.motion_file import load_motion, save_motion

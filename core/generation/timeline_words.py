@@ -14,7 +14,13 @@ the root's path and the feet's reach shortened together, the frames and cadence 
 - anything else 1.
 
 The scale eases from one segment's to the next over ``EASE`` frames, so the feet do not jump at a
-boundary; the feet are then planted as for any timeline.
+boundary. A segment that names a turn ("turns around", "turns left", "spins"; ``turn_words.angle_of``)
+turns the body that far over its own frames (what it turns by itself counted, eased as a single
+prompt's turn) and every later segment goes on in the new direction: "walks forward" -> "turns
+around" -> "walks forward" comes back. A segment that walks in a circle (``circle_walk.names_circle``)
+turns a whole turn at an even rate over its frames, so its course goes once round (its travel / 2 pi
+the radius; left unless the words say clockwise or to the right); one that barely travels (under
+``CIRCLE_TRAVEL``) is left as it is. The feet are then planted as for any timeline.
 """
 from __future__ import annotations
 
@@ -22,9 +28,13 @@ import numpy as np
 
 from .on_the_spot import asks_on_the_spot, spot_scale
 from .pace_words import SLOW_SPEED, asks_slow_flight, asks_slow_steps
+from .circle_walk import names_circle, turns_right
 from .stride_scale import scaled_strides
+from .track import headings, travel
+from .turn_words import angle_of, eased_turn, turned_by
 
 EASE = 8   # frames over which the stride scale moves from one segment's to the next
+CIRCLE_TRAVEL = 0.5   # m: a circle segment that travels less is not bent round
 
 
 def segment_scale(prompt: str, joints: np.ndarray) -> float:
@@ -36,14 +46,42 @@ def segment_scale(prompt: str, joints: np.ndarray) -> float:
     return 1.0
 
 
+def turn_profile(joints: np.ndarray, bounds, prompts) -> np.ndarray | None:
+    """(T,) yaw each frame of a timeline is turned by so that every segment naming a turn or a circle
+    turns that far and the segments after it keep the new heading; None when no segment does."""
+    own = np.unwrap(headings(joints))
+    phi = np.zeros(len(own))
+    total, turns = 0.0, False
+    for (a, b), prompt in zip(np.asarray(bounds), prompts):
+        phi[a:] = total
+        if b - a < 2:
+            continue
+        angle, turn = angle_of(prompt), None
+        if angle is not None:
+            turn = eased_turn(own[a:b], angle)
+        elif names_circle(prompt) and travel(joints[a:b])[-1] >= CIRCLE_TRAVEL:
+            whole = -2 * np.pi if turns_right(prompt) else 2 * np.pi
+            turn = (whole - (own[b - 1] - own[a])) * np.arange(b - a) / (b - a - 1)
+        if turn is not None:
+            phi[a:b] += turn
+            total += turn[-1]
+            phi[b:] = total
+            turns = True
+    return phi if turns else None
+
+
 def worded_joints(joints: np.ndarray, bounds, prompts) -> np.ndarray | None:
-    """(T,22,3) joints of a timeline with each segment's strides scaled as its words ask (``bounds``:
-    (S,2) frames, ``prompts``: S texts); None when no segment asks for anything."""
+    """(T,22,3) joints of a timeline with each segment's strides scaled and turns made as its words
+    ask (``bounds``: (S,2) frames, ``prompts``: S texts); None when no segment asks for anything."""
     J = np.asarray(joints, np.float64)
     scale = np.ones(len(J))
     for (a, b), prompt in zip(np.asarray(bounds), prompts):
         scale[a:b] = segment_scale(prompt, J[a:b])
-    if (scale >= 1.0).all():
+    phi = turn_profile(J, bounds, prompts)
+    if (scale >= 1.0).all() and phi is None:
         return None
-    eased = np.convolve(np.pad(scale, EASE // 2, mode="edge"), np.ones(EASE) / EASE, mode="same")[EASE // 2:-(EASE // 2)]
-    return scaled_strides(J, eased)
+    if (scale < 1.0).any():
+        eased = np.convolve(np.pad(scale, EASE // 2, mode="edge"), np.ones(EASE) / EASE,
+                            mode="same")[EASE // 2:-(EASE // 2)]
+        J = scaled_strides(J, eased)
+    return J if phi is None else turned_by(J, phi)

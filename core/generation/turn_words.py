@@ -59,20 +59,32 @@ def angle_of(text: str) -> float | None:
     return float(-a if right else a)
 
 
-def turned(track: Track, angle: float) -> Track:
-    """``track`` turned so that over its length it turns ``angle`` in all (what it turns by itself
-    is counted), eased (smoothstep) over ``TURN_SPAN`` of its frames. The body turns about its
-    pelvis's smoothed course and the course's own steps turn with it, so a walk that turns around
-    walks back rather than on backwards. The contacts are the track's (planting follows)."""
-    J = track.joints
-    n = len(J)
-    own = np.unwrap(headings(J))
+def eased_turn(own: np.ndarray, angle: float) -> np.ndarray:
+    """(T,) yaw to add to frames whose own unwrapped heading is ``own`` so that over them the body
+    turns ``angle`` in all (what it turns by itself is counted), eased (smoothstep) over
+    ``TURN_SPAN`` of the frames."""
+    n = len(own)
     u = np.clip((np.arange(n) / max(n - 1, 1) - TURN_SPAN[0]) / (TURN_SPAN[1] - TURN_SPAN[0]), 0.0, 1.0)
-    phi = (angle - (own[-1] - own[0])) * u * u * (3 - 2 * u)
+    return (angle - (own[-1] - own[0])) * u * u * (3 - 2 * u)
+
+
+def turned_by(joints: np.ndarray, phi: np.ndarray) -> np.ndarray:
+    """(T,22,3) ``joints`` with frame t turned by ``phi[t]`` about the pelvis's smoothed course, the
+    course's own steps turned with it, so a walk that turns around walks back rather than on
+    backwards."""
+    J = np.asarray(joints, np.float64)
+    n = len(J)
     c = root_centre(J)
     old = np.stack([c[:, 0], np.zeros(n), c[:, 1]], axis=1)              # (T,3) the course, on the floor
     new = old[:1] + np.vstack([np.zeros((1, 3)), np.cumsum(rotate_y(np.diff(old, axis=0), phi[1:]), axis=0)])
-    return Track(rotate_y(J - old[:, None], phi) + new[:, None], track.contacts)
+    return rotate_y(J - old[:, None], phi) + new[:, None]
+
+
+def turned(track: Track, angle: float) -> Track:
+    """``track`` turned so that over its length it turns ``angle`` in all (``eased_turn``,
+    ``turned_by``). The contacts are the track's (planting follows)."""
+    phi = eased_turn(np.unwrap(headings(track.joints)), angle)
+    return Track(turned_by(track.joints, phi), track.contacts)
 
 
 def turn_motion(motion, body, text: str, ik_refine_iters: int = 10):
