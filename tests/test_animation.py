@@ -2,6 +2,7 @@
 path, speed, timeline of prompts continuing from the previous segment's tokens."""
 from __future__ import annotations
 
+import dataclasses
 import json
 import subprocess
 import sys
@@ -99,6 +100,27 @@ def test_in_place_no_drift_feet_alternate(walk):
     seq = [v for i, v in enumerate(only) if v and (i == 0 or v != only[i - 1])]
     changes = sum(a != b for a, b in zip(seq, seq[1:]))
     assert changes >= 3                                                   # left, right, left, right
+
+
+def test_a_motion_held_in_place_stays_in_place_on_a_new_body_and_a_new_strip(gen, walk, tmp_path):
+    """``in_place`` keeps the tokens; its file says it was held in place, so re-decoding for a new
+    body (the Shape sliders) and regenerating a timeline's strip hold it again. Before, the
+    re-decoded walk travelled its 4 m again."""
+    from shapemove.core.generation.in_place import in_place, root_drift
+    from shapemove.core.generation.sequence import generate_sequence, regenerate_segment
+    from shapemove.core.scene.motion_file import load_motion, save_motion
+
+    held = load_motion(save_motion(tmp_path / "held.npz", in_place(walk)))
+    assert held.held_in_place and not walk.held_in_place and root_drift(held) <= 0.01
+    taller = np.full(10, 0.8, np.float32)
+    assert root_drift(gen.redecode(walk, taller)) > 1.0
+    again = gen.redecode(held, taller)
+    assert again.held_in_place and root_drift(again) <= 0.01
+    assert again.joints[:, 0, 1].mean() > held.joints[:, 0, 1].mean() + 0.02   # the new body all the same
+    timeline = in_place(generate_sequence(gen, [("a person walks forward", 2.0), ("a person jogs forward", 2.0)], seed=0))
+    strip = regenerate_segment(gen, timeline, 1, seed=5)
+    assert strip.held_in_place and root_drift(strip) <= 0.01
+    assert root_drift(regenerate_segment(gen, dataclasses.replace(timeline, held_in_place=False), 1, seed=5)) > 1.0
 
 
 def test_path_follow_s_curve(gen, walk):

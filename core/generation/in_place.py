@@ -4,7 +4,9 @@ themselves, crowds, previews).
 The root (pelvis) keeps its height and every rotation (so the facing and the turns stay); its
 horizontal position is held at the first frame's. The whole body moves with it, so the feet now
 slide under the body exactly as much as it travelled (a treadmill): they still step and alternate
-as in the original. A loop's ``loop_advance`` loses its horizontal part.
+as in the original. A loop's ``loop_advance`` loses its horizontal part. The motion says so
+(``Motion.held_in_place``, kept in its file), so re-decoding it for another body
+(``Generator.redecode``) and regenerating a timeline's strip hold it in place again.
 """
 from __future__ import annotations
 
@@ -36,4 +38,5 @@ def in_place(motion: Motion) -> Motion:
     if motion.loop_advance is not None:
         out.loop_advance = np.array([0.0, motion.loop_advance[1], 0.0], np.float32)
     out.warnings = list(motion.warnings)
+    out.held_in_place = True
     return out

@@ -298,7 +298,7 @@ def regenerate_segment(gen, motion: Motion, index: int, seed: int, prompt: str |
                        by_parts: bool = True) -> Motion:
     """Segment ``index`` sampled again (new ``seed``, optionally a new ``prompt``/``seconds``),
     continuing from the previous segment; every other segment keeps its codes (and its arms'), the
-    body its betas."""
+    body its betas; a timeline held in place is held in place again."""
     old_per, old_arms = segment_codes(motion), segment_codes(motion, arms=True)
     per, arms = list(old_per), list(old_arms)
     prompts = list(motion.segment_prompts)
@@ -323,6 +323,10 @@ def regenerate_segment(gen, motion: Motion, index: int, seed: int, prompt: str |
     track = splice(before, after, start, old_end, start + len(per[index]) * down)
     out = _planted(gen, track, None, extra, per, prompts, motion.betas, words=by_parts)
     out.shape_source = "given"
+    if motion.held_in_place:   # a timeline held in place stays so
+        from .in_place import in_place
+
+        out = in_place(out)
     return out
 
 
