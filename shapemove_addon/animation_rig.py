@@ -92,6 +92,14 @@ def _make_cycles(action, obj) -> None:
         mod.mode_before = mod.mode_after = "REPEAT" if fc.data_path.endswith(ROTATION_PATHS) else "REPEAT_OFFSET"
 
 
+def cycle_action(arm, action, cycle: int) -> None:
+    """Make ``action`` (keyed for one cycle of ``cycle`` frames and its closing key) repeat: its
+    F-Curves' Cycles modifiers (``_make_cycles``), its frame range, the rig's loop length."""
+    _make_cycles(action, arm)
+    arm[LOOP_KEY] = int(cycle)
+    action.frame_range = (FIRST_FRAME, FIRST_FRAME + cycle)
+
+
 def replay_strips(arm, action) -> bool:
     """Point a timeline rig's strips at ``action`` (its motion decoded again for a new body: the same
     frames), each strip keeping its timing (a strip the user moved or scaled stays where it is), and
@@ -166,9 +174,7 @@ def build_animated_rig(context, motion, body_model, name: str = "ShapeMove", col
         arm[ROOT_MOTION_KEY] = root_motion.upper()
         scene = context.scene
         if ch.cycle is not None:
-            _make_cycles(rig.action, arm)
-            arm[LOOP_KEY] = int(ch.cycle)
-            rig.action.frame_range = (FIRST_FRAME, FIRST_FRAME + ch.cycle)
+            cycle_action(arm, rig.action, ch.cycle)
             scene.frame_end = FIRST_FRAME + PREVIEW_CYCLES * ch.cycle - 1
         if motion.segment_bounds is not None:
             _add_strips(arm, rig.action, motion)

@@ -103,11 +103,12 @@ def apply_motion(rig, motion) -> bpy.types.Action:
     """Replace the rig's action with ``motion``'s keys (same action name; the old one is removed
     when nothing else uses it), the travel on what the rig was built to carry it with (its root
     motion: the pelvis, the object, a root bone, or none for in place; ``animation_rig``); a timeline
-    rig's strips play the new action with their own timing (``animation_rig.replay_strips``). The
+    rig's strips play the new action with their own timing (``animation_rig.replay_strips``); a
+    loop's new action repeats as the old one did (``animation_rig.cycle_action``). The
     bones must already sit on the rest joints of motion.betas. (A decoded motion is already
     grounded on the body's mesh by core's decode.)"""
     from ..core.scene.root_motion import rig_channels
-    from .animation_rig import ROOT_MOTION_KEY, key_travel, replay_strips
+    from .animation_rig import ROOT_MOTION_KEY, cycle_action, key_travel, replay_strips
 
     mode = str(rig.get(ROOT_MOTION_KEY, "PELVIS"))
     ch = rig_channels(motion, mode)
@@ -123,6 +124,8 @@ def apply_motion(rig, motion) -> bpy.types.Action:
         name = old.name if old is not None else name
     action = write_pose_action(rig, rotations, transl, motion.fps, names, name + "_new")
     key_travel(bpy.context, rig, action, ch.travel, mode)
+    if ch.cycle is not None:
+        cycle_action(rig, action, ch.cycle)
     replay_strips(rig, action)
     if old is not None and old.users == 0:
         bpy.data.actions.remove(old)

@@ -123,6 +123,38 @@ def test_a_motion_held_in_place_stays_in_place_on_a_new_body_and_a_new_strip(gen
     assert root_drift(regenerate_segment(gen, dataclasses.replace(timeline, held_in_place=False), 1, seed=5)) > 1.0
 
 
+def test_a_loop_moved_onto_a_new_body_takes_its_stride_and_still_closes(gen):
+    """A loop has no tokens: a Shape slider alone kept its rotations and its old travel on the new
+    legs, and the planted feet slid (3.0 mm per frame for this walk on a taller body, 8.8 for a
+    jog). ``loop.replant_loop`` moves it as a take is moved: the stride scaled by leg length, the
+    feet planted again, the cycle closed with its new advance. ``Generator.redecode`` takes it that
+    way; a loop held in place is not planted (its feet slide under it by design)."""
+    from shapemove.core.generation.generate import Request
+    from shapemove.core.generation.in_place import in_place
+    from shapemove.core.generation.loop import generate_loop, replant_loop, seam_report
+    from shapemove.core.scene.motion_file import make_motion
+
+    def slide(m):   # mean planted-foot step, m per frame
+        J, C = m.joints[:, [7, 8, 10, 11]][:, :, [0, 2]], m.contacts.astype(bool)
+        return float(np.linalg.norm(np.diff(J, axis=0), axis=2)[C[1:] & C[:-1]].mean())
+
+    loop = generate_loop(gen, Request("a person walks forward", seed=0))
+    taller = np.full(10, 1.0, np.float32)
+    slider_alone = make_motion(gen.body, loop.poses, loop.transl, taller, fps=loop.fps, contacts=loop.contacts)
+    moved = gen.redecode(loop, taller)
+    assert loop.remakeable and moved.planted_loop and moved.num_frames == loop.num_frames
+    assert slide(slider_alone) > 2e-3 and slide(moved) < 0.5e-3 and slide(loop) < 0.5e-3
+    legs = lambda m: float(m.joints[0, 0, 1])   # noqa: E731  pelvis height of the first frame
+    ratio = np.linalg.norm(moved.loop_advance) / np.linalg.norm(loop.loop_advance)
+    assert ratio == pytest.approx(legs(moved) / legs(loop), rel=0.05) and ratio > 1.04
+    assert seam_report(moved)["jump_ratio"] <= seam_report(loop)["jump_ratio"] + 0.1
+    assert abs(moved.joints[:, [7, 8, 10, 11], 1].min() - loop.joints[:, [7, 8, 10, 11], 1].min()) < 0.01
+    held = in_place(loop)
+    assert not held.planted_loop and not held.remakeable
+    with pytest.raises(ShapeMoveError, match="only a loop"):
+        replant_loop(held, gen.body, taller)
+
+
 def test_path_follow_s_curve(gen, walk):
     from shapemove.core.generation.path_follow import follow_path, path_report
 

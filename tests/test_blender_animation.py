@@ -99,6 +99,28 @@ def test_a_redecoded_motion_keeps_the_rigs_root_motion(openbody, mode):
     assert ("root" in arm.data.bones) == (mode == "ROOT_BONE")
 
 
+def test_a_redecoded_loop_still_cycles(openbody):
+    """A loop rig given new keys for a new body (``redecode.apply_motion``, the Shape sliders) keeps
+    cycling with the new advance: before, the new action had no Cycles modifiers and stopped after
+    one cycle."""
+    from shapemove.shapemove_addon.animation_rig import LOOP_KEY, build_animated_rig
+    from shapemove.shapemove_addon.redecode import apply_motion
+
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    m = _loop(openbody)
+    rig = build_animated_rig(bpy.context, m, openbody, name="Loop", root_motion="PELVIS")
+    arm = rig.armature
+    longer = make_motion(openbody, m.poses, m.transl, np.zeros(10), fps=20, prompt="loop test",
+                         loop_advance=(1.1 * ADV).astype(np.float32))
+    apply_motion(arm, longer)
+    adv_z_up = 1.1 * np.array([ADV[0], -ADV[2], ADV[1]])
+    for f in (2, 7):   # one and two cycles later: the same pose moved by the new advance
+        a, b, c = _pelvis(arm, f), _pelvis(arm, f + P), _pelvis(arm, f + 2 * P)
+        np.testing.assert_allclose(b - a, adv_z_up, atol=1e-4)
+        np.testing.assert_allclose(c - b, adv_z_up, atol=1e-4)
+    assert arm[LOOP_KEY] == P and tuple(arm.animation_data.action.frame_range) == (1.0, 1.0 + P)
+
+
 def test_timeline_nla_strips_play_the_segments(openbody):
     from shapemove.shapemove_addon.animation_rig import TRACK_NAME, build_animated_rig
 

@@ -426,8 +426,8 @@ class Generator:
         """The same tokens on another body (``decode.redecode``; a motion made by body part is
         composed and mirrored again, ``parts.redecode_parts``; a timeline assembled again,
         ``sequence.redecode_timeline``); a take played by its own rotations (no tokens, measured
-        contacts) is planted again on the new body (``retarget.replant``). A motion held in place
-        (``in_place.py``) is held in place again."""
+        contacts) is planted again on the new body (``retarget.replant``), a loop likewise, as a
+        loop (``loop.replant_loop``). A motion held in place (``in_place.py``) is held in place again."""
         out = self._redecoded(motion, betas)
         if motion.held_in_place and not out.held_in_place:
             from .in_place import in_place
@@ -436,6 +436,10 @@ class Generator:
         return out
 
     def _redecoded(self, motion: Motion, betas) -> Motion:
+        if motion.planted_loop:   # a loop has no tokens: moved by its rotations, as a take
+            from .loop import replant_loop
+
+            return replant_loop(motion, self.body, betas, self.ik_refine_iters)
         if motion.planted_take:
             from .retarget import replant
 

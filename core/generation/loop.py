@@ -154,6 +154,36 @@ def close_cycle(poses, transl, advance) -> tuple[np.ndarray, np.ndarray]:
     return matrix_to_axis_angle(R).astype(np.float32), t.astype(np.float32)
 
 
+def replant_loop(motion: Motion, body, betas, ik_refine_iters: int = 10) -> Motion:
+    """A loop moved onto the body ``betas`` by its own rotations, as a take is (``retarget.replant``:
+    the stride scaled by leg length, its contacts planted again), where a body-shape slider alone
+    would keep the old stride on the new legs. Three copies in a row are moved together and the
+    middle one kept (as ``plant_loop`` plants), so the contact runs crossing the seam stay one run
+    and the cycle still closes; its advance is the new body's."""
+    from .retarget import replant
+
+    if not motion.planted_loop:
+        raise ShapeMoveError("only a loop with its planted contacts and its travel (loop_advance, contacts, not held "
+                             "in place) is moved onto a new body")
+    P = motion.num_frames
+    adv = np.asarray(motion.loop_advance, np.float64)
+    shift = np.repeat(np.arange(-1, 2), P)[:, None] * adv[None]                  # (3P,3) each copy's offset
+    three = Motion(joints=np.tile(motion.joints, (3, 1, 1)) + shift[:, None].astype(np.float32),
+                   betas=motion.betas, poses=np.tile(motion.poses, (3, 1, 1)),
+                   transl=(np.tile(motion.transl, (3, 1)) + shift).astype(np.float32), fps=motion.fps,
+                   body_model=motion.body_model, prompt=motion.prompt, contacts=np.tile(motion.contacts, (3, 1)),
+                   contacts_measured=True)
+    m3 = replant(three, body, betas, ik_refine_iters)
+    moved = m3.transl[2 * P] - m3.transl[P]
+    loop_adv = np.array([moved[0], 0.0, moved[2]], np.float32)
+    poses, transl = close_cycle(m3.poses[P:2 * P + 1], m3.transl[P:2 * P + 1], loop_adv)
+    transl[:, [0, 2]] -= transl[0, [0, 2]]                                       # the cycle starts over the origin
+    m = make_motion(body, poses, transl, m3.betas, fps=motion.fps, prompt=motion.prompt,
+                    contacts=m3.contacts[P:2 * P], contacts_measured=motion.contacts_measured, loop_advance=loop_adv)
+    m.notes, m.ik_error_cm = list(motion.notes), m3.ik_error_cm
+    return m
+
+
 def loop_motion(motion: Motion, body, seconds: float | None = None, ik_refine_iters: int = 10) -> Motion:
     """An existing motion made into a loop (its best cut, see the module doc)."""
     track = track_of(motion)

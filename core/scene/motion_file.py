@@ -79,10 +79,17 @@ class Motion:
         return not has_tokens and self.contacts_measured and self.contacts is not None
 
     @property
+    def planted_loop(self) -> bool:
+        """A loop with its planted contacts and its travel (not held in place, where the feet slide
+        under the body by design): moved onto another body by its own rotations, as a loop, by
+        ``generation.loop.replant_loop``."""
+        return self.loop_advance is not None and self.contacts is not None and not self.held_in_place
+
+    @property
     def remakeable(self) -> bool:
         """Whether the motion can be made again for another body: it has motion tokens (decoded
-        again) or it is a ``planted_take`` (planted again)."""
-        return (self.tokens is not None and len(self.tokens) > 0) or self.planted_take
+        again), or it is a ``planted_take`` or a ``planted_loop`` (planted again)."""
+        return (self.tokens is not None and len(self.tokens) > 0) or self.planted_take or self.planted_loop
 
 
 def make_motion(body, poses, transl, betas, fps: float = 20.0, prompt: str | None = None, **extra) -> Motion:

@@ -156,7 +156,7 @@ def _parts(motion) -> list[str]:
 
 
 def redecode(params, progress, cancel) -> dict:
-    """params {"motion" (.npz with tokens, or a take played by its own rotations), "betas" (10), "model",
+    """params {"motion" (.npz with tokens, a take played by its own rotations or a loop), "betas" (10), "model",
     "body", "out"} -> the same tokens decoded for the new body (a take: planted again on it,
     ``retarget.replant``), written to ``out``."""
 
