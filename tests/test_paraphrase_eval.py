@@ -54,6 +54,10 @@ def test_paraphrase_eval_on_a_tiny_model(tiny_bundle, tmp_path, capsys):  # noqa
     assert set(fr["reachable"]) == set(res["reachable"]) and all(v is None or 0 <= v <= 1 for v in fr["reachable"].values())
     assert (fr["reachable"]["motion"] is None) == (fr["motion"]["prompts"] == 0)
     assert res["seeds"] == [0] and all(r["seed"] == 0 for r in rows)
+    assert res["seconds"] == 1 and "length: 1 s each" in out and all(r["seconds"] == 1.0 for r in rows)
+    raw_right = sum(r["motion_features_pred"] == r["action"] for r in rows if r["action"] in fr["actions"])
+    assert fr["motion_features"]["prompts"] == fr["motion"]["prompts"]          # the frequent actions by the raw judge
+    assert fr["motion_features"]["accuracy"] == pytest.approx(raw_right / max(1, fr["motion"]["prompts"]))
 
     # two seeds: every prompt generated once per seed, seed 0's generations as in the one-seed run,
     # and the accuracies counted over all the generations
@@ -86,6 +90,12 @@ def test_paraphrase_eval_on_a_tiny_model(tiny_bundle, tmp_path, capsys):  # noqa
     three = json.loads((tmp_path / "r3.json").read_text())
     assert three["library"] == str(lib) and three["kept_library"] == len(rows)
     assert all(r["kept_clips"] == ["library:stroll"] for r in three["rows"])
+
+    # --model-length: each motion as long as the model makes it (the product's default), not --seconds
+    assert main(["eval", "paraphrase", "--model", str(model), "--prompts", str(tmp_path / "p.json"), "--seconds", "1",
+                 "--model-length", "--data", str(data), "--json", str(tmp_path / "r4.json"), "--quiet"]) == 0
+    four = json.loads((tmp_path / "r4.json").read_text())
+    assert four["seconds"] is None and "length: the model's choice" in capsys.readouterr().out
 
 
 def test_bad_prompt_files(tmp_path):

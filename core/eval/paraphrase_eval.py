@@ -173,7 +173,8 @@ def eval_paraphrase(model_dir=None, prompts=None, tma=None, seed: int | list[int
         motion_emb = embed_motions(model, [played], mean, std)[0]
         embs.append(motion_emb)
         feats.append(played)
-        rows.append({**it, "seed": s, "motion_proto_pred": actions[int(np.argmax(A @ motion_emb))],
+        rows.append({**it, "seed": s, "seconds": round(m.num_frames / m.fps, 2),
+                     "motion_proto_pred": actions[int(np.argmax(A @ motion_emb))],
                      "warned": bool(m.warnings), "kept_clips": list(m.retrieved_clips),
                      "parts": list(m.part_prompts) if m.part_prompts else None,
                      "mirrored": bool(m.mirrored or m.arms_mirrored)})
@@ -203,6 +204,8 @@ def eval_paraphrase(model_dir=None, prompts=None, tma=None, seed: int | list[int
             **({"nearest_caption": _tally(rows, "nearest_caption_pred")} if nearest else {}),
             "frequent": {"min_clips": frequent, "actions": sorted({r["action"] for r in often}),
                          "motion": _tally(often, "motion_pred"),
+                         **({"motion_features": _tally(often, "motion_features_pred")}
+                            if feature_classifier is not None else {}),
                          "reachable": {k: _reachable(per, often) for k, per in per_action.items()},
                          **({"nearest_caption": _tally(often, "nearest_caption_pred")} if nearest else {})},
             "retrieval": bool(retrieval and gen.reads_memory),
@@ -210,6 +213,7 @@ def eval_paraphrase(model_dir=None, prompts=None, tma=None, seed: int | list[int
             "retrieval_prefix": retrieval_prefix if retrieval and gen.reads_memory else 0,
             "retrieved": retrieved if retrieval else 0, "retrieval_first": retrieval_first,
             "kept_retrieved": sum(bool(r["kept_clips"]) for r in rows), "by_parts": by_parts, "seeds": seeds,
+            "seconds": seconds,
             "library": str(library) if library is not None else None,
             "kept_library": sum(any(str(c).startswith("library:") for c in r["kept_clips"]) for r in rows),
             "composed": sum(bool(r["parts"]) for r in rows), "mirrored": sum(r["mirrored"] for r in rows),
@@ -299,6 +303,7 @@ def format_results(res: dict) -> str:
     if fr.get("motion"):
         lines.append(f"actions with >= {fr['min_clips']} real training clips ({fr['motion']['prompts']} prompts): motion "
                      f"{_pct(fr['motion']['accuracy'])} ({_pct(fr['motion']['accuracy_lenient'])} lenient)"
+                     + (f", without the TMA {_pct(fr['motion_features']['accuracy'])}" if fr.get("motion_features") else "")
                      + (f", nearest caption {_pct(fr['nearest_caption']['accuracy'])}" if fr.get("nearest_caption") else "")
                      + (", reachable " + ", ".join(f"{k} {_pct(v)}" for k, v in fr["reachable"].items())
                         if fr.get("reachable") else ""))
@@ -306,6 +311,9 @@ def format_results(res: dict) -> str:
                  f"retrieved as candidates: {res.get('retrieved', 0)} per prompt"
                  + (f", alone from caption similarity {res['retrieval_first']:g}" if res.get("retrieval_first") else "")
                  + f"; kept a retrieved clip for {res.get('kept_retrieved', 0)} prompts (judged without its own take)")
+    secs = res.get("seconds", 4.0)
+    lines.append("length: " + (f"{secs:g} s each" if secs is not None else
+                               "the model's choice (the product's default when no length is set)"))
     lines.append(f"by body part: {'on' if res.get('by_parts', True) else 'off'}; two things composed for "
                  f"{res.get('composed', 0)} prompts, mirrored to a named side for {res.get('mirrored', 0)}")
     seeded = res.get("retrieval_prefix") or 0
@@ -328,6 +336,9 @@ def add_arguments(p) -> None:
                         "(default $SHAPEMOVE_BUILT, else data/built)")
     p.add_argument("--tma", type=Path, default=None, help="TMA whose embeddings are compared (default: the model's tma/)")
     p.add_argument("--seconds", type=float, default=4.0, help="length of each generated motion")
+    p.add_argument("--model-length", action="store_true",
+                   help="the model decides each motion's length, as the product does when no length is set "
+                        "(instead of --seconds)")
     p.add_argument("--seed", type=int, nargs="+", default=[0], metavar="SEED",
                    help="one or more seeds: each prompt is generated once per seed and the accuracies sum them "
                         "(one seed moves a 150-prompt set by about 5 prompts: compare models on two or more)")
@@ -354,7 +365,8 @@ def from_cli(args) -> int:
 
     progress = PercentBar("eval paraphrase", args.quiet)  # opened at the first prompt, after the classifier's bars
     try:
-        res = eval_paraphrase(args.model, args.prompts, args.tma, args.seed, args.seconds, progress, data=args.data,
+        seconds = None if args.model_length else args.seconds
+        res = eval_paraphrase(args.model, args.prompts, args.tma, args.seed, seconds, progress, data=args.data,
                               show_progress=not args.quiet, candidates=args.candidates,
                               retrieval=not args.no_retrieval, retrieval_prefix=args.retrieval_prefix,
                               retrieved=args.retrieved, retrieval_first=args.retrieval_first,
