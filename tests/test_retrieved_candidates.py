@@ -56,15 +56,16 @@ def test_a_library_clip_competes_beside_nearer_training_captions(gen, memory):
     """A user's library clip joins the candidates though training captions are nearer: the library
     clip nearest to the prompt when its caption is within ``LIBRARY_MARGIN`` of the nearest caption's
     similarity (and at least ``LIBRARY_FLOOR``), and the nearest library clip of an action the prompt
-    names. A clip shorter than asked, one already retrieved, or one of another action far from the
-    prompt is not offered."""
+    names. A clip shorter than asked competes whole while it covers ``LIBRARY_SHORTEST`` of the
+    length; a shorter one, one already retrieved, or one of another action far from the prompt is
+    not offered."""
     from shapemove.core.generation.retrieved_candidates import LIBRARY_FLOOR, LIBRARY_MARGIN, library_codes
 
     reader = gen._text_encoder()
     codes = [int(x) for x in memory.clip_tokens[0]]     # any codes: the captions decide
     memory.add_clips(["library:mine", "library:short", "library:jab"],
                      [["a person punches with the left hand."], ["someone punches the air."], ["a boxer jabs."]],
-                     [codes, codes[:8], codes], reader, actions=[[], [], ["punch"]])   # as if only the jab named one
+                     [codes, codes[:4], codes], reader, actions=[[], [], ["punch"]])   # as if only the jab named one
     lib = {"library:mine", "library:short", "library:jab"}
     prompt = "somebody punches"
     found = retrieved_codes(memory, reader, prompt, 1, 10, 20)
@@ -77,8 +78,11 @@ def test_a_library_clip_competes_beside_nearer_training_captions(gen, memory):
     assert rows[0][1] == pytest.approx(sim) and rows[1][1] < near - LIBRARY_MARGIN   # the jab: by its action
     assert [r[0] for r in library_codes(memory, reader, prompt, lib, found, 10, 20, margin=near - sim - 0.01)] == \
         ["library:jab"]
-    # the short clip (8 codes) is nearer than "mine" once 4 codes will do
+    # the short clip (4 codes) is nearer than "mine" once 4 codes will do: asked 8, it competes whole
     assert memory.clip_ids[memory.nearest_of(sentence_vectors(reader, [prompt])[0], [3, 4, 5], 4)[0]] == "library:short"
+    whole = library_codes(memory, reader, prompt, lib, retrieved_codes(memory, reader, prompt, 1, 8, 8), 8, 8)
+    assert ("library:short", pytest.approx(memory.nearest_of(sentence_vectors(reader, [prompt])[0], [4], 4)[1]),
+            codes[:4]) in [tuple(r) for r in whole]
     walk = "a person walks forward"                   # far from every library caption, no punch named
     assert library_codes(memory, reader, walk, lib, retrieved_codes(memory, reader, walk, 1, 10, 20), 10, 20) == []
     assert library_codes(memory, reader, prompt, lib, found + rows, 10, 20) == []    # already candidates
@@ -228,6 +232,14 @@ def test_a_library_kick_the_codec_flattens_is_played_as_captured(mocap_root, ope
     with pytest.raises(ShapeMoveError, match="library folder not found"):
         jobs_shapemove.generate({"prompt": caption, "library": str(tmp_path / "nowhere"), "out": str(tmp_path / "x.npz")},
                                 lambda *a: None, lambda: False)
+    # asked longer than the clip (11.8 s of codes): it competes whole while it covers half the length
+    # asked, and says it is shorter; asked more than twice its length, it does not compete
+    whole = own.generate_batch([Request(caption, seconds=16, seed=0, retrieval_first=0.0)])[0]
+    assert whole.retrieved_clips == ["library:kick"] and whole.num_frames == 236
+    assert any("played whole, shorter than the 16 s asked" in n for n in whole.notes)
+    assert lift(whole.joints[:, 8, 1]) > 0.9 * lift(src)
+    far = own.generate_batch([Request(caption, seconds=25, seed=0, retrieval_first=0.0)])[0]
+    assert "library:kick" not in far.retrieved_clips and far.num_frames == 500 and not far.notes
 
 
 def test_a_library_kick_loops_and_stays_in_place_as_captured(mocap_root, openbody, tmp_path):

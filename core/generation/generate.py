@@ -375,6 +375,7 @@ class Generator:
                           or self.decode_motion(codes[0], betas, prompt=r.prompt))
                 motion.shape_source = source
                 motion.retrieved_clips = [c for c in kept if c]
+                self._say_if_short(motion, kept[0], r.seconds)
                 if r.by_parts:  # the codec does not carry turning: a circle or a turn the words name, given back
                     motion = (circle_motion(motion, self.body, r.prompt, self.ik_refine_iters)   # circle_walk.py
                               if self.asks_circle(r.prompt, check) else
@@ -390,6 +391,16 @@ class Generator:
             if progress is not None:
                 progress((i + 1) / len(reqs), r.prompt)
         return out
+
+    def _say_if_short(self, motion: Motion, clip: str | None, seconds: float | None) -> None:
+        """A note when a kept library clip, shorter than the length asked, was played whole
+        (``retrieved_candidates.LIBRARY_SHORTEST``)."""
+        if clip not in self.library_files or seconds is None:
+            return
+        if motion.num_frames < self._length(seconds)[0] * self.vae.cfg.downsample:
+            motion.notes.append(f"your library clip {self.library_files[clip].name} lasts "
+                                f"{motion.num_frames / motion.fps:.1f} s: played whole, shorter than the "
+                                f"{seconds:g} s asked")
 
     def body_shape(self, r: Request, predicted: np.ndarray) -> tuple[np.ndarray, str]:
         """The betas for a request and where they came from: explicit betas; else, when the shape

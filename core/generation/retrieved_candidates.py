@@ -23,11 +23,14 @@ prompt names.
 """
 from __future__ import annotations
 
+import math
+
 from ..models.motion_memory import sentence_vectors
 
 WINDOWS = 3   # windows of a clip longer than the requested length: its start, middle and end
 LIBRARY_MARGIN = 0.08   # a user's library clip competes when its caption is this near the nearest caption's
 LIBRARY_FLOOR = 0.4     # ... and at least this near the prompt (MiniLM cosine)
+LIBRARY_SHORTEST = 0.5  # a library clip shorter than asked competes whole when it covers this share of the length
 
 
 def windows(codes, min_codes: int, max_codes: int) -> list[list[int]]:
@@ -65,12 +68,15 @@ def library_codes(memory, reader, prompt: str, library, found, min_codes: int, m
     ``margin``, and the nearest library clip of an action the prompt names (``data/actions.py``
     patterns, read from its caption): thousands of training captions would otherwise keep a user's
     own clip out of the candidates ("a karate front kick" finds the training kicks, not the user's
-    "front kick with the right leg"; "a woman kicks" finds "A person kicks."). Clips already in
-    ``found`` are not offered again; [] when none qualifies."""
+    "front kick with the right leg"; "a woman kicks" finds "A person kicks."). A library clip
+    shorter than ``min_codes`` competes whole when it covers ``LIBRARY_SHORTEST`` of it (most
+    captured kicks and punches last under the 4 s a user asks; the generator says so when one is
+    kept). Clips already in ``found`` are not offered again; [] when none qualifies."""
     from ..data.actions import action_spans
 
     if memory is None or not library:
         return []
+    min_codes = max(1, math.ceil(LIBRARY_SHORTEST * min_codes))
     mine = [i for i, c in enumerate(memory.clip_ids) if c in library]
     taken = {f[0] for f in found}
     offered = []
