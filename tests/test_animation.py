@@ -132,6 +132,7 @@ def test_a_loop_moved_onto_a_new_body_takes_its_stride_and_still_closes(gen):
     from shapemove.core.generation.generate import Request
     from shapemove.core.generation.in_place import in_place
     from shapemove.core.generation.loop import generate_loop, replant_loop, seam_report
+    from shapemove.core.generation.track import headings
     from shapemove.core.scene.motion_file import make_motion
 
     def slide(m):   # mean planted-foot step, m per frame
@@ -149,6 +150,11 @@ def test_a_loop_moved_onto_a_new_body_takes_its_stride_and_still_closes(gen):
     assert ratio == pytest.approx(legs(moved) / legs(loop), rel=0.05) and ratio > 1.04
     assert seam_report(moved)["jump_ratio"] <= seam_report(loop)["jump_ratio"] + 0.1
     assert abs(moved.joints[:, [7, 8, 10, 11], 1].min() - loop.joints[:, [7, 8, 10, 11], 1].min()) < 0.01
+    # it starts where it started, facing and going the way it went (a planted take starts facing +Z)
+    np.testing.assert_allclose(moved.joints[0, 0, [0, 2]], loop.joints[0, 0, [0, 2]], atol=1e-4)
+    assert abs(headings(moved.joints)[0] - headings(loop.joints)[0]) < np.radians(1.0)
+    way = lambda m: np.arctan2(m.loop_advance[0], m.loop_advance[2])   # noqa: E731
+    assert abs(way(moved) - way(loop)) < np.radians(1.0)
     held = in_place(loop)
     assert not held.planted_loop and not held.remakeable
     with pytest.raises(ShapeMoveError, match="only a loop"):

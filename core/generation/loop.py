@@ -25,9 +25,11 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import torch
 
 from ..constants import FPS
 from ..errors import ShapeMoveError
+from ..motion.skeleton_ops import facing_directions, heading_angles
 from ..scene.motion_file import Motion, make_motion
 from .on_the_spot import LOOP_ALLOWED, spot_track
 from .prompts import check_prompt
@@ -177,11 +179,29 @@ def replant_loop(motion: Motion, body, betas, ik_refine_iters: int = 10) -> Moti
     moved = m3.transl[2 * P] - m3.transl[P]
     loop_adv = np.array([moved[0], 0.0, moved[2]], np.float32)
     poses, transl = close_cycle(m3.poses[P:2 * P + 1], m3.transl[P:2 * P + 1], loop_adv)
-    transl[:, [0, 2]] -= transl[0, [0, 2]]                                       # the cycle starts over the origin
+    # a planted take starts facing +Z: turned back to the loop's own first facing, where it went before
+    (was, now), rest = heading_angles(facing_directions(np.stack([motion.joints[0], m3.joints[P]]))), \
+        body.rest_joints(torch.as_tensor(np.asarray(m3.betas, np.float32))[None])[0, 0].numpy()
+    poses, transl = turned_about_y(poses, transl, rest, was - now)
+    loop_adv = rotate_y(loop_adv, was - now).astype(np.float32)
+    transl[:, [0, 2]] += motion.joints[0, 0, [0, 2]] - (transl[0, [0, 2]] + rest[[0, 2]])   # and where it started
     m = make_motion(body, poses, transl, m3.betas, fps=motion.fps, prompt=motion.prompt,
                     contacts=m3.contacts[P:2 * P], contacts_measured=motion.contacts_measured, loop_advance=loop_adv)
     m.notes, m.ik_error_cm = list(motion.notes), m3.ik_error_cm
     return m
+
+
+def turned_about_y(poses, transl, rest_root, angle: float) -> tuple[np.ndarray, np.ndarray]:
+    """(T,24,3) axis-angle poses and (T,3) transl of a body turned by ``angle`` about the vertical
+    through the origin (``rest_root``: the body's rest root joint, which transl offsets)."""
+    from ..geometry.rotations import axis_angle_to_matrix, matrix_to_axis_angle
+
+    c, s = np.cos(angle), np.sin(angle)
+    yaw = np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])                  # as ``track.rotate_y``
+    R = axis_angle_to_matrix(np.asarray(poses, np.float64))
+    R[:, 0] = yaw @ R[:, 0]
+    root = rotate_y(np.asarray(transl, np.float64) + rest_root, angle) - rest_root
+    return matrix_to_axis_angle(R).astype(np.float32), root.astype(np.float32)
 
 
 def loop_motion(motion: Motion, body, seconds: float | None = None, ik_refine_iters: int = 10) -> Motion:
