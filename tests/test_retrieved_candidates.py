@@ -242,7 +242,7 @@ def test_a_library_kick_the_codec_flattens_is_played_as_captured(mocap_root, ope
     assert "library:kick" not in far.retrieved_clips and far.num_frames == 500 and not far.notes
 
 
-def test_a_library_kick_loops_and_stays_in_place_as_captured(mocap_root, openbody, tmp_path):
+def test_a_library_kick_loops_and_stays_in_place_as_captured(mocap_root, openbody, tmp_path, monkeypatch):
     """Generate Animated with the Library (the worker's animate job, "library"): a loop of a kept
     library kick is cut from the captured take with the kick inside the cycle, and held in place it
     keeps its rise; both carry the note. Without the library the same job loops the model's codes, which
@@ -275,6 +275,21 @@ def test_a_library_kick_loops_and_stays_in_place_as_captured(mocap_root, openbod
     assert np.ptp(m.joints[:, 0, [0, 2]], axis=0).max() < 1e-4 and lift(m.joints[:, 8, 1]) > 0.85 * src
     r = job(loop=True, seconds=2.0)                     # the codes' loop: the kick flattened
     assert not r["notes"] and lift(load_motion(r["path"]).joints[:, 8, 1]) < 0.5 * src
+    # a prompt no library clip competes for is sampled once, not first for the library and again
+    from shapemove.core.generation.generate import Generator, Request
+    from shapemove.core.generation.loop import generate_loop
+
+    gen = Generator(None)
+    gen.add_library(lib)
+    calls = []
+    tokens_for = gen.tokens_for
+    monkeypatch.setattr(gen, "tokens_for", lambda *a, **k: calls.append(1) or tokens_for(*a, **k))
+    assert not gen.offers_library(Request("a person walks forward", seconds=2.0))
+    walk = generate_loop(gen, Request("a person walks forward", seconds=2.0, seed=0, by_parts=False))
+    assert calls == [] and not walk.notes
+    assert gen.offers_library(Request(caption, seconds=2.0))
+    generate_loop(gen, Request(caption, seconds=2.0, seed=0, by_parts=False))
+    assert calls == [1]
 
 
 def test_a_library_kick_is_found_for_words_the_training_kicks_are_nearer_to(mocap_root, openbody, tmp_path,

@@ -216,6 +216,13 @@ class Generator:
         found = retrieved_codes(self.t5.memory, self._text_encoder(), r.prompt, r.retrieved, lo, hi)
         return found + library_codes(self.t5.memory, self._text_encoder(), r.prompt, self.library_files, found, lo, hi)
 
+    def offers_library(self, r: Request) -> bool:
+        """Whether a clip of the user's library competes for ``r`` at its length (``retrieved_candidates``):
+        a caption comparison, no sampling."""
+        if not self.library_files:
+            return False
+        return any(cid in self.library_files for cid, _, _ in self._retrieved(r, *self._length(r.seconds)))
+
     def _retrieval_seeds(self, r: Request, n: int) -> list[list[int]]:
         """Prefixes for the seeded share of ``n`` candidates (``retrieval_seeds.py``): only for a model
         that reads retrieved clips, with retrieval on, and a best-of-N to choose among them."""

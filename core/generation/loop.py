@@ -218,14 +218,16 @@ def loop_motion(motion: Motion, body, seconds: float | None = None, ik_refine_it
 def _library_loop(gen, req, lo: int, hi: int):
     """A loop of the user's library clip that ``req`` keeps among the samples when the codes cannot
     carry it (``Generator.library_take``: played as captured, feet planted), cut where it loops
-    best; None without a library or when a sample or a window the codes carry wins (it is looped
-    from its codes as any sample)."""
+    best; None without a library, when none of its clips competes for the prompt (nothing is
+    sampled then: the loop's own samples follow), or when a sample or a window the codes carry wins
+    (it is looped from its codes as any sample)."""
     from dataclasses import replace
 
-    if not gen.library_files:
-        return None
     seconds = hi * gen.vae.cfg.downsample / FPS if lo == hi else None
-    chosen = gen.tokens_for([replace(req, seconds=seconds)], library_as_captured=True)
+    asked = replace(req, seconds=seconds)
+    if not gen.offers_library(asked):
+        return None
+    chosen = gen.tokens_for([asked], library_as_captured=True)
     betas, source = body_for(gen, req.prompt, req.shape_text, req.betas, chosen.betas[0].numpy())
     take = gen.library_take(chosen.kept[0], chosen.codes[0], betas, req.prompt)
     if take is None:
