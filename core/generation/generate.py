@@ -12,6 +12,8 @@ joints: the decoded positions' legs, the upper body posed from the decoded rotat
 """
 from __future__ import annotations
 
+import dataclasses
+
 from pathlib import Path
 from typing import NamedTuple
 
@@ -39,6 +41,7 @@ from .rerank import CandidatePicker
 from .retrieval_seeds import seed_prefixes, seeded_count
 from .on_the_spot import on_the_spot
 from .retrieved_candidates import library_codes, retrieved_codes
+from .stop_words import rest_code, stop_codes, stop_request
 from .sampling_params import (DEFAULT_GUIDANCE, check_candidates, check_guidance, check_retrieval_first,
                               check_retrieval_prefix, check_retrieved, check_sampling)
 from .request import Request
@@ -119,6 +122,7 @@ class Generator:
         self._picker = None
         self.library_files: dict[str, Path] = {}   # memory clip id -> the user's file (add_library)
         self._library_takes: dict[str, dict | None] = {}  # library clips read as captured (library_takes.read_take)
+        self._rest_code: int | None = None   # the code that decodes to standing still (stop_words.rest_code), -1: none
 
     @property
     def picker(self) -> CandidatePicker | None:
@@ -374,12 +378,16 @@ class Generator:
         for i, (r, check) in enumerate(zip(reqs, checks)):
             if cancel is not None and cancel():
                 break
-            motion = generate_by_parts(self, r) if r.by_parts else None
+            stop = stop_request(r.prompt) if r.by_parts else None   # "takes three steps and stops"
+            motion = generate_by_parts(self, r) if r.by_parts and stop is None else None
             if motion is None:  # one action, no side named: the motion as the model writes it
-                codes, pred, kept = self.tokens_for([r], library_as_captured=True)
+                asked = dataclasses.replace(r, prompt=stop[0]) if stop else r
+                codes, pred, kept = self.tokens_for([asked], library_as_captured=True)
                 betas, source = self.body_shape(r, pred[0].numpy())
                 motion = (self.library_take(kept[0], codes[0], betas, r.prompt)   # a library clip as captured
                           or self.decode_motion(codes[0], betas, prompt=r.prompt))
+                if stop is not None and motion.tokens is not None:   # stop_words.py: cut, then stand
+                    motion = self.stopped(motion, stop[1])
                 motion.shape_source = source
                 motion.retrieved_clips = [c for c in kept if c]
                 self._say_if_short(motion, kept[0], r.seconds)
@@ -397,6 +405,21 @@ class Generator:
             out.append(motion)
             if progress is not None:
                 progress((i + 1) / len(reqs), r.prompt)
+        return out
+
+    def stopped(self, motion: Motion, steps: int | None) -> Motion:
+        """``motion`` (decoded from its tokens) cut after ``steps`` foot strikes (None: half its
+        length) and standing still for the rest (``stop_words.py``), decoded again; unchanged when
+        the model has no standing code or the gait strikes fewer times."""
+        if self._rest_code is None:
+            self._rest_code = rest_code(self.t5.memory if self.t5 is not None else None, self.vae) or -1
+        if self._rest_code < 0:
+            return motion
+        codes = stop_codes(motion.tokens, motion.contacts, steps, self.vae.cfg.downsample, self._rest_code)
+        if codes == [int(c) for c in motion.tokens]:
+            return motion
+        out = self.decode_motion(codes, motion.betas, prompt=motion.prompt)
+        out.shape_source, out.retrieved_clips = motion.shape_source, list(motion.retrieved_clips)
         return out
 
     def _say_if_short(self, motion: Motion, clip: str | None, seconds: float | None) -> None:

@@ -1,0 +1,110 @@
+"""Stopping: "takes three steps forward and stops" walks three steps and then stands.
+
+The training data has no caption of standing still, so the T5 writes a gait on to the end: "a
+person walks forward" -> "a person stands still" as a timeline kept walking (seed 0) or slowed to
+0.24 m/s (seed 1). The codec itself knows standing, though: some codes, repeated, decode to a body
+standing still, and the decoder's own transition from walking codes into them brings the body to
+a halt within about half a second, feet planted. So a prompt that says the gait stops is generated
+without its stop clause, its codes are cut after the step the words count (or at half the length
+when they name no count), and the model's standing code fills the rest of the length; the whole is
+decoded again as one sequence. The motion keeps those tokens, so a new body decodes the same stop.
+
+- The stop: "and stops", "then stops", "comes to a stop", "halts", "stands still", "stops walking"
+  after the gait ("stops" alone, or "without stopping", "non-stop": nothing).
+- The count: "three steps", "a step", "a couple of steps" (2), "a few steps" (3), digits; a step is
+  a foot strike (a new contact of either foot) after the first frame.
+- The standing code (``rest_code``): of the codes the memory's real clips hold for at least
+  ``REST_RUN`` codes in a row, the one whose repetition decodes with the least joint speed and
+  root travel, wrists below the shoulders (arms down); found once per model.
+
+    prompt, steps = stop_request("a man takes three steps forward and stops")   # ("a man takes steps forward", 3)
+"""
+from __future__ import annotations
+
+import re
+from collections import Counter
+
+import numpy as np
+import torch
+
+from ..data.actions import find_actions
+from ..motion.contacts import runs
+
+STOP = re.compile(r"\s*(?:,\s*)?(?:\b(?:and|then)\s+)*(?:\b(?:he|she|they|it)\s+)?"
+                  r"\b(?:stops?(?:\s+(?:walking|running|jogging|moving))?|halts?|comes? to a (?:stop|halt)|"
+                  r"stands? still|stays? still)\b(?:\s+(?:there|still))?\s*\.?\s*$")
+NEGATED = re.compile(r"\b(?:without stopping|non-?stop|never stops?|doesn't stop|does not stop)\b")
+NUMBERS = {"a": 1, "one": 1, "a single": 1, "two": 2, "a couple of": 2, "a couple": 2, "three": 3, "a few": 3,
+           "four": 4, "five": 5, "six": 6, "seven": 7, "eight": 8, "nine": 9, "ten": 10}
+COUNT = re.compile(r"\b(" + "|".join(sorted(map(re.escape, NUMBERS), key=len, reverse=True)) + r"|\d{1,2})\s+"
+                   r"(?:\w+\s+)?(?:steps?|strides?|paces?)\b")
+GAITS = {"walk", "run", "jog", "sprint", "sneak", "march", "limp", "walk backward", "sidestep", "zombie walk"}
+REST_RUN = 4       # codes in a row: a code held this long in a real clip is a candidate standing code
+REST_PROBE = 10    # codes the candidate is repeated for when it is decoded
+MAX_STEPS = 20
+
+
+def stop_request(text: str) -> tuple[str, int | None] | None:
+    """(the prompt without its stop clause, the steps it counts or None) when ``text`` asks a gait
+    to stop; None otherwise."""
+    t = str(text)
+    low = t.lower()
+    match = STOP.search(low)
+    if match is None or NEGATED.search(low):
+        return None
+    gait = t[:match.start()].strip().rstrip(",")
+    counted = COUNT.search(gait.lower())
+    if not gait or (counted is None and not set(find_actions(gait.lower())) & GAITS):
+        return None   # "a person stops", "she waves and stops": no gait to stop
+    steps = None
+    if counted is not None:
+        word = counted.group(1)
+        steps = int(word) if word.isdigit() else NUMBERS[word]
+        steps = steps if 1 <= steps <= MAX_STEPS else None
+    return gait, steps
+
+
+def rest_code(memory, vae) -> int | None:
+    """The code that decodes to a body standing still (module doc); None without a memory."""
+    if memory is None or not len(memory):
+        return None
+    held = Counter()
+    for tokens in memory.clip_tokens:
+        t = np.asarray(tokens)
+        if len(t) == 0:
+            continue
+        starts = np.r_[0, np.flatnonzero(np.diff(t)) + 1, len(t)]
+        for a, b in zip(starts[:-1], starts[1:]):
+            if b - a >= REST_RUN and int(t[a]) < vae.quantizer.codebook_size:
+                held[int(t[a])] += 1
+    if not held:
+        return None
+    from ..motion.features import joints_from_features
+    from .decode import decode_features
+
+    best, cost = None, np.inf
+    with torch.no_grad():
+        for code, _ in held.most_common(12):
+            J = joints_from_features(decode_features([code] * REST_PROBE, vae, np.zeros(10, np.float32)).numpy())
+            if (J[:, [20, 21], 1] > J[:, [16, 17], 1]).any():   # a hand above its shoulder: not at rest
+                continue
+            c = float(np.linalg.norm(np.diff(J, axis=0), axis=2).mean() + np.linalg.norm(J[-1, 0, [0, 2]] - J[0, 0, [0, 2]]))
+            if c < cost:
+                best, cost = code, c
+    return best
+
+
+def stop_codes(codes, contacts, steps: int | None, down: int, rest: int) -> list[int]:
+    """``codes`` (the gait's) cut after its ``steps``-th foot strike (a new contact of joints 7-8
+    after frame 0, read from the planted ``contacts``; None: half the codes) and filled to their
+    length with ``rest``; the codes unchanged when the gait strikes fewer times than counted."""
+    codes = [int(c) for c in codes]
+    if steps is None:
+        keep = max(1, len(codes) // 2)
+    else:
+        c = np.asarray(contacts, bool)
+        strikes = sorted(a for k in (0, 1) for a, _ in runs(c[:, k]) if a > 0)
+        if len(strikes) < steps:
+            return codes
+        keep = min(len(codes), strikes[steps - 1] // down + 2)   # the code that lands the step, and the next
+    return codes[:keep] + [rest] * (len(codes) - keep)

@@ -1,0 +1,65 @@
+"""Stopping (core/generation/stop_words.py): "takes three steps forward and stops" walks three steps
+and then stands, with the model's own standing code; the tokens are kept, so a new body stops too."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from shapemove.core.generation.stop_words import stop_codes, stop_request
+
+
+@pytest.mark.parametrize("text, want", [
+    ("a man takes three steps forward and stops", ("a man takes three steps forward", 3)),
+    ("a person walks forward and then stops.", ("a person walks forward", None)),
+    ("she jogs, then comes to a stop", ("she jogs", None)),
+    ("a woman walks a few steps and stands still", ("a woman walks a few steps", 3)),
+    ("a man walks 4 steps then halts", ("a man walks 4 steps", 4)),
+    ("he takes a step and stops", ("he takes a step", 1)),
+    ("A man walks forward and stops walking", ("A man walks forward", None)),
+    ("someone runs without stopping", None),       # negated
+    ("a person stops", None),                      # no gait to stop
+    ("she waves and stops", None),                 # a gesture, not a gait
+    ("a person walks forward", None),
+])
+def test_the_words_that_stop_a_gait(text, want):
+    assert stop_request(text) == want
+
+
+def test_stop_codes_cut_after_the_counted_strike():
+    contacts = np.zeros((40, 4), np.uint8)
+    for a in (0, 9, 21, 30):                        # frame 0 is no strike: strikes at 9, 21, 30
+        contacts[a:a + 5, (a // 9) % 2] = 1
+    codes = list(range(10))
+    assert stop_codes(codes, contacts, 2, 4, 99) == [0, 1, 2, 3, 4, 5, 6] + [99] * 3    # strike 21 -> code 5, +1
+    assert stop_codes(codes, contacts, None, 4, 99) == [0, 1, 2, 3, 4] + [99] * 5       # half the length
+    assert stop_codes(codes, contacts, 5, 4, 99) == codes                               # fewer strikes than counted
+
+
+@pytest.fixture(scope="module")
+def gen_default():
+    from shapemove.core.generation.generate import Generator
+
+    return Generator(None)
+
+
+def test_three_steps_and_a_stop(gen_default):
+    """The default model: "a man takes three steps forward and stops" (4 s) strikes three times, then
+    stands still for the last 1.5 s; the plain walk walks to the end. A taller body stops too."""
+    from shapemove.core.generation.generate import Request
+    from shapemove.core.motion.contacts import runs
+
+    def speeds(m):
+        r = m.joints[:, 0, [0, 2]]
+        return np.linalg.norm(np.diff(r, axis=0), axis=1) * m.fps
+
+    m = gen_default.generate_batch([Request("a man takes three steps forward and stops", seconds=4, seed=0)])[0]
+    plain = gen_default.generate_batch([Request("a man takes three steps forward", seconds=4, seed=0)])[0]
+    s, p = speeds(m), speeds(plain)
+    assert m.num_frames == 80 and m.tokens is not None and m.tokens[-1] == gen_default._rest_code
+    assert s[:30].mean() > 0.5 and s[-30:].mean() < 0.08 and p[-30:].mean() > 0.5
+    strikes = sorted(a for k in (0, 1) for a, _ in runs(m.contacts[:, k].astype(bool)) if a > 0)
+    assert 3 <= len(strikes) <= 4                                  # three steps (and the closing one)
+    J, C = m.joints[:, [7, 8, 10, 11]][:, :, [0, 2]], m.contacts.astype(bool)
+    assert np.linalg.norm(np.diff(J, axis=0), axis=2)[C[1:] & C[:-1]].mean() < 0.5e-3    # feet planted
+    taller = gen_default.redecode(m, np.full(10, 0.8, np.float32))
+    assert speeds(taller)[-30:].mean() < 0.08 and taller.joints[:, 0, 1].mean() > m.joints[:, 0, 1].mean()
