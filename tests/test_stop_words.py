@@ -63,3 +63,27 @@ def test_three_steps_and_a_stop(gen_default):
     assert np.linalg.norm(np.diff(J, axis=0), axis=2)[C[1:] & C[:-1]].mean() < 0.5e-3    # feet planted
     taller = gen_default.redecode(m, np.full(10, 0.8, np.float32))
     assert speeds(taller)[-30:].mean() < 0.08 and taller.joints[:, 0, 1].mean() > m.joints[:, 0, 1].mean()
+
+
+def test_a_timeline_segment_that_stands_still_stands(gen_default):
+    """"walks forward" -> "stands still" -> "walks forward": the T5 has no standing caption and its
+    middle segment walked on (seed 0: 1.1-1.3 m/s); it is now the model's standing code, so the body
+    halts early in the segment, stands, and walks on after it. Regenerate Strip keeps it."""
+    from shapemove.core.generation.sequence import boundary_report, generate_sequence, regenerate_segment
+    from shapemove.core.generation.stop_words import asks_stand_still
+
+    assert asks_stand_still("a person stands still") and asks_stand_still("she waits")
+    assert not asks_stand_still("she stands up") and not asks_stand_still("a man walks and stops")
+    segs = [("a person walks forward", 2.0), ("a person stands still", 2.0), ("a person walks forward", 2.0)]
+
+    def middle(m):   # root speed over the middle segment's last 1.4 s
+        r = m.joints[:, 0, [0, 2]]
+        return float(np.linalg.norm(np.diff(r[52:80], axis=0), axis=1).mean() * m.fps)
+
+    plain = generate_sequence(gen_default, segs, seed=0, by_parts=False)
+    m = generate_sequence(gen_default, segs, seed=0)
+    assert middle(plain) > 0.5 and middle(m) < 0.1
+    assert m.tokens[10:20].tolist() == [gen_default.rest_code()] * 10
+    assert boundary_report(m)["jump_ratio"] <= 2.0
+    again = regenerate_segment(gen_default, m, 1, seed=4)
+    assert middle(again) < 0.1

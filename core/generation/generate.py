@@ -407,15 +407,22 @@ class Generator:
                 progress((i + 1) / len(reqs), r.prompt)
         return out
 
+    def rest_code(self) -> int | None:
+        """The code that decodes to standing still (``stop_words.rest_code``, found once); None
+        for a model without a memory or such a code."""
+        if self._rest_code is None:
+            found = rest_code(self.t5.memory if self.t5 is not None else None, self.vae)
+            self._rest_code = -1 if found is None else found
+        return None if self._rest_code < 0 else self._rest_code
+
     def stopped(self, motion: Motion, steps: int | None) -> Motion:
         """``motion`` (decoded from its tokens) cut after ``steps`` foot strikes (None: half its
         length) and standing still for the rest (``stop_words.py``), decoded again; unchanged when
         the model has no standing code or the gait strikes fewer times."""
-        if self._rest_code is None:
-            self._rest_code = rest_code(self.t5.memory if self.t5 is not None else None, self.vae) or -1
-        if self._rest_code < 0:
+        rest = self.rest_code()
+        if rest is None:
             return motion
-        codes = stop_codes(motion.tokens, motion.contacts, steps, self.vae.cfg.downsample, self._rest_code)
+        codes = stop_codes(motion.tokens, motion.contacts, steps, self.vae.cfg.downsample, rest)
         if codes == [int(c) for c in motion.tokens]:
             return motion
         out = self.decode_motion(codes, motion.betas, prompt=motion.prompt)

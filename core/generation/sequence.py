@@ -38,6 +38,7 @@ from ..torch_threads import one_torch_thread
 from .decode import decode_features
 from .prompts import check_prompt
 from .sampling_params import DEFAULT_CANDIDATES, check_candidates, check_sampling
+from .stop_words import asks_stand_still
 from .token_sampling import body_for, sample_codes
 from .track import Track, decoded_track, plant, rotate_y
 
@@ -77,13 +78,16 @@ def check_segments(segments) -> list[Segment]:
 def _segment(gen, prompt, shape_text, n, prefix, arms_prefix, betas, seed, temperature, top_k, candidates, guidance,
              by_parts: bool):
     """(codes, the arms' codes or None, [BETA] prediction) of one segment: two things at once are
-    made by part (module doc), any other prompt whole."""
+    made by part (module doc), standing still is the model's standing code (``stop_words.py``), any
+    other prompt whole."""
     from .parts import plan_of
 
     plan, side = plan_of(prompt, gen) if by_parts else (None, None)
     if plan is None:
         codes, pred = _segment_codes(gen, prompt, shape_text, n, prefix, betas, seed, temperature, top_k, candidates,
                                      guidance)
+        if by_parts and asks_stand_still(prompt) and gen.rest_code() is not None:   # no caption stands still
+            return [gen.rest_code()] * len(codes), None, pred                       # (stop_words.py)
         return (_on_side(gen.vae, codes, prefix, side) if side is not None else codes), None, pred
     codes, pred = _segment_codes(gen, plan.legs_prompt, shape_text, n, prefix, betas, seed, temperature, top_k,
                                  candidates, guidance)

@@ -8,6 +8,8 @@ a halt within about half a second, feet planted. So a prompt that says the gait 
 without its stop clause, its codes are cut after the step the words count (or at half the length
 when they name no count), and the model's standing code fills the rest of the length; the whole is
 decoded again as one sequence. The motion keeps those tokens, so a new body decodes the same stop.
+A timeline's segment that only asks to stand still ("stands still", "waits", "pauses";
+``asks_stand_still``) is that code too (``sequence._segment``).
 
 - The stop: "and stops", "then stops", "comes to a stop", "halts", "stands still", "stops walking"
   after the gait ("stops" alone, or "without stopping", "non-stop": nothing).
@@ -38,6 +40,9 @@ NUMBERS = {"a": 1, "one": 1, "a single": 1, "two": 2, "a couple of": 2, "a coupl
            "four": 4, "five": 5, "six": 6, "seven": 7, "eight": 8, "nine": 9, "ten": 10}
 COUNT = re.compile(r"\b(" + "|".join(sorted(map(re.escape, NUMBERS), key=len, reverse=True)) + r"|\d{1,2})\s+"
                    r"(?:\w+\s+)?(?:steps?|strides?|paces?)\b")
+STILL = re.compile(r"\b(?:stands?|standing) (?:still|there|idle|motionless|quietly|around)\b|\b(?:stays?|staying) "
+                   r"(?:still|put)\b|\b(?:waits?|waiting|pauses?|pausing|stops?|halts?|idles?|idling|rests?|resting)\b|"
+                   r"\b(?:holds?|holding) still\b")
 GAITS = {"walk", "run", "jog", "sprint", "sneak", "march", "limp", "walk backward", "sidestep", "zombie walk"}
 REST_RUN = 4       # codes in a row: a code held this long in a real clip is a candidate standing code
 REST_PROBE = 10    # codes the candidate is repeated for when it is decoded
@@ -62,6 +67,13 @@ def stop_request(text: str) -> tuple[str, int | None] | None:
         steps = int(word) if word.isdigit() else NUMBERS[word]
         steps = steps if 1 <= steps <= MAX_STEPS else None
     return gait, steps
+
+
+def asks_stand_still(text: str) -> bool:
+    """Whether a prompt only asks the body to stand still ("a person stands still", "she waits",
+    "he pauses"): a still word and no action (a timeline's segment of standing)."""
+    t = str(text).lower()
+    return bool(STILL.search(t)) and not find_actions(t) and stop_request(t) is None and not NEGATED.search(t)
 
 
 def rest_code(memory, vae) -> int | None:
