@@ -33,6 +33,7 @@ def test_stop_codes_cut_after_the_counted_strike():
     assert stop_codes(codes, contacts, 2, 4, 99) == [0, 1, 2, 3, 4, 5, 6] + [99] * 3    # strike 21 -> code 5, +1
     assert stop_codes(codes, contacts, None, 4, 99) == [0, 1, 2, 3, 4] + [99] * 5       # half the length
     assert stop_codes(codes, contacts, 5, 4, 99) == codes                               # fewer strikes than counted
+    assert stop_codes(codes, contacts, 2, 4, 99, stand=8) == [0, 1, 2, 3, 4, 5, 6] + [99] * 8   # the model's length
 
 
 @pytest.fixture(scope="module")
@@ -61,6 +62,9 @@ def test_three_steps_and_a_stop(gen_default):
     assert 3 <= len(strikes) <= 4                                  # three steps (and the closing one)
     J, C = m.joints[:, [7, 8, 10, 11]][:, :, [0, 2]], m.contacts.astype(bool)
     assert np.linalg.norm(np.diff(J, axis=0), axis=2)[C[1:] & C[:-1]].mean() < 0.5e-3    # feet planted
+    free = gen_default.generate_batch([Request("a man takes three steps forward and stops", seed=0)])[0]
+    assert free.tokens[-8:].tolist() == [gen_default._rest_code] * 8 and free.tokens[-9] != gen_default._rest_code
+    assert speeds(free)[-24:].mean() < 0.08                      # no length asked: 1.6 s of standing after the stop
     taller = gen_default.redecode(m, np.full(10, 0.8, np.float32))
     assert speeds(taller)[-30:].mean() < 0.08 and taller.joints[:, 0, 1].mean() > m.joints[:, 0, 1].mean()
 

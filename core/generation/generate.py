@@ -41,7 +41,7 @@ from .rerank import CandidatePicker
 from .retrieval_seeds import seed_prefixes, seeded_count
 from .on_the_spot import on_the_spot
 from .retrieved_candidates import library_codes, retrieved_codes
-from .stop_words import rest_code, stop_codes, stop_request
+from .stop_words import STAND_SECONDS, rest_code, stop_codes, stop_request
 from .sampling_params import (DEFAULT_GUIDANCE, check_candidates, check_guidance, check_retrieval_first,
                               check_retrieval_prefix, check_retrieved, check_sampling)
 from .request import Request
@@ -387,7 +387,7 @@ class Generator:
                 motion = (self.library_take(kept[0], codes[0], betas, r.prompt)   # a library clip as captured
                           or self.decode_motion(codes[0], betas, prompt=r.prompt))
                 if stop is not None and motion.tokens is not None:   # stop_words.py: cut, then stand
-                    motion = self.stopped(motion, stop[1])
+                    motion = self.stopped(motion, stop[1], r.seconds)
                 motion.shape_source = source
                 motion.retrieved_clips = [c for c in kept if c]
                 self._say_if_short(motion, kept[0], r.seconds)
@@ -415,14 +415,17 @@ class Generator:
             self._rest_code = -1 if found is None else found
         return None if self._rest_code < 0 else self._rest_code
 
-    def stopped(self, motion: Motion, steps: int | None) -> Motion:
+    def stopped(self, motion: Motion, steps: int | None, seconds: float | None = None) -> Motion:
         """``motion`` (decoded from its tokens) cut after ``steps`` foot strikes (None: half its
-        length) and standing still for the rest (``stop_words.py``), decoded again; unchanged when
-        the model has no standing code or the gait strikes fewer times."""
+        length) and standing still for the rest of ``seconds`` (None: the length was the model's,
+        ``STAND_SECONDS`` of standing) (``stop_words.py``), decoded again; unchanged when the model
+        has no standing code or the gait strikes fewer times."""
         rest = self.rest_code()
         if rest is None:
             return motion
-        codes = stop_codes(motion.tokens, motion.contacts, steps, self.vae.cfg.downsample, rest)
+        down = self.vae.cfg.downsample
+        stand = None if seconds is not None else max(1, round(STAND_SECONDS * FPS / down))
+        codes = stop_codes(motion.tokens, motion.contacts, steps, down, rest, stand)
         if codes == [int(c) for c in motion.tokens]:
             return motion
         out = self.decode_motion(codes, motion.betas, prompt=motion.prompt)

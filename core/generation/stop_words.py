@@ -6,8 +6,8 @@ person walks forward" -> "a person stands still" as a timeline kept walking (see
 standing still, and the decoder's own transition from walking codes into them brings the body to
 a halt within about half a second, feet planted. So a prompt that says the gait stops is generated
 without its stop clause, its codes are cut after the step the words count (or at half the length
-when they name no count), and the model's standing code fills the rest of the length; the whole is
-decoded again as one sequence. The motion keeps those tokens, so a new body decodes the same stop.
+when they name no count), and the model's standing code fills the rest of the length (``STAND_SECONDS``
+of it when no length was asked); the whole is decoded again as one sequence. The motion keeps those tokens, so a new body decodes the same stop.
 A timeline's segment that only asks to stand still ("stands still", "waits", "pauses";
 ``asks_stand_still``) is that code too (``sequence._segment``).
 
@@ -47,6 +47,7 @@ GAITS = {"walk", "run", "jog", "sprint", "sneak", "march", "limp", "walk backwar
 REST_RUN = 4       # codes in a row: a code held this long in a real clip is a candidate standing code
 REST_PROBE = 10    # codes the candidate is repeated for when it is decoded
 MAX_STEPS = 20
+STAND_SECONDS = 1.6   # standing after the stop when the model decides the length (none was asked)
 
 
 def stop_request(text: str) -> tuple[str, int | None] | None:
@@ -106,10 +107,11 @@ def rest_code(memory, vae) -> int | None:
     return best
 
 
-def stop_codes(codes, contacts, steps: int | None, down: int, rest: int) -> list[int]:
+def stop_codes(codes, contacts, steps: int | None, down: int, rest: int, stand: int | None = None) -> list[int]:
     """``codes`` (the gait's) cut after its ``steps``-th foot strike (a new contact of joints 7-8
     after frame 0, read from the planted ``contacts``; None: half the codes) and filled to their
-    length with ``rest``; the codes unchanged when the gait strikes fewer times than counted."""
+    length with ``rest`` (``stand`` codes of it instead when given: a length the model chose); the
+    codes unchanged when the gait strikes fewer times than counted."""
     codes = [int(c) for c in codes]
     if steps is None:
         keep = max(1, len(codes) // 2)
@@ -119,4 +121,4 @@ def stop_codes(codes, contacts, steps: int | None, down: int, rest: int) -> list
         if len(strikes) < steps:
             return codes
         keep = min(len(codes), strikes[steps - 1] // down + 2)   # the code that lands the step, and the next
-    return codes[:keep] + [rest] * (len(codes) - keep)
+    return codes[:keep] + [rest] * (len(codes) - keep if stand is None else stand)
