@@ -56,14 +56,14 @@ def test_three_steps_and_a_stop(gen_default):
     m = gen_default.generate_batch([Request("a man takes three steps forward and stops", seconds=4, seed=0)])[0]
     plain = gen_default.generate_batch([Request("a man takes three steps forward", seconds=4, seed=0)])[0]
     s, p = speeds(m), speeds(plain)
-    assert m.num_frames == 80 and m.tokens is not None and m.tokens[-1] == gen_default._rest_code
+    assert m.num_frames == 80 and m.tokens is not None and m.tokens[-1] == gen_default.rest_code
     assert s[:30].mean() > 0.5 and s[-30:].mean() < 0.08 and p[-30:].mean() > 0.5
     strikes = sorted(a for k in (0, 1) for a, _ in runs(m.contacts[:, k].astype(bool)) if a > 0)
     assert 3 <= len(strikes) <= 4                                  # three steps (and the closing one)
     J, C = m.joints[:, [7, 8, 10, 11]][:, :, [0, 2]], m.contacts.astype(bool)
     assert np.linalg.norm(np.diff(J, axis=0), axis=2)[C[1:] & C[:-1]].mean() < 0.5e-3    # feet planted
     free = gen_default.generate_batch([Request("a man takes three steps forward and stops", seed=0)])[0]
-    assert free.tokens[-8:].tolist() == [gen_default._rest_code] * 8 and free.tokens[-9] != gen_default._rest_code
+    assert free.tokens[-8:].tolist() == [gen_default.rest_code] * 8 and free.tokens[-9] != gen_default.rest_code
     assert speeds(free)[-24:].mean() < 0.08                      # no length asked: 1.6 s of standing after the stop
     taller = gen_default.redecode(m, np.full(10, 0.8, np.float32))
     assert speeds(taller)[-30:].mean() < 0.08 and taller.joints[:, 0, 1].mean() > m.joints[:, 0, 1].mean()
@@ -87,7 +87,7 @@ def test_a_timeline_segment_that_stands_still_stands(gen_default):
     plain = generate_sequence(gen_default, segs, seed=0, by_parts=False)
     m = generate_sequence(gen_default, segs, seed=0)
     assert middle(plain) > 0.5 and middle(m) < 0.1
-    assert m.tokens[10:20].tolist() == [gen_default.rest_code()] * 10
+    assert m.tokens[10:20].tolist() == [gen_default.rest_code] * 10
     assert boundary_report(m)["jump_ratio"] <= 2.0
     again = regenerate_segment(gen_default, m, 1, seed=4)
     assert middle(again) < 0.1

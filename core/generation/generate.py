@@ -13,7 +13,7 @@ joints: the decoded positions' legs, the upper body posed from the decoded rotat
 from __future__ import annotations
 
 import dataclasses
-
+from functools import cached_property
 from pathlib import Path
 from typing import NamedTuple
 
@@ -41,7 +41,7 @@ from .rerank import CandidatePicker
 from .retrieval_seeds import seed_prefixes, seeded_count
 from .on_the_spot import on_the_spot
 from .retrieved_candidates import library_codes, retrieved_codes
-from .stop_words import STAND_SECONDS, rest_code, stop_codes, stop_request
+from .stop_words import STAND_SECONDS, standing_code, stop_codes, stop_request
 from .sampling_params import (DEFAULT_GUIDANCE, check_candidates, check_guidance, check_retrieval_first,
                               check_retrieval_prefix, check_retrieved, check_sampling)
 from .request import Request
@@ -122,7 +122,6 @@ class Generator:
         self._picker = None
         self.library_files: dict[str, Path] = {}   # memory clip id -> the user's file (add_library)
         self._library_takes: dict[str, dict | None] = {}  # library clips read as captured (library_takes.read_take)
-        self._rest_code: int | None = None   # the code that decodes to standing still (stop_words.rest_code), -1: none
 
     @property
     def picker(self) -> CandidatePicker | None:
@@ -209,8 +208,14 @@ class Generator:
 
     def _from_action_clips(self, r: Request, found):
         """(candidate codes, their clips, betas) from clips of the asked-for action."""
-        beta = self.t5.predict_betas(self.t5.inputs_for(self.tok, [r.prompt], [r.shape_text]))[0]
-        return [c for _, c in found], [cid for cid, _ in found], beta
+        return [c for _, c in found], [cid for cid, _ in found], self.predicted_betas(r.prompt, r.shape_text)
+
+    @torch.no_grad()
+    def predicted_betas(self, prompt: str, shape_text: str | None) -> torch.Tensor:
+        """(10,) the [BETA] head's betas for a prompt, without sampling any codes (the same state
+        a sample's [BETA] is read from)."""
+        with one_torch_thread():
+            return self.t5.predict_betas(self.t5.inputs_for(self.tok, [prompt], [shape_text]))[0]
 
     def _retrieved(self, r: Request, lo: int, hi: int) -> list[tuple[str, float, list[int]]]:
         """(clip id, caption similarity, codes) of the memory's clips nearest to the prompt (``retrieved_candidates.py``),
@@ -407,20 +412,18 @@ class Generator:
                 progress((i + 1) / len(reqs), r.prompt)
         return out
 
+    @cached_property
     def rest_code(self) -> int | None:
-        """The code that decodes to standing still (``stop_words.rest_code``, found once); None
+        """The code that decodes to standing still (``stop_words.standing_code``, found once); None
         for a model without a memory or such a code."""
-        if self._rest_code is None:
-            found = rest_code(self.t5.memory if self.t5 is not None else None, self.vae)
-            self._rest_code = -1 if found is None else found
-        return None if self._rest_code < 0 else self._rest_code
+        return standing_code(self.t5.memory if self.t5 is not None else None, self.vae)
 
     def stopped(self, motion: Motion, steps: int | None, seconds: float | None = None) -> Motion:
         """``motion`` (decoded from its tokens) cut after ``steps`` foot strikes (None: half its
         length) and standing still for the rest of ``seconds`` (None: the length was the model's,
         ``STAND_SECONDS`` of standing) (``stop_words.py``), decoded again; unchanged when the model
         has no standing code or the gait strikes fewer times."""
-        rest = self.rest_code()
+        rest = self.rest_code
         if rest is None:
             return motion
         down = self.vae.cfg.downsample

@@ -35,7 +35,7 @@ from .on_the_spot import LOOP_ALLOWED, spot_track
 from .prompts import check_prompt
 from .sampling_params import DEFAULT_CANDIDATES, check_candidates, check_sampling
 from .token_sampling import body_for, sample_codes
-from .track import Track, decoded_track, headings, plant, rotate_y, track_of
+from .track import Track, decoded_track, headings, plant, rotate_y, track_of, yaw_matrix
 
 MIN_PERIOD = 1.0       # s: the shortest cycle (two steps of a walk)
 BLEND = 6              # frames over which the seam's last offset is blended in
@@ -196,10 +196,8 @@ def turned_about_y(poses, transl, rest_root, angle: float) -> tuple[np.ndarray, 
     through the origin (``rest_root``: the body's rest root joint, which transl offsets)."""
     from ..geometry.rotations import axis_angle_to_matrix, matrix_to_axis_angle
 
-    c, s = np.cos(angle), np.sin(angle)
-    yaw = np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])                  # as ``track.rotate_y``
     R = axis_angle_to_matrix(np.asarray(poses, np.float64))
-    R[:, 0] = yaw @ R[:, 0]
+    R[:, 0] = yaw_matrix(angle) @ R[:, 0]
     root = rotate_y(np.asarray(transl, np.float64) + rest_root, angle) - rest_root
     return matrix_to_axis_angle(R).astype(np.float32), root.astype(np.float32)
 

@@ -262,13 +262,14 @@ def start_at_origin(rotations: np.ndarray, root: np.ndarray, rest: np.ndarray) -
     the hips and shoulders across (left minus right) of frame 0 posed on the rest joints ``rest``."""
     from ..body.skeleton import PARENTS
     from ..geometry.fk import forward_kinematics
+    from .track import yaw_matrix
 
     rotations = np.asarray(rotations, np.float64)
     posed = forward_kinematics(rotations[:1], np.asarray(rest, np.float64), PARENTS)[0][0]
     across = (posed[1] - posed[2]) + (posed[16] - posed[17])
     forward = np.cross(across, [0.0, 1.0, 0.0])
     a = -np.arctan2(forward[0], forward[2])            # the turn that brings the facing to +Z
-    yaw = np.array([[np.cos(a), 0.0, np.sin(a)], [0.0, 1.0, 0.0], [-np.sin(a), 0.0, np.cos(a)]])
+    yaw = yaw_matrix(a)
     out = rotations.copy()
     out[:, 0] = yaw @ rotations[:, 0]
     moved = np.asarray(root, np.float64) - [root[0][0], 0.0, root[0][2]]

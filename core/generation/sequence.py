@@ -82,12 +82,13 @@ def _segment(gen, prompt, shape_text, n, prefix, arms_prefix, betas, seed, tempe
     other prompt whole."""
     from .parts import plan_of
 
+    if by_parts and asks_stand_still(prompt) and gen.rest_code is not None:   # no caption stands still: nothing
+        pred = gen.predicted_betas(prompt, shape_text).numpy().astype(np.float32)  # to sample (stop_words.py)
+        return [gen.rest_code] * n, None, pred
     plan, side = plan_of(prompt, gen) if by_parts else (None, None)
     if plan is None:
         codes, pred = _segment_codes(gen, prompt, shape_text, n, prefix, betas, seed, temperature, top_k, candidates,
                                      guidance)
-        if by_parts and asks_stand_still(prompt) and gen.rest_code() is not None:   # no caption stands still
-            return [gen.rest_code()] * len(codes), None, pred                       # (stop_words.py)
         return (_on_side(gen.vae, codes, prefix, side) if side is not None else codes), None, pred
     codes, pred = _segment_codes(gen, plan.legs_prompt, shape_text, n, prefix, betas, seed, temperature, top_k,
                                  candidates, guidance)

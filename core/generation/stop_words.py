@@ -15,7 +15,7 @@ A timeline's segment that only asks to stand still ("stands still", "waits", "pa
   after the gait ("stops" alone, or "without stopping", "non-stop": nothing).
 - The count: "three steps", "a step", "a couple of steps" (2), "a few steps" (3), digits; a step is
   a foot strike (a new contact of either foot) after the first frame.
-- The standing code (``rest_code``): of the codes the memory's real clips hold for at least
+- The standing code (``standing_code``): of the codes the memory's real clips hold for at least
   ``REST_RUN`` codes in a row, the one whose repetition decodes with the least joint speed and
   root travel, wrists below the shoulders (arms down); found once per model.
 
@@ -77,7 +77,7 @@ def asks_stand_still(text: str) -> bool:
     return bool(STILL.search(t)) and not find_actions(t) and stop_request(t) is None and not NEGATED.search(t)
 
 
-def rest_code(memory, vae) -> int | None:
+def standing_code(memory, vae) -> int | None:
     """The code that decodes to a body standing still (module doc); None without a memory."""
     if memory is None or not len(memory):
         return None

@@ -167,6 +167,13 @@ def motion_speed(motion_or_joints, fps: float = FPS) -> float:
     return float(s[-1] / max(len(s) - 1, 1) * fps)
 
 
+def yaw_matrix(angle: float) -> np.ndarray:
+    """(3,3) rotation by ``angle`` about +Y, the one ``rotate_y`` applies to points (a heading of
+    ``headings`` grows by ``angle``)."""
+    c, s = np.cos(angle), np.sin(angle)
+    return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
+
+
 def rotate_y(points, angle) -> np.ndarray:
     """Rotate (...,3) points about +Y by ``angle`` (per leading frame when an array)."""
     a = np.asarray(angle, np.float64)
