@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from shapemove.core.generation.stop_words import stop_codes, stop_request
+from shapemove.core.generation.stop_words import standing_after, stop_cut, stop_request
 
 
 @pytest.mark.parametrize("text, want", [
@@ -30,10 +30,12 @@ def test_stop_codes_cut_after_the_counted_strike():
     for a in (0, 9, 21, 30):                        # frame 0 is no strike: strikes at 9, 21, 30
         contacts[a:a + 5, (a // 9) % 2] = 1
     codes = list(range(10))
-    assert stop_codes(codes, contacts, 2, 4, 99) == [0, 1, 2, 3, 4, 5, 6] + [99] * 3    # strike 21 -> code 5, +1
-    assert stop_codes(codes, contacts, None, 4, 99) == [0, 1, 2, 3, 4] + [99] * 5       # half the length
-    assert stop_codes(codes, contacts, 5, 4, 99) == codes                               # fewer strikes than counted
-    assert stop_codes(codes, contacts, 2, 4, 99, stand=8) == [0, 1, 2, 3, 4, 5, 6] + [99] * 8   # the model's length
+    assert stop_cut(contacts, 2, 10, 4) == 7                                       # strike 21 -> code 5, +1
+    assert stop_cut(contacts, 3, 10, 4) == 9 and stop_cut(contacts, 1, 10, 4) == 4
+    assert stop_cut(contacts, None, 10, 4) == 5 and stop_cut(contacts, None, 1, 4) == 1   # half the length
+    assert stop_cut(contacts, 4, 10, 4) is None                                    # fewer strikes than counted
+    assert standing_after(codes, 7, 99) == [0, 1, 2, 3, 4, 5, 6] + [99] * 3
+    assert standing_after(codes, 7, 99, stand=8) == [0, 1, 2, 3, 4, 5, 6] + [99] * 8   # the model's length
 
 
 @pytest.fixture(scope="module")
@@ -91,3 +93,26 @@ def test_a_timeline_segment_that_stands_still_stands(gen_default):
     assert boundary_report(m)["jump_ratio"] <= 2.0
     again = regenerate_segment(gen_default, m, 1, seed=4)
     assert middle(again) < 0.1
+
+
+def test_two_things_at_once_then_a_stop(gen_default):
+    """"walks forward waving, then stops" is made by part (a walk's legs, a wave's arms) and both
+    parts stop at the same code: it walked waving to the end when the stop was generated whole
+    (no arms stream); now the hand is up while it walks, down once it stands. A new body keeps it."""
+    from shapemove.core.generation.generate import Request
+
+    def speeds(m):
+        r = m.joints[:, 0, [0, 2]]
+        return np.linalg.norm(np.diff(r, axis=0), axis=1) * m.fps
+
+    m = gen_default.generate_batch([Request("a woman walks forward waving, then stops", seconds=4, seed=0)])[0]
+    rest = gen_default.rest_code
+    assert m.part_prompts is not None and m.arms_tokens is not None and m.prompt.endswith("then stops")
+    assert m.tokens[-1] == rest and m.arms_tokens[-1] == rest and len(m.tokens) == len(m.arms_tokens)
+    assert (m.tokens == rest).sum() == (m.arms_tokens == rest).sum() >= 5       # cut at the same code
+    s = speeds(m)
+    assert s[:30].mean() > 0.5 and s[-30:].mean() < 0.08
+    hand_up = (m.joints[:, [20, 21], 1] - m.joints[:, [16, 17], 1]).max(1)     # wrist over shoulder, m
+    assert hand_up[:40].max() > 0.1 and hand_up[-30:].max() < 0.0
+    taller = gen_default.redecode(m, np.full(10, 0.8, np.float32))
+    assert speeds(taller)[-30:].mean() < 0.08 and taller.arms_tokens is not None

@@ -41,7 +41,7 @@ from .rerank import CandidatePicker
 from .retrieval_seeds import seed_prefixes, seeded_count
 from .on_the_spot import on_the_spot
 from .retrieved_candidates import library_codes, retrieved_codes
-from .stop_words import STAND_SECONDS, standing_code, stop_codes, stop_request
+from .stop_words import STAND_SECONDS, standing_after, standing_code, stop_cut, stop_request
 from .sampling_params import (DEFAULT_GUIDANCE, check_candidates, check_guidance, check_retrieval_first,
                               check_retrieval_prefix, check_retrieved, check_sampling)
 from .request import Request
@@ -384,14 +384,17 @@ class Generator:
             if cancel is not None and cancel():
                 break
             stop = stop_request(r.prompt) if r.by_parts else None   # "takes three steps and stops"
-            motion = generate_by_parts(self, r) if r.by_parts and stop is None else None
+            asked = dataclasses.replace(r, prompt=stop[0]) if stop else r   # generated without its stop
+            motion = generate_by_parts(self, asked) if r.by_parts else None
+            if motion is not None and stop is not None:
+                motion.prompt = r.prompt
+                motion = self.stopped(motion, stop[1], r.seconds)   # both parts stop (stop_words.py)
             if motion is None:  # one action, no side named: the motion as the model writes it
-                asked = dataclasses.replace(r, prompt=stop[0]) if stop else r
                 codes, pred, kept = self.tokens_for([asked], library_as_captured=True)
                 betas, source = self.body_shape(r, pred[0].numpy())
                 motion = (self.library_take(kept[0], codes[0], betas, r.prompt)   # a library clip as captured
                           or self.decode_motion(codes[0], betas, prompt=r.prompt))
-                if stop is not None and motion.tokens is not None:   # stop_words.py: cut, then stand
+                if stop is not None:   # stop_words.py: cut, then stand
                     motion = self.stopped(motion, stop[1], r.seconds)
                 motion.shape_source = source
                 motion.retrieved_clips = [c for c in kept if c]
@@ -421,18 +424,24 @@ class Generator:
     def stopped(self, motion: Motion, steps: int | None, seconds: float | None = None) -> Motion:
         """``motion`` (decoded from its tokens) cut after ``steps`` foot strikes (None: half its
         length) and standing still for the rest of ``seconds`` (None: the length was the model's,
-        ``STAND_SECONDS`` of standing) (``stop_words.py``), decoded again; unchanged when the model
-        has no standing code or the gait strikes fewer times."""
+        ``STAND_SECONDS`` of standing) (``stop_words.py``), decoded again as it was made (a motion
+        made by part: its arms' tokens cut at the same code, mirrors kept); unchanged when the
+        model has no standing code or the gait strikes fewer times."""
         rest = self.rest_code
-        if rest is None:
+        if rest is None or motion.tokens is None or motion.planted_take:   # a take plays its own rotations
             return motion
         down = self.vae.cfg.downsample
         stand = None if seconds is not None else max(1, round(STAND_SECONDS * FPS / down))
-        codes = stop_codes(motion.tokens, motion.contacts, steps, down, rest, stand)
-        if codes == [int(c) for c in motion.tokens]:
+        keep = stop_cut(motion.contacts, steps, len(motion.tokens), down)
+        codes = None if keep is None else standing_after(motion.tokens, keep, rest, stand)
+        if codes is None or codes == [int(c) for c in motion.tokens]:
             return motion
-        out = self.decode_motion(codes, motion.betas, prompt=motion.prompt)
+        arms = motion.arms_tokens
+        cut = dataclasses.replace(motion, tokens=np.asarray(codes, np.int32), arms_tokens=(
+            None if arms is None else np.asarray(standing_after(arms, keep, rest, stand), np.int32)))
+        out = self._redecoded(cut, motion.betas)
         out.shape_source, out.retrieved_clips = motion.shape_source, list(motion.retrieved_clips)
+        out.part_prompts = motion.part_prompts
         return out
 
     def _say_if_short(self, motion: Motion, clip: str | None, seconds: float | None) -> None:

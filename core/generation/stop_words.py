@@ -107,18 +107,21 @@ def standing_code(memory, vae) -> int | None:
     return best
 
 
-def stop_codes(codes, contacts, steps: int | None, down: int, rest: int, stand: int | None = None) -> list[int]:
-    """``codes`` (the gait's) cut after its ``steps``-th foot strike (a new contact of joints 7-8
-    after frame 0, read from the planted ``contacts``; None: half the codes) and filled to their
-    length with ``rest`` (``stand`` codes of it instead when given: a length the model chose); the
-    codes unchanged when the gait strikes fewer times than counted."""
-    codes = [int(c) for c in codes]
+def stop_cut(contacts, steps: int | None, n: int, down: int) -> int | None:
+    """How many of a gait's ``n`` codes are kept: up to the code that lands its ``steps``-th foot
+    strike (a new contact of joints 7-8 after frame 0, read from the planted ``contacts``) and the
+    next; half of them when ``steps`` is None; None when the gait strikes fewer times than counted."""
     if steps is None:
-        keep = max(1, len(codes) // 2)
-    else:
-        c = np.asarray(contacts, bool)
-        strikes = sorted(a for k in (0, 1) for a, _ in runs(c[:, k]) if a > 0)
-        if len(strikes) < steps:
-            return codes
-        keep = min(len(codes), strikes[steps - 1] // down + 2)   # the code that lands the step, and the next
+        return max(1, n // 2)
+    c = np.asarray(contacts, bool)
+    strikes = sorted(a for k in (0, 1) for a, _ in runs(c[:, k]) if a > 0)
+    if len(strikes) < steps:
+        return None
+    return min(n, strikes[steps - 1] // down + 2)
+
+
+def standing_after(codes, keep: int, rest: int, stand: int | None = None) -> list[int]:
+    """The first ``keep`` of ``codes``, then ``rest`` to their length (``stand`` codes of it
+    instead when given: a length the model chose)."""
+    codes = [int(c) for c in codes]
     return codes[:keep] + [rest] * (len(codes) - keep if stand is None else stand)
