@@ -129,6 +129,29 @@ def test_ground_shift_caps_flight_of_predicted_contacts():
     np.testing.assert_allclose(h_free[12:28], 0.40)  # measured contacts: heights kept (e.g. climbing)
 
 
+def test_ground_shift_keeps_a_jump_longer_than_a_step():
+    """A 14-frame flight (0.7 s) rising 0.4 m and falling, between two contacts, is a jump: kept at
+    its height (before, every stretch over 10 frames was grounded and a decoded "jumps twice" hopped
+    3 cm). Higher than a ballistic flight of that length allows, flat-topped, too long or at the
+    clip's end, it is grounded as before."""
+    def heights(flight, T=40, s=10):
+        low = np.zeros(T)
+        low[s:s + len(flight)] = flight
+        c = np.zeros((T, 4), np.uint8)
+        c[:s, 0] = c[s + len(flight):, 0] = 1
+        return low + ground_shift(np.stack([low, low], 1), low, c, max_flight=10)
+
+    t = np.arange(14) + 0.5
+    jump = 0.4 * (1 - ((t - 7) / 7) ** 2)             # a parabola: 0.06 m at the ends, 0.4 m at the top
+    np.testing.assert_allclose(heights(jump)[10:24], jump)
+    np.testing.assert_allclose(heights(2.5 * jump)[10:24], 0.0)            # 1 m in 0.7 s: no jump can
+    np.testing.assert_allclose(heights(np.full(14, 0.4))[10:24], 0.0)      # floating, not rising
+    t = np.arange(24) + 0.5
+    np.testing.assert_allclose(heights(0.4 * (1 - ((t - 12) / 12) ** 2))[10:34], 0.0)   # 1.2 s: too long
+    end = heights(jump, T=24)                                              # no landing: grounded
+    np.testing.assert_allclose(end[10:24], 0.0)
+
+
 def test_known_contacts_planted_without_drift_and_body_smoothed(openbody):
     """A decoded clip whose body slides 3 mm/frame and jitters 2 mm, with known contacts (as the
     retargeting path plants the source's): the posed foot in contact stays within 1 mm."""

@@ -28,6 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..constants import FPS
 from ..motion.contacts import CONTACT_IDS, runs
 
 FADE = 4          # frames over which a planted target blends back into the mocap target
@@ -175,7 +176,22 @@ def pin_feet(rotations, transl, rest, parents, targets, weights, soft_reach: flo
     return rot
 
 
-MAX_FLIGHT = 10   # frames (0.5 s at 20 fps, a 30 cm jump): longer flights are missed steps
+MAX_FLIGHT = 10   # frames (0.5 s at 20 fps, a 30 cm jump): longer flights are missed steps, unless they jump
+MAX_JUMP = 20     # frames (1 s): the longest stretch without contact that can still be a jump
+JUMP_RISE = 0.08  # m: a jump's lowest point rises at least this far over the floor
+GRAVITY = 9.81
+
+
+def _jumps(heights, fps: float = FPS) -> bool:
+    """Whether a stretch without contact, between two contacts, whose lowest point is at ``heights``
+    (m over the floor, contacts' grounding interpolated) is a jump: at most ``MAX_JUMP`` frames,
+    rising from near the floor (half its peak at either end) to ``JUMP_RISE`` or more, and no
+    higher than a ballistic flight of that length can (g t^2 / 8). A body floating for seconds, or
+    higher than its time in the air allows, is a decoder that missed its steps."""
+    h = np.asarray(heights, dtype=np.float64)
+    peak = float(h.max())
+    return (len(h) <= MAX_JUMP and peak >= JUMP_RISE and max(h[0], h[-1]) <= peak / 2
+            and peak <= GRAVITY * (len(h) / fps) ** 2 / 8)
 
 
 def ground_shift(per_foot, lowest_all, contacts, max_flight: int | None = None) -> np.ndarray:
@@ -187,8 +203,9 @@ def ground_shift(per_foot, lowest_all, contacts, max_flight: int | None = None) 
     frames (held at the ends). No contact at all: one shift for the clip, lowest point on 0.
     Finally every frame is lifted where needed so that no point is below the floor.
     ``max_flight`` (frames): a stretch without contact longer than that cannot be a flight phase
-    (predicted contacts missed a step): its lowest point goes to the floor instead. None (measured
-    mocap contacts): every stretch keeps its interpolated height, e.g. climbing."""
+    (predicted contacts missed a step): its lowest point goes to the floor instead, unless it rises
+    and falls as a jump does (``_jumps``: a decoded "jumps up" is in the air for 12-16 frames). None
+    (measured mocap contacts): every stretch keeps its interpolated height, e.g. climbing."""
     c = np.asarray(contacts).astype(bool)
     foot_on = np.stack([c[:, 0] | c[:, 2], c[:, 1] | c[:, 3]], axis=1)        # left, right
     support = foot_on.any(1)
@@ -201,7 +218,7 @@ def ground_shift(per_foot, lowest_all, contacts, max_flight: int | None = None) 
         shift = np.full(len(c), -low_all.min())
     if max_flight is not None:
         for s, e in runs(~support):
-            if e - s > max_flight:
+            if e - s > max_flight and not (0 < s and e < len(c) and _jumps(low_all[s:e] + shift[s:e])):
                 shift[s:e] = -low_all[s:e]
     return np.maximum(shift, -low_all)
 

@@ -10,7 +10,9 @@ costs one batched SA-VAE decode and one TMA pass (tens of milliseconds), not a s
 Travel and pace words come first: a candidate whose root travel goes against "forward",
 "backwards", "in place" or "steps to the left" is set aside before the TMA chooses
 (``travel_words``), and for "walks quickly" or "a brisk walk" only the fastest candidates
-compete (``pace_words``), since the TMA reads what the body does, not which way or how fast it goes.
+compete (``pace_words``), and for "jumps twice" only those that leave the floor the number of times
+nearest the asked one (``count_words``), since the TMA reads what the body does, not which way, how
+fast or how many times.
 
 Bias to keep in mind: R-precision and the paraphrase classifier also read TMA embeddings, so
 ``eval generate`` scores the generator with one candidate, and ``eval paraphrase`` also reports a
@@ -20,6 +22,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .count_words import asked_jumps, flights, nearest_count
 from .pace_words import asks_fast, fastest, gait_speed
 from .travel_words import allowed
 
@@ -37,9 +40,12 @@ class CandidatePicker:
         return embed_motions(self.model, feats, self.mean, self.std) @ text
 
     def pick(self, prompt: str, feats: list) -> int:
-        """Index of the candidate closest to ``prompt`` among those that obey its travel and pace
-        words (the first on a tie)."""
+        """Index of the candidate closest to ``prompt`` among those that obey its travel, pace and
+        count words (the first on a tie)."""
         keep = allowed(prompt, feats)
         if asks_fast(prompt):
             keep = fastest(np.array([gait_speed(f) for f in feats]), keep)
+        jumps = asked_jumps(prompt)
+        if jumps is not None:
+            keep = nearest_count([flights(f) for f in feats], jumps, keep)
         return int(np.argmax(np.where(keep, self.scores(prompt, feats), -np.inf)))
