@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from shapemove.core.generation.count_words import LIFT, MIN_FLIGHT, asked_jumps, flights, nearest_count
+from shapemove.core.generation.count_words import DIP, LIFT, MIN_RUN, asked_count, dips, flights, nearest_count
 
 
 @pytest.mark.parametrize("text, want", [
@@ -15,13 +15,18 @@ from shapemove.core.generation.count_words import LIFT, MIN_FLIGHT, asked_jumps,
     ("does five jumping jacks", 5),
     ("he takes two big jumps forward", 2),
     ("jumps 3 times in place", 3),
+    ("a person does three squats", 3),
+    ("a man squats twice", 2),
     ("someone jumps up", None),            # no count
     ("a man walks twice around", None),    # no jump
     ("a man jumps over two boxes", None),  # two of something else
     ("a woman jumps 100 times", None),     # beyond MAX_COUNT
 ])
-def test_the_words_that_count_jumps(text, want):
-    assert asked_jumps(text) == want
+def test_the_words_that_count_jumps_and_squats(text, want):
+    got = asked_count(text)
+    assert (got and got[1]) == want
+    if want is not None:
+        assert got[0] is (dips if "squat" in text else flights)
 
 
 def _features(heights) -> np.ndarray:
@@ -35,11 +40,22 @@ def _features(heights) -> np.ndarray:
 def test_flights_are_runs_of_both_feet_in_the_air():
     h = np.full(60, 0.03)
     h[10:20] = 0.03 + 2 * LIFT             # a jump
-    h[30:30 + MIN_FLIGHT - 1] = 0.5        # too short: a glitch, not a flight
+    h[30:30 + MIN_RUN - 1] = 0.5        # too short: a glitch, not a flight
     h[40:50] = 0.03 + LIFT / 2             # too low: a shuffle
     assert flights(_features(h)) == 1
     h[40:50] = 0.03 + 1.5 * LIFT
     assert flights(_features(h)) == 2
+
+
+def test_dips_are_runs_of_the_root_well_under_standing():
+    f = np.zeros((60, 263))
+    f[:, 3] = 0.95
+    f[10:20, 3] = 0.95 - 2 * DIP          # a squat
+    f[30:34, 3] = 0.95 - DIP / 2           # a bob: not deep enough
+    f[40:40 + MIN_RUN - 1, 3] = 0.3        # too short
+    assert dips(f) == 1
+    f[45:55, 3] = 0.95 - 1.5 * DIP
+    assert dips(f) == 2
 
 
 def test_the_nearest_count_competes():
@@ -49,11 +65,12 @@ def test_the_nearest_count_competes():
     assert not nearest_count([1, 2], 2, np.zeros(2, bool)).any()
 
 
-def test_the_default_model_jumps_as_many_times_as_asked():
-    """The default model, "a man jumps forward twice" and "someone does four jumps in place", four
-    seeds each, counted on the planted motion (runs of 3+ frames with no foot contact in which the
-    lowest foot joint clears 8 cm): 7 of 8 asked counts; before (the TMA alone, long flights
-    grounded) 3 of 8."""
+def test_the_default_model_jumps_and_squats_as_many_times_as_asked():
+    """The default model, four seeds each, counted on the planted motion (jumps: runs of 3+ frames
+    with no foot contact in which the lowest foot joint clears 8 cm; squats: runs of 3+ frames with
+    the pelvis 20 cm under its standing height): "a man jumps forward twice" and "someone does four
+    jumps in place" (4 s) 7 of 8 asked counts, before (the TMA alone, long flights grounded) 3 of 8;
+    "a man squats twice" (6 s) 3 of 4, before 0 of 4."""
     from shapemove.core.generation.generate import Generator, Request
     from shapemove.core.motion.contacts import runs
 
@@ -64,7 +81,13 @@ def test_the_default_model_jumps_as_many_times_as_asked():
         y = m.joints[:, [7, 8, 10, 11], 1].min(1)
         return sum(1 for a, b in runs(air) if b - a >= 3 and y[a:b].max() > y.min() + 0.08)
 
-    got = {p: [jumps(gen.generate_batch([Request(p, seconds=4, seed=s)])[0]) for s in range(4)]
-           for p in ("a man jumps forward twice", "someone does four jumps in place")}
-    right = sum(n == want for (p, ns), want in zip(got.items(), (2, 4)) for n in ns)
-    assert right >= 6, got
+    def squats(m):
+        y = m.joints[:, 0, 1]
+        return sum(1 for a, b in runs(y < np.percentile(y, 90) - 0.2) if b - a >= 3)
+
+    asks = [("a man jumps forward twice", 4, jumps, 2), ("someone does four jumps in place", 4, jumps, 4),
+            ("a man squats twice", 6, squats, 2)]
+    got = {p: [count(gen.generate_batch([Request(p, seconds=sec, seed=s)])[0]) for s in range(4)]
+           for p, sec, count, _ in asks}
+    right = sum(n == want for (p, _, _, want) in asks for n in got[p])
+    assert right >= 8, got

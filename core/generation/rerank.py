@@ -10,8 +10,8 @@ costs one batched SA-VAE decode and one TMA pass (tens of milliseconds), not a s
 Travel and pace words come first: a candidate whose root travel goes against "forward",
 "backwards", "in place" or "steps to the left" is set aside before the TMA chooses
 (``travel_words``), and for "walks quickly" or "a brisk walk" only the fastest candidates
-compete (``pace_words``), and for "jumps twice" only those that leave the floor the number of times
-nearest the asked one (``count_words``), since the TMA reads what the body does, not which way, how
+compete (``pace_words``), and for "jumps twice" or "three squats" only those that leave the floor or
+go down the number of times nearest the asked one (``count_words``), since the TMA reads what the body does, not which way, how
 fast or how many times.
 
 Bias to keep in mind: R-precision and the paraphrase classifier also read TMA embeddings, so
@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .count_words import asked_jumps, flights, nearest_count
+from .count_words import asked_count, nearest_count
 from .pace_words import asks_fast, fastest, gait_speed
 from .travel_words import allowed
 
@@ -45,7 +45,8 @@ class CandidatePicker:
         keep = allowed(prompt, feats)
         if asks_fast(prompt):
             keep = fastest(np.array([gait_speed(f) for f in feats]), keep)
-        jumps = asked_jumps(prompt)
-        if jumps is not None:
-            keep = nearest_count([flights(f) for f in feats], jumps, keep)
+        counted = asked_count(prompt)
+        if counted is not None:
+            count, want = counted
+            keep = nearest_count([count(f) for f in feats], want, keep)
         return int(np.argmax(np.where(keep, self.scores(prompt, feats), -np.inf)))
