@@ -17,7 +17,10 @@ from shapemove.core.generation.count_words import DIP, LIFT, MIN_RUN, asked_coun
     ("jumps 3 times in place", 3),
     ("a person does three squats", 3),
     ("a man squats twice", 2),
+    ("she jumps a couple of times", 2),
+    ("he does a few jumps", 3),
     ("someone jumps up", None),            # no count
+    ("a person jumps", None),              # "a" counts nothing here
     ("a man walks twice around", None),    # no jump
     ("a man jumps over two boxes", None),  # two of something else
     ("a woman jumps 100 times", None),     # beyond MAX_COUNT

@@ -31,10 +31,11 @@ DIP = 0.20                     # metres under the standing root height
 MIN_RUN = 3                    # frames (0.15 s)
 MAX_COUNT = 12
 
-_NUMBER = {"once": 1, "one": 1, "a single": 1, "twice": 2, "two": 2, "a couple of": 2, "thrice": 3, "three": 3,
-           "four": 4, "five": 5, "six": 6, "seven": 7, "eight": 8, "nine": 9, "ten": 10}
-_WORD = "|".join(sorted(map(re.escape, _NUMBER), key=len, reverse=True))
-_COUNT = re.compile(rf"\b(?:(once|twice|thrice)|({_WORD}|\d{{1,2}})\s+(?:times\b|(?:\w+\s+)?(?:jump|hop|leap|squat)\w*))",
+NUMBERS = {"a": 1, "one": 1, "a single": 1, "two": 2, "a couple of": 2, "a couple": 2, "three": 3, "a few": 3,
+           "four": 4, "five": 5, "six": 6, "seven": 7, "eight": 8, "nine": 9, "ten": 10}   # "three steps" too
+TIMES = {"once": 1, "twice": 2, "thrice": 3}
+_QUANTITY = "|".join(sorted(map(re.escape, set(NUMBERS) - {"a"}), key=len, reverse=True))   # "a person jumps": no count
+_COUNT = re.compile(rf"\b(?:(once|twice|thrice)|({_QUANTITY}|\d{{1,2}})\s+(?:times\b|(?:\w+\s+)?(?:jump|hop|leap|squat)\w*))",
                     re.I)
 
 
@@ -69,7 +70,7 @@ def asked_count(prompt: str):
     if not named or m is None:
         return None
     word = (m.group(1) or m.group(2)).lower()
-    n = int(word) if word.isdigit() else _NUMBER[word]
+    n = int(word) if word.isdigit() else {**NUMBERS, **TIMES}[word]
     return (COUNTERS[named[0]], n) if 1 <= n <= MAX_COUNT else None
 
 

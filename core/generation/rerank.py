@@ -9,10 +9,10 @@ costs one batched SA-VAE decode and one TMA pass (tens of milliseconds), not a s
 
 Travel and pace words come first: a candidate whose root travel goes against "forward",
 "backwards", "in place" or "steps to the left" is set aside before the TMA chooses
-(``travel_words``), and for "walks quickly" or "a brisk walk" only the fastest candidates
-compete (``pace_words``), and for "jumps twice" or "three squats" only those that leave the floor or
-go down the number of times nearest the asked one (``count_words``), since the TMA reads what the body does, not which way, how
-fast or how many times.
+(``travel_words``), for "walks quickly" or "a brisk walk" only the fastest candidates compete
+(``pace_words``), and for "jumps twice" or "three squats" only those that leave the floor or go
+down the number of times nearest the asked one (``count_words``), since the TMA reads what the
+body does, not which way, how fast or how many times.
 
 Bias to keep in mind: R-precision and the paraphrase classifier also read TMA embeddings, so
 ``eval generate`` scores the generator with one candidate, and ``eval paraphrase`` also reports a
