@@ -20,6 +20,10 @@ from shapemove.core.generation.stop_words import standing_after, stop_cut, stop_
     ("a person stops", None),                      # no gait to stop
     ("she waves and stops", None),                 # a gesture, not a gait
     ("a person walks forward", None),
+    ("a man takes three steps forward", ("a man takes three steps forward", 3)),   # a count alone stops too
+    ("she takes a step back.", ("she takes a step back", 1)),
+    ("a dancer takes two steps and spins", None),  # another action beside the steps
+    ("a man steps to the side repeatedly", None),  # "a man steps": no count
 ])
 def test_the_words_that_stop_a_gait(text, want):
     assert stop_request(text) == want
@@ -47,7 +51,8 @@ def gen_default():
 
 def test_three_steps_and_a_stop(gen_default):
     """The default model: "a man takes three steps forward and stops" (4 s) strikes three times, then
-    stands still for the last 1.5 s; the plain walk walks to the end. A taller body stops too."""
+    stands still for the last 1.5 s; a plain walk walks to the end. A taller body stops too. Without
+    the stop word ("a man takes three steps forward") it stops too: it walked on to the end before."""
     from shapemove.core.generation.generate import Request
     from shapemove.core.motion.contacts import runs
 
@@ -56,7 +61,7 @@ def test_three_steps_and_a_stop(gen_default):
         return np.linalg.norm(np.diff(r, axis=0), axis=1) * m.fps
 
     m = gen_default.generate_batch([Request("a man takes three steps forward and stops", seconds=4, seed=0)])[0]
-    plain = gen_default.generate_batch([Request("a man takes three steps forward", seconds=4, seed=0)])[0]
+    plain = gen_default.generate_batch([Request("a man walks forward", seconds=4, seed=0)])[0]
     s, p = speeds(m), speeds(plain)
     assert m.num_frames == 80 and m.tokens is not None and m.tokens[-1] == gen_default.rest_code
     assert s[:30].mean() > 0.5 and s[-30:].mean() < 0.08 and p[-30:].mean() > 0.5
@@ -67,6 +72,8 @@ def test_three_steps_and_a_stop(gen_default):
     free = gen_default.generate_batch([Request("a man takes three steps forward and stops", seed=0)])[0]
     assert free.tokens[-8:].tolist() == [gen_default.rest_code] * 8 and free.tokens[-9] != gen_default.rest_code
     assert speeds(free)[-24:].mean() < 0.08                      # no length asked: 1.6 s of standing after the stop
+    counted = gen_default.generate_batch([Request("a man takes three steps forward", seconds=4, seed=0)])[0]
+    assert speeds(counted)[:30].mean() > 0.5 and speeds(counted)[-30:].mean() < 0.08
     taller = gen_default.redecode(m, np.full(10, 0.8, np.float32))
     assert speeds(taller)[-30:].mean() < 0.08 and taller.joints[:, 0, 1].mean() > m.joints[:, 0, 1].mean()
 
@@ -114,5 +121,7 @@ def test_two_things_at_once_then_a_stop(gen_default):
     assert s[:30].mean() > 0.5 and s[-30:].mean() < 0.08
     hand_up = (m.joints[:, [20, 21], 1] - m.joints[:, [16, 17], 1]).max(1)     # wrist over shoulder, m
     assert hand_up[:40].max() > 0.1 and hand_up[-30:].max() < 0.0
+    counted = gen_default.generate_batch([Request("a man takes three steps forward", seconds=4, seed=0)])[0]
+    assert speeds(counted)[:30].mean() > 0.5 and speeds(counted)[-30:].mean() < 0.08
     taller = gen_default.redecode(m, np.full(10, 0.8, np.float32))
     assert speeds(taller)[-30:].mean() < 0.08 and taller.arms_tokens is not None

@@ -14,7 +14,9 @@ A timeline's segment that only asks to stand still ("stands still", "waits", "pa
 - The stop: "and stops", "then stops", "comes to a stop", "halts", "stands still", "stops walking"
   after the gait ("stops" alone, or "without stopping", "non-stop": nothing).
 - The count: "three steps", "a step", "a couple of steps" (2), "a few steps" (3), digits; a step is
-  a foot strike (a new contact of either foot) after the first frame.
+  a foot strike (a new contact of either foot) after the first frame. A count alone stops too:
+  "takes three steps forward", "she takes a step back" walk that many steps and stand (none other
+  than a gait named: "takes two steps and spins" is left alone).
 - The standing code (``standing_code``): of the codes the memory's real clips hold for at least
   ``REST_RUN`` codes in a row, the one whose repetition decodes with the least joint speed and
   root travel, wrists below the shoulders (arms down); found once per model.
@@ -39,6 +41,11 @@ STOP = re.compile(r"\s*(?:,\s*)?(?:\b(?:and|then)\s+)*(?:\b(?:he|she|they|it)\s+
 NEGATED = re.compile(r"\b(?:without stopping|non-?stop|never stops?|doesn't stop|does not stop)\b")
 COUNT = re.compile(r"\b(" + "|".join(sorted(map(re.escape, NUMBERS), key=len, reverse=True)) + r"|\d{1,2})\s+"
                    r"(?:\w+\s+)?(?:steps?|strides?|paces?)\b")
+# a count alone ("takes three steps forward", no stop word): "a" only right before the step ("a man steps
+# aside" counts nothing)
+COUNT_ALONE = re.compile(r"\b(" + "|".join(sorted(map(re.escape, set(NUMBERS) - {"a"}), key=len, reverse=True))
+                         + r"|\d{1,2})\s+(?:\w+\s+)?(?:steps?|strides?|paces?)\b|\b(a)\s+(?:single\s+|small\s+|big\s+|"
+                         r"quick\s+|short\s+|long\s+)?(?:step|stride|pace)\b")
 STILL = re.compile(r"\b(?:stands?|standing) (?:still|there|idle|motionless|quietly|around)\b|\b(?:stays?|staying) "
                    r"(?:still|put)\b|\b(?:waits?|waiting|pauses?|pausing|stops?|halts?|idles?|idling|rests?|resting)\b|"
                    r"\b(?:holds?|holding) still\b")
@@ -51,19 +58,26 @@ STAND_SECONDS = 1.6   # standing after the stop when the model decides the lengt
 
 def stop_request(text: str) -> tuple[str, int | None] | None:
     """(the prompt without its stop clause, the steps it counts or None) when ``text`` asks a gait
-    to stop; None otherwise."""
+    to stop, or counts the steps of a gait and asks nothing else ("takes three steps forward": the
+    whole prompt, 3); None otherwise."""
     t = str(text)
     low = t.lower()
-    match = STOP.search(low)
-    if match is None or NEGATED.search(low):
+    if NEGATED.search(low):
         return None
-    gait = t[:match.start()].strip().rstrip(",")
-    counted = COUNT.search(gait.lower())
-    if not gait or (counted is None and not set(find_actions(gait.lower())) & GAITS):
-        return None   # "a person stops", "she waves and stops": no gait to stop
+    match = STOP.search(low)
+    if match is None:
+        counted = COUNT_ALONE.search(low)
+        if counted is None or set(find_actions(low)) - GAITS:
+            return None   # no count, or another action beside the steps ("takes two steps and spins")
+        gait = t.strip().rstrip(".")
+    else:
+        gait = t[:match.start()].strip().rstrip(",")
+        counted = COUNT.search(gait.lower())
+        if not gait or (counted is None and not set(find_actions(gait.lower())) & GAITS):
+            return None   # "a person stops", "she waves and stops": no gait to stop
     steps = None
     if counted is not None:
-        word = counted.group(1)
+        word = counted.group(1) or counted.group(2)
         steps = int(word) if word.isdigit() else NUMBERS[word]
         steps = steps if 1 <= steps <= MAX_STEPS else None
     return gait, steps
