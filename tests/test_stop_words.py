@@ -24,6 +24,7 @@ from shapemove.core.generation.stop_words import standing_after, stop_cut, stop_
     ("she takes a step back.", ("she takes a step back", 1)),
     ("a dancer takes two steps and spins", None),  # another action beside the steps
     ("a man steps to the side repeatedly", None),  # "a man steps": no count
+    ("someone runs at a quick pace", None),        # a pace, not a step
 ])
 def test_the_words_that_stop_a_gait(text, want):
     assert stop_request(text) == want

@@ -45,7 +45,7 @@ COUNT = re.compile(r"\b(" + "|".join(sorted(map(re.escape, NUMBERS), key=len, re
 # aside" counts nothing)
 COUNT_ALONE = re.compile(r"\b(" + "|".join(sorted(map(re.escape, set(NUMBERS) - {"a"}), key=len, reverse=True))
                          + r"|\d{1,2})\s+(?:\w+\s+)?(?:steps?|strides?|paces?)\b|\b(a)\s+(?:single\s+|small\s+|big\s+|"
-                         r"quick\s+|short\s+|long\s+)?(?:step|stride|pace)\b")
+                         r"quick\s+|short\s+|long\s+)?step\b")   # not "a brisk pace", "a long stride"
 STILL = re.compile(r"\b(?:stands?|standing) (?:still|there|idle|motionless|quietly|around)\b|\b(?:stays?|staying) "
                    r"(?:still|put)\b|\b(?:waits?|waiting|pauses?|pausing|stops?|halts?|idles?|idling|rests?|resting)\b|"
                    r"\b(?:holds?|holding) still\b")
