@@ -12,6 +12,8 @@ from shapemove.core.generation.travel_words import SLACK, Travel, allowed, body_
     ("A person backs up step by step", Travel(forward=-1)),
     ("the character retreats, walking in reverse", Travel(forward=-1)),
     ("walks forward and backward", Travel()),                      # both ways: no direction
+    ("she takes a quick step back", Travel(forward=-1)),
+    ("a boxer steps back and forth", Travel()),
     ("A man shuffles to his left", Travel(side=1)),
     ("crab walk sideways to the right", Travel(side=-1)),
     ("the goalkeeper side-steps to the right along the line", Travel(side=-1)),

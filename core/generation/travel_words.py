@@ -1,4 +1,5 @@
-"""Travel the words name: "forward", "backwards", "in place", "steps to the left", "moves sideways".
+"""Travel the words name: "forward", "backwards", "steps back", "in place", "steps to the left",
+"moves sideways".
 
 Best of N (``rerank.CandidatePicker``) compares candidates with the prompt through the TMA, which
 reads what the body does, not which way it goes: for "a tall heavy man trudges forward" it chose
@@ -21,7 +22,8 @@ import numpy as np
 SLACK = 0.5  # metres of travel against the words that are tolerated (a sway, a step to balance)
 
 _FORWARD = re.compile(r"\b(forwards?|ahead|onwards?|toward(?:s)? (?:the )?(?:camera|viewer))\b", re.I)
-_BACKWARD = re.compile(r"\b(backwards?|in reverse|backs? (?:up|away)|backing (?:up|away)|retreat\w*)\b", re.I)
+_BACKWARD = re.compile(r"\b(backwards?|in reverse|backs? (?:up|away)|backing (?:up|away)|retreat\w*|"
+                       r"(?:steps?|stepping) back(?! and forth))\b", re.I)
 _IN_PLACE = re.compile(r"\b(in place|on the spot)\b", re.I)
 # a side named for travel: a verb of going, then within three words "to the left" / "to his right"
 _GOING = r"\b(?:steps?|stepping|shuffl\w*|walk\w*|mov\w*|slid\w*|glid\w*|crab\w*|strafe\w*|side-?step\w*|run\w*|jog\w*|hop\w*|go(?:es|ing)?)\b"
