@@ -126,3 +126,26 @@ def test_two_things_at_once_then_a_stop(gen_default):
     assert speeds(counted)[:30].mean() > 0.5 and speeds(counted)[-30:].mean() < 0.08
     taller = gen_default.redecode(m, np.full(10, 0.8, np.float32))
     assert speeds(taller)[-30:].mean() < 0.08 and taller.arms_tokens is not None
+
+
+def test_a_timeline_segment_that_counts_its_steps_stands_after_them(gen_default):
+    """"a man takes three steps forward" 3 s -> "he waves" 2 s: the first segment walks three steps
+    (and the closing one) and stands until the wave; without the word edits it walked its 3 s
+    (seed 0: 1.1 m/s at 2 s). Regenerate Strip keeps it."""
+    from shapemove.core.generation.sequence import boundary_report, generate_sequence, regenerate_segment
+    from shapemove.core.motion.contacts import runs
+
+    segs = [("a man takes three steps forward", 3.0), ("he waves", 2.0)]
+
+    def speed(m, a, b):
+        r = m.joints[a:b + 1, 0, [0, 2]]
+        return float(np.linalg.norm(np.diff(r, axis=0), axis=1).mean() * m.fps)
+
+    plain = generate_sequence(gen_default, segs, seed=0, by_parts=False)
+    m = generate_sequence(gen_default, segs, seed=0)
+    assert speed(plain, 35, 50) > 0.5 and speed(m, 0, 20) > 0.5 and speed(m, 40, 60) < 0.1
+    strikes = [a for k in (0, 1) for a, _ in runs(m.contacts[:60, k].astype(bool)) if a > 0]
+    assert 3 <= len(strikes) <= 4 and m.tokens[14] == gen_default.rest_code
+    assert boundary_report(m)["jump_ratio"] <= 2.0
+    again = regenerate_segment(gen_default, m, 0, seed=3)
+    assert speed(again, 40, 60) < 0.1

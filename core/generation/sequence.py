@@ -38,7 +38,7 @@ from ..torch_threads import one_torch_thread
 from .decode import decode_features
 from .prompts import check_prompt
 from .sampling_params import DEFAULT_CANDIDATES, check_candidates, check_sampling
-from .stop_words import asks_stand_still
+from .stop_words import asks_stand_still, standing_after, stop_cut, stop_request
 from .token_sampling import body_for, sample_codes
 from .track import Track, decoded_track, plant, rotate_y
 
@@ -78,23 +78,45 @@ def check_segments(segments) -> list[Segment]:
 def _segment(gen, prompt, shape_text, n, prefix, arms_prefix, betas, seed, temperature, top_k, candidates, guidance,
              by_parts: bool):
     """(codes, the arms' codes or None, [BETA] prediction) of one segment: two things at once are
-    made by part (module doc), standing still is the model's standing code (``stop_words.py``), any
-    other prompt whole."""
+    made by part (module doc), standing still is the model's standing code (``stop_words.py``), a
+    gait that stops or counts its steps ("takes three steps forward") stands after them, any other
+    prompt whole."""
     from .parts import plan_of
 
     if by_parts and asks_stand_still(prompt) and gen.rest_code is not None:   # no caption stands still: nothing
         pred = gen.predicted_betas(prompt, shape_text).numpy().astype(np.float32)  # to sample (stop_words.py)
         return [gen.rest_code] * n, None, pred
+    stop = stop_request(prompt) if by_parts and gen.rest_code is not None else None
+    prompt = prompt if stop is None else stop[0]
     plan, side = plan_of(prompt, gen) if by_parts else (None, None)
     if plan is None:
         codes, pred = _segment_codes(gen, prompt, shape_text, n, prefix, betas, seed, temperature, top_k, candidates,
                                      guidance)
-        return (_on_side(gen.vae, codes, prefix, side) if side is not None else codes), None, pred
-    codes, pred = _segment_codes(gen, plan.legs_prompt, shape_text, n, prefix, betas, seed, temperature, top_k,
-                                 candidates, guidance)
-    arms, _ = _segment_codes(gen, plan.arms_prompt, shape_text, len(codes), arms_prefix, betas, seed + 1, temperature,
-                             top_k, candidates, guidance)
+        codes, arms = (_on_side(gen.vae, codes, prefix, side) if side is not None else codes), None
+    else:
+        codes, pred = _segment_codes(gen, plan.legs_prompt, shape_text, n, prefix, betas, seed, temperature, top_k,
+                                     candidates, guidance)
+        arms, _ = _segment_codes(gen, plan.arms_prompt, shape_text, len(codes), arms_prefix, betas, seed + 1,
+                                 temperature, top_k, candidates, guidance)
+    keep = None if stop is None else _steps_kept(gen.vae, codes, prefix, stop[1])
+    if keep is not None:   # both parts stand after the counted steps (Generator.stopped for one prompt)
+        codes = standing_after(codes, keep, gen.rest_code)
+        arms = None if arms is None else standing_after(arms, keep, gen.rest_code)
     return codes, arms, pred
+
+
+@torch.no_grad()
+def _steps_kept(vae, codes: list[int], prefix: list[int], steps: int | None) -> int | None:
+    """How many of a segment's gait ``codes`` its counted ``steps`` keep (``stop_words.stop_cut``),
+    read from the foot contacts the decoder gives them after the codes they continue (canonical body);
+    None when the gait strikes fewer times."""
+    from ..motion.contacts import to_feature_order
+
+    down = vae.cfg.downsample
+    with one_torch_thread():
+        feats = decode_features(list(prefix) + list(codes), vae, np.zeros(10, np.float32)).numpy()
+    contacts = to_feature_order(feats[len(prefix) * down:, 259:263] > 0.5)   # the same swap puts them back in 7, 8, 10, 11
+    return stop_cut(contacts, steps, len(codes), down)
 
 
 @torch.no_grad()
