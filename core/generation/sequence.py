@@ -86,7 +86,8 @@ def _segment(gen, prompt, shape_text, n, prefix, arms_prefix, betas, seed, tempe
     if by_parts and asks_stand_still(prompt) and gen.rest_code is not None:   # no caption stands still: nothing
         pred = gen.predicted_betas(prompt, shape_text).numpy().astype(np.float32)  # to sample (stop_words.py)
         return [gen.rest_code] * n, None, pred
-    stop = stop_request(prompt) if by_parts and gen.rest_code is not None else None
+    stop = stop_request(prompt) if by_parts else None   # the standing code is found only when one is asked
+    stop = stop if stop is not None and gen.rest_code is not None else None
     prompt = prompt if stop is None else stop[0]
     plan, side = plan_of(prompt, gen) if by_parts else (None, None)
     if plan is None:

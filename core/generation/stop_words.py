@@ -21,7 +21,7 @@ A timeline's segment that only asks to stand still ("stands still", "waits", "pa
   ``REST_RUN`` codes in a row, the one whose repetition decodes with the least joint speed and
   root travel, wrists below the shoulders (arms down); found once per model.
 
-    prompt, steps = stop_request("a man takes three steps forward and stops")   # ("a man takes steps forward", 3)
+    prompt, steps = stop_request("a man takes three steps forward and stops")   # ("a man takes three steps forward", 3)
 """
 from __future__ import annotations
 
@@ -33,7 +33,7 @@ import torch
 
 from ..data.actions import find_actions
 from ..motion.contacts import runs
-from .count_words import NUMBERS
+from .count_words import NUMBERS, QUANTITY
 
 STOP = re.compile(r"\s*(?:,\s*)?(?:\b(?:and|then)\s+)*(?:\b(?:he|she|they|it)\s+)?"
                   r"\b(?:stops?(?:\s+(?:walking|running|jogging|moving))?|halts?|comes? to a (?:stop|halt)|"
@@ -43,9 +43,8 @@ COUNT = re.compile(r"\b(" + "|".join(sorted(map(re.escape, NUMBERS), key=len, re
                    r"(?:\w+\s+)?(?:steps?|strides?|paces?)\b")
 # a count alone ("takes three steps forward", no stop word): "a" only right before the step ("a man steps
 # aside" counts nothing)
-COUNT_ALONE = re.compile(r"\b(" + "|".join(sorted(map(re.escape, set(NUMBERS) - {"a"}), key=len, reverse=True))
-                         + r"|\d{1,2})\s+(?:\w+\s+)?(?:steps?|strides?|paces?)\b|\b(a)\s+(?:single\s+|small\s+|big\s+|"
-                         r"quick\s+|short\s+|long\s+)?step\b")   # not "a brisk pace", "a long stride"
+COUNT_ALONE = re.compile(r"\b(" + QUANTITY + r"|\d{1,2})\s+(?:\w+\s+)?(?:steps?|strides?|paces?)\b|"
+                         r"\b(a)\s+(?:single\s+|small\s+|big\s+|quick\s+|short\s+|long\s+)?step\b")   # not "a brisk pace"
 STILL = re.compile(r"\b(?:stands?|standing) (?:still|there|idle|motionless|quietly|around)\b|\b(?:stays?|staying) "
                    r"(?:still|put)\b|\b(?:waits?|waiting|pauses?|pausing|stops?|halts?|idles?|idling|rests?|resting)\b|"
                    r"\b(?:holds?|holding) still\b")
