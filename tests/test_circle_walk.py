@@ -1,10 +1,11 @@
-"""Walking in a circle (core/generation/circle_walk.py): the words' circle walked by a straight
-track, turning the named way, once round; a motion that does not travel left alone."""
+"""Walking in a circle or a figure eight (core/generation/circle_walk.py): the words' course walked by
+a straight track, turning the named way, once round; a motion that does not travel left alone."""
 import numpy as np
 import pytest
 
-from shapemove.core.generation.circle_walk import (MAX_RADIUS, MIN_RADIUS, circle_line, circled, names_circle,
-                                                   radius_for, turns_right)
+from shapemove.core.generation.circle_walk import (CIRCLE, EIGHT, MAX_RADIUS, MIN_RADIUS, circle_line, circled,
+                                                   course_named, eight_line, names_circle, radius_for, straight_gait,
+                                                   turns_right)
 from shapemove.core.generation.track import Track, headings, root_centre
 
 
@@ -77,3 +78,59 @@ def test_generation_walks_the_circle_the_prompt_asks_for():
     plain = gen.generate_batch([Request("a person walks in a circle", seconds=4, seed=0, by_parts=False)])[0]
     assert plain.tokens is not None and path_of(plain.joints) != "walk in a circle"
     assert m.joints[:, :, 1].min() > -0.05                           # feet still on the floor
+
+
+@pytest.mark.parametrize("text, course, straight", [
+    ("a person walks in a figure eight", EIGHT, ("a person walks", "walk")),
+    ("someone jogs a figure-8 path clockwise, waving", EIGHT, ("someone jogs, waving", "jog")),
+    ("a man runs in a circle to the right", CIRCLE, ("a man runs", "run")),
+    ("walks in circles counter-clockwise", CIRCLE, ("walks", "walk")),
+    ("a person goes around in a circle", CIRCLE, None),            # no gait left to walk straight
+    ("a man walks forward to the right", None, None),
+])
+def test_the_words_name_the_course_and_the_gait_walked_straight(text, course, straight):
+    assert course_named(text) == course and straight_gait(text) == straight
+
+
+def test_the_eight_is_two_loops_touching_at_the_start():
+    """Hand-derived: loops of radius r = distance / 4 pi (here 1.5 m), the first to the left (+X),
+    centred at (r, 0); half round it is (2r, 0), once round the start heading +Z again, then the
+    other loop, centred at (-r, 0)."""
+    r = 1.5
+    line = eight_line(4 * np.pi * r, right=False)
+    quarter = np.pi * r / 2
+    pts = line.point([np.pi * r, 2 * np.pi * r, 3 * np.pi * r, 4 * np.pi * r])
+    assert pts == pytest.approx(np.array([[2 * r, 0], [0, 0], [-2 * r, 0], [0, 0]]), abs=0.02)
+    assert line.point([quarter])[0] == pytest.approx([r - r * np.cos(np.pi / 2), r], abs=0.02)
+    assert np.abs(np.linalg.norm(line.point(np.linspace(0.1, 2 * np.pi * r - 0.1, 50)) - [r, 0], axis=1) - r).max() < 0.02
+    yaw = line.heading([np.pi * r, 3 * np.pi * r])
+    assert yaw[0] == pytest.approx(np.pi, abs=0.05) and yaw[1] == pytest.approx(np.pi, abs=0.05)  # back the other way
+    mirrored = eight_line(4 * np.pi * r, right=True).point([np.pi * r, 3 * np.pi * r])
+    assert mirrored == pytest.approx(np.array([[-2 * r, 0], [2 * r, 0]]), abs=0.02)
+    assert radius_for(2.0) == MIN_RADIUS and eight_line(2.0, False).length > 4 * np.pi * MIN_RADIUS   # once round at least
+
+
+def test_a_straight_walk_goes_round_the_eight():
+    walk = _straight_walk(frames=200)                               # 12 m: once round two 0.95 -> 1 m loops
+    bent = circled(walk, "a person walks in a figure eight")
+    turn = np.unwrap(headings(bent.joints))
+    turn -= turn[0]
+    assert turn.max() > 1.8 * np.pi and turn[-1] < turn.max() - 1.5 * np.pi    # round one way, then most of the way back
+    c = root_centre(bent.joints)
+    assert c[:, 0].max() > 1.8 and c[:, 0].min() < -1.8                       # both loops, either side of the start
+    read = circled(walk, "a person walks", course=EIGHT)                      # the caller read the eight elsewhere
+    assert np.allclose(root_centre(read.joints), c)
+
+
+def test_generation_walks_the_eight_at_a_walking_pace():
+    """"walks in a figure eight" is generated as a plain walk ("a person walks": the captured eights
+    decode at a third of a walk's pace) and bent round both loops; the feet stay on the floor."""
+    from shapemove.core.generation.generate import Generator, Request
+    from shapemove.core.generation.track import travel
+
+    gen = Generator(None)
+    m = gen.generate_batch([Request("a person walks in a figure eight", seconds=10, seed=0)])[0]
+    c = root_centre(m.joints)
+    assert travel(m.joints)[-1] > 8.0 and c[:, 0].max() > 1.5 and c[:, 0].min() < -1.5
+    assert m.tokens is None and m.prompt == "a person walks in a figure eight"
+    assert m.joints[:, :, 1].min() > -0.05

@@ -27,7 +27,7 @@ from ..constants import FPS
 from ..errors import ShapeMoveError
 from ..motion.features import motion_features
 from ..scene.motion_file import Motion
-from .circle_walk import CIRCLE, circled
+from .circle_walk import COURSES, circled, straight_gait
 from .decode import motion_from_joints
 from .part_compose import compose_arms, mirror_track, needs_mirror
 from .part_prompts import PartPlan, named_side, plan_parts
@@ -106,7 +106,9 @@ def generate_by_parts(gen, r) -> Motion | None:
         m.shape_source = source
         m.retrieved_clips = [c for c in kept if c]
         return m
-    legs_req = dataclasses.replace(r, prompt=plan.legs_prompt, action=plan.legs_action)
+    gait = straight_gait(plan.legs_prompt) if plan.legs_action in COURSES else None   # walked straight, then bent
+    legs_req = dataclasses.replace(r, prompt=gait[0], action=gait[1]) if gait else \
+        dataclasses.replace(r, prompt=plan.legs_prompt, action=plan.legs_action)
     codes, pred, kept = gen.tokens_for([legs_req])
     seconds = len(codes[0]) * gen.vae.cfg.downsample / FPS
     arms_req = dataclasses.replace(r, prompt=plan.arms_prompt, seconds=seconds, seed=r.seed + 1, action=plan.arms_action)
@@ -117,8 +119,8 @@ def generate_by_parts(gen, r) -> Motion | None:
     arms, arms_mirrored = _side_fixed(arms_codes[0], gen.vae, gen.body, betas, plan.arms_side)
     tokens = dict(tokens=np.asarray(codes[0], np.int32), arms_tokens=np.asarray(arms_codes[0], np.int32),
                   arms_mirrored=arms_mirrored)
-    if plan.legs_action == CIRCLE:  # the codec does not carry turning: the words' circle is walked (circle_walk.py)
-        legs, tokens = circled(legs, plan.legs_prompt), {}   # an edit: no tokens kept
+    if plan.legs_action in COURSES:  # the codec does not carry turning: the words' circle or eight is walked (circle_walk.py)
+        legs, tokens = circled(legs, plan.legs_prompt, course=plan.legs_action), {}   # an edit: no tokens kept
     m = assemble(gen.body, betas, legs, arms, r.prompt, gen.ik_refine_iters, **tokens)
     m.shape_source = source
     m.part_prompts = (plan.legs_prompt, plan.arms_prompt)

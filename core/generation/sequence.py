@@ -35,6 +35,7 @@ from ..constants import FPS
 from ..errors import ShapeMoveError
 from ..scene.motion_file import Motion
 from ..torch_threads import one_torch_thread
+from .circle_walk import course_named, walked_straight
 from .decode import decode_features
 from .prompts import check_prompt
 from .sampling_params import DEFAULT_CANDIDATES, check_candidates, check_sampling
@@ -90,13 +91,13 @@ def _segment(gen, prompt, shape_text, n, prefix, arms_prefix, betas, seed, tempe
     stop = stop if stop is not None and gen.rest_code is not None else None
     prompt = prompt if stop is None else stop[0]
     plan, side = plan_of(prompt, gen) if by_parts else (None, None)
+    legs = prompt if plan is None else plan.legs_prompt
+    legs = walked_straight(legs) if by_parts and course_named(prompt) else legs   # its gait, bent by timeline_words
+    codes, pred = _segment_codes(gen, legs, shape_text, n, prefix, betas, seed, temperature, top_k, candidates,
+                                 guidance)
     if plan is None:
-        codes, pred = _segment_codes(gen, prompt, shape_text, n, prefix, betas, seed, temperature, top_k, candidates,
-                                     guidance)
         codes, arms = (_on_side(gen.vae, codes, prefix, side) if side is not None else codes), None
     else:
-        codes, pred = _segment_codes(gen, plan.legs_prompt, shape_text, n, prefix, betas, seed, temperature, top_k,
-                                     candidates, guidance)
         arms, _ = _segment_codes(gen, plan.arms_prompt, shape_text, len(codes), arms_prefix, betas, seed + 1,
                                  temperature, top_k, candidates, guidance)
     keep = None if stop is None else _steps_kept(gen.vae, codes, prefix, stop[1])
