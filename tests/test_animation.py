@@ -308,10 +308,9 @@ def test_a_timeline_segment_that_walks_in_a_circle_goes_round_once(gen):
 
 def test_a_timeline_segment_that_walks_a_figure_eight_goes_round_both_loops(gen):
     """A figure-eight segment is sampled as its gait walked straight ("a person walks") and turned a
-    whole turn one way over its first half and back over its second (``timeline_words.course_turn``):
+    whole turn one way over its first half and back over its second (``course_walk.course_turn``):
     round one loop, then the other, leaving as it came."""
     from shapemove.core.generation.sequence import generate_sequence
-    from shapemove.core.generation.timeline_words import course_turn
     from shapemove.core.generation.track import headings, travel
 
     segs = [("a person walks forward", 2.0), ("a person walks in a figure eight", 8.0), ("a person walks forward", 2.0)]
@@ -322,10 +321,6 @@ def test_a_timeline_segment_that_walks_a_figure_eight_goes_round_both_loops(gen)
     assert travel(m.joints[a1:b1])[-1] > 5.0                                          # at a walk's pace
     d0, d2 = r[b0 - 1] - r[a0], r[b2 - 1] - r[a2]
     assert d0 @ d2 / np.linalg.norm(d0) / np.linalg.norm(d2) > 0.7
-    # the profile alone, hand-derived: a body that does not turn by itself
-    u = course_turn(np.zeros(101), eight=True, right=False)
-    assert u[50] == pytest.approx(2 * np.pi) and u[-1] == pytest.approx(0.0) and u[25] == pytest.approx(np.pi)
-    assert course_turn(np.linspace(0, 1, 101), eight=False, right=True)[-1] == pytest.approx(-2 * np.pi - 1)
 
 
 def test_motion_file_round_trip(tmp_path, walk, gen):

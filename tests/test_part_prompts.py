@@ -13,6 +13,9 @@ from shapemove.core.generation.part_prompts import named_side, plan_parts
     ("he sprints and punches the air", "he sprints", "a person punches the air", ("sprint", "punch")),
     ("a person walks backwards beckoning", "a person walks backwards", "a person beckoning", ("walk backward", "beckon")),
     ("a man marches while throwing a ball", "a man marches", "a person throwing a ball", ("march", "throw")),
+    # "back and forth" is a course, not two clauses ("walks back" + "forth waving" before)
+    ("a person walks back and forth waving", "a person walks back and forth", "a person waving", ("walk", "wave")),
+    ("a man jogs to and fro and waves", "a man jogs to and fro", "a person waves", ("jog", "wave")),
 ])
 def test_two_things_split_into_a_legs_and_an_arms_prompt(text, legs, arms, acts):
     plan = plan_parts(text)

@@ -6,7 +6,7 @@ import pytest
 from shapemove.core.generation.track import Track, headings, root_centre
 from shapemove.core.generation.turn_words import angle_of, turned
 
-from test_circle_walk import _straight_walk
+from test_course_walk import _straight_walk
 
 
 @pytest.mark.parametrize("text, angle", [

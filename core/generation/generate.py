@@ -31,7 +31,7 @@ from ..models.text_encoder import load_text_encoder
 from ..scene.motion_file import Motion
 from ..torch_threads import one_torch_thread
 from .action_clips import ACTION_CLIPS, UNASKED_SECONDS, action_clips
-from .circle_walk import COURSES, circle_motion, course_named, walked_straight
+from .course_walk import ACTIONS as COURSE_ACTIONS, course_motion, course_named, walked_straight
 from .decode import decode_features, decode_tokens, redecode
 from .library_takes import captured_window, read_take, window_fit
 from .model_bundle import model_files, part_warnings, resolve_model_dir
@@ -241,14 +241,14 @@ class Generator:
 
     @staticmethod
     def asks_course(prompt: str, check) -> str | None:
-        """The course a prompt asks to walk (``circle_walk.CIRCLE`` or ``EIGHT``), or None: in the
+        """The course a prompt asks to walk (``course_walk.COURSES``), or None: in the
         action patterns' words, or by its nearest training caption ("pace around in a loop"), read
         from its ``check_text`` (None: no known captions) as ``parts.clause_classifier`` reads a
         clause's."""
         named = course_named(prompt)
         if named is not None or check is None or check.similarity < CLAUSE_NEAR:
             return named
-        return check.nearest_action if check.nearest_action in COURSES else None
+        return check.nearest_action if check.nearest_action in COURSE_ACTIONS else None
 
     # -- what the model knows ----------------------------------------------------------------
     @property
@@ -391,7 +391,7 @@ class Generator:
             if motion is not None and stop is not None:
                 motion.prompt = r.prompt
                 motion = self.stopped(motion, stop[1], r.seconds)   # both parts stop (stop_words.py)
-            course = self.asks_course(r.prompt, check) if r.by_parts else None   # circle_walk.py
+            course = self.asks_course(r.prompt, check) if r.by_parts else None   # course_walk.py
             if motion is None:  # one action, no side named: the motion as the model writes it
                 sampled = asked if course is None else dataclasses.replace(asked, prompt=walked_straight(asked.prompt))
                 codes, pred, kept = self.tokens_for([sampled], library_as_captured=True)
@@ -404,7 +404,7 @@ class Generator:
                 motion.retrieved_clips = [c for c in kept if c]
                 self._say_if_short(motion, kept[0], r.seconds)
                 if r.by_parts:  # the codec does not carry turning: a course or a turn the words name, given back
-                    motion = (circle_motion(motion, self.body, r.prompt, self.ik_refine_iters, course)   # circle_walk.py
+                    motion = (course_motion(motion, self.body, r.prompt, self.ik_refine_iters, course)   # course_walk.py
                               if course is not None else
                               turn_motion(motion, self.body, r.prompt, self.ik_refine_iters))           # turn_words.py
                     motion = slow_motion(motion, self.body, r.prompt, self.ik_refine_iters)      # slow_steps.py

@@ -31,8 +31,9 @@ LEGS = frozenset(LEGS_ACTIONS) | {"sprint", "walk in a figure eight"}   # not "z
 ARMS = frozenset(ARMS_ACTIONS)
 FOOT_ACTIONS = frozenset({"kick", "spin kick", "kick ball", "hop"})
 SEQUENCE = re.compile(r"\b(then|after|afterwards|before|followed by|next|finally|later)\b")
-CONNECTOR = re.compile(r",|;|\b(?:while|whilst|as|and|with|at the same time|all the while|meanwhile|"
-                       r"simultaneously)\b")
+# "and" joins two clauses, not the pairs "back and forth", "to and fro", "up and down", "round and round"
+CONNECTOR = re.compile(r",|;|\b(?:while|whilst|as|and(?!\s+(?:forth|fro|forwards|down|round)\b)|with|at the same time|"
+                       r"all the while|meanwhile|simultaneously)\b")
 SUBJECT = re.compile(r"^(?:(?:a|an|the|this|that|one|some|my|our|his|her|their|your)\s+(?:[\w-]+,?\s+){0,3}?)?"
                      r"(?:person|man|woman|boy|girl|guy|lady|kid|child|someone|somebody|he|she|they|people|"
                      r"soldier|dancer|athlete|figure|character|actor|player|runner|walker|human|i|you|we)\b")

@@ -27,7 +27,7 @@ from ..constants import FPS
 from ..errors import ShapeMoveError
 from ..motion.features import motion_features
 from ..scene.motion_file import Motion
-from .circle_walk import COURSES, circled, straight_gait
+from .course_walk import ACTIONS as COURSE_ACTIONS, course_motion, course_named, on_course, straight_gait, walked_straight
 from .decode import motion_from_joints
 from .part_compose import compose_arms, mirror_track, needs_mirror
 from .part_prompts import PartPlan, named_side, plan_parts
@@ -93,20 +93,21 @@ def generate_by_parts(gen, r) -> Motion | None:
     if plan is None and side is None:
         return None
     if plan is None:  # one action, a named side: judged on the planted motion, the one the user sees
-        codes, pred, kept = gen.tokens_for([r], library_as_captured=True)   # (planting, the foot roll above all,
-        betas, source = gen.body_shape(r, pred[0].numpy())                  # changes how far a foot travels)
+        course = course_named(r.prompt)          # "paces back and forth, waving his right hand": its gait
+        sampled = dataclasses.replace(r, prompt=walked_straight(r.prompt)) if course else r   # sampled straight
+        codes, pred, kept = gen.tokens_for([sampled], library_as_captured=True)   # (planting, the foot roll above
+        betas, source = gen.body_shape(r, pred[0].numpy())                  # all, changes how far a foot travels)
         m = gen.library_take(kept[0], codes[0], betas, r.prompt)   # a library clip the codes miss, as captured
-        if m is not None and not needs_mirror(m.joints, *side):
-            m.shape_source, m.retrieved_clips = source, [c for c in kept if c]
-            return m
-        m = gen.decode_motion(codes[0], betas, prompt=r.prompt)
-        if needs_mirror(m.joints, *side):
-            m = assemble(gen.body, betas, _track(codes[0], gen.vae, gen.body, betas, True), None, r.prompt, gen.ik_refine_iters,
-                         tokens=np.asarray(codes[0], np.int32), mirrored=True)
+        if m is None or needs_mirror(m.joints, *side):
+            m = gen.decode_motion(codes[0], betas, prompt=r.prompt)
+            if needs_mirror(m.joints, *side):
+                m = assemble(gen.body, betas, _track(codes[0], gen.vae, gen.body, betas, True), None, r.prompt,
+                             gen.ik_refine_iters, tokens=np.asarray(codes[0], np.int32), mirrored=True)
         m.shape_source = source
         m.retrieved_clips = [c for c in kept if c]
-        return m
-    gait = straight_gait(plan.legs_prompt) if plan.legs_action in COURSES else None   # walked straight, then bent
+        return m if course is None else course_motion(m, gen.body, r.prompt, gen.ik_refine_iters, course)
+    course = plan.legs_action if plan.legs_action in COURSE_ACTIONS else course_named(plan.legs_prompt)
+    gait = straight_gait(plan.legs_prompt) if course is not None else None   # walked straight, then bent
     legs_req = dataclasses.replace(r, prompt=gait[0], action=gait[1]) if gait else \
         dataclasses.replace(r, prompt=plan.legs_prompt, action=plan.legs_action)
     codes, pred, kept = gen.tokens_for([legs_req])
@@ -119,8 +120,8 @@ def generate_by_parts(gen, r) -> Motion | None:
     arms, arms_mirrored = _side_fixed(arms_codes[0], gen.vae, gen.body, betas, plan.arms_side)
     tokens = dict(tokens=np.asarray(codes[0], np.int32), arms_tokens=np.asarray(arms_codes[0], np.int32),
                   arms_mirrored=arms_mirrored)
-    if plan.legs_action in COURSES:  # the codec does not carry turning: the words' circle or eight is walked (circle_walk.py)
-        legs, tokens = circled(legs, plan.legs_prompt, course=plan.legs_action), {}   # an edit: no tokens kept
+    if course is not None:  # the codec does not carry turning: the words' course is walked (course_walk.py)
+        legs, tokens = on_course(legs, plan.legs_prompt, course=course), {}   # an edit: no tokens kept
     m = assemble(gen.body, betas, legs, arms, r.prompt, gen.ik_refine_iters, **tokens)
     m.shape_source = source
     m.part_prompts = (plan.legs_prompt, plan.arms_prompt)

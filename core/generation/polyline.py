@@ -1,7 +1,7 @@
 """A path as the feet walk it: a polyline of [x, z] points resampled by arc length, and a joint
 track put onto it (``follow_track``): the track's course is split into the distance travelled
 s(t) and its heading, and the body, relative to both, is put down at the line's point at the same
-distance, turned to the line's tangent there. ``path_follow`` (a user's path) and ``circle_walk``
+distance, turned to the line's tangent there. ``path_follow`` (a user's path) and ``course_walk``
 (a circle the words name) walk their lines with it.
 
 Paths: a JSON list of [x, z] points in metres (Y up, as the motion file). The polyline is

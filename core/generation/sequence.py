@@ -35,7 +35,7 @@ from ..constants import FPS
 from ..errors import ShapeMoveError
 from ..scene.motion_file import Motion
 from ..torch_threads import one_torch_thread
-from .circle_walk import course_named, walked_straight
+from .course_walk import course_named, walked_straight
 from .decode import decode_features
 from .prompts import check_prompt
 from .sampling_params import DEFAULT_CANDIDATES, check_candidates, check_sampling

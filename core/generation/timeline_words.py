@@ -17,12 +17,12 @@ The scale eases from one segment's to the next over ``EASE`` frames, so the feet
 boundary. A segment that names a turn ("turns around", "turns left", "spins"; ``turn_words.angle_of``)
 turns the body that far over its own frames (what it turns by itself counted, eased as a single
 prompt's turn) and every later segment goes on in the new direction: "walks forward" -> "turns
-around" -> "walks forward" comes back. A segment that walks in a circle (``circle_walk.course_named``)
-turns a whole turn at an even rate over its frames, so its course goes once round (its travel / 2 pi
-the radius; left unless the words say clockwise or to the right); one that walks a figure eight
-(``circle_walk.names_eight``) turns a whole turn that way over the first half of its frames and
-back over the second, so its course goes round one loop and then the other and it leaves facing as
-it came; one that barely travels (under ``CIRCLE_TRAVEL``) is left as it is. The feet are then planted as for any timeline.
+around" -> "walks forward" comes back. A segment that walks a course (a circle, a figure eight, back
+and forth, a zigzag: ``course_walk.course_named``) is turned along it over a whole number of the
+course's periods fitted to its travel (``course_walk.course_turn``: a circle once round, its travel /
+2 pi the radius; left first unless the words say clockwise or to the right), so it leaves the way the
+course ends and the next segment goes on from there; one that barely travels (under
+``CIRCLE_TRAVEL``) is left as it is. The feet are then planted as for any timeline.
 """
 from __future__ import annotations
 
@@ -30,13 +30,13 @@ import numpy as np
 
 from .on_the_spot import asks_on_the_spot, spot_scale
 from .pace_words import SLOW_SPEED, asks_slow_flight, asks_slow_steps
-from .circle_walk import EIGHT, course_named, turns_right
+from .course_walk import course_named, course_turn, turns_right
 from .stride_scale import scaled_strides
 from .track import headings, travel
 from .turn_words import angle_of, eased_turn, turned_by
 
 EASE = 8   # frames over which the stride scale moves from one segment's to the next
-CIRCLE_TRAVEL = 0.5   # m: a circle segment that travels less is not bent round
+CIRCLE_TRAVEL = 0.5   # m: a course segment that travels less is not bent
 
 
 def segment_scale(prompt: str, joints: np.ndarray) -> float:
@@ -62,23 +62,13 @@ def turn_profile(joints: np.ndarray, bounds, prompts) -> np.ndarray | None:
         if angle is not None:
             turn = eased_turn(own[a:b], angle)
         elif course is not None and travel(joints[a:b])[-1] >= CIRCLE_TRAVEL:
-            turn = course_turn(own[a:b], course == EIGHT, turns_right(prompt))
+            turn = course_turn(own[a:b], travel(joints[a:b]), course, turns_right(prompt))
         if turn is not None:
             phi[a:b] += turn
             total += turn[-1]
             phi[b:] = total
             turns = True
     return phi if turns else None
-
-
-def course_turn(own: np.ndarray, eight: bool, right: bool) -> np.ndarray:
-    """(n,) yaw added to a segment whose own heading is ``own`` (n,) so that it goes once round a
-    circle at an even rate, or round a figure eight (a whole turn one way over the first half, back
-    over the second), left first unless ``right``; what it turns by itself is taken out evenly."""
-    u = np.arange(len(own)) / (len(own) - 1)
-    whole = -2 * np.pi if right else 2 * np.pi
-    target = whole * (1.0 - np.abs(1.0 - 2.0 * u)) if eight else whole * u
-    return target - (own[-1] - own[0]) * u
 
 
 def worded_joints(joints: np.ndarray, bounds, prompts) -> np.ndarray | None:

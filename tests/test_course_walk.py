@@ -1,11 +1,11 @@
-"""Walking in a circle or a figure eight (core/generation/circle_walk.py): the words' course walked by
-a straight track, turning the named way, once round; a motion that does not travel left alone."""
+"""Walking a course the words name (core/generation/course_walk.py): a circle, a figure eight, back and
+forth, a zigzag, walked by a straight track the named way; a motion that does not travel left alone."""
 import numpy as np
 import pytest
 
-from shapemove.core.generation.circle_walk import (CIRCLE, EIGHT, MAX_RADIUS, MIN_RADIUS, circle_line, circled,
-                                                   course_named, eight_line, names_circle, radius_for, straight_gait,
-                                                   turns_right)
+from shapemove.core.generation.course_walk import (BACK_AND_FORTH, CIRCLE, EIGHT, MAX_RADIUS, MIN_RADIUS, U_RADIUS,
+                                                   ZIG, ZIG_ANGLE, ZIGZAG, on_course, course_line, course_named,
+                                                   course_turn, radius_for, straight_gait, turns_right)
 from shapemove.core.generation.track import Track, headings, root_centre
 
 
@@ -18,16 +18,16 @@ from shapemove.core.generation.track import Track, headings, root_centre
     ("a person waves", False, False),
 ])
 def test_the_words_name_the_circle_and_its_way(text, circle, right):
-    assert names_circle(text) == circle and turns_right(text) == right
+    assert (course_named(text) == CIRCLE) == circle and turns_right(text) == right
 
 
 def test_radius_goes_round_once_within_bounds():
     assert radius_for(2 * np.pi * 2.0) == pytest.approx(2.0)
     assert radius_for(1.0) == MIN_RADIUS and radius_for(100.0) == MAX_RADIUS
-    line = circle_line(2 * np.pi * 2.0, right=False)
+    line = course_line(2 * np.pi * 2.0, CIRCLE, right=False)
     quarter = line.point([np.pi])[0]                       # a quarter of a 2 m circle
     assert quarter == pytest.approx([2.0, 2.0], abs=0.02)  # turning left: towards +X (the body's left)
-    assert line.point([np.pi])[0][0] == pytest.approx(-circle_line(2 * np.pi * 2.0, right=True).point([np.pi])[0][0])
+    assert line.point([np.pi])[0][0] == pytest.approx(-course_line(2 * np.pi * 2.0, CIRCLE, right=True).point([np.pi])[0][0])
 
 
 def _straight_walk(frames=80, speed=1.2, fps=20.0):
@@ -48,13 +48,13 @@ def _straight_walk(frames=80, speed=1.2, fps=20.0):
 
 def test_a_straight_walk_goes_round_the_circle_and_keeps_its_steps():
     walk = _straight_walk()
-    bent = circled(walk, "a person walks in a circle")
+    bent = on_course(walk, "a person walks in a circle")
     assert bent.joints.shape == walk.joints.shape
     turn = np.unwrap(headings(bent.joints))
     assert turn[-1] - turn[0] > 2.5                                # about 3.8 rad of 4.8 m on a 1 m circle
     c = root_centre(bent.joints)                                   # on the 1 m circle about (1, 0)
     assert np.abs(np.linalg.norm(c - [MIN_RADIUS, 0.0], axis=1) - MIN_RADIUS).max() < 0.1
-    right = circled(walk, "a person walks in a circle clockwise")
+    right = on_course(walk, "a person walks in a circle clockwise")
     assert np.unwrap(headings(right.joints))[-1] - np.unwrap(headings(right.joints))[0] < -2.5
     local = lambda J: np.linalg.norm(J[:, 10] - J[:, 11], axis=-1)  # noqa: E731  the feet's stride, kept
     assert np.allclose(local(bent.joints), local(walk.joints), atol=0.03)
@@ -62,7 +62,7 @@ def test_a_straight_walk_goes_round_the_circle_and_keeps_its_steps():
 
 def test_a_motion_that_does_not_travel_is_left_alone():
     still = _straight_walk(speed=0.0)
-    assert circled(still, "a person walks in a circle") is still
+    assert on_course(still, "a person walks in a circle") is still
 
 
 def test_generation_walks_the_circle_the_prompt_asks_for():
@@ -87,6 +87,14 @@ def test_generation_walks_the_circle_the_prompt_asks_for():
     ("walks in circles counter-clockwise", CIRCLE, ("walks", "walk")),
     ("a person goes around in a circle", CIRCLE, None),            # no gait left to walk straight
     ("a man walks forward to the right", None, None),
+    ("a man paces back and forth", BACK_AND_FORTH, ("a man walks", "walk")),
+    ("a nervous woman is pacing up and down the hallway", BACK_AND_FORTH, ("a nervous woman is walking", "walk")),
+    ("a guard jogs back and forth", BACK_AND_FORTH, ("a guard jogs", "jog")),
+    ("a person rocks back and forth", None, None),                  # no gait: not a course
+    ("a person steps back and forth", None, None),
+    ("a soldier zigzags across the field", ZIGZAG, ("a soldier walks across the field", "walk")),
+    ("someone runs in a zigzag", ZIGZAG, ("someone runs", "run")),
+    ("a man walks at a steady pace", None, None),
 ])
 def test_the_words_name_the_course_and_the_gait_walked_straight(text, course, straight):
     assert course_named(text) == course and straight_gait(text) == straight
@@ -97,7 +105,7 @@ def test_the_eight_is_two_loops_touching_at_the_start():
     centred at (r, 0); half round it is (2r, 0), once round the start heading +Z again, then the
     other loop, centred at (-r, 0)."""
     r = 1.5
-    line = eight_line(4 * np.pi * r, right=False)
+    line = course_line(4 * np.pi * r, EIGHT, right=False)
     quarter = np.pi * r / 2
     pts = line.point([np.pi * r, 2 * np.pi * r, 3 * np.pi * r, 4 * np.pi * r])
     assert pts == pytest.approx(np.array([[2 * r, 0], [0, 0], [-2 * r, 0], [0, 0]]), abs=0.02)
@@ -105,20 +113,52 @@ def test_the_eight_is_two_loops_touching_at_the_start():
     assert np.abs(np.linalg.norm(line.point(np.linspace(0.1, 2 * np.pi * r - 0.1, 50)) - [r, 0], axis=1) - r).max() < 0.02
     yaw = line.heading([np.pi * r, 3 * np.pi * r])
     assert yaw[0] == pytest.approx(np.pi, abs=0.05) and yaw[1] == pytest.approx(np.pi, abs=0.05)  # back the other way
-    mirrored = eight_line(4 * np.pi * r, right=True).point([np.pi * r, 3 * np.pi * r])
+    mirrored = course_line(4 * np.pi * r, EIGHT, right=True).point([np.pi * r, 3 * np.pi * r])
     assert mirrored == pytest.approx(np.array([[-2 * r, 0], [2 * r, 0]]), abs=0.02)
-    assert radius_for(2.0) == MIN_RADIUS and eight_line(2.0, False).length > 4 * np.pi * MIN_RADIUS   # once round at least
+    assert radius_for(2.0) == MIN_RADIUS and course_line(2.0, EIGHT, False).length > 4 * np.pi * MIN_RADIUS   # once round at least
+
+
+def test_back_and_forth_and_zigzag_lines():
+    """Hand-derived: back and forth for 10 m is a leg of 5 - 0.3 pi m out along +Z, a U-turn of
+    U_RADIUS to the left, the leg back 0.6 m aside, a U-turn; a zigzag goes ZIG m at 45 degrees to
+    the left, then ZIG m at 45 degrees to the right."""
+    leg = 5.0 - np.pi * U_RADIUS
+    line = course_line(10.0, BACK_AND_FORTH, right=False)
+    assert line.point([leg])[0] == pytest.approx([0.0, leg], abs=0.02)
+    assert line.point([leg + np.pi * U_RADIUS])[0] == pytest.approx([2 * U_RADIUS, leg], abs=0.02)
+    assert line.point([2 * leg + np.pi * U_RADIUS])[0] == pytest.approx([2 * U_RADIUS, 0.0], abs=0.02)
+    assert line.point([10.0])[0] == pytest.approx([0.0, 0.0], abs=0.02)                # out and back, once
+    assert line.heading([leg / 2, leg + np.pi * U_RADIUS + leg / 2]) == pytest.approx([0.0, np.pi], abs=0.02)
+    zig = course_line(6.0, ZIGZAG, right=False)
+    d = np.sin(ZIG_ANGLE) * ZIG
+    assert zig.point([ZIG, 2 * ZIG, 4 * ZIG])[:, 1] == pytest.approx([d, 2 * d, 4 * d], rel=0.05)   # on along +Z (eased corners: a little more)
+    assert zig.point([ZIG])[0][0] == pytest.approx(d, abs=0.1) and abs(zig.point([2 * ZIG])[0][0]) < 0.05
+    assert zig.heading([ZIG / 2, 1.5 * ZIG]) == pytest.approx([ZIG_ANGLE, -ZIG_ANGLE], abs=0.02)
+
+
+def test_a_timeline_segment_turns_whole_periods_of_its_course():
+    """``course_turn`` fits whole periods to the segment's travel: a circle's whole turn, an eight
+    round and back, back and forth's two half turns; what the body turned by itself taken out."""
+    s = np.linspace(0.0, 9.0, 91)
+    still = np.zeros(91)
+    assert course_turn(still, s, CIRCLE, False)[[0, 45, 90]] == pytest.approx([0, np.pi, 2 * np.pi])
+    assert course_turn(still, s, EIGHT, False)[[0, 45, 90]] == pytest.approx([0, 2 * np.pi, 0], abs=1e-9)
+    fro = course_turn(still, s, BACK_AND_FORTH, True)                     # right first: clockwise
+    assert fro[[0, 30, 60, 90]] == pytest.approx([0, 0, -np.pi, -2 * np.pi], abs=1e-9)
+    assert course_turn(np.linspace(0, 1, 91), s, CIRCLE, True)[-1] == pytest.approx(-2 * np.pi - 1)
+    zig = course_turn(still, s, ZIGZAG, False)                            # 9 m: three periods of 3 m
+    assert zig[[0, 7, 22, 30, 90]] == pytest.approx([0, ZIG_ANGLE, -ZIG_ANGLE, 0, 0], abs=1e-6)
 
 
 def test_a_straight_walk_goes_round_the_eight():
     walk = _straight_walk(frames=200)                               # 12 m: once round two 0.95 -> 1 m loops
-    bent = circled(walk, "a person walks in a figure eight")
+    bent = on_course(walk, "a person walks in a figure eight")
     turn = np.unwrap(headings(bent.joints))
     turn -= turn[0]
     assert turn.max() > 1.8 * np.pi and turn[-1] < turn.max() - 1.5 * np.pi    # round one way, then most of the way back
     c = root_centre(bent.joints)
     assert c[:, 0].max() > 1.8 and c[:, 0].min() < -1.8                       # both loops, either side of the start
-    read = circled(walk, "a person walks", course=EIGHT)                      # the caller read the eight elsewhere
+    read = on_course(walk, "a person walks", course=EIGHT)                      # the caller read the eight elsewhere
     assert np.allclose(root_centre(read.joints), c)
 
 

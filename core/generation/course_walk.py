@@ -1,0 +1,224 @@
+"""Walking a course the words name: a circle, a figure eight, back and forth, a zigzag. The words
+say the path, the feet keep their steps. (Until the twenty-third session: ``circle_walk.py``.)
+
+The SA-VAE's tokens do not carry how fast the root turns. Real circle walks and jogs of the
+training data turn 0.6-1.05 rad/s; the same clips encoded and decoded by the shipped codec turn
+0.06-0.23 rad/s, so "walks around in a circle" comes out as a straight walk whether the T5 writes
+it or a captured circle is retrieved (measured in ``docs/prompts.md``). The prompt names the path,
+so the path is given: the decoded track is walked along the course (``polyline.follow_track``:
+the body keeps its steps, sway and limbs; its course is bent and the feet are planted again), as a
+path drawn by the user would be.
+
+A course is one heading profile over a period of it (``Course.heading``: the yaw at a fraction u of
+the period, turning left positive, 0 at u = 0) and the period's length for a motion that travels so
+far (``Course.period_for``). A single prompt walks the profile repeated (``course_line``); a
+timeline's segment walks a whole number of periods fitted to its own travel (``course_turn``), so
+the next segment goes on the way the course leaves it. Left first unless the words say "clockwise"
+(not "counter-" or "anti-clockwise") or "to the right":
+
+- ``CIRCLE`` ("walks around in a circle"): once round, radius ``radius_for`` (the travel / 2 pi,
+  within ``MIN_RADIUS`` .. ``MAX_RADIUS``).
+- ``EIGHT`` ("walks in a figure eight", "a figure-8 path"): two circles touching where the walk
+  starts, once round one way, then once round the other; each loop's radius lets the motion go
+  once round the whole eight.
+- ``BACK_AND_FORTH`` ("walks back and forth", "paces the room"): out, a U-turn of ``U_RADIUS``,
+  back along a line ``2 U_RADIUS`` aside, a U-turn: once out and back over the motion's travel
+  (legs of ``LEG_MIN`` .. ``LEG_MAX``).
+- ``ZIGZAG`` ("zigzags across the yard"): legs of ``ZIG`` metres alternately ``ZIG_ANGLE`` to
+  either side of the way the walk goes, turning between them over ``ZIG_TURN`` of a leg.
+
+The gait is generated without the course's words when the rest still names one ("a person walks in
+a figure eight" -> "a person walks"; "paces", "zigzags" -> "walks"; ``straight_gait``): the captured
+circles and eights the model learnt them from turn, and decoded without their turning they walk at
+0.3-0.6 m/s (a plain walk 1.1 m/s), so a 10 s eight went half round one loop. A motion that does
+not travel (a wave, a sit, "rocks back and forth") is left as it is.
+
+    track = on_course(track, "a woman walks around in a circle, waving")
+    track = on_course(track, "a man paces back and forth")
+"""
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+
+from ..constants import FPS
+from ..data.actions import find_actions
+from ..data.compose_parts import LEGS_ACTIONS
+from .polyline import MIN_SPEED, Polyline, follow_track
+from .track import Track, motion_speed, travel
+
+CIRCLE = "walk in a circle"
+EIGHT = "walk in a figure eight"
+BACK_AND_FORTH = "back and forth"
+ZIGZAG = "zigzag"
+ACTIONS = (CIRCLE, EIGHT)            # the courses that are actions of the data (``data.actions``)
+MIN_RADIUS, MAX_RADIUS = 1.0, 3.0   # m: a circle's, an eight's loops'
+U_RADIUS = 0.3                      # m: back and forth's U-turns
+LEG_MIN, LEG_MAX = 1.0, 5.0         # m: back and forth's legs
+ZIG, ZIG_ANGLE, ZIG_TURN = 1.5, np.pi / 4, 0.15   # m, radians, share of a leg
+STEP = 0.005                        # m: a course's heading integrated at this step
+
+CLOCKWISE = re.compile(r"(?<![-\w])(?:clockwise|to the right|rightward)\b")
+COUNTER = re.compile(r"\b(?:counter|anti)[- ]?clockwise\b")
+_PACE = r"\bpac(?:es|ing)\b(?!\s+(?:himself|herself|themselves|oneself|yourself))"
+_BACK_AND_FORTH = re.compile(r"\b(?:back and forth|to and fro|backwards and forwards|up and down the "
+                             rf"(?:room|hall|hallway|corridor|street|platform|stage))\b|{_PACE}", re.I)
+_ZIGZAG = re.compile(r"\bzig[- ]?zag(?:s|ging|ged)?\b", re.I)
+_COURSE_VERB = re.compile(rf"{_PACE}|\bzig[- ]?zag(?:s|ging|ged)\b", re.I)   # the course as the verb: "walks"
+# the course in words, cut out for its gait: "in a circle", "around in circles", "a figure-8 path",
+# "in a zigzag", "back and forth", "up and down the room"
+COURSE_WORDS = re.compile(
+    r"(?:\s+(?:around|round|along|on|in|into|through|doing|making|tracing|following))*\s+(?:(?:a|an|the)\s+)?"
+    r"(?:(?:small|big|large|wide|tight|full)\s+)?(?:figure[- ]?(?:of[- ])?(?:8|eight)|circles?|zig[- ]?zag)"
+    r"(?:[- ]shaped)?(?:\s+(?:path|route|pattern|course|shape|loop|line))?\b"
+    r"|\s+(?:back and forth|to and fro|backwards and forwards)\b"
+    r"|\s+up and down the (?:room|hall|hallway|corridor|street|platform|stage)\b", re.I)
+TURN_WAY = re.compile(r"\s+(?:(?:counter|anti)[- ]?)?clockwise\b|\s+(?:to the (?:right|left)|rightwards?|leftwards?)\b",
+                      re.I)   # the course's way round, not the gait's ("runs in a circle to the right")
+
+
+def radius_for(distance: float) -> float:
+    """The radius (m) of a circle once round in ``distance`` metres, within MIN..MAX_RADIUS."""
+    return float(np.clip(distance / (2 * np.pi), MIN_RADIUS, MAX_RADIUS))
+
+
+def _leg_for(distance: float) -> float:
+    """Back and forth's leg (m): once out and back in ``distance`` metres, within LEG_MIN..LEG_MAX."""
+    return float(np.clip(distance / 2 - np.pi * U_RADIUS, LEG_MIN, LEG_MAX))
+
+
+def _circle(u, period):
+    return 2 * np.pi * u
+
+
+def _eight(u, period):
+    return 2 * np.pi * (1.0 - np.abs(1.0 - 2.0 * u))
+
+
+def _stadium(u, period):
+    """Out, a U-turn of U_RADIUS, back, a U-turn: the legs fill what the U-turns leave of the period."""
+    turn = min(np.pi * U_RADIUS / period, 0.5)       # each U-turn's share of the period
+    leg = 0.5 - turn
+    return np.pi * (np.clip((u - leg) / turn, 0.0, 1.0) + np.clip((u - 2 * leg - turn) / turn, 0.0, 1.0))
+
+
+def _zigzag(u, period):
+    """Half a period at +ZIG_ANGLE, half at -ZIG_ANGLE, the turns between them eased (cosine) over
+    ZIG_TURN of a leg, from and back to straight ahead at the period's ends."""
+    w = ZIG_TURN / 2                                  # one turn's share of the period
+    ease = lambda x: 0.5 - 0.5 * np.cos(np.pi * np.clip(x, 0.0, 1.0))   # noqa: E731
+    return ZIG_ANGLE * (ease(u / (w / 2)) - 2 * ease((u - 0.5 + w / 2) / w) + ease((u - 1 + w / 2) / (w / 2)))
+
+
+@dataclass(frozen=True)
+class Course:
+    """``heading(u, period)``: the yaw (radians, left positive) at fractions ``u`` in [0, 1] of a
+    period ``period`` metres long, 0 at u = 0 and ``net`` at u = 1; ``period_for(distance)``: the
+    period (m) for a motion that travels ``distance`` metres."""
+    heading: Callable
+    net: float
+    period_for: Callable[[float], float]
+
+    def yaw(self, s, period: float, right: bool) -> np.ndarray:
+        """The course's yaw at distances ``s`` (m) along it, periods of ``period`` m repeated."""
+        n, u = np.divmod(np.asarray(s, np.float64) / period, 1.0)
+        return (-1.0 if right else 1.0) * (self.heading(u, period) + self.net * n)
+
+
+COURSES = {
+    CIRCLE: Course(_circle, 2 * np.pi, lambda d: 2 * np.pi * radius_for(d)),
+    EIGHT: Course(_eight, 0.0, lambda d: 4 * np.pi * radius_for(d / 2)),
+    BACK_AND_FORTH: Course(_stadium, 2 * np.pi, lambda d: 2 * _leg_for(d) + 2 * np.pi * U_RADIUS),
+    ZIGZAG: Course(_zigzag, 0.0, lambda d: 2 * ZIG),
+}
+
+
+def course_named(text: str) -> str | None:
+    """The course the words name (``EIGHT`` before ``CIRCLE``: "a figure eight" is not a circle;
+    back and forth and a zigzag only with a gait to walk it, or as the verb: "sways back and forth"
+    names none), else None."""
+    acts = find_actions(text)
+    if EIGHT in acts or CIRCLE in acts:
+        return EIGHT if EIGHT in acts else CIRCLE
+    gait = any(a in LEGS_ACTIONS for a in acts) or _COURSE_VERB.search(str(text)) is not None
+    for name, words in ((BACK_AND_FORTH, _BACK_AND_FORTH), (ZIGZAG, _ZIGZAG)):
+        if gait and words.search(str(text)):
+            return name
+    return None
+
+
+def straight_gait(text: str) -> tuple[str, str] | None:
+    """(the words without the course they name and its way round, the gait left in them) --
+    "someone jogs in a figure eight clockwise, waving" -> ("someone jogs, waving", "jog"), "a man
+    paces back and forth" -> ("a man walks", "walk") -- or None when no course phrase is found or
+    what is left names no gait ("goes around in a circle")."""
+    text = str(text)
+    if not (COURSE_WORDS.search(text) or _COURSE_VERB.search(text)):
+        return None
+    straight = _COURSE_VERB.sub(_walk_verb, COURSE_WORDS.sub("", text))
+    straight = re.sub(r"\s+([,.;])", r"\1", TURN_WAY.sub("", straight)).strip()
+    gaits = [a for a in find_actions(straight) if a in LEGS_ACTIONS and a not in ACTIONS]
+    return (straight, gaits[0]) if gaits else None
+
+
+def _walk_verb(m: re.Match) -> str:
+    """"paces" -> "walks", "pacing" / "zigzagging" -> "walking", "zigzagged" -> "walked"."""
+    word = m.group(0).lower()
+    return "walking" if word.endswith("ing") else "walked" if word.endswith("ed") else "walks"
+
+
+def walked_straight(text: str) -> str:
+    """The words a course's gait is sampled from (``straight_gait``'s), else ``text`` itself."""
+    gait = straight_gait(text)
+    return gait[0] if gait else text
+
+
+def turns_right(text: str) -> bool:
+    """Clockwise seen from above: "clockwise", "to the right" (not "counter-clockwise")."""
+    t = str(text).lower()
+    return bool(CLOCKWISE.search(COUNTER.sub(" ", t)))
+
+
+def course_line(distance: float, course: str, right: bool) -> Polyline:
+    """``course`` from the origin, heading +Z, as long as ``distance`` metres need (at least one
+    period and a quarter more): its heading integrated every ``STEP`` m."""
+    c = COURSES[course]
+    period = c.period_for(distance)
+    s = np.arange(0.0, max(distance, period) + period / 4 + STEP, STEP)
+    yaw = c.yaw(s, period, right)
+    mid = (yaw[1:] + yaw[:-1]) / 2
+    xz = np.concatenate([[[0.0, 0.0]], np.cumsum(np.stack([np.sin(mid), np.cos(mid)], axis=1) * STEP, axis=0)])
+    return Polyline(xz)
+
+
+def course_turn(own: np.ndarray, s: np.ndarray, course: str, right: bool) -> np.ndarray:
+    """(n,) yaw added to a timeline segment whose own heading is ``own`` (n,) and whose travel is
+    ``s`` (n,) metres from its start: the course over a whole number of periods fitted to its travel
+    (at least one), what it turns by itself taken out evenly along its travel."""
+    c = COURSES[course]
+    total = max(float(s[-1]), 1e-6)
+    period = total / max(1, round(total / c.period_for(total)))
+    return c.yaw(s, period, right) - (own[-1] - own[0]) * np.asarray(s, np.float64) / total
+
+
+def on_course(track: Track, text: str, fps: float = FPS, course: str | None = None) -> Track:
+    """``track`` walked along the course ``text`` asks for (``course``, when given, says which: the
+    caller may have read it from the nearest known caption; else the words', else a circle);
+    unchanged when it does not travel."""
+    if motion_speed(track.joints, fps) < MIN_SPEED:
+        return track
+    course = course or course_named(text) or CIRCLE
+    return follow_track(track, course_line(float(travel(track.joints)[-1]), course, turns_right(text)), crop=False)
+
+
+def course_motion(motion, body, text: str, ik_refine_iters: int = 10, course: str | None = None):
+    """A generated ``Motion`` walked along the course ``text`` asks for (``course``: as ``on_course``;
+    ``track.replanted``: an edit, no tokens kept); the motion itself when it does not travel."""
+    from .track import replanted, track_of
+
+    tr = track_of(motion)
+    bent = on_course(tr, text, motion.fps, course)
+    return motion if bent is tr else replanted(motion, body, bent, ik_refine_iters)
