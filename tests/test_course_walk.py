@@ -95,6 +95,11 @@ def test_generation_walks_the_circle_the_prompt_asks_for():
     ("a soldier zigzags across the field", ZIGZAG, ("a soldier walks across the field", "walk")),
     ("someone runs in a zigzag", ZIGZAG, ("someone runs", "run")),
     ("a man walks at a steady pace", None, None),
+    ("The hiker paces ahead at a steady clip.", None, None),
+    ("Walk forward while rotating your arms in circles.", None, None),
+    ("a person walks in circles, swinging the arms", CIRCLE, ("a person walks, swinging the arms", "walk")),          # "paces" sent on: a walk, no course
+    ("a worried father paces the hospital corridor", BACK_AND_FORTH, ("a worried father walks the hospital corridor", "walk")),
+    ("he is pacing nervously", BACK_AND_FORTH, ("he is walking nervously", "walk")),
 ])
 def test_the_words_name_the_course_and_the_gait_walked_straight(text, course, straight):
     assert course_named(text) == course and straight_gait(text) == straight

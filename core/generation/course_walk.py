@@ -63,7 +63,11 @@ STEP = 0.005                        # m: a course's heading integrated at this s
 
 CLOCKWISE = re.compile(r"(?<![-\w])(?:clockwise|to the right|rightward)\b")
 COUNTER = re.compile(r"\b(?:counter|anti)[- ]?clockwise\b")
-_PACE = r"\bpac(?:es|ing)\b(?!\s+(?:himself|herself|themselves|oneself|yourself))"
+# "paces" is back and forth only where nothing sends it on: "paces the room", "is pacing nervously", "paces
+# back and forth", "she paces." -- not "paces ahead at a steady clip", "paces along the road"
+_PACE = (r"\bpac(?:es|ing)\b(?=\s+(?:(?:around|about|round)\s+)?(?:the|a|his|her|their)\s+(?:[\w-]+\s+)?(?:room|floor|halls?|"
+         r"hallway|corridor|office|cell|stage|platform|deck|yard|kitchen|ward|lobby)\b|\s+(?:nervously|impatiently|"
+         r"anxiously|restlessly|worriedly|around|about|back and forth|to and fro|up and down)\b|\s*(?:[,.;!]|$))")
 _BACK_AND_FORTH = re.compile(r"\b(?:back and forth|to and fro|backwards and forwards|up and down the "
                              rf"(?:room|hall|hallway|corridor|street|platform|stage))\b|{_PACE}", re.I)
 _ZIGZAG = re.compile(r"\bzig[- ]?zag(?:s|ging|ged)?\b", re.I)
@@ -76,6 +80,9 @@ COURSE_WORDS = re.compile(
     r"(?:[- ]shaped)?(?:\s+(?:path|route|pattern|course|shape|loop|line))?\b"
     r"|\s+(?:back and forth|to and fro|backwards and forwards)\b"
     r"|\s+up and down the (?:room|hall|hallway|corridor|street|platform|stage)\b", re.I)
+# circles the arms make, not the walk: "rotating your arms in circles", "swinging the arms around in circles"
+_ARM_CIRCLES = re.compile(r"\b(?:arms?|hands?|fists?|wrists?)\b(?:\s+[\w-]+){0,2}?\s+(?:(?:a)?round\s+)?in\s+"
+                          r"(?:(?:big|small|wide|large)\s+)?circles?\b", re.I)
 TURN_WAY = re.compile(r"\s+(?:(?:counter|anti)[- ]?)?clockwise\b|\s+(?:to the (?:right|left)|rightwards?|leftwards?)\b",
                       re.I)   # the course's way round, not the gait's ("runs in a circle to the right")
 
@@ -138,10 +145,11 @@ COURSES = {
 
 def course_named(text: str) -> str | None:
     """The course the words name (``EIGHT`` before ``CIRCLE``: "a figure eight" is not a circle;
-    back and forth and a zigzag only with a gait to walk it, or as the verb: "sways back and forth"
-    names none), else None."""
+    not the circles the arms make: "walks forward rotating the arms in circles"; back and forth and a
+    zigzag only with a gait to walk it, or as the verb: "sways back and forth" names none), else
+    None."""
     acts = find_actions(text)
-    if EIGHT in acts or CIRCLE in acts:
+    if EIGHT in acts or (CIRCLE in acts and not _ARM_CIRCLES.search(str(text))):
         return EIGHT if EIGHT in acts else CIRCLE
     gait = any(a in LEGS_ACTIONS for a in acts) or _COURSE_VERB.search(str(text)) is not None
     for name, words in ((BACK_AND_FORTH, _BACK_AND_FORTH), (ZIGZAG, _ZIGZAG)):
@@ -153,10 +161,10 @@ def course_named(text: str) -> str | None:
 def straight_gait(text: str) -> tuple[str, str] | None:
     """(the words without the course they name and its way round, the gait left in them) --
     "someone jogs in a figure eight clockwise, waving" -> ("someone jogs, waving", "jog"), "a man
-    paces back and forth" -> ("a man walks", "walk") -- or None when no course phrase is found or
-    what is left names no gait ("goes around in a circle")."""
+    paces back and forth" -> ("a man walks", "walk") -- or None when the words name no course
+    (``course_named``) or what is left names no gait ("goes around in a circle")."""
     text = str(text)
-    if not (COURSE_WORDS.search(text) or _COURSE_VERB.search(text)):
+    if course_named(text) is None:
         return None
     straight = _COURSE_VERB.sub(_walk_verb, COURSE_WORDS.sub("", text))
     straight = re.sub(r"\s+([,.;])", r"\1", TURN_WAY.sub("", straight)).strip()

@@ -35,7 +35,7 @@ from ..constants import FPS
 from ..errors import ShapeMoveError
 from ..scene.motion_file import Motion
 from ..torch_threads import one_torch_thread
-from .course_walk import course_named, walked_straight
+from .course_walk import walked_straight
 from .decode import decode_features
 from .prompts import check_prompt
 from .sampling_params import DEFAULT_CANDIDATES, check_candidates, check_sampling
@@ -92,7 +92,7 @@ def _segment(gen, prompt, shape_text, n, prefix, arms_prefix, betas, seed, tempe
     prompt = prompt if stop is None else stop[0]
     plan, side = plan_of(prompt, gen) if by_parts else (None, None)
     legs = prompt if plan is None else plan.legs_prompt
-    legs = walked_straight(legs) if by_parts and course_named(prompt) else legs   # its gait, bent by timeline_words
+    legs = walked_straight(legs) if by_parts else legs   # a course's gait, bent by timeline_words
     codes, pred = _segment_codes(gen, legs, shape_text, n, prefix, betas, seed, temperature, top_k, candidates,
                                  guidance)
     if plan is None:
