@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from shapemove.core.generation.stop_words import standing_after, stop_cut, stop_request
+from shapemove.core.generation.stop_words import asked_distance, distance_cut, standing_after, stop_cut, stop_request
 
 
 @pytest.mark.parametrize("text, want", [
@@ -25,6 +25,11 @@ from shapemove.core.generation.stop_words import standing_after, stop_cut, stop_
     ("a dancer takes two steps and spins", None),  # another action beside the steps
     ("a man steps to the side repeatedly", None),  # "a man steps": no count
     ("someone runs at a quick pace", None),        # a pace, not a step
+    ("a man walks 3 metres forward", ("a man walks forward", None)),      # a distance: sampled without it
+    ("she runs ten meters and stops", ("she runs", None)),
+    ("a woman walks 2 m forward, waving", ("a woman walks forward, waving", None)),   # a gesture stops with it
+    ("a man walks 3 metres and spins", None),      # another action after the distance
+    ("a six foot man walks forward", None),        # a height, not a distance
 ])
 def test_the_words_that_stop_a_gait(text, want):
     assert stop_request(text) == want
@@ -41,6 +46,27 @@ def test_stop_codes_cut_after_the_counted_strike():
     assert stop_cut(contacts, 4, 10, 4) is None                                    # fewer strikes than counted
     assert standing_after(codes, 7, 99) == [0, 1, 2, 3, 4, 5, 6] + [99] * 3
     assert standing_after(codes, 7, 99, stand=8) == [0, 1, 2, 3, 4, 5, 6] + [99] * 8   # the model's length
+
+
+@pytest.mark.parametrize("text, metres", [
+    ("a man walks 3 metres forward", 3.0), ("someone jogs 20 feet", 6.096), ("she runs ten meters", 10.0),
+    ("walk 2.5 m to the left", 2.5), ("a soldier marches 200 yards", None),       # 183 m: over MAX_METRES
+    ("a soldier marches 50 yards", 45.72), ("a man six feet tall walks 2 m", 2.0), ("a 2 m tall woman runs", None),
+    ("a man jumps 2 metres", None),                # no gait
+])
+def test_the_distance_a_gait_is_asked_to_go(text, metres):
+    got = asked_distance(text)
+    assert (got is None) if metres is None else got == pytest.approx(metres)
+
+
+def test_the_distance_cut_is_the_code_that_gets_there():
+    """A root going 1 m/s along +Z at 20 fps reaches 2 m (less REACH_SLACK, 0.1 m) at frame 38:
+    codes of 4 frames, the 10th holds it."""
+    t = np.arange(80) / 20.0
+    joints = np.zeros((80, 22, 3))
+    joints[:, :, 2] = t[:, None]
+    assert distance_cut(joints, 2.0, 20, 4) == 10
+    assert distance_cut(joints, 3.9, 20, 4) == 20 and distance_cut(joints, 5.0, 20, 4) is None
 
 
 @pytest.fixture(scope="module")
@@ -149,3 +175,24 @@ def test_a_timeline_segment_that_counts_its_steps_stands_after_them(gen_default)
     assert boundary_report(m)["jump_ratio"] <= 2.0
     again = regenerate_segment(gen_default, m, 0, seed=3)
     assert speed(again, 40, 60) < 0.1
+
+
+def test_a_walk_goes_the_distance_asked_and_stands(gen_default):
+    """"a man walks 3 metres forward" (6 s) is cut where the body is 3 m from its start and stands
+    there; one asked further than it can walk in the length says so. A timeline's segment too."""
+    from shapemove.core.generation.generate import Request
+    from shapemove.core.generation.sequence import generate_sequence
+
+    def gone(m, a=0, b=None):
+        r = m.joints[:, 0, [0, 2]]
+        return float(np.linalg.norm(r[(len(r) if b is None else b) - 1] - r[a]))
+
+    m = gen_default.generate_batch([Request("a man walks 3 metres forward", seconds=6, seed=0)])[0]
+    assert abs(gone(m) - 3.0) < 0.3 and m.prompt == "a man walks 3 metres forward"
+    speed = np.linalg.norm(np.diff(m.joints[-20:, 0, [0, 2]], axis=0), axis=1).mean() * m.fps
+    assert speed < 0.1 and m.tokens is not None                       # stands for its last second, tokens kept
+    far = gen_default.generate_batch([Request("a man walks 10 metres", seconds=4, seed=0)])[0]
+    assert gone(far) < 8 and any("of the 10.0 m asked" in n for n in far.notes)
+    t = generate_sequence(gen_default, [("a man walks 3 metres forward", 4.0), ("he waves", 2.0)], seed=0)
+    (a, b), _ = t.segment_bounds
+    assert abs(gone(t, a, b) - 3.0) < 0.3                                 # before: 2.0-2.1 m, cut at half

@@ -41,7 +41,8 @@ from .rerank import CandidatePicker
 from .retrieval_seeds import seed_prefixes, seeded_count
 from .on_the_spot import on_the_spot
 from .retrieved_candidates import library_codes, retrieved_codes
-from .stop_words import STAND_SECONDS, standing_after, standing_code, stop_cut, stop_request
+from .stop_words import (DISTANCE_PACE, DISTANCE_SECONDS, STAND_SECONDS, asked_distance, distance_cut,
+                         standing_after, standing_code, stop_cut, stop_request)
 from .sampling_params import (DEFAULT_GUIDANCE, check_candidates, check_guidance, check_retrieval_first,
                               check_retrieval_prefix, check_retrieved, check_sampling)
 from .request import Request
@@ -386,11 +387,13 @@ class Generator:
             if cancel is not None and cancel():
                 break
             stop = stop_request(r.prompt) if r.by_parts else None   # "takes three steps and stops"
-            asked = dataclasses.replace(r, prompt=stop[0]) if stop else r   # generated without its stop
+            metres = asked_distance(r.prompt) if stop else None      # "walks 3 metres": that far, then stands
+            asked = dataclasses.replace(r, prompt=stop[0], seconds=r.seconds if r.seconds or not metres else
+                                        min(DISTANCE_SECONDS, metres / DISTANCE_PACE + 1.0)) if stop else r
             motion = generate_by_parts(self, asked) if r.by_parts else None
             if motion is not None and stop is not None:
                 motion.prompt = r.prompt
-                motion = self.stopped(motion, stop[1], r.seconds)   # both parts stop (stop_words.py)
+                motion = self.stopped(motion, stop[1], r.seconds, metres)   # both parts stop (stop_words.py)
             course = self.asks_course(r.prompt, check) if r.by_parts else None   # course_walk.py
             if motion is None:  # one action, no side named: the motion as the model writes it
                 sampled = asked if course is None else dataclasses.replace(asked, prompt=walked_straight(asked.prompt))
@@ -399,7 +402,7 @@ class Generator:
                 motion = (self.library_take(kept[0], codes[0], betas, r.prompt)   # a library clip as captured
                           or self.decode_motion(codes[0], betas, prompt=r.prompt))
                 if stop is not None:   # stop_words.py: cut, then stand
-                    motion = self.stopped(motion, stop[1], r.seconds)
+                    motion = self.stopped(motion, stop[1], r.seconds, metres)
                 motion.shape_source = source
                 motion.retrieved_clips = [c for c in kept if c]
                 self._say_if_short(motion, kept[0], r.seconds)
@@ -425,28 +428,47 @@ class Generator:
         for a model without a memory or such a code."""
         return standing_code(self.t5.memory if self.t5 is not None else None, self.vae)
 
-    def stopped(self, motion: Motion, steps: int | None, seconds: float | None = None) -> Motion:
+    def stopped(self, motion: Motion, steps: int | None, seconds: float | None = None,
+                metres: float | None = None) -> Motion:
         """``motion`` (decoded from its tokens) cut after ``steps`` foot strikes (None: half its
-        length) and standing still for the rest of ``seconds`` (None: the length was the model's,
-        ``STAND_SECONDS`` of standing) (``stop_words.py``), decoded again as it was made (a motion
-        made by part: its arms' tokens cut at the same code, mirrors kept); unchanged when the
-        model has no standing code or the gait strikes fewer times."""
+        length), or where it is ``metres`` from its start (of that code and the next, the one that
+        stands nearest the distance once decoded again), and standing still for the rest of
+        ``seconds`` (None: the length was the model's, ``STAND_SECONDS`` of standing)
+        (``stop_words.py``), decoded again as it was made (a motion made by part: its arms' tokens
+        cut at the same code, mirrors kept); unchanged when the model has no standing code or the
+        gait strikes fewer times; with a note when it does not get as far as asked."""
         rest = self.rest_code
         if rest is None or motion.tokens is None or motion.planted_take:   # a take plays its own rotations
             return motion
         down = self.vae.cfg.downsample
         stand = None if seconds is not None else max(1, round(STAND_SECONDS * FPS / down))
-        keep = stop_cut(motion.contacts, steps, len(motion.tokens), down)
-        codes = None if keep is None else standing_after(motion.tokens, keep, rest, stand)
-        if codes is None or codes == [int(c) for c in motion.tokens]:
-            return motion
-        arms = motion.arms_tokens
-        cut = dataclasses.replace(motion, tokens=np.asarray(codes, np.int32), arms_tokens=(
-            None if arms is None else np.asarray(standing_after(arms, keep, rest, stand), np.int32)))
-        out = self._redecoded(cut, motion.betas)
-        out.shape_source, out.retrieved_clips = motion.shape_source, list(motion.retrieved_clips)
-        out.part_prompts = motion.part_prompts
-        return out
+        n = len(motion.tokens)
+        if metres is None:
+            keep = stop_cut(motion.contacts, steps, n, down)
+            keeps = [] if keep is None else [keep]
+        else:
+            keep = distance_cut(motion.joints, metres, n, down)
+            keeps = [] if keep is None else sorted({keep, min(n, keep + 1)})
+            if keep is None:
+                gone = float(np.linalg.norm(motion.joints[-1, 0, [0, 2]] - motion.joints[0, 0, [0, 2]]))
+                motion.notes.append(f"went {gone:.1f} m of the {metres:.1f} m asked in {motion.num_frames / motion.fps:.1f} s: "
+                                    "ask for more seconds")
+        best, off = motion, np.inf
+        for k in keeps:
+            codes = standing_after(motion.tokens, k, rest, stand)
+            if codes == [int(c) for c in motion.tokens]:
+                continue
+            arms = motion.arms_tokens
+            cut = dataclasses.replace(motion, tokens=np.asarray(codes, np.int32), arms_tokens=(
+                None if arms is None else np.asarray(standing_after(arms, k, rest, stand), np.int32)))
+            out = self._redecoded(cut, motion.betas)
+            gone = float(np.linalg.norm(out.joints[-1, 0, [0, 2]] - out.joints[0, 0, [0, 2]]))
+            if metres is None or abs(gone - metres) < off:
+                best, off = out, (0.0 if metres is None else abs(gone - metres))
+        if best is not motion:
+            best.shape_source, best.retrieved_clips = motion.shape_source, list(motion.retrieved_clips)
+            best.part_prompts = motion.part_prompts
+        return best
 
     def _say_if_short(self, motion: Motion, clip: str | None, seconds: float | None) -> None:
         """A note when a kept library clip, shorter than the length asked, was played whole

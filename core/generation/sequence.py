@@ -39,7 +39,7 @@ from .course_walk import walked_straight
 from .decode import decode_features
 from .prompts import check_prompt
 from .sampling_params import DEFAULT_CANDIDATES, check_candidates, check_sampling
-from .stop_words import asks_stand_still, standing_after, stop_cut, stop_request
+from .stop_words import asked_distance, asks_stand_still, distance_cut, standing_after, stop_cut, stop_request
 from .token_sampling import body_for, sample_codes
 from .track import Track, decoded_track, plant, rotate_y
 
@@ -89,6 +89,7 @@ def _segment(gen, prompt, shape_text, n, prefix, arms_prefix, betas, seed, tempe
         return [gen.rest_code] * n, None, pred
     stop = stop_request(prompt) if by_parts else None   # the standing code is found only when one is asked
     stop = stop if stop is not None and gen.rest_code is not None else None
+    metres = asked_distance(prompt) if stop is not None else None   # "walks 3 metres": that far, then stands
     prompt = prompt if stop is None else stop[0]
     plan, side = plan_of(prompt, gen) if by_parts else (None, None)
     legs = prompt if plan is None else plan.legs_prompt
@@ -100,7 +101,7 @@ def _segment(gen, prompt, shape_text, n, prefix, arms_prefix, betas, seed, tempe
     else:
         arms, _ = _segment_codes(gen, plan.arms_prompt, shape_text, len(codes), arms_prefix, betas, seed + 1,
                                  temperature, top_k, candidates, guidance)
-    keep = None if stop is None else _steps_kept(gen.vae, codes, prefix, stop[1])
+    keep = None if stop is None else _steps_kept(gen.vae, codes, prefix, stop[1], metres)
     if keep is not None:   # both parts stand after the counted steps (Generator.stopped for one prompt)
         codes = standing_after(codes, keep, gen.rest_code)
         arms = None if arms is None else standing_after(arms, keep, gen.rest_code)
@@ -108,15 +109,19 @@ def _segment(gen, prompt, shape_text, n, prefix, arms_prefix, betas, seed, tempe
 
 
 @torch.no_grad()
-def _steps_kept(vae, codes: list[int], prefix: list[int], steps: int | None) -> int | None:
-    """How many of a segment's gait ``codes`` its counted ``steps`` keep (``stop_words.stop_cut``),
-    read from the foot contacts the decoder gives them after the codes they continue (canonical body);
-    None when the gait strikes fewer times."""
+def _steps_kept(vae, codes: list[int], prefix: list[int], steps: int | None, metres: float | None = None) -> int | None:
+    """How many of a segment's gait ``codes`` its counted ``steps`` keep (``stop_words.stop_cut``), or
+    its ``metres`` (``stop_words.distance_cut``), read from the foot contacts or the root the decoder
+    gives them after the codes they continue (canonical body); None when the gait strikes fewer times
+    or does not get that far."""
     from ..motion.contacts import to_feature_order
+    from ..motion.features import joints_from_features
 
     down = vae.cfg.downsample
     with one_torch_thread():
         feats = decode_features(list(prefix) + list(codes), vae, np.zeros(10, np.float32)).numpy()
+    if metres is not None:
+        return distance_cut(joints_from_features(feats)[len(prefix) * down:], metres, len(codes), down)
     contacts = to_feature_order(feats[len(prefix) * down:, 259:263] > 0.5)   # the same swap puts them back in 7, 8, 10, 11
     return stop_cut(contacts, steps, len(codes), down)
 

@@ -17,6 +17,11 @@ A timeline's segment that only asks to stand still ("stands still", "waits", "pa
   a foot strike (a new contact of either foot) after the first frame. A count alone stops too:
   "takes three steps forward", "she takes a step back" walk that many steps and stand (none other
   than a gait named: "takes two steps and spins" is left alone).
+- A distance: "walks 3 metres forward", "runs ten meters and stops", "jogs 20 feet" (metres, meters,
+  m, feet, ft, yards): the cut is the code where the body is that far from where it started in a
+  straight line (``distance_cut``; of that code and the next, the one whose motion, decoded again,
+  stands nearest the distance). A body's height ("six feet tall", "a six foot man") is no distance.
+  With no length asked, the motion is made long enough for a slow walk to get there.
 - The standing code (``standing_code``): of the codes the memory's real clips hold for at least
   ``REST_RUN`` codes in a row, the one whose repetition decodes with the least joint speed and
   root travel, wrists below the shoulders (arms down); found once per model.
@@ -32,6 +37,7 @@ import numpy as np
 import torch
 
 from ..data.actions import find_actions
+from ..data.compose_parts import ARMS_ACTIONS
 from ..motion.contacts import runs
 from .count_words import NUMBERS, QUANTITY
 
@@ -48,6 +54,18 @@ COUNT_ALONE = re.compile(r"\b(" + QUANTITY + r"|\d{1,2})\s+(?:\w+\s+)?(?:steps?|
 STILL = re.compile(r"\b(?:stands?|standing) (?:still|there|idle|motionless|quietly|around)\b|\b(?:stays?|staying) "
                    r"(?:still|put)\b|\b(?:waits?|waiting|pauses?|pausing|stops?|halts?|idles?|idling|rests?|resting)\b|"
                    r"\b(?:holds?|holding) still\b")
+UNITS = {"m": 1.0, "metre": 1.0, "meter": 1.0, "metres": 1.0, "meters": 1.0, "feet": 0.3048, "foot": 0.3048,
+         "ft": 0.3048, "yard": 0.9144, "yards": 0.9144, "yd": 0.9144, "yds": 0.9144}
+DISTANCE = re.compile(r"\b(\d{1,3}(?:\.\d+)?|" + "|".join(sorted(map(re.escape, NUMBERS), key=len, reverse=True)) +
+                      r")\s*(" + "|".join(sorted(UNITS, key=len, reverse=True)) + r")\b"
+                      r"(?![-\s]*(?:tall|high|in height|long|wide|deep|man|woman|person|guy|girl|boy|lady|kid|child|"
+                      r"giant|figure|athlete|soldier|dancer|player)\b)")
+SPOKEN_DISTANCE = re.compile(r"\s*\b(?:(?:for|about|around|some|roughly|nearly|almost|another)\s+)*" + DISTANCE.pattern,
+                             re.I)   # "for about 5 m": what the gait is sampled without
+MAX_METRES = 100.0
+REACH_SLACK = 0.1          # m: a gait this close to the distance has got there
+DISTANCE_PACE = 0.7        # m/s: with no length asked, a distance is given time for this slow a walk ...
+DISTANCE_SECONDS = 60.0    # ... up to this long (the longest length a prompt may ask)
 GAITS = {"walk", "run", "jog", "sprint", "sneak", "march", "limp", "walk backward", "sidestep", "zombie walk"}
 REST_RUN = 4       # codes in a row: a code held this long in a real clip is a candidate standing code
 REST_PROBE = 10    # codes the candidate is repeated for when it is decoded
@@ -56,9 +74,10 @@ STAND_SECONDS = 1.6   # standing after the stop when the model decides the lengt
 
 
 def stop_request(text: str) -> tuple[str, int | None] | None:
-    """(the prompt without its stop clause, the steps it counts or None) when ``text`` asks a gait
-    to stop, or counts the steps of a gait and asks nothing else ("takes three steps forward": the
-    whole prompt, 3); None otherwise."""
+    """(the prompt without its stop clause or distance, the steps it counts or None) when ``text``
+    asks a gait to stop, counts the steps of a gait and asks nothing else ("takes three steps
+    forward": the whole prompt, 3), or gives a gait a distance ("walks 3 metres forward": "walks
+    forward", None; ``asked_distance`` says how far); None otherwise."""
     t = str(text)
     low = t.lower()
     if NEGATED.search(low):
@@ -66,20 +85,37 @@ def stop_request(text: str) -> tuple[str, int | None] | None:
     match = STOP.search(low)
     if match is None:
         counted = COUNT_ALONE.search(low)
-        if counted is None or set(find_actions(low)) - GAITS:
-            return None   # no count, or another action beside the steps ("takes two steps and spins")
-        gait = t.strip().rstrip(".")
+        others = set(find_actions(low)) - GAITS
+        if counted is not None and not others:
+            gait = t.strip().rstrip(".")
+        elif counted is None and asked_distance(low) is not None and not others - set(ARMS_ACTIONS):
+            gait = t.strip().rstrip(".")   # "walks 3 metres forward (waving)": both parts stop there
+        else:
+            return None   # no count or distance, or another action beside them ("takes two steps and spins")
     else:
         gait = t[:match.start()].strip().rstrip(",")
         counted = COUNT.search(gait.lower())
         if not gait or (counted is None and not set(find_actions(gait.lower())) & GAITS):
             return None   # "a person stops", "she waves and stops": no gait to stop
+    gait = re.sub(r"\s+([,.;])", r"\1", SPOKEN_DISTANCE.sub("", gait)).strip() or gait   # the cut goes that far
     steps = None
     if counted is not None:
         word = counted.group(1) or counted.group(2)
         steps = int(word) if word.isdigit() else NUMBERS[word]
         steps = steps if 1 <= steps <= MAX_STEPS else None
     return gait, steps
+
+
+def asked_distance(text: str) -> float | None:
+    """Metres a gait is asked to go ("walks 3 metres", "ten feet", "2.5 m"), when the words name a
+    gait and a distance of at most ``MAX_METRES``; else None."""
+    low = str(text).lower()
+    m = DISTANCE.search(low)
+    if m is None or not set(find_actions(low)) & GAITS:
+        return None
+    n = float(m.group(1)) if m.group(1)[0].isdigit() else NUMBERS[m.group(1)]
+    metres = n * UNITS[m.group(2)]
+    return metres if 0 < metres <= MAX_METRES else None
 
 
 def asks_stand_still(text: str) -> bool:
@@ -130,6 +166,15 @@ def stop_cut(contacts, steps: int | None, n: int, down: int) -> int | None:
     if len(strikes) < steps:
         return None
     return min(n, strikes[steps - 1] // down + 2)
+
+
+def distance_cut(joints, metres: float, n: int, down: int) -> int | None:
+    """How many of a gait's ``n`` codes are kept: up to the code whose frames bring the root
+    ``metres`` from its first position (straight line, floor plane; within ``REACH_SLACK``) in the
+    (T, 22, 3) ``joints``; None when it never gets that far."""
+    root = np.asarray(joints, np.float64)[:, 0, [0, 2]]
+    far = np.flatnonzero(np.linalg.norm(root - root[0], axis=1) >= metres - REACH_SLACK)
+    return None if not len(far) else min(n, int(far[0]) // down + 1)
 
 
 def standing_after(codes, keep: int, rest: int, stand: int | None = None) -> list[int]:
