@@ -59,10 +59,11 @@ def turn_profile(joints: np.ndarray, bounds, prompts) -> np.ndarray | None:
         if b - a < 2:
             continue
         angle, course, turn = angle_of(prompt), course_named(prompt), None
+        s = travel(joints[a:b]) if angle is None and course is not None else None
         if angle is not None:
             turn = eased_turn(own[a:b], angle)
-        elif course is not None and travel(joints[a:b])[-1] >= CIRCLE_TRAVEL:
-            turn = course_turn(own[a:b], travel(joints[a:b]), course, turns_right(prompt))
+        elif s is not None and s[-1] >= CIRCLE_TRAVEL:
+            turn = course_turn(own[a:b], s, course, turns_right(prompt))
         if turn is not None:
             phi[a:b] += turn
             total += turn[-1]
