@@ -3,7 +3,7 @@ forth, a zigzag, walked by a straight track the named way; a motion that does no
 import numpy as np
 import pytest
 
-from shapemove.core.generation.course_walk import (BACK_AND_FORTH, CIRCLE, EIGHT, MAX_RADIUS, MIN_RADIUS, U_RADIUS,
+from shapemove.core.generation.course_walk import (BACK_AND_FORTH, CIRCLE, DIAGONAL, EIGHT, MAX_RADIUS, MIN_RADIUS, U_RADIUS,
                                                    ZIG, ZIG_ANGLE, ZIGZAG, on_course, course_line, course_named,
                                                    course_turn, radius_for, straight_gait, turns_right)
 from shapemove.core.generation.track import Track, headings, root_centre
@@ -100,6 +100,9 @@ def test_generation_walks_the_circle_the_prompt_asks_for():
     ("a person walks in circles, swinging the arms", CIRCLE, ("a person walks, swinging the arms", "walk")),          # "paces" sent on: a walk, no course
     ("a worried father paces the hospital corridor", BACK_AND_FORTH, ("a worried father walks the hospital corridor", "walk")),
     ("he is pacing nervously", BACK_AND_FORTH, ("he is walking nervously", "walk")),
+    ("a woman walks diagonally to the right", DIAGONAL, ("a woman walks", "walk")),
+    ("someone runs off at an angle", DIAGONAL, ("someone runs off", "run")),
+    ("the dancer moves diagonally", None, None),                     # no gait
 ])
 def test_the_words_name_the_course_and_the_gait_walked_straight(text, course, straight):
     assert course_named(text) == course and straight_gait(text) == straight
@@ -141,6 +144,17 @@ def test_back_and_forth_and_zigzag_lines():
     assert zig.heading([ZIG / 2, 1.5 * ZIG]) == pytest.approx([ZIG_ANGLE, -ZIG_ANGLE], abs=0.02)
 
 
+def test_the_diagonal_turns_to_45_degrees_and_keeps_it():
+    """Hand-derived: after its first DIAGONAL_EASE (0.6) m the diagonal to the right heads -45
+    degrees (towards -X, the body's right) and goes on straight that way."""
+    line = course_line(5.0, DIAGONAL, right=True)
+    assert line.heading([0.0])[0] == pytest.approx(0.0, abs=0.15)
+    assert line.heading([1.0, 3.0, 5.0]) == pytest.approx([-np.pi / 4] * 3, abs=0.01)
+    d = line.point([5.0])[0] - line.point([1.0])[0]
+    assert d == pytest.approx(4.0 * np.array([-1.0, 1.0]) / np.sqrt(2), abs=0.01)
+    assert course_turn(np.zeros(11), np.linspace(0, 5.0, 11), DIAGONAL, False)[-1] == pytest.approx(np.pi / 4)
+
+
 def test_a_timeline_segment_turns_whole_periods_of_its_course():
     """``course_turn`` fits whole periods to the segment's travel: a circle's whole turn, an eight
     round and back, back and forth's two half turns; what the body turned by itself taken out."""
@@ -179,3 +193,6 @@ def test_generation_walks_the_eight_at_a_walking_pace():
     assert travel(m.joints)[-1] > 8.0 and c[:, 0].max() > 1.5 and c[:, 0].min() < -1.5
     assert m.tokens is None and m.prompt == "a person walks in a figure eight"
     assert m.joints[:, :, 1].min() > -0.05
+    d = gen.generate_batch([Request("a woman walks diagonally to the right", seconds=4, seed=0)])[0]
+    r = root_centre(d.joints)
+    assert -55 < np.degrees(np.arctan2(*(r[-1] - r[0]))) < -35 and travel(d.joints)[-1] > 3.0   # before: -3 degrees

@@ -1,4 +1,4 @@
-"""Walking a course the words name: a circle, a figure eight, back and forth, a zigzag. The words
+"""Walking a course the words name: a circle, a figure eight, back and forth, a zigzag, a diagonal. The words
 say the path, the feet keep their steps. (Until the twenty-third session: ``circle_walk.py``.)
 
 The SA-VAE's tokens do not carry how fast the root turns. Real circle walks and jogs of the
@@ -26,6 +26,9 @@ the next segment goes on the way the course leaves it. Left first unless the wor
   (legs of ``LEG_MIN`` .. ``LEG_MAX``).
 - ``ZIGZAG`` ("zigzags across the yard"): legs of ``ZIG`` metres alternately ``ZIG_ANGLE`` to
   either side of the way the walk goes, turning between them over ``ZIG_TURN`` of a leg.
+- ``DIAGONAL`` ("walks diagonally to the right", "runs off at an angle"): ``DIAGONAL_ANGLE`` to the
+  named side (left unless it says right), turned to over the first ``DIAGONAL_EASE`` metres; in a
+  timeline the segments after it go on that way.
 
 The gait is generated without the course's words when the rest still names one ("a person walks in
 a figure eight" -> "a person walks"; "paces", "zigzags" -> "walks"; ``straight_gait``): the captured
@@ -54,11 +57,13 @@ CIRCLE = "walk in a circle"
 EIGHT = "walk in a figure eight"
 BACK_AND_FORTH = "back and forth"
 ZIGZAG = "zigzag"
+DIAGONAL = "diagonal"
 ACTIONS = (CIRCLE, EIGHT)            # the courses that are actions of the data (``data.actions``)
 MIN_RADIUS, MAX_RADIUS = 1.0, 3.0   # m: a circle's, an eight's loops'
 U_RADIUS = 0.3                      # m: back and forth's U-turns
 LEG_MIN, LEG_MAX = 1.0, 5.0         # m: back and forth's legs
 ZIG, ZIG_ANGLE, ZIG_TURN = 1.5, np.pi / 4, 0.15   # m, radians, share of a leg
+DIAGONAL_ANGLE, DIAGONAL_EASE = np.pi / 4, 0.6   # radians, m
 STEP = 0.005                        # m: a course's heading integrated at this step
 
 CLOCKWISE = re.compile(r"(?<![-\w])(?:clockwise|to the right|rightward)\b")
@@ -71,6 +76,7 @@ _PACE = (r"\bpac(?:es|ing)\b(?=\s+(?:(?:around|about|round)\s+)?(?:the|a|his|her
 _BACK_AND_FORTH = re.compile(r"\b(?:back and forth|to and fro|backwards and forwards|up and down the "
                              rf"(?:room|hall|hallway|corridor|street|platform|stage))\b|{_PACE}", re.I)
 _ZIGZAG = re.compile(r"\bzig[- ]?zag(?:s|ging|ged)?\b", re.I)
+_DIAGONAL = re.compile(r"\bdiagonal(?:ly)?\b|\bat an angle\b", re.I)
 _COURSE_VERB = re.compile(rf"{_PACE}|\bzig[- ]?zag(?:s|ging|ged)\b", re.I)   # the course as the verb: "walks"
 # the course in words, cut out for its gait: "in a circle", "around in circles", "a figure-8 path",
 # "in a zigzag", "back and forth", "up and down the room"
@@ -78,7 +84,7 @@ COURSE_WORDS = re.compile(
     r"(?:\s+(?:around|round|along|on|in|into|through|doing|making|tracing|following))*\s+(?:(?:a|an|the)\s+)?"
     r"(?:(?:small|big|large|wide|tight|full)\s+)?(?:figure[- ]?(?:of[- ])?(?:8|eight)|circles?|zig[- ]?zag)"
     r"(?:[- ]shaped)?(?:\s+(?:path|route|pattern|course|shape|loop|line))?\b"
-    r"|\s+(?:back and forth|to and fro|backwards and forwards)\b"
+    r"|\s+(?:back and forth|to and fro|backwards and forwards|diagonally|at an angle)\b"
     r"|\s+up and down the (?:room|hall|hallway|corridor|street|platform|stage)\b", re.I)
 # circles the arms make, not the walk: "rotating your arms in circles", "swinging the arms around in circles"
 _ARM_CIRCLES = re.compile(r"\b(?:arms?|hands?|fists?|wrists?)\b(?:\s+[\w-]+){0,2}?\s+(?:(?:a)?round\s+)?in\s+"
@@ -112,12 +118,22 @@ def _stadium(u, period):
     return np.pi * (np.clip((u - leg) / turn, 0.0, 1.0) + np.clip((u - 2 * leg - turn) / turn, 0.0, 1.0))
 
 
+def _ease(x):
+    """0 -> 1 over x in [0, 1] (half a cosine), 0 before, 1 after."""
+    return 0.5 - 0.5 * np.cos(np.pi * np.clip(x, 0.0, 1.0))
+
+
 def _zigzag(u, period):
     """Half a period at +ZIG_ANGLE, half at -ZIG_ANGLE, the turns between them eased (cosine) over
     ZIG_TURN of a leg, from and back to straight ahead at the period's ends."""
     w = ZIG_TURN / 2                                  # one turn's share of the period
-    ease = lambda x: 0.5 - 0.5 * np.cos(np.pi * np.clip(x, 0.0, 1.0))   # noqa: E731
-    return ZIG_ANGLE * (ease(u / (w / 2)) - 2 * ease((u - 0.5 + w / 2) / w) + ease((u - 1 + w / 2) / (w / 2)))
+    return ZIG_ANGLE * (_ease(u / (w / 2)) - 2 * _ease((u - 0.5 + w / 2) / w) + _ease((u - 1 + w / 2) / (w / 2)))
+
+
+def _diagonal(u, period):
+    """DIAGONAL_ANGLE, turned to over the first DIAGONAL_EASE metres; the period is longer than
+    any motion (``COURSES``), so it never starts again."""
+    return DIAGONAL_ANGLE * _ease(u * period / DIAGONAL_EASE)
 
 
 @dataclass(frozen=True)
@@ -140,6 +156,7 @@ COURSES = {
     EIGHT: Course(_eight, 0.0, lambda d: 4 * np.pi * radius_for(d / 2)),
     BACK_AND_FORTH: Course(_stadium, 2 * np.pi, lambda d: 2 * _leg_for(d) + 2 * np.pi * U_RADIUS),
     ZIGZAG: Course(_zigzag, 0.0, lambda d: 2 * ZIG),
+    DIAGONAL: Course(_diagonal, DIAGONAL_ANGLE, lambda d: 2 * d + 10.0),
 }
 
 
@@ -152,7 +169,7 @@ def course_named(text: str) -> str | None:
     if EIGHT in acts or (CIRCLE in acts and not _ARM_CIRCLES.search(str(text))):
         return EIGHT if EIGHT in acts else CIRCLE
     gait = any(a in LEGS_ACTIONS for a in acts) or _COURSE_VERB.search(str(text)) is not None
-    for name, words in ((BACK_AND_FORTH, _BACK_AND_FORTH), (ZIGZAG, _ZIGZAG)):
+    for name, words in ((BACK_AND_FORTH, _BACK_AND_FORTH), (ZIGZAG, _ZIGZAG), (DIAGONAL, _DIAGONAL)):
         if gait and words.search(str(text)):
             return name
     return None

@@ -18,7 +18,7 @@ boundary. A segment that names a turn ("turns around", "turns left", "spins"; ``
 turns the body that far over its own frames (what it turns by itself counted, eased as a single
 prompt's turn) and every later segment goes on in the new direction: "walks forward" -> "turns
 around" -> "walks forward" comes back. A segment that walks a course (a circle, a figure eight, back
-and forth, a zigzag: ``course_walk.course_named``) is turned along it over a whole number of the
+and forth, a zigzag, a diagonal: ``course_walk.course_named``) is turned along it over a whole number of the
 course's periods fitted to its travel (``course_walk.course_turn``: a circle once round, its travel /
 2 pi the radius; left first unless the words say clockwise or to the right), so it leaves the way the
 course ends and the next segment goes on from there; one that barely travels (under
