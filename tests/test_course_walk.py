@@ -60,6 +60,25 @@ def test_a_straight_walk_goes_round_the_circle_and_keeps_its_steps():
     assert np.allclose(local(bent.joints), local(walk.joints), atol=0.03)
 
 
+def test_a_backward_walk_goes_round_backwards():
+    """A stick figure stepping backwards (facing +Z, going -Z) bent round a circle keeps going the way
+    its back faces (``polyline.gait_offset``: pi); a sidestep (going +X, the body's left) pi/2.
+    Before, the body was turned to face the way the circle goes and its legs stepped backwards."""
+    from shapemove.core.generation.polyline import gait_offset
+
+    back = _straight_walk(speed=-1.2)
+    assert abs(gait_offset(back.joints)) == pytest.approx(np.pi) and gait_offset(_straight_walk().joints) == 0.0
+    side = _straight_walk(speed=0.0)
+    side.joints[..., 0] += 1.2 * np.arange(80)[:, None] / 20.0
+    assert gait_offset(side.joints) == pytest.approx(np.pi / 2)
+    bent = on_course(back, "a person walks backwards in a circle")
+    v = np.diff(root_centre(bent.joints), axis=0)
+    h = headings(bent.joints)[1:]
+    facing = np.stack([np.sin(h), np.cos(h)], axis=1)
+    assert ((v * facing).sum(1) / np.linalg.norm(v, axis=1)).mean() < -0.9          # still backwards
+    assert np.unwrap(headings(bent.joints))[-1] - np.unwrap(headings(bent.joints))[0] > 2.5   # and round
+
+
 def test_a_motion_that_does_not_travel_is_left_alone():
     still = _straight_walk(speed=0.0)
     assert on_course(still, "a person walks in a circle") is still

@@ -22,6 +22,7 @@ MIN_LENGTH = 0.2     # m
 MAX_LENGTH = 1000.0  # m
 MIN_SPEED = 0.15     # m/s: a motion slower than this does not travel (a wave, a sit)
 MAX_POINTS = 100_000
+FORWARD_WITHIN = np.radians(60)   # a gait travelling this close to the way it faces goes forward
 
 
 def check_path(points) -> np.ndarray:
@@ -77,9 +78,24 @@ class Polyline:
         return d[np.arange(len(xz)), i], self.yaw[i]
 
 
+def gait_offset(joints) -> float:
+    """The way a track travels less the way it faces, snapped to a quarter turn: 0 for a gait going
+    forward (anything within ``FORWARD_WITHIN``), pi for one going backwards, +-pi/2 for a sidestep
+    (yaw, travel weighted)."""
+    c = root_centre(joints)
+    v = np.diff(c, axis=0)
+    w = np.linalg.norm(v, axis=1)
+    if w.sum() < 1e-9:
+        return 0.0
+    rel = np.arctan2(v[:, 0], v[:, 1]) - headings(joints)[1:]
+    mean = float(np.arctan2((w * np.sin(rel)).sum(), (w * np.cos(rel)).sum()))
+    return 0.0 if abs(mean) < FORWARD_WITHIN else float(np.round(mean / (np.pi / 2)) * np.pi / 2)
+
+
 def follow_track(track: Track, line: Polyline, crop: bool = True) -> Track:
-    """The track's body moved onto ``line`` (see the module doc); ``crop``: frames after the
-    one that reaches the end of the path are dropped."""
+    """The track's body moved onto ``line`` (see the module doc), going along it the way it went
+    (``gait_offset``: a backward walk faces away from the way the line goes); ``crop``: frames after
+    the one that reaches the end of the path are dropped."""
     J = track.joints
     h = headings(J)
     c = root_centre(J)
@@ -89,7 +105,7 @@ def follow_track(track: Track, line: Polyline, crop: bool = True) -> Track:
     local[..., 2] -= c[:, None, 1]
     local = rotate_y(local, -h)
     xz = line.point(s)
-    out = rotate_y(local, line.heading(s))
+    out = rotate_y(local, line.heading(s) - gait_offset(J))
     out[..., 0] += xz[:, None, 0]
     out[..., 2] += xz[:, None, 1]
     n = len(J)
