@@ -34,7 +34,8 @@ MAX_COUNT = 12
 NUMBERS = {"a": 1, "one": 1, "a single": 1, "two": 2, "a couple of": 2, "a couple": 2, "three": 3, "a few": 3,
            "four": 4, "five": 5, "six": 6, "seven": 7, "eight": 8, "nine": 9, "ten": 10}   # "three steps" too
 TIMES = {"once": 1, "twice": 2, "thrice": 3}
-# the number words but "a", as a regex alternation, longest first: "a person jumps" counts nothing
+# the number words as a regex alternation, longest first; QUANTITY without "a" ("a person jumps" counts nothing)
+NUMBER_WORDS = "|".join(sorted(map(re.escape, NUMBERS), key=len, reverse=True))
 QUANTITY = "|".join(sorted(map(re.escape, set(NUMBERS) - {"a"}), key=len, reverse=True))
 _COUNT = re.compile(rf"\b(?:(once|twice|thrice)|({QUANTITY}|\d{{1,2}})\s+(?:times\b|(?:\w+\s+)?(?:jump|hop|leap|squat)\w*))",
                     re.I)

@@ -70,11 +70,12 @@ CLOCKWISE = re.compile(r"(?<![-\w])(?:clockwise|to the right|rightward)\b")
 COUNTER = re.compile(r"\b(?:counter|anti)[- ]?clockwise\b")
 # "paces" is back and forth only where nothing sends it on: "paces the room", "is pacing nervously", "paces
 # back and forth", "she paces." -- not "paces ahead at a steady clip", "paces along the road"
+_TO_AND_FRO = r"back and forth|to and fro|backwards and forwards"
+_UP_AND_DOWN = r"up and down the (?:room|hall|hallway|corridor|street|platform|stage)"
 _PACE = (r"\bpac(?:es|ing)\b(?=\s+(?:(?:around|about|round)\s+)?(?:the|a|his|her|their)\s+(?:[\w-]+\s+)?(?:room|floor|halls?|"
          r"hallway|corridor|office|cell|stage|platform|deck|yard|kitchen|ward|lobby)\b|\s+(?:nervously|impatiently|"
          r"anxiously|restlessly|worriedly|around|about|back and forth|to and fro|up and down)\b|\s*(?:[,.;!]|$))")
-_BACK_AND_FORTH = re.compile(r"\b(?:back and forth|to and fro|backwards and forwards|up and down the "
-                             rf"(?:room|hall|hallway|corridor|street|platform|stage))\b|{_PACE}", re.I)
+_BACK_AND_FORTH = re.compile(rf"\b(?:{_TO_AND_FRO}|{_UP_AND_DOWN})\b|{_PACE}", re.I)
 _ZIGZAG = re.compile(r"\bzig[- ]?zag(?:s|ging|ged)?\b", re.I)
 _DIAGONAL = re.compile(r"\bdiagonal(?:ly)?\b|\bat an angle\b", re.I)
 _COURSE_VERB = re.compile(rf"{_PACE}|\bzig[- ]?zag(?:s|ging|ged)\b", re.I)   # the course as the verb: "walks"
@@ -84,8 +85,7 @@ COURSE_WORDS = re.compile(
     r"(?:\s+(?:around|round|along|on|in|into|through|doing|making|tracing|following))*\s+(?:(?:a|an|the)\s+)?"
     r"(?:(?:small|big|large|wide|tight|full)\s+)?(?:figure[- ]?(?:of[- ])?(?:8|eight)|circles?|zig[- ]?zag)"
     r"(?:[- ]shaped)?(?:\s+(?:path|route|pattern|course|shape|loop|line))?\b"
-    r"|\s+(?:back and forth|to and fro|backwards and forwards|diagonally|at an angle)\b"
-    r"|\s+up and down the (?:room|hall|hallway|corridor|street|platform|stage)\b", re.I)
+    rf"|\s+(?:{_TO_AND_FRO}|diagonally|at an angle)\b|\s+{_UP_AND_DOWN}\b", re.I)
 # circles the arms make, not the walk: "rotating your arms in circles", "swinging the arms around in circles"
 _ARM_CIRCLES = re.compile(r"\b(?:arms?|hands?|fists?|wrists?)\b(?:\s+[\w-]+){0,2}?\s+(?:(?:a)?round\s+)?in\s+"
                           r"(?:(?:big|small|wide|large)\s+)?circles?\b", re.I)

@@ -42,7 +42,7 @@ from .retrieval_seeds import seed_prefixes, seeded_count
 from .on_the_spot import on_the_spot
 from .retrieved_candidates import library_codes, retrieved_codes
 from .stop_words import (DISTANCE_PACE, DISTANCE_SECONDS, STAND_SECONDS, asked_distance, distance_cut,
-                         standing_after, standing_code, stop_cut, stop_request)
+                         from_start, standing_after, standing_code, stop_cut, stop_request)
 from .sampling_params import (DEFAULT_GUIDANCE, check_candidates, check_guidance, check_retrieval_first,
                               check_retrieval_prefix, check_retrieved, check_sampling)
 from .request import Request
@@ -450,7 +450,7 @@ class Generator:
             keep = distance_cut(motion.joints, metres, n, down)
             keeps = [] if keep is None else sorted({keep, min(n, keep + 1)})
             if keep is None:
-                gone = float(np.linalg.norm(motion.joints[-1, 0, [0, 2]] - motion.joints[0, 0, [0, 2]]))
+                gone = float(from_start(motion.joints)[-1])
                 motion.notes.append(f"went {gone:.1f} m of the {metres:.1f} m asked in {motion.num_frames / motion.fps:.1f} s: "
                                     "ask for more seconds")
         best, off = motion, np.inf
@@ -462,7 +462,7 @@ class Generator:
             cut = dataclasses.replace(motion, tokens=np.asarray(codes, np.int32), arms_tokens=(
                 None if arms is None else np.asarray(standing_after(arms, k, rest, stand), np.int32)))
             out = self._redecoded(cut, motion.betas)
-            gone = float(np.linalg.norm(out.joints[-1, 0, [0, 2]] - out.joints[0, 0, [0, 2]]))
+            gone = float(from_start(out.joints)[-1])
             if metres is None or abs(gone - metres) < off:
                 best, off = out, (0.0 if metres is None else abs(gone - metres))
         if best is not motion:

@@ -82,12 +82,16 @@ def gait_offset(joints) -> float:
     """The way a track travels less the way it faces, snapped to a quarter turn: 0 for a gait going
     forward (anything within ``FORWARD_WITHIN``), pi for one going backwards, +-pi/2 for a sidestep
     (yaw, travel weighted)."""
-    c = root_centre(joints)
-    v = np.diff(c, axis=0)
+    return _offset(root_centre(joints), headings(joints))
+
+
+def _offset(centre: np.ndarray, heading: np.ndarray) -> float:
+    """``gait_offset`` from the track's smoothed root path (T, 2) and heading (T,)."""
+    v = np.diff(centre, axis=0)
     w = np.linalg.norm(v, axis=1)
     if w.sum() < 1e-9:
         return 0.0
-    rel = np.arctan2(v[:, 0], v[:, 1]) - headings(joints)[1:]
+    rel = np.arctan2(v[:, 0], v[:, 1]) - heading[1:]
     mean = float(np.arctan2((w * np.sin(rel)).sum(), (w * np.cos(rel)).sum()))
     return 0.0 if abs(mean) < FORWARD_WITHIN else float(np.round(mean / (np.pi / 2)) * np.pi / 2)
 
@@ -105,7 +109,7 @@ def follow_track(track: Track, line: Polyline, crop: bool = True) -> Track:
     local[..., 2] -= c[:, None, 1]
     local = rotate_y(local, -h)
     xz = line.point(s)
-    out = rotate_y(local, line.heading(s) - gait_offset(J))
+    out = rotate_y(local, line.heading(s) - _offset(c, h))
     out[..., 0] += xz[:, None, 0]
     out[..., 2] += xz[:, None, 1]
     n = len(J)

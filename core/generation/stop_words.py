@@ -39,13 +39,13 @@ import torch
 from ..data.actions import find_actions
 from ..data.compose_parts import ARMS_ACTIONS
 from ..motion.contacts import runs
-from .count_words import NUMBERS, QUANTITY
+from .count_words import NUMBER_WORDS, NUMBERS, QUANTITY
 
 STOP = re.compile(r"\s*(?:,\s*)?(?:\b(?:and|then)\s+)*(?:\b(?:he|she|they|it)\s+)?"
                   r"\b(?:stops?(?:\s+(?:walking|running|jogging|moving))?|halts?|comes? to a (?:stop|halt)|"
                   r"stands? still|stays? still)\b(?:\s+(?:there|still))?\s*\.?\s*$")
 NEGATED = re.compile(r"\b(?:without stopping|non-?stop|never stops?|doesn't stop|does not stop)\b")
-COUNT = re.compile(r"\b(" + "|".join(sorted(map(re.escape, NUMBERS), key=len, reverse=True)) + r"|\d{1,2})\s+"
+COUNT = re.compile(r"\b(" + NUMBER_WORDS + r"|\d{1,2})\s+"
                    r"(?:\w+\s+)?(?:steps?|strides?|paces?)\b")
 # a count alone ("takes three steps forward", no stop word): "a" only right before the step ("a man steps
 # aside" counts nothing)
@@ -56,7 +56,7 @@ STILL = re.compile(r"\b(?:stands?|standing) (?:still|there|idle|motionless|quiet
                    r"\b(?:holds?|holding) still\b")
 UNITS = {"m": 1.0, "metre": 1.0, "meter": 1.0, "metres": 1.0, "meters": 1.0, "feet": 0.3048, "foot": 0.3048,
          "ft": 0.3048, "yard": 0.9144, "yards": 0.9144, "yd": 0.9144, "yds": 0.9144}
-DISTANCE = re.compile(r"\b(\d{1,3}(?:\.\d+)?|" + "|".join(sorted(map(re.escape, NUMBERS), key=len, reverse=True)) +
+DISTANCE = re.compile(r"\b(\d{1,3}(?:\.\d+)?|" + NUMBER_WORDS +
                       r")\s*(" + "|".join(sorted(UNITS, key=len, reverse=True)) + r")\b"
                       r"(?![-\s]*(?:tall|high|in height|long|wide|deep|man|woman|person|guy|girl|boy|lady|kid|child|"
                       r"giant|figure|athlete|soldier|dancer|player)\b)")
@@ -168,12 +168,18 @@ def stop_cut(contacts, steps: int | None, n: int, down: int) -> int | None:
     return min(n, strikes[steps - 1] // down + 2)
 
 
+def from_start(joints) -> np.ndarray:
+    """(T,) how far (m) the root of (T, 22, 3) ``joints`` is from its first position, in a straight
+    line on the floor plane."""
+    root = np.asarray(joints, np.float64)[:, 0, [0, 2]]
+    return np.linalg.norm(root - root[0], axis=1)
+
+
 def distance_cut(joints, metres: float, n: int, down: int) -> int | None:
     """How many of a gait's ``n`` codes are kept: up to the code whose frames bring the root
-    ``metres`` from its first position (straight line, floor plane; within ``REACH_SLACK``) in the
-    (T, 22, 3) ``joints``; None when it never gets that far."""
-    root = np.asarray(joints, np.float64)[:, 0, [0, 2]]
-    far = np.flatnonzero(np.linalg.norm(root - root[0], axis=1) >= metres - REACH_SLACK)
+    ``metres`` from its first position (``from_start``; within ``REACH_SLACK``) in the (T, 22, 3)
+    ``joints``; None when it never gets that far."""
+    far = np.flatnonzero(from_start(joints) >= metres - REACH_SLACK)
     return None if not len(far) else min(n, int(far[0]) // down + 1)
 
 
