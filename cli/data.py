@@ -1,5 +1,6 @@
 """`python -m shapemove data build --source PATH [PATH ...] --out DIR` and
-`python -m shapemove data compose --data DIR --count N --seed 0`."""
+`python -m shapemove data compose --data DIR --count N --seed 0`,
+`python -m shapemove data library --data DIR --out LIBRARY.npz` (data/library_build.py)."""
 from __future__ import annotations
 
 from pathlib import Path
@@ -38,6 +39,12 @@ def add_arguments(p):
     m.add_argument("--data", type=Path, required=True, help="a dataset folder made by `data build`")
     m.add_argument("--body-model", default=None, help="openbody (default) or a path to SMPL model files")
     m.add_argument("--shard", default="0/1", help="i/n: mirror every n-th clip starting at i (n processes on one --data)")
+    lb = sub.add_parser("library", help="the captured takes of a built dataset (train + val) as one motion library .npz")
+    lb.add_argument("--data", type=Path, required=True, help="a dataset folder made by `data build`")
+    lb.add_argument("--out", type=Path, required=True, help="the library file to write (.npz)")
+    lb.add_argument("--model", type=Path, default=None,
+                    help="the model folder whose TMA embeds the captions (default: the embedded default model)")
+    lb.add_argument("--body-model", default=None, help="openbody (default) or a path to SMPL model files")
 
 
 def _shard(text: str) -> tuple[int, int]:
@@ -49,7 +56,35 @@ def _shard(text: str) -> tuple[int, int]:
     return shard
 
 
+def _library(args) -> int:
+    from tqdm import tqdm
+
+    from ..core.body.load import load_body_model
+    from ..core.data.library_build import build_library
+    from ..core.generation.model_bundle import model_files, resolve_model_dir
+    from ..core.model_files import add_to_manifest
+
+    if args.out.suffix.lower() != ".npz":
+        raise ShapeMoveError(f"--out must end in .npz, got {args.out}")
+    model = resolve_model_dir(args.model)
+    tma = model_files(model)["tma"]
+    bar = tqdm(total=100, desc="library", unit="%")
+    lib = build_library(args.data, args.out, body=load_body_model(args.body_model),
+                        tma_file=tma if tma.is_file() else None,
+                        progress=lambda f, cid: bar.update(round(100 * f) - bar.n))
+    bar.close()
+    out = args.out.resolve()
+    if out.parent == model.resolve() and (model / "manifest.json").is_file():
+        add_to_manifest(model, [out])   # the model folder's manifest lists it, as its other files
+    frames = int(lib.frames.sum())
+    print(f"wrote {args.out}: {len(lib)} takes, {frames / 20 / 60:.1f} min, {args.out.stat().st_size / 1e6:.1f} MB"
+          + ("" if tma.is_file() else " (no TMA: no caption vectors)"))
+    return 0
+
+
 def run(args) -> int:
+    if args.action == "library":
+        return _library(args)
     if args.action == "compose-parts":
         from ..core.body.load import load_body_model
         from ..core.data.compose_parts import compose_parts_dataset

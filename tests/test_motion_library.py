@@ -1,0 +1,94 @@
+"""The motion library file: what a built dataset's captured takes become, read back bounded."""
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from shapemove.core.data.library_build import FREQUENT_TAKES, build_library, library_metas, thinned
+from shapemove.core.data.motion_library import MotionLibrary, short_licence, source_name
+from shapemove.core.errors import ShapeMoveError
+
+
+def test_source_name_and_licence():
+    assert source_name("hdm05", "HDM_bd_kickLFront1Reps_003_120") == "HDM05 bd kickLFront 003"
+    assert source_name("bandai", "dataset-1_bow_active_001") == "Bandai dataset-1_bow_active_001"
+    assert short_licence("CC BY-SA 3.0 (HDM05, Mueller et al. 2007)") == "CC BY-SA 3.0"
+
+
+def _meta(i, action, dataset="bandai", style="a", frames=100):
+    return {"id": f"c{i:03d}", "dataset": dataset, "frames": frames,
+            "labels": {"actions": [action] if action else [], "style": style}}
+
+
+def test_frequent_actions_thinned_round_robin_over_groups():
+    walks = [_meta(i, "walk", style="abc"[i % 3], frames=100 + i) for i in range(FREQUENT_TAKES + 30)]
+    kicks = [_meta(500 + i, "kick") for i in range(FREQUENT_TAKES + 5)]
+    kept = thinned(walks + kicks)
+    kept_walks = [m for m in kept if m["labels"]["actions"] == ["walk"]]
+    assert len(kept_walks) == FREQUENT_TAKES
+    styles = [m["labels"]["style"] for m in kept_walks]
+    assert {styles.count(s) for s in "abc"} == {FREQUENT_TAKES // 3}   # each style as often
+    # the longest of each group first: no walk kept is shorter than one left out of its group
+    for s in "abc":
+        left = [m["frames"] for m in walks if m["labels"]["style"] == s and m not in kept_walks]
+        assert min(m["frames"] for m in kept_walks if m["labels"]["style"] == s) > max(left)
+    assert len([m for m in kept if m["labels"]["actions"] == ["kick"]]) == FREQUENT_TAKES + 5   # all kept
+
+
+def test_library_of_a_built_dataset(tiny_dataset, tmp_path, openbody):
+    import torch
+
+    from shapemove.core.geometry.rotations import matrix_to_axis_angle
+
+    metas = library_metas(tiny_dataset)
+    every = [json.loads(p.read_text()) for p in (tiny_dataset / "meta").glob("*.json")]
+    assert {m["split"] for m in metas} <= {"train", "val"} and any(m["split"] == "val" for m in metas)
+    assert not any(m.get("augmented_from") for m in metas)
+    assert len(metas) == sum(1 for m in every if m["split"] != "test" and not m.get("augmented_from"))
+    out = tmp_path / "library.npz"
+    lib = build_library(tiny_dataset, out, body=openbody)
+    back = MotionLibrary.load(out)
+    assert len(back) == len(metas) and back.vectors is None
+    k = [m["id"] for m in metas].index("HDM_bd_kickLFront1Reps_001_120")
+    take = back.take(k)
+    assert take.action == "kick" and take.provenance == "captured: HDM05 bd kickLFront 001 (CC BY-SA 3.0)"
+    assert "left leg" in " ".join(take.captions)
+    poses = np.load(tiny_dataset / "poses" / f"{take.clip_id}.npy")
+    transl = np.load(tiny_dataset / "transl" / f"{take.clip_id}.npy")
+    assert take.rotations.shape == (len(poses), 24, 3, 3) and take.rotations.dtype == np.float32
+    # float16 axis-angle: within a thousandth of a radian (well under a millimetre at the hand)
+    assert np.abs(matrix_to_axis_angle(take.rotations) - poses).max() < 3e-3
+    rest = openbody.rest_joints(torch.as_tensor(take.betas)[None])[0].numpy()
+    np.testing.assert_allclose(take.root, transl + rest[0], atol=1e-5)
+    np.testing.assert_array_equal(take.contacts, np.load(tiny_dataset / "contacts" / f"{take.clip_id}.npy"))
+    raw = 2 * lib.a["rotations"].nbytes + lib.a["root"].nbytes + lib.a["contacts"].nbytes
+    assert out.stat().st_size < 0.5 * raw    # float16 and compressed: under half the float32 arrays
+
+
+def _write(path, **arrays):
+    with open(path, "wb") as f:
+        np.savez(f, **arrays)
+
+
+def test_load_refuses_pickles_and_bad_shapes(tmp_path):
+    take = {"poses": np.zeros((8, 24, 3)), "root": np.zeros((8, 3)), "contacts": np.ones((8, 4), np.uint8),
+            "betas": np.zeros(10), "fps": 20, "clip_id": "a", "action": "kick", "source": "me", "licence": "CC0",
+            "captions": ["a person kicks"]}
+    good = MotionLibrary.from_takes([take, take])
+    good.save(tmp_path / "ok.npz")
+    assert len(MotionLibrary.load(tmp_path / "ok.npz")) == 2
+    _write(tmp_path / "pickled.npz", **{**good.a, "captions": np.array([["x"], 1], dtype=object)})
+    with pytest.raises(ShapeMoveError, match="pickle"):
+        MotionLibrary.load(tmp_path / "pickled.npz")
+    _write(tmp_path / "short.npz", **{**good.a, "starts": np.array([0, 8, 20])})
+    with pytest.raises(ShapeMoveError, match="rotations must be"):
+        MotionLibrary.load(tmp_path / "short.npz")
+    _write(tmp_path / "nan.npz", **{**good.a, "root": np.full((16, 3), np.nan, np.float32)})
+    with pytest.raises(ShapeMoveError, match="root must be finite"):
+        MotionLibrary.load(tmp_path / "nan.npz")
+    with pytest.raises(ShapeMoveError, match="MB"):
+        MotionLibrary.load(tmp_path / "ok.npz", max_bytes=1000)
+    with pytest.raises(ShapeMoveError, match="not found"):
+        MotionLibrary.load(tmp_path / "none.npz")
