@@ -1,4 +1,4 @@
-"""`python -m shapemove generate --prompt TEXT [--shape-text TEXT] [--betas b0,…,b9] [--seconds S]
+"""`python -m shapemove generate --prompt TEXT | --prompts FILE [--shape-text TEXT] [--betas b0,…,b9] [--seconds S]
 [--seed N] [--temperature T] [--loop] [--in-place] [--path PATH.json] [--speed X | --stretch S]
 --out OUT.npz`: text -> body shape + motion file (animation options: docs/animation.md)."""
 from __future__ import annotations
@@ -14,7 +14,10 @@ from ..core.scene.motion_file import save_motion
 
 
 def add_arguments(p):
-    p.add_argument("--prompt", required=True, help='motion text, e.g. "a person jogs forward and waves"')
+    p.add_argument("--prompt", default=None, help='motion text, e.g. "a person jogs forward and waves"')
+    p.add_argument("--prompts", type=Path, default=None,
+                   help="a batch: a .txt file of prompts or a .jsonl of objects with per-line options; --out is "
+                        "then a folder with a motion per line and manifest.jsonl (docs/batches.md)")
     p.add_argument("--shape-text", default=None, help='body text, e.g. "a tall, heavy-set man" or a measured sentence')
     p.add_argument("--betas", default=None, help="explicit body shape b0,…,b9 (overrides the predicted one)")
     p.add_argument("--shape-from", choices=["auto", "head"], default="auto",
@@ -48,6 +51,9 @@ def add_arguments(p):
                    help="generate the prompt whole: no legs + arms composition of two things at once, no mirroring "
                         "to a named left or right, no circle walked for 'in a circle', no turn given back for 'turns around'")
     add_animation_arguments(p)
+    from .batch_run import add_batch_arguments
+
+    add_batch_arguments(p)
 
 
 def add_animation_arguments(p):
@@ -78,6 +84,12 @@ def run(args) -> int:
     from ..core.body.measure import format_body, measure
     from ..core.generation.generate import Generator, parse_betas
 
+    if args.prompts is not None:
+        from .generate_batch import run_generate_batch
+
+        return run_generate_batch(args)
+    if args.prompt is None:
+        raise ShapeMoveError("give --prompt TEXT (one motion) or --prompts FILE (a batch)")
     if args.out.suffix.lower() != ".npz":
         raise ShapeMoveError(f"--out must end in .npz, got {args.out}")
     check_sampling(args.seed, args.temperature, args.top_k)  # before loading any model

@@ -31,6 +31,7 @@ from ..atomic import atomic_path
 from ..body.skeleton import NUM_BODY_JOINTS, NUM_JOINTS
 from ..errors import ShapeMoveError
 from ..io.npz_read import read_npz
+from ..io.npz_write import write_npz
 
 
 FLAGS = ("mirrored", "arms_mirrored", "held_in_place")   # stored as uint8 1 when set
@@ -199,7 +200,7 @@ def save_motion(path, m: Motion) -> Path:
 
     with atomic_path(path) as tmp:  # read-only folder, a parent that is a file, disk full: a sentence, no *.tmp
         with open(tmp, "wb") as f:
-            np.savez(f, **arrays)
+            write_npz(f, arrays)  # no time stamps: the same motion gives the same bytes
     return path
 
 

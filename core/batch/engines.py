@@ -1,0 +1,126 @@
+"""Where a batch's items run. Each engine's ``run(task, specs, folder)`` yields the items' records
+as they finish (in any order); the caller is the one manifest writer.
+
+- ``InProcess``: one after another in this process (``--jobs 1``).
+- ``ProcessPool(jobs)``: ``jobs`` worker processes (spawned, so each imports torch and loads the
+  model once and keeps it: the task caches it per process); an item is handed out when a worker
+  frees up (at most two per worker queued); workers write their files into the batch folder.
+- ``DaskCluster(address)``: items as tasks on a running Dask distributed cluster; a task returns its
+  files' bytes (``item_run.run_remote``) and they are written here, so the workers need no shared
+  disk, only this package and the model folder (the default model ships inside the package).
+Ctrl-C stops handing out items; what finished is in the manifest.
+"""
+from __future__ import annotations
+
+import os
+import threading
+import time
+from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+from concurrent.futures.process import BrokenProcessPool
+from pathlib import Path
+
+from ..atomic import atomic_write_bytes
+from ..errors import ShapeMoveError
+from .item_run import run_item, run_remote
+from .outputs import sha256_of
+
+QUEUED_PER_WORKER = 2
+
+
+class InProcess:
+    jobs = 1
+
+    def run(self, task, specs, folder):
+        for spec in specs:
+            yield run_item(task, spec, folder)
+
+
+def _watch_parent(parent: int) -> None:
+    """A worker whose batch process died (kill -9) exits instead of running on orphaned."""
+    while True:
+        time.sleep(1.0)
+        if os.getppid() != parent:
+            os._exit(1)
+
+
+def _init_worker(threads: int, parent: int) -> None:
+    os.environ.setdefault("TQDM_DISABLE", "1")
+    import torch
+
+    torch.set_num_threads(threads)
+    threading.Thread(target=_watch_parent, args=(parent,), daemon=True).start()
+
+
+class ProcessPool:
+    def __init__(self, jobs: int):
+        if not 1 <= jobs <= 256:
+            raise ShapeMoveError(f"--jobs takes 1 to 256 worker processes, got {jobs}")
+        self.jobs = jobs
+
+    def run(self, task, specs, folder):
+        import multiprocessing
+
+        threads = max(1, (os.cpu_count() or 1) // self.jobs)
+        pool = ProcessPoolExecutor(self.jobs, mp_context=multiprocessing.get_context("spawn"),
+                                   initializer=_init_worker, initargs=(threads, os.getpid()))
+        specs, running = iter(specs), set()
+        try:
+            while True:
+                while len(running) < self.jobs * QUEUED_PER_WORKER:
+                    spec = next(specs, None)
+                    if spec is None:
+                        break
+                    running.add(pool.submit(run_item, task, spec, str(folder)))
+                if not running:
+                    return
+                finished, running = wait(running, return_when=FIRST_COMPLETED)
+                for fut in finished:
+                    try:
+                        yield fut.result()
+                    except BrokenProcessPool:
+                        raise ShapeMoveError("a worker process died (out of memory, or killed); the items "
+                                             "finished so far are in the manifest: run the same command again "
+                                             "to go on") from None
+        finally:
+            pool.shutdown(wait=True, cancel_futures=True)
+
+
+class DaskCluster:
+    def __init__(self, address: str, timeout: float = 30.0):
+        try:
+            from distributed import Client
+        except ImportError:
+            raise ShapeMoveError("--dask needs Dask distributed: pip install distributed") from None
+        try:
+            self.client = Client(address, timeout=timeout, set_as_default=False)
+        except (OSError, TimeoutError, ValueError) as exc:
+            raise ShapeMoveError(f"cannot reach the Dask scheduler at {address}: {exc}") from None
+        self.jobs = max(1, sum(w.get("nthreads", 1) for w in self.client.scheduler_info()["workers"].values()))
+
+    def run(self, task, specs, folder):
+        from distributed import as_completed
+
+        specs, ac = iter(specs), as_completed()
+
+        def submit_next() -> None:
+            spec = next(specs, None)
+            if spec is not None:
+                ac.add(self.client.submit(run_remote, task, spec, pure=False))
+
+        for _ in range(self.jobs * QUEUED_PER_WORKER):
+            submit_next()
+        try:
+            for fut in ac:
+                record, blobs = fut.result()
+                for e in record["outputs"]:
+                    path = Path(folder) / e["file"]
+                    atomic_write_bytes(path, blobs[e["file"]])
+                    if sha256_of(path) != e["sha256"]:
+                        raise ShapeMoveError(f"{path}: the bytes written differ from the worker's (disk problem?)")
+                fut.release()
+                yield record
+                submit_next()
+        finally:
+            for fut in list(ac.futures):
+                fut.cancel()
+            self.client.close()
