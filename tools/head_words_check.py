@@ -41,8 +41,8 @@ CHECKS = {
     "a short chubby woman": {"gender": "f", "weight": "hi", "height_cm": (0, 163)},
     "a young female gymnast": {"gender": "f", "age": (0, 30)},
 }
-# a second list, written on 2026-11-26 (twelfth session) BEFORE the head variants of that session were
-# trained and never looked at while choosing them: its words are in no training text either
+# a second list, written on 2026-11-26 BEFORE the head variants of that day (docs/design-notes.md, Bodies)
+# were trained and never looked at while choosing them: its words are in no training text either
 BLIND = {
     "an old fisherman": {"gender": "m", "age": (60, 200)},
     "a teenage skateboarder": {"age": (0, 21)},
@@ -85,7 +85,7 @@ BLIND = {
     "a short fat grandpa": {"gender": "m", "age": (60, 200), "weight": "hi"},
     "a petite young man": {"gender": "m", "age": (0, 30)},
 }
-# a third list, written on 2026-11-26 (thirteenth session) after the unit reader (meets 3) was
+# a third list, written on 2026-11-26 after the unit reader (meets 3) was
 # trained and before any head was judged on it: heights and weights in forms neither training nor
 # `eval shape-words` writes ("6'1", "metres", "centimeters", "14 stone", ages and girths beside
 # them). Each stated size must come out within 2 cm / 3 kg (the issue's bar for the head).
@@ -187,7 +187,7 @@ def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--model", action="append", type=Path, required=True, help="model folder (repeat to compare)")
     ap.add_argument("--set", choices=sorted(SETS), default="own",
-                    help="own: the first list; blind: the twelfth session's list, never used to choose a head; "
+                    help="own: the first list; blind: a list never used to choose a head; "
                          "numbers: sizes stated in forms no training text uses, each within 2 cm / 3 kg")
     ap.add_argument("--json", type=Path, default=None)
     args = ap.parse_args()

@@ -6,8 +6,7 @@
 For each held-out prompt ({"text", "action", "also"?}, written by hand, never trained or tuned on)
 the model generates a motion, and its action is read three ways, each from the features of what the
 rig plays (``motion_features`` of the planted Motion, computed as the dataset builder computes a
-clip's; before the sixteenth session a plain prompt was read from its decoded features, whose
-rotations the rig did not play):
+clip's, not the decoded features, whose rotations the rig does not play):
 
 - ``motion`` (the target: >= 80 % right): the generated motion's TMA motion embedding among the
   training clips' motion embeddings of the built dataset ``data``: the majority action of its 5

@@ -1,5 +1,5 @@
 """Walking a course the words name: a circle, a figure eight, back and forth, a zigzag, a diagonal. The words
-say the path, the feet keep their steps. (Until the twenty-third session: ``circle_walk.py``.)
+say the path, the feet keep their steps.
 
 The SA-VAE's tokens do not carry how fast the root turns. Real circle walks and jogs of the
 training data turn 0.6-1.05 rad/s; the same clips encoded and decoded by the shipped codec turn

@@ -7,7 +7,7 @@ decoded positions), and they do not carry the action equally: played from the po
 so the rotations follow the positions as they do in the training clips), the default model's
 motions for the blind held-out paraphrases read as the asked action 50 % of the time on the
 frequent actions (TMA judge); with the upper body posed from the decoded rotations, 68 % (70 %
-lenient; docs/evaluation.md, the sixteenth session).
+lenient; docs/design-notes.md, Planting and retargeting).
 
 The legs and the path stay the positions': they were trained with the foot and stability losses,
 travel as fast as real clips of the same action and stride with the leg length. Posed from the

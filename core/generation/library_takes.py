@@ -4,7 +4,7 @@
 captioned motions to the retrieval memory (``Generator.add_library``): a clip whose caption is near
 the prompt joins best-of-N's candidates as windows of its SA-VAE codes (``retrieved_candidates.py``).
 Decoded, those codes flatten what the codec cannot carry: the user's own captured kick comes back
-as a raised knee (docs/evaluation.md, "The nineteenth session"). Retargeting measures that before it
+as a raised knee (docs/codec.md, "Which actions the codec keeps"). Retargeting measures that before it
 moves a take (``take_fidelity.py``), and a library window is measured the same way: its codes
 decoded on the clip's own body against the clip's own frames of that window (``window_fit``). Where
 the worst second misses by more than ``LOST_TAKE_MM``, the window is what the rig would play as

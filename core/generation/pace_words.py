@@ -10,7 +10,7 @@ of the candidates compete. Speed is the root's mean horizontal speed along its p
 the features' root velocities.
 
 A slow pace is not chosen among the candidates: the slowest candidates of a walk are often limps
-and creeps, so choosing them cost the gait (``docs/evaluation.md``, fifteenth session). Instead the
+and creeps, so choosing them cost the gait (``docs/design-notes.md``, Prompts). Instead the
 chosen motion of a stepping gait (a walk, march, sneak, limp, ...: no flight phase) is played at
 ``SLOW_SPEED`` over the same length (``slow_steps.slow_motion``: an edit, like a turn the words
 name). A jog or a run asked slowly keeps its cadence and flights and takes ``SLOW_SPEED`` shorter

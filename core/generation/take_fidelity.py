@@ -13,8 +13,8 @@ compares them) against the take's own (read from its shape-aware features the sa
 
 An action lasts about a second, so a short kick in a long walk is judged by its own second, not
 diluted by the walk. ``LOST_TAKE_MM`` is where the decoded action stops being the captured one
-(chosen on captured training clips of every action and checked on test clips: docs/evaluation.md,
-"The nineteenth session").
+(chosen on captured training clips of every action and checked on test clips: docs/design-notes.md,
+Planting and retargeting).
 """
 from __future__ import annotations
 
