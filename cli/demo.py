@@ -10,6 +10,7 @@ from pathlib import Path
 
 from ..core.data.shape_text import shape_adjectives
 from ..core.errors import ShapeMoveError
+from ..core.plan.explain import plan_lines
 from ..core.scene.motion_file import save_motion
 
 DEFAULT_PROMPT = "a person jogs forward and waves"
@@ -46,9 +47,13 @@ def run(args) -> int:
     print(f"prompt:      {motion.prompt}")
     print(f"shape text:  {args.shape_text}  (body from: {motion.shape_source or '[BETA] head'})")
     print(f"motion:      {motion.num_frames} frames at {motion.fps:g} fps ({motion.num_frames / motion.fps:.1f} s), "
-          f"{len(motion.tokens)} tokens, generated in {t1 - t0:.1f} s")
+          f"{motion.num_tokens} tokens, generated in {t1 - t0:.1f} s")
     if motion.part_prompts:
         print(f"by part:     legs {motion.part_prompts[0]!r}, arms {motion.part_prompts[1]!r}")
+    for line in plan_lines(args.prompt, motion):
+        print(line)
+    for n in motion.notes:
+        print(f"note: {n}")
     print(f"body:        {shape_adjectives(m, _sex(gen.body, motion.betas))}: " + format_body(m))
     print(f"scene:       {(args.out / 'shapemove.blend').resolve()}  ({info['vertices']} vertices, {info['bones']} bones, "
           f"frames {info['frame_start']}-{info['frame_end']})")

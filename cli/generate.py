@@ -1,6 +1,8 @@
 """`python -m shapemove generate --prompt TEXT | --prompts FILE [--shape-text TEXT] [--betas b0,…,b9] [--seconds S]
 [--seed N] [--temperature T] [--loop] [--in-place] [--path PATH.json] [--speed X | --stretch S]
---out OUT.npz`: text -> body shape + motion file (animation options: docs/animation.md)."""
+--out OUT.npz`: text -> body shape + motion file (animation options: docs/animation.md). A prompt of
+motions in order ("walks forward, then sits down") is made as a timeline of them (``core/plan/``);
+``--explain`` prints the plan as JSON and generates nothing."""
 from __future__ import annotations
 
 from pathlib import Path
@@ -33,7 +35,10 @@ def add_arguments(p):
                    help="classifier-free guidance scale (default: the model's, 2 for models trained with null prompts; 0 = none)")
     p.add_argument("--model", type=Path, default=None, help="model folder (default: the embedded default model)")
     p.add_argument("--body-model", default=None, help="openbody (default) or a path to SMPL-family model files")
-    p.add_argument("--out", type=Path, required=True)
+    p.add_argument("--out", type=Path, default=None, help="the motion file to write (.npz)")
+    p.add_argument("--explain", action="store_true",
+                   help="print the plan of the prompt as JSON (its segments in order, each with its share of the "
+                        "length and what the words were understood to ask) and generate nothing")
     p.add_argument("--library", type=Path, default=None,
                    help="a folder of your own captioned motions added to the retrieval memory (no retraining)")
     p.add_argument("--no-retrieval", action="store_true",
@@ -84,6 +89,18 @@ def run(args) -> int:
     from ..core.body.measure import format_body, measure
     from ..core.generation.generate import Generator, parse_betas
 
+    if args.explain:   # the plan, without loading any model
+        import json
+
+        if args.prompt is None:
+            raise ShapeMoveError("--explain shows the plan of one --prompt TEXT")
+        from ..core.plan.explain import plan_json
+
+        print(json.dumps(plan_json(args.prompt, args.seconds, loop=args.loop, in_place=args.in_place,
+                                   path=args.path is not None), indent=2))
+        return 0
+    if args.out is None:
+        raise ShapeMoveError("give the motion file to write with --out OUT.npz (or --explain to see the plan only)")
     if args.prompts is not None:
         from .generate_batch import run_generate_batch
 
@@ -123,8 +140,14 @@ def run(args) -> int:
     for w in motion.warnings:  # a prompt far from the training captions
         print(f"warning: {w}", file=sys.stderr)
     m = measure(gen.body, motion.betas)
+    ik = "" if motion.ik_error_cm is None else f", IK error {motion.ik_error_cm:.2f} cm"
     print(f"wrote {args.out}: {motion.num_frames} frames ({motion.num_frames / motion.fps:.1f} s), "
-          f"{len(motion.tokens) if motion.tokens is not None else 0} tokens, IK error {motion.ik_error_cm:.2f} cm")
+          f"{motion.num_tokens} tokens{ik}")
+    if not args.no_parts:
+        from ..core.plan.explain import plan_lines
+
+        for line in plan_lines(args.prompt, motion):
+            print(line)
     if motion.part_prompts:
         print(f"two things at once: legs {motion.part_prompts[0]!r}, arms {motion.part_prompts[1]!r}"
               + (" (arms mirrored to the named side)" if motion.arms_mirrored else ""))

@@ -1,5 +1,6 @@
 """`python -m shapemove retarget --motion IN (--betas b0,…,b9 | --shape-text TEXT) [--checkpoint RUN]
---out OUT.npz [--naive]`: a captured motion (BVH, ASF/AMC, AMASS .npz) performed by another body.
+--out OUT.npz [--naive]`: a captured motion (BVH, ASF/AMC, AMASS .npz) or a ShapeMove motion file
+performed by another body.
 
 The body: explicit betas, or a shape text - a measured sentence ("A person standing 190 cm tall,
 with a waist circumference of 100 cm") or adjectives ("a tall, heavy-set man") - turned into
@@ -19,7 +20,7 @@ from ..core.scene.motion_file import save_motion
 
 
 def add_arguments(p):
-    p.add_argument("--motion", type=Path, required=True, help="input motion: .bvh, .amc (with its .asf) or AMASS .npz")
+    p.add_argument("--motion", type=Path, required=True, help="input motion: .bvh, .amc (with its .asf), AMASS .npz or a ShapeMove motion .npz")
     p.add_argument("--betas", default=None, help="target body shape b0,…,b9 (missing values are 0)")
     p.add_argument("--shape-text", default=None, help='target body as text, e.g. "A person standing 190 cm tall"')
     p.add_argument("--checkpoint", type=Path, default=None,

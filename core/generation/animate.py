@@ -4,7 +4,8 @@ loop, in place, along a path, speed / stretch. See docs/animation.md.
 Order: the motion is made (``loop.generate_loop`` for a loop, ``path_follow`` for a path, else the
 generator), then played at ``speed`` or stretched to ``stretch`` seconds (``time_warp``), then walked
 along the path, and last held in place (``in_place``). Combinations that contradict each other
-are refused before anything is generated.
+are refused before anything is generated; where an option overrides what the words ask (a loop and
+"in a circle"), the motion's notes say which won (``plan/option_conflicts.py``).
 """
 from __future__ import annotations
 
@@ -13,6 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ShapeMoveError
+from ..plan.option_conflicts import option_notes
 from ..scene.motion_file import Motion
 from .time_warp import check_seconds, check_speed
 
@@ -94,4 +96,6 @@ def animate(gen, req, a: Animation, progress=None, cancel=None) -> Motion:
         motion = in_place(motion)
     motion.warnings = list(keep[0]) + [w for w in motion.warnings if w not in keep[0]]
     motion.shape_source, motion.prompt_check, motion.notes = keep[1], keep[2], list(keep[3])
+    if req.by_parts:   # the words an option overrides, said (plan/option_conflicts.py)
+        motion.notes += option_notes(req.prompt, loop=a.loop, in_place=a.in_place, path=a.path is not None)
     return motion

@@ -40,6 +40,7 @@ from .prompts import check_prompt
 from .rerank import CandidatePicker
 from .retrieval_seeds import seed_prefixes, seeded_count
 from .on_the_spot import on_the_spot
+from ..plan.segments import MIN_SEGMENT_SECONDS, plan_segments
 from .retrieved_candidates import library_codes, retrieved_codes
 from .stop_words import (DISTANCE_PACE, DISTANCE_SECONDS, STAND_SECONDS, asked_distance, distance_cut,
                          from_start, standing_after, standing_code, stop_cut, stop_request)
@@ -386,6 +387,15 @@ class Generator:
         for i, (r, check) in enumerate(zip(reqs, checks)):
             if cancel is not None and cancel():
                 break
+            plan = plan_segments(r.prompt) if r.by_parts else None   # "walks forward, then sits down"
+            if plan is not None and plan.is_sequence:
+                motion = self.planned_sequence(r, plan)
+                motion.warnings = [check.warning] if check is not None and check.warning else []
+                motion.prompt_check = check
+                out.append(motion)
+                if progress is not None:
+                    progress((i + 1) / len(reqs), r.prompt)
+                continue
             stop = stop_request(r.prompt) if r.by_parts else None   # "takes three steps and stops"
             metres = asked_distance(r.prompt) if stop else None      # "walks 3 metres": that far, then stands
             asked = dataclasses.replace(r, prompt=stop[0], seconds=r.seconds if r.seconds or not metres else
@@ -421,6 +431,21 @@ class Generator:
             if progress is not None:
                 progress((i + 1) / len(reqs), r.prompt)
         return out
+
+    def planned_sequence(self, r: Request, plan) -> Motion:
+        """A prompt of segments in order (``plan.segments.Plan``: "walks forward, then sits down") made
+        as a timeline of its segments (``sequence.generate_sequence``), each its share of ``r.seconds``
+        (``Plan.lengths``), one body for all."""
+        from .sequence import generate_sequence
+
+        lengths = plan.lengths(r.seconds)
+        if min(lengths) < MIN_SEGMENT_SECONDS:
+            raise ShapeMoveError(f"{r.prompt!r} is {len(lengths)} motions in order: {r.seconds:g} s gives each "
+                                 f"{min(lengths):.2f} s, under the {MIN_SEGMENT_SECONDS:g} s one needs; ask for more seconds")
+        motion = generate_sequence(self, [(s.text, sec) for s, sec in zip(plan.segments, lengths)], r.shape_text,
+                                   r.betas, r.seed, r.temperature, r.top_k, r.candidates, r.guidance, by_parts=True)
+        motion.prompt = r.prompt
+        return motion
 
     @cached_property
     def rest_code(self) -> int | None:

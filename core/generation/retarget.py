@@ -1,8 +1,8 @@
 """Move a captured motion onto another body: through the SA-VAE (HUMOS-style) or naively.
 
 ``retarget(motion, vae, body, betas)``:
-  1. read the clip as 22 SMPL joints at 20 fps (BVH, ASF/AMC, AMASS .npz; ``io.mocap.load_smpl22``)
-     or take a ``Motion22``;
+  1. read the clip as 22 SMPL joints at 20 fps (BVH, ASF/AMC, AMASS .npz; ``io.mocap.load_smpl22``;
+     a ShapeMove motion file's own joints, ``scene.motion_file``) or take a ``Motion22``;
   2. the dataset builder's per-clip steps (``data.build.ClipProcessor``): fit the subject's betas
      to its bone lengths, IK onto that body, the same rotations on the canonical body (betas = 0,
      stride scaled by the pelvis height) -> canonical HumanML3D features;
@@ -38,7 +38,7 @@ import torch
 from ..constants import FPS
 from ..errors import ShapeMoveError
 from ..io.mocap import Motion22
-from ..scene.motion_file import Motion, make_motion, validate
+from ..scene.motion_file import Motion, is_motion_file, load_motion, make_motion, validate
 from .decode import check_betas, decode_tokens
 
 
@@ -80,9 +80,13 @@ def source_joints(motion, body=None, read: dict | None = None) -> tuple[np.ndarr
         path = Path(motion)
         if not path.is_file():
             raise ShapeMoveError(f"motion file not found: {path}")
-        motion = load_smpl22(path, fps=FPS, body_model=body, **(read or {}))
+        if is_motion_file(path):   # ShapeMove's own motion file: its body's joints, already SMPL-22 at 20 fps
+            own = load_motion(path)
+            motion = Motion22(own.joints, own.fps, str(path), path.stem, np.zeros((22, 3), np.float32), rig="shapemove")
+        else:
+            motion = load_smpl22(path, fps=FPS, body_model=body, **(read or {}))
     if not isinstance(motion, Motion22):
-        raise ShapeMoveError("retarget needs a motion file (.bvh, .amc, AMASS .npz) or a Motion22, "
+        raise ShapeMoveError("retarget needs a motion file (.bvh, .amc, AMASS .npz, a ShapeMove .npz) or a Motion22, "
                              f"got {type(motion).__name__}")
     joints = np.asarray(motion.joints, dtype=np.float64)
     if joints.ndim != 3 or joints.shape[1:] != (22, 3):

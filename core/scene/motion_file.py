@@ -72,6 +72,12 @@ class Motion:
         return int(self.poses.shape[0])
 
     @property
+    def num_tokens(self) -> int:
+        """The motion tokens it keeps: 0 for a motion made by its rotations (a course, a turn, a loop,
+        a take played as captured)."""
+        return 0 if self.tokens is None else int(len(self.tokens))
+
+    @property
     def planted_take(self) -> bool:
         """A take played by its own rotations with its measured contacts and no motion tokens (a
         retarget the codes missed, a library clip): made again for another body by
@@ -204,6 +210,25 @@ def save_motion(path, m: Motion) -> Path:
     return path
 
 
+REQUIRED = ("joints", "betas", "poses", "transl", "fps", "body_model")
+
+
+def is_motion_file(path) -> bool:
+    """Whether ``path`` is a ``.npz`` with this format's arrays (read from the archive's list of
+    names, nothing loaded): told apart from an AMASS ``.npz`` (``trans``, no ``joints``)."""
+    import zipfile
+
+    path = Path(path)
+    if path.suffix.lower() != ".npz" or not path.is_file():
+        return False
+    try:
+        with zipfile.ZipFile(path) as z:
+            names = {n[:-4] if n.endswith(".npy") else n for n in z.namelist()}
+    except (zipfile.BadZipFile, OSError):
+        return False
+    return set(REQUIRED) <= names
+
+
 def load_motion(path) -> Motion:
     """Read and validate a motion file; ShapeMoveError names what is missing or malformed."""
     path = Path(path)
@@ -214,7 +239,7 @@ def load_motion(path) -> Motion:
         data = read_npz(path, max_bytes=512 * 2**20, what="motion file")
     except ShapeMoveError as exc:
         raise ShapeMoveError(f"cannot read motion file {exc}") from None
-    missing = [k for k in ("joints", "betas", "poses", "transl", "fps", "body_model") if k not in data]
+    missing = [k for k in REQUIRED if k not in data]
     if missing:
         raise ShapeMoveError(f"motion file {path} lacks {', '.join(missing)}")
     for key, kinds in (("loop_advance", "iuf"), ("segment_bounds", "iu")):

@@ -1,0 +1,44 @@
+"""The plan of a prompt shown to people: as JSON (``generate --explain``, nothing generated) and as
+one line per segment (what ``generate`` and ``demo`` print after generating).
+
+    plan_json("a person walks forward, then sits down", seconds=6)
+    -> {"prompt": ..., "seconds": 6.0, "segments": [
+          {"text": "a person walks forward", "share": 0.5, "seconds": 3.0,
+           "understood": {"actions": ["walk"], "travel": "forward"}},
+          {"text": "a person sits down", "share": 0.5, "seconds": 3.0, "understood": {"actions": ["sit"]}}]}
+
+A single segment's seconds are null when the length is the model's to choose.
+"""
+from __future__ import annotations
+
+from .option_conflicts import option_notes
+from .reading import said, understood
+from .segments import plan_segments
+
+
+def plan_json(prompt: str, seconds: float | None = None, loop: bool = False, in_place: bool = False,
+              path: bool = False) -> dict:
+    """The plan of ``prompt`` (module doc), with the notes of the options it is asked with."""
+    plan = plan_segments(prompt)
+    lengths = plan.lengths(seconds) if plan.is_sequence or seconds is not None else [None]
+    out = {"prompt": plan.prompt, "seconds": None if seconds is None else float(seconds),
+           "segments": [{"text": s.text, "share": round(s.share, 4),
+                         "seconds": None if sec is None else round(sec, 3), "understood": understood(s.text)}
+                        for s, sec in zip(plan.segments, lengths)]}
+    notes = option_notes(prompt, loop=loop, in_place=in_place, path=path)
+    if notes:
+        out["notes"] = notes
+    return out
+
+
+def plan_lines(prompt: str, motion=None) -> list[str]:
+    """One line per segment of ``prompt``'s plan: its text, its seconds (from ``motion``'s segments
+    when it is a timeline of them) and what was understood of it."""
+    plan = plan_segments(prompt)
+    if not plan.is_sequence:
+        return [f"understood: {said(understood(plan.segments[0].text))}"]
+    bounds = getattr(motion, "segment_bounds", None)
+    spans = ([f"{(int(e) - int(s)) / motion.fps:.1f} s" for s, e in bounds]
+             if bounds is not None and len(bounds) == len(plan.segments) else [f"{s.share:.0%}" for s in plan.segments])
+    return [f"understood {i} of {len(plan.segments)} ({span}): {s.text!r}: {said(understood(s.text))}"
+            for i, (s, span) in enumerate(zip(plan.segments, spans), 1)]

@@ -1,0 +1,123 @@
+"""A prompt's ordered segments: "a person walks forward, then sits down" is two.
+
+    plan = plan_segments("after waving, she jogs")
+    [s.text for s in plan.segments]  -> ["she is waving", "she jogs"]
+    plan.lengths(6.0)                -> [3.0, 3.0]
+
+Only words that order make segments: "then", "and then", ", then", "after that", "afterwards",
+"next", "finally", "followed by", "first ... then", and "before" / "after" in front of a clause
+("after waving, she jogs", "she jogs after waving", "before sitting down he waves": the wave
+first). "And" alone never cuts: two things at once ("jogs and waves") are one segment made by body
+part (``generation/parts.py``), and "back and forth", "to and fro", "up and down" are courses.
+"After" / "before" cut only before a participle or a pronoun ("runs after the ball" is one thing).
+A stop after "then" is the gait's own ("walks forward, then stops": one segment that stops,
+``generation/stop_words.py``).
+A segment without a subject gets the prompt's ("a man walks, then sits" -> "a man sits"); a bare
+participle is said as a clause ("waving" -> "she is waving"). Each segment gets an equal share of
+the length (``SEGMENT_SECONDS`` each when no length is asked).
+"""
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+
+from ..generation.part_prompts import SUBJECT, _subject, _with_subject
+from ..generation.stop_words import STOP
+
+# words that put what follows after what precedes ("then"): a cut with that order
+THEN = re.compile(r"\s*(?:[,;.]\s*)?\b(?:and\s+)?(?:then|after\s+that|afterwards?|next(?!\s+to\b)|finally|followed\s+by|"
+                  r"and\s+(?:finally|afterwards?))\b\s*,?\s*")
+# "before" / "after" in front of a clause: a participle or a pronoun follows ("runs after the ball" is no cut)
+_CLAUSE_AHEAD = r"(?=[a-z'-]+ing\b|(?:he|she|they|someone|somebody|i|we|you)\b)"
+MIDDLE = re.compile(r"\s*,?\s*\b(before|after)\s+" + _CLAUSE_AHEAD)
+LEADING = re.compile(r"^\s*(before|after)\s+" + _CLAUSE_AHEAD)
+FIRST = re.compile(r"\b(?:first(?:ly)?|at first|initially|to begin with|to start with)\b\s*,?\s*")
+PARTICIPLE = re.compile(r"^[a-z'-]{2,}ing\b")
+DEFAULT_SUBJECT = "a person"
+SEGMENT_SECONDS = 3.0       # a segment's length when the prompt's length is the model's to choose
+MIN_SEGMENT_SECONDS = 0.4   # the shortest segment a timeline takes (``generation.sequence.check_segments``)
+
+
+@dataclass(frozen=True)
+class PlannedSegment:
+    text: str       # the segment's own prompt, with a subject
+    share: float    # its share of the whole length (the shares add up to 1)
+
+
+@dataclass(frozen=True)
+class Plan:
+    prompt: str
+    segments: tuple[PlannedSegment, ...]
+
+    @property
+    def is_sequence(self) -> bool:
+        return len(self.segments) > 1
+
+    def lengths(self, total: float | None) -> list[float]:
+        """Each segment's seconds of a motion ``total`` seconds long (None: ``SEGMENT_SECONDS`` each)."""
+        total = SEGMENT_SECONDS * len(self.segments) if total is None else float(total)
+        return [s.share * total for s in self.segments]
+
+
+def _tidy(piece: str) -> str:
+    piece = re.sub(r"\s+", " ", piece).strip(" ,;.:!")
+    return re.sub(r"^(?:and|then|so)\b\s*", "", piece).strip(" ,;.")
+
+
+def _main_clause_start(t: str) -> int | None:
+    """Where a clause opening with "before" / "after" and no comma ends: at the first subject after
+    its first words ("before sitting down he waves" -> "he waves"); None when there is none."""
+    for w in list(re.finditer(r"\b[a-z]", t))[1:]:
+        if SUBJECT.match(t[w.start():]) and re.search(r"\w\s+\w", t[w.start():]):
+            return w.start()
+    return None
+
+
+def _ordered(piece: str) -> list[str]:
+    """One piece between "then"s cut at a "before" / "after" clause, in the order it happens."""
+    lead = LEADING.match(piece)
+    if lead:
+        rest = piece[lead.end():]
+        comma = rest.find(",")
+        cut = comma if comma >= 0 else _main_clause_start(rest)
+        if cut is not None:
+            sub, main = rest[:cut], rest[cut:]
+            pair = [sub, main] if lead.group(1) == "after" else [main, sub]
+            return [p for part in pair for p in _ordered(_tidy(part))]
+    mid = MIDDLE.search(piece)
+    if mid and mid.start() > 0:
+        main, sub = piece[:mid.start()], piece[mid.end():]
+        pair = [sub, main] if mid.group(1) == "after" else [main, sub]
+        return [p for part in pair for p in _ordered(_tidy(part))]
+    return [piece]
+
+
+def _as_prompt(piece: str, subject: str) -> str:
+    piece = _tidy(FIRST.sub("", piece, count=1) if FIRST.search(piece) else piece)
+    if PARTICIPLE.match(piece):
+        return f"{subject} is {piece}"
+    return _with_subject(piece, subject)
+
+
+def split_segments(prompt: str) -> list[str]:
+    """The prompts of ``prompt``'s segments in the order they happen (module doc); one when no word
+    orders it, the prompt itself."""
+    t = re.sub(r"\s+", " ", str(prompt)).strip().lower()
+    pieces = []
+    for p in (_tidy(p) for p in THEN.split(t)):
+        subject = SUBJECT.match(p)
+        if pieces and p and STOP.match(p[subject.end():] if subject else p):   # "walks forward, then stops": its stop
+            pieces[-1] = f"{pieces[-1]}, then {p}"
+        else:
+            pieces.append(p)
+    ordered = [q for p in pieces if p for q in _ordered(p) if _tidy(q)]
+    if len(ordered) < 2:
+        return [str(prompt).strip()]
+    subject = next((_subject(q) for q in ordered if SUBJECT.match(q)), DEFAULT_SUBJECT)
+    return [_as_prompt(q, _subject(q) if SUBJECT.match(q) else subject) for q in ordered]
+
+
+def plan_segments(prompt: str) -> Plan:
+    """The typed plan of ``prompt``: its ordered segments, each with an equal share of the length."""
+    texts = split_segments(prompt)
+    return Plan(str(prompt), tuple(PlannedSegment(t, 1.0 / len(texts)) for t in texts))

@@ -1,0 +1,102 @@
+"""A prompt's ordered segments (core/plan/segments.py), what the readers understand of each
+(core/plan/reading.py), the notes of an option that overrides the words
+(core/plan/option_conflicts.py) and `generate --explain` (no model loaded)."""
+import json
+
+import pytest
+
+from shapemove.cli import main
+from shapemove.core.plan.explain import plan_json, plan_lines
+from shapemove.core.plan.option_conflicts import option_notes
+from shapemove.core.plan.reading import understood
+from shapemove.core.plan.segments import SEGMENT_SECONDS, plan_segments, split_segments
+
+
+@pytest.mark.parametrize("prompt, segments", [
+    ("a person walks forward, then sits down", ["a person walks forward", "a person sits down"]),
+    ("after waving, she jogs", ["she is waving", "she jogs"]),
+    ("a man jogs and then waves", ["a man jogs", "a man waves"]),
+    ("before sitting down he waves", ["he waves", "he is sitting down"]),
+    ("she jogs after waving", ["she is waving", "she jogs"]),
+    ("a person waves before he sits down", ["a person waves", "he sits down"]),
+    ("first a person walks forward, then turns around, then sits down",
+     ["a person walks forward", "a person turns around", "a person sits down"]),
+    ("she first waves, then jogs in place", ["she waves", "she jogs in place"]),
+    ("a woman walks in a circle followed by jumping twice", ["a woman walks in a circle", "a woman is jumping twice"]),
+    ("the man squats, afterwards he jumps", ["the man squats", "he jumps"]),
+    ("a person sits down after walking in a circle", ["a person is walking in a circle", "a person sits down"]),
+    ("someone walks up and down the room then sits", ["someone walks up and down the room", "someone sits"]),
+    ("a man kicks with the left leg and then punches with the right hand",
+     ["a man kicks with the left leg", "a man punches with the right hand"]),
+])
+def test_ordering_words_make_segments_in_the_order_they_happen(prompt, segments):
+    assert split_segments(prompt) == segments
+    plan = plan_segments(prompt)
+    assert plan.is_sequence and [s.text for s in plan.segments] == segments
+    assert sum(s.share for s in plan.segments) == pytest.approx(1.0)
+
+
+@pytest.mark.parametrize("prompt", [
+    "a man walks back and forth", "a person walks to and fro", "someone paces up and down the room",
+    "a person jogs and waves", "a dog runs after the ball", "a person walks next to the wall",
+    "a person walks forward and turns around", "A woman jogs along, waving her left hand",
+    "a person walks forward and then stops.", "she jogs, then comes to a stop", "a man walks 4 steps then halts",
+    "a woman walks forward waving, then stops", "he runs, then he stops",
+])
+def test_and_alone_courses_and_things_at_once_stay_one_segment(prompt):
+    assert split_segments(prompt) == [prompt]
+    assert not plan_segments(prompt).is_sequence
+
+
+def test_lengths_share_the_seconds_or_take_a_default_each():
+    plan = plan_segments("a person walks forward, then turns around, then sits down")
+    assert plan.lengths(6.0) == pytest.approx([2.0, 2.0, 2.0])
+    assert plan.lengths(None) == pytest.approx([SEGMENT_SECONDS] * 3)
+
+
+def test_the_readings_are_the_generators():
+    assert understood("a man walks 3 metres forward and stops") == {
+        "actions": ["walk"], "travel": "forward", "distance_m": 3.0, "stop": True}
+    assert understood("someone turns around")["turn_degrees"] == 180
+    assert understood("she takes three steps and stops")["steps"] == 3
+    assert understood("a person jumps twice")["count"] == 2
+    assert understood("a person jogs in place")["in_place"] is True
+    assert understood("he waves with the left hand")["side"] == "left hand"
+    r = understood("a woman jogs in a circle clockwise and waves")
+    assert (r["course"], r["course_way"], r["arms"]) == ("walk in a circle", "right", "a person waves")
+
+
+def test_an_option_that_overrides_the_words_says_it_won():
+    assert option_notes("a man walks in a circle") == []
+    (loop,) = option_notes("a man walks in a circle", loop=True)
+    assert loop.startswith("--loop won over 'in a circle'")
+    assert "180 degrees" in option_notes("someone turns around", loop=True)[0]
+    assert option_notes("a person walks forward, then sits down", loop=True)[0].startswith("--loop won over the order of 2")
+    assert option_notes("she walks 5 metres and stops", in_place=True) == [
+        "--in-place won over the distance of 5 m: the travel is removed"]
+    assert option_notes("a person walks in a zigzag", path=True) == ["--path won over 'zigzag': the body walks your path"]
+    assert option_notes("a person walks forward", loop=True, in_place=True) == []
+
+
+def test_explain_prints_the_plan_as_json_without_a_model(tmp_path, capsys):
+    code = main(["generate", "--prompt", "after waving, she jogs in a circle", "--seconds", "4", "--loop", "--explain",
+                 "--model", str(tmp_path / "no_model_here")])
+    assert code == 0
+    out = json.loads(capsys.readouterr().out)
+    assert [s["text"] for s in out["segments"]] == ["she is waving", "she jogs in a circle"]
+    assert [s["seconds"] for s in out["segments"]] == [2.0, 2.0]
+    assert out["segments"][1]["understood"]["course"] == "walk in a circle"
+    assert len(out["notes"]) == 2 and out == plan_json("after waving, she jogs in a circle", 4, loop=True)
+    assert plan_json("a person waves")["segments"][0]["seconds"] is None
+
+
+def test_generate_without_out_or_explain_is_one_sentence(capsys):
+    assert main(["generate", "--prompt", "a person waves"]) == 2
+    assert capsys.readouterr().err.startswith("error: give the motion file to write with --out")
+
+
+def test_one_line_per_segment():
+    assert plan_lines("a person walks forward") == ["understood: walk; forward"]
+    lines = plan_lines("a person walks forward, then sits down")
+    assert lines == ["understood 1 of 2 (50%): 'a person walks forward': walk; forward",
+                     "understood 2 of 2 (50%): 'a person sits down': sit"]
