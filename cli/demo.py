@@ -31,10 +31,10 @@ def run(args) -> int:
     import time
 
     from ..core.body.measure import format_body, measure
-    from ..core.generation.generate import Generator
+    from ..core.generation.loaded_generator import loaded_generator
 
     t0 = time.time()
-    gen = Generator(args.model)
+    gen = loaded_generator(args.model)
     motion = gen.generate(args.prompt, args.shape_text, seconds=args.seconds, seed=args.seed)
     save_motion(args.out / "motion.npz", motion)
     t1 = time.time()

@@ -87,7 +87,8 @@ def animation_of(args):
 
 def run(args) -> int:
     from ..core.body.measure import format_body, measure
-    from ..core.generation.generate import Generator, parse_betas
+    from ..core.generation.generate import parse_betas
+    from ..core.generation.loaded_generator import loaded_generator
 
     if args.explain:   # the plan, without loading any model
         import json
@@ -122,10 +123,10 @@ def run(args) -> int:
     ensure_parent(args.out)  # a parent that is a file, or no permission: said now, not after generating
     betas = parse_betas(args.betas) if args.betas else None
     animation = animation_of(args)
-    gen = Generator(args.model, body=args.body_model)
+    gen = loaded_generator(args.model, args.body_model, args.library)
     gen.set_retrieval(not args.no_retrieval)
     if args.library is not None:
-        print(f"retrieval memory: {gen.add_library(args.library)} motions added from {args.library}")
+        print(f"retrieval memory: {len(gen.library_files)} motions added from {args.library}")
     from ..core.generation.animate import animate
     from ..core.generation.generate import Request
 

@@ -56,12 +56,13 @@ def run(args) -> int:
             raise ShapeMoveError(f"give one --seconds per --prompt ({len(args.prompt)} prompts, {len(args.seconds)} lengths)")
         segments = check_segments(list(zip(args.prompt, args.seconds)))
     ensure_parent(args.out)
-    from ..core.generation.generate import Generator, parse_betas
+    from ..core.generation.generate import parse_betas
+    from ..core.generation.loaded_generator import loaded_generator
     from ..core.generation.in_place import in_place
     from ..core.generation.sequence import generate_sequence, regenerate_segment, segment_codes
 
     betas = parse_betas(args.betas) if args.betas else None
-    gen = Generator(args.model, body=args.body_model)
+    gen = loaded_generator(args.model, args.body_model)
     if args.regenerate is not None:
         motion = regenerate_segment(gen, base, args.regenerate - 1, args.seed, args.prompt[0] if args.prompt else None,
                                     args.seconds[0] if args.seconds else None, args.temperature, args.top_k,

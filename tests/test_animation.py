@@ -417,11 +417,12 @@ def test_timeline_segments_are_the_actions_asked(gen):
 
 def test_worker_ops_animate_and_sequence(tmp_path, gen):
     from shapemove.core.scene.motion_file import load_motion
-    from shapemove.core.worker import jobs_animation, jobs_shapemove
+    from shapemove.core.generation import loaded_generator
+    from shapemove.core.worker import jobs_animation
     from shapemove.core.worker.ops import default_jobs
 
     assert {"animate", "sequence"} <= set(default_jobs())
-    jobs_shapemove._GENERATORS.clear()
+    loaded_generator._LOADED.clear()
     never = lambda: False   # noqa: E731
     out = jobs_animation.animate({"prompt": "a person walks forward", "seconds": 2, "speed": 2.0, "in_place": True,
                                   "out": str(tmp_path / "a.npz")}, lambda f, m: None, never)

@@ -4,7 +4,8 @@ search, train, betas_from_text (and measure, which ``ops`` already serves).
 Each op is ``op(params, progress, cancel) -> dict`` (JSON-able); files are handed over by path:
 the UI passes an ``out`` path (.npz) under its data folder and builds the rig from the file the
 op wrote (atomically). ``register(JOBS)`` adds the ops to a registry (core/worker/ops.py's JOBS).
-Loaded generators are kept per (model folder, body) so a long-lived worker answers fast.
+One generator is kept loaded per process (``generation/loaded_generator.py``) so a long-lived worker
+answers fast.
 """
 from __future__ import annotations
 
@@ -15,13 +16,13 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ShapeMoveError
-from ..generation.model_bundle import part_warnings, resolve_model_dir
+from ..generation.loaded_generator import loaded_generator
+from ..generation.model_bundle import part_warnings
 from ..scene.motion_file import load_motion, save_motion
 from ..search.motion_search import check_query, index_library, library_clip, search as _search
 from .op_support import JobCancelled, param
 
 TRAIN_KINDS = ("vae", "t5", "tma")
-_GENERATORS: dict = {}
 
 
 # -- helpers -----------------------------------------------------------------------------------
@@ -46,29 +47,9 @@ def _betas(params: dict, op: str, name: str = "betas", default=None):
 
 
 def _generator(model, body, library=None):
-    """A cached Generator for (model folder or None = default, body spec, library folder or None:
-    the user's captioned motions added to its memory, ``Generator.add_library``). A changed model
-    or library file loads it again."""
-    from ..generation.generate import Generator
-    from ..search.motion_search import list_library
-
-    d = resolve_model_dir(model or None)
-    stamp = max((p.stat().st_mtime_ns for p in d.rglob("*") if p.is_file()), default=0)
-    lib = None
-    if library:
-        folder = Path(library)
-        if not folder.is_dir():
-            raise ShapeMoveError(f"library folder not found: {folder}")
-        files = [f for _, _, deps in list_library(folder) for f in deps if f.is_file()]
-        lib = (str(folder.resolve()), len(files), max((f.stat().st_mtime_ns for f in files), default=0))
-    key = (str(d.resolve()), body or "openbody", stamp, lib)
-    if key not in _GENERATORS:
-        _GENERATORS.clear()  # one loaded model set at a time
-        gen = Generator(d, body=body or None)
-        if lib is not None:
-            gen.add_library(lib[0])
-        _GENERATORS[key] = gen
-    return _GENERATORS[key]
+    """The process's loaded Generator for (model folder or None = default, body spec, library folder
+    or None) (``generation.loaded_generator``)."""
+    return loaded_generator(model, body, library)
 
 
 def _measurements(body, betas) -> dict:
