@@ -26,7 +26,8 @@ def test_torch_measure_matches_fast_measure_and_has_gradients():
 
 
 def test_lr_schedule_is_a_plain_float():
-    from shapemove.core.train.train_t5 import T5TrainConfig, lr_at
+    from shapemove.core.train.train_t5 import T5TrainConfig
+    from shapemove.core.train.warmup_cosine import lr_at
 
     c = T5TrainConfig(steps=100, warmup_steps=10)
     assert all(type(lr_at(s, c)) is float for s in (0, 9, 10, 50, 100, 150))  # numpy scalars break last.pt loading

@@ -51,6 +51,16 @@ def default_built_dir() -> Path | None:
     return p if p.is_dir() else None
 
 
+
+def built_dir(data, why: str) -> Path:
+    """``data``, else ``default_built_dir()``; neither: a ShapeMoveError saying ``why`` the built dataset
+    is needed and how to name it."""
+    data = data if data is not None else default_built_dir()
+    if data is None:
+        raise ShapeMoveError(f"{why}: pass --data BUILT, the built dataset the model was trained on "
+                             "(or set SHAPEMOVE_BUILT; default data/built when it exists)")
+    return data
+
 def check_built(data) -> Path:
     data = Path(data)
     if not data.is_dir():

@@ -120,25 +120,18 @@ def eval_paraphrase(model_dir=None, prompts=None, tma=None, seed: int | list[int
     from ..generation.generate import Generator, Request
     from ..generation.model_bundle import model_files
     from ..motion.features import motion_features
-    from ..generation.sampling_params import (DEFAULT_CANDIDATES, DEFAULT_RETRIEVAL_FIRST, DEFAULT_RETRIEVAL_PREFIX,
-                                              DEFAULT_RETRIEVED)
-    from .action_classifier import ActionClassifier, default_built_dir
+    from ..generation.sampling_params import or_defaults
+    from .action_classifier import ActionClassifier, built_dir
     from .tma_embed import embed_motions, embed_texts, load_tma
 
     items = load_prompts(prompts)
     seeds = [int(seed)] if isinstance(seed, (int, np.integer)) else [int(s) for s in seed]
     if not seeds or len(set(seeds)) != len(seeds):
         raise ShapeMoveError(f"eval paraphrase needs one or more distinct seeds, got {list(seeds)}")
-    candidates = DEFAULT_CANDIDATES if candidates is None else candidates
-    retrieval_prefix = DEFAULT_RETRIEVAL_PREFIX if retrieval_prefix is None else retrieval_prefix
-    retrieved = DEFAULT_RETRIEVED if retrieved is None else retrieved
-    retrieval_first = DEFAULT_RETRIEVAL_FIRST if retrieval_first is None else retrieval_first
+    candidates, retrieved, retrieval_first, retrieval_prefix = or_defaults(candidates, retrieved, retrieval_first,
+                                                                           retrieval_prefix)
     if classifier is None:
-        data = data if data is not None else default_built_dir()
-        if data is None:
-            raise ShapeMoveError("eval paraphrase classifies generated motions by their nearest training clips: "
-                                 "pass --data BUILT, the built dataset the model was trained on "
-                                 "(or set SHAPEMOVE_BUILT; default data/built when it exists)")
+        data = built_dir(data, "eval paraphrase classifies generated motions by their nearest training clips")
     gen = generator if generator is not None else Generator(model_dir)
     gen.set_retrieval(retrieval)
     if library is not None:

@@ -107,22 +107,17 @@ def eval_parts(model_dir=None, data=None, sides=None, two_things=None, seed: int
     """Generate one motion per held-out prompt and judge it by part (module docstring). Returns
     {"sides": {...}, "two_things": {...}, "judge_real", "targets", "settings", "rows": {...}}."""
     from ..generation.generate import Generator, Request
-    from ..generation.sampling_params import DEFAULT_CANDIDATES, DEFAULT_RETRIEVAL_FIRST, DEFAULT_RETRIEVED
+    from ..generation.sampling_params import or_defaults
     from ..models.motion_memory import take_of
     from ..motion.features import motion_features
-    from .action_classifier import default_built_dir
+    from .action_classifier import built_dir
     from .part_judge import PartJudge, arms_right, legs_right
     from .part_judge_accuracy import leave_one_out, real_accuracy
 
     side_items, two_items = load_sides(sides), load_two_things(two_things)
-    candidates = DEFAULT_CANDIDATES if candidates is None else candidates
-    retrieved = DEFAULT_RETRIEVED if retrieved is None else retrieved
-    retrieval_first = DEFAULT_RETRIEVAL_FIRST if retrieval_first is None else retrieval_first
+    candidates, retrieved, retrieval_first, _ = or_defaults(candidates, retrieved, retrieval_first)
     if judge is None:
-        data = data if data is not None else default_built_dir()
-        if data is None:
-            raise ShapeMoveError("eval parts judges generated motions against real clips: pass --data BUILT, a "
-                                 "built dataset (or set SHAPEMOVE_BUILT; default data/built when it exists)")
+        data = built_dir(data, "eval parts judges generated motions against real clips")
         judge = PartJudge.from_data(data, "train", progress=show_progress)
     real = real_accuracy(judge, data, "test", progress=show_progress) if judge_check and data is not None else None
     gen = generator if generator is not None else Generator(model_dir)

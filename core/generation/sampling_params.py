@@ -20,6 +20,16 @@ MAX_RETRIEVED = 16
 DEFAULT_RETRIEVAL_FIRST = None  # caption similarity from which only retrieved clips compete (None: never)
 
 
+def or_defaults(candidates: int | None = None, retrieved: int | None = None,
+                retrieval_first: float | None = None, retrieval_prefix: int | None = None) -> tuple:
+    """(candidates, retrieved, retrieval_first, retrieval_prefix), each one not given (None) the product's
+    default: what an evaluation samples with unless it is told otherwise."""
+    return (DEFAULT_CANDIDATES if candidates is None else candidates,
+            DEFAULT_RETRIEVED if retrieved is None else retrieved,
+            DEFAULT_RETRIEVAL_FIRST if retrieval_first is None else retrieval_first,
+            DEFAULT_RETRIEVAL_PREFIX if retrieval_prefix is None else retrieval_prefix)
+
+
 def _integer(value, name: str) -> int:
     if isinstance(value, bool):
         raise ShapeMoveError(f"{name} must be a whole number, got {value!r}")

@@ -44,6 +44,7 @@ import torch
 from ..atomic import atomic_path
 from ..config_presets import load_config, refuse_unknown
 from ..errors import ShapeMoveError
+from .warmup_cosine import OptimizerSettings, adamw_warmup_cosine
 
 KIND = "shapemove-head"
 FEATURE_KEYS = ("seed", "dataset_examples", "pool", "stated_share", "no_shape_average", "teen_share", "height_margin")
@@ -51,15 +52,12 @@ FEATURES_FORMAT = 4   # 3: the shape texts' number features beside their states;
 
 
 @dataclass
-class HeadTrainConfig:
+class HeadTrainConfig(OptimizerSettings):
     head: dict = field(default_factory=lambda: {"kind": "text", "hidden": 256, "width": 128, "queries": 4, "heads": 4,
                                                 "sliders": 6})  # writes OpenBody's 6 sliders + a residual
     steps: int = 8000
     batch_size: int = 128
     lr: float = 1e-3
-    warmup_steps: int = 200
-    weight_decay: float = 0.01
-    grad_clip: float = 1.0
     seed: int = 0
     dataset_examples: int = 8000     # draws of the T5's training examples
     pool: int = 24000                # new bodies described in words and numbers
@@ -332,7 +330,6 @@ def train_head(model_dir, data, out, config: HeadTrainConfig | None = None, resu
     from .resume import restore, rng_state
     from .run_log import StepLog
     from .t5_dataset import T2MExamples
-    from .train_t5 import lr_at
 
     c = config or HeadTrainConfig()
     if steps is not None:
@@ -375,8 +372,7 @@ def train_head(model_dir, data, out, config: HeadTrainConfig | None = None, resu
     train_idx = torch.as_tensor(sorted(set(range(n)) - set(val_idx.tolist())), dtype=torch.long)
 
     units = label_units(feats, examples.measure, readback.mass) if c.head.get("meets") == 3 else None
-    optimizer = torch.optim.AdamW(learn, lr=c.lr, weight_decay=c.weight_decay)
-    scheduler = torch.optim.lr_scheduler.LambdaLR(optimizer, lambda s: lr_at(s, c))
+    optimizer, scheduler = adamw_warmup_cosine(learn, c)
     step, rng = 0, random.Random(c.seed + 1)
     last = out / "last.pt"
     if resume and last.is_file():

@@ -20,7 +20,6 @@ and actions with their MiniLM vectors: ``known_texts.py``).
 """
 from __future__ import annotations
 
-import math
 import random
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
@@ -38,6 +37,7 @@ from ..models.tokenizer import add_motion_tokens, load_tokenizer, tokenizer_from
 from . import distributed
 from .checkpoint_cadence import finish, save_if_due
 from .run_log import StepLog
+from .warmup_cosine import OptimizerSettings, adamw_warmup_cosine
 from .checkpoint import config_differences, load_checkpoint, save_checkpoint
 from .t5_dataset import T2MExamples, all_texts, collate, collate_minilm, tokenize_clips
 from .optimizer_step import optimizer_step
@@ -49,14 +49,11 @@ HEAD_KEYS = ("head_steps", "head_batch_size", "head_lr", "head_measure_weight", 
 
 
 @dataclass
-class T5TrainConfig:
+class T5TrainConfig(OptimizerSettings):
     size: dict = field(default_factory=lambda: asdict(T5Size()))
     steps: int = 3000
     batch_size: int = 32
     lr: float = 5e-4
-    warmup_steps: int = 200
-    weight_decay: float = 0.01
-    grad_clip: float = 1.0
     beta_weight: float = 1.0
     max_codes: int = 50            # 10 s at 20 fps, 4x downsampling
     m2t_share: float = 0.0         # share of motion-to-text examples (the paper's pre-training; T5 encoder)
@@ -117,13 +114,6 @@ class T5TrainConfig:
             return cls(**data)
 
         return load_config("T5", name_or_path, {"tiny": cls.tiny, "small": cls, "paper": cls.paper}, from_json)
-
-
-def lr_at(step: int, c: T5TrainConfig) -> float:
-    if step < c.warmup_steps:
-        return (step + 1) / c.warmup_steps
-    p = (step - c.warmup_steps) / max(1, c.steps - c.warmup_steps)
-    return 0.1 + 0.9 * 0.5 * (1 + math.cos(math.pi * min(1.0, p)))  # a float: numpy scalars would make last.pt unloadable
 
 
 def vae_stamp(path: Path) -> str:
@@ -201,8 +191,7 @@ def _train(data, vae_path, out, c, base_model, resume, dist, progress, cancel, v
         model = ShapeMoveT5.build(tok, size_from_dict(c.size), base_model=base_model, beta_weight=c.beta_weight)
     # -- 3. model, optimizer, resume ---------------------------------------------------------
     model = model.to(dist.device)
-    optimizer = torch.optim.AdamW(model.parameters(), lr=c.lr, weight_decay=c.weight_decay)
-    scheduler = torch.optim.lr_scheduler.LambdaLR(optimizer, lambda s: lr_at(s, c))
+    optimizer, scheduler = adamw_warmup_cosine(model.parameters(), c)
     step, rng = 0, random.Random(c.seed + 1000 * dist.rank)
     head_state = None
     last = out / "last.pt"

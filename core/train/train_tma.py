@@ -18,7 +18,6 @@ pure function of (seed, step), so an interrupted and resumed run equals an unint
 """
 from __future__ import annotations
 
-import math
 import os
 import random
 from dataclasses import asdict, dataclass, field
@@ -42,6 +41,7 @@ from ..models.tokenizer import load_tokenizer, tokenizer_from_sentencepiece, tra
 from . import distributed
 from .checkpoint_cadence import finish, save_if_due
 from .run_log import StepLog
+from .warmup_cosine import OptimizerSettings, adamw_warmup_cosine
 from .checkpoint import load_checkpoint, make_metadata, save_checkpoint, stats_hash
 from .motion_dataset import load_stats, read_split
 from .optimizer_step import optimizer_step
@@ -53,14 +53,11 @@ FEATURE_KINDS = ("norm_joint_vecs", "new_joint_vecs")
 
 
 @dataclass
-class TMATrainConfig:
+class TMATrainConfig(OptimizerSettings):
     model: dict = field(default_factory=lambda: asdict(TMAConfig()))  # sentencepiece: vocab_size set from it
     steps: int = 6000
     batch_size: int = 64
     lr: float = 2e-4
-    warmup_steps: int = 200
-    weight_decay: float = 0.01
-    grad_clip: float = 1.0
     vocab_size: int = 2000          # sentencepiece only: upper bound (a small corpus gets fewer pieces)
     shape_aware_share: float = 0.5  # share of crops from new_joint_vecs (else norm_joint_vecs)
     bank_share: float = BANK_SHARE  # share of captions drawn from the paraphrase bank (data/paraphrase_bank.py)
@@ -105,14 +102,6 @@ class TMATrainConfig:
         m = self.model
         if m["dim"] % m["heads"] or m["dim"] % 2 or m["max_frames"] < 4:
             raise ShapeMoveError("TMA model: dim must be even and divisible by heads; max_frames >= 4")
-
-
-def lr_at(step: int, c: TMATrainConfig) -> float:
-    """Multiplier of ``c.lr``: linear warm-up, then cosine down to 10 %."""
-    if step < c.warmup_steps:
-        return (step + 1) / c.warmup_steps
-    p = min(1.0, (step - c.warmup_steps) / max(1, c.steps - c.warmup_steps))
-    return 0.1 + 0.9 * 0.5 * (1 + math.cos(math.pi * p))
 
 
 class TMAClips:
@@ -242,8 +231,7 @@ def _train(data, out, c, resume, body_name, dist, progress, cancel, verbose) -> 
     # -- model, optimizer, resume ------------------------------------------------------------
     torch.manual_seed(c.seed)  # same initial weights on every rank
     model = TMA(cfg).to(dist.device)
-    optimizer = torch.optim.AdamW(model.parameters(), lr=c.lr, weight_decay=c.weight_decay)
-    scheduler = torch.optim.lr_scheduler.LambdaLR(optimizer, lambda s: lr_at(s, c))
+    optimizer, scheduler = adamw_warmup_cosine(model.parameters(), c)
     step = 0
     last = out / "last.pt"
     if resume and last.is_file():
