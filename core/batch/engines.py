@@ -17,6 +17,7 @@ import threading
 import time
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
+from itertools import islice
 from pathlib import Path
 
 from ..atomic import atomic_write_bytes
@@ -100,15 +101,22 @@ class DaskCluster:
     def run(self, task, specs, folder):
         from distributed import as_completed
 
-        specs, ac = iter(specs), as_completed()
+        specs = iter(specs)
+
+        def submit(spec):
+            return self.client.submit(run_remote, task, spec, pure=False)
+
+        first = [submit(spec) for spec in islice(specs, self.jobs * QUEUED_PER_WORKER)]
+        if not first:
+            self.client.close()
+            return
+        ac = as_completed(first, loop=self.client.loop)
 
         def submit_next() -> None:
             spec = next(specs, None)
             if spec is not None:
-                ac.add(self.client.submit(run_remote, task, spec, pure=False))
+                ac.add(submit(spec))
 
-        for _ in range(self.jobs * QUEUED_PER_WORKER):
-            submit_next()
         try:
             for fut in ac:
                 record, blobs = fut.result()

@@ -30,6 +30,18 @@ def item_specs(kind: str, items, count: int, settings: dict, model: dict, where:
              "settings": settings, "model": model, "stem": it.stem, "where": where} for it in items]
 
 
+def remove_leftovers(folder: Path, stems) -> int:
+    """Remove the temporary files (``NAME.PID.tmp``, core/atomic.py) a killed run left of the
+    items about to run; a finished file never has that name, so none is mistaken for one."""
+    stems, removed = set(stems), 0
+    if folder.is_dir():
+        for p in folder.iterdir():
+            if ".tmp" in p.name and p.name.split(".")[0] in stems and p.is_file():
+                p.unlink(missing_ok=True)
+                removed += 1
+    return removed
+
+
 def run_batch(kind: str, task, items, count: int, settings: dict, model: dict, where: dict, folder, engine=None,
               shard: Shard = ALL, progress_stream=None, interval: float = 10.0) -> BatchResult:
     """Run ``task`` on the ``items`` not yet done into ``folder``; ``count``: the file's items."""
@@ -39,6 +51,7 @@ def run_batch(kind: str, task, items, count: int, settings: dict, model: dict, w
     manifest = folder / manifest_name(shard)
     done_before = finished_items(manifest, {s["item"]: s["key"] for s in specs})
     todo = [s for s in specs if s["item"] not in done_before]
+    remove_leftovers(folder, [s["stem"] for s in todo])
     result = BatchResult(manifest, len(specs), len(specs) - len(todo))
     progress = BatchProgress(len(specs), result.skipped, label=kind, stream=progress_stream, interval=interval)
     labels = {it.index: it.label for it in items}
@@ -50,6 +63,8 @@ def run_batch(kind: str, task, items, count: int, settings: dict, model: dict, w
             for record in engine.run(task, todo, folder):
                 writer.append(record)
                 ok = record["status"] == "done"
+                for note in (record.get("source") or {}).get("notes") or []:   # a library take played as captured
+                    progress.write(f"item {record['item']}: {note}")
                 if ok:
                     result.done += 1
                 else:
