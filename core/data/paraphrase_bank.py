@@ -290,26 +290,27 @@ def sentence(action: str, rng: random.Random) -> str:
     vp = rng.choice(e["vps"])
     subj = _subject(rng, e)
     shapes = ["decl", "decl", "prog", "imp", "make", "show", "fragment"] + (["noun", "noun_do"] if e["nouns"] else [])
-    shape = rng.choice(shapes)
-    if shape == "decl":
-        s = f"{subj} {vp}."
-    elif shape == "prog":
-        s = f"{subj} is {progressive(vp)}."
-    elif shape == "imp":
-        s = f"{_base_vp(vp)}."
-    elif shape == "make":
-        lead = rng.choice(["make", "have", "let", "get"])
-        obj = rng.choice(OBJECTS)
-        s = f"{lead} {obj} {'to ' if lead == 'get' else ''}{_base_vp(vp)}."
-    elif shape == "show":
-        s = f"{rng.choice(['show', 'animate', 'generate', 'a clip of', 'an animation of'])} {subj} {progressive(vp)}."
-    elif shape == "fragment":
-        s = f"{subj} {progressive(vp)}."
-    elif shape == "noun":
-        s = f"{rng.choice(e['nouns'])}."
-    else:
-        s = f"{subj} {rng.choice(['does', 'performs', 'does', 'shows'])} {rng.choice(e['nouns'])}."
-    return _tidy(s)
+    return _tidy(SHAPES[rng.choice(shapes)](subj, vp, e["nouns"], rng))
+
+
+def _make(vp: str, rng: random.Random) -> str:
+    """"make someone walk", "get the figure to walk"."""
+    lead = rng.choice(["make", "have", "let", "get"])
+    return f"{lead} {rng.choice(OBJECTS)} {'to ' if lead == 'get' else ''}{_base_vp(vp)}."
+
+
+# the sentence shapes of ``sentence``: (subject, verb phrase, the action's nouns, rng) -> the sentence
+SHAPES = {
+    "decl": lambda subj, vp, nouns, rng: f"{subj} {vp}.",
+    "prog": lambda subj, vp, nouns, rng: f"{subj} is {progressive(vp)}.",
+    "imp": lambda subj, vp, nouns, rng: f"{_base_vp(vp)}.",
+    "make": lambda subj, vp, nouns, rng: _make(vp, rng),
+    "show": lambda subj, vp, nouns, rng:
+        f"{rng.choice(['show', 'animate', 'generate', 'a clip of', 'an animation of'])} {subj} {progressive(vp)}.",
+    "fragment": lambda subj, vp, nouns, rng: f"{subj} {progressive(vp)}.",
+    "noun": lambda subj, vp, nouns, rng: f"{rng.choice(nouns)}.",
+    "noun_do": lambda subj, vp, nouns, rng: f"{subj} {rng.choice(['does', 'performs', 'does', 'shows'])} {rng.choice(nouns)}.",
+}
 
 
 def sequence_sentence(actions: list[str], rng: random.Random) -> str:
