@@ -78,8 +78,9 @@ def run_and_report(kind: str, task, args, items, count: int, settings: dict, whe
     except KeyboardInterrupt:
         print(f"interrupted: the finished items are in {args.out}; run the same command again to go on")
         return 130
-    print(f"{kind}: {res.skipped + res.done} of {res.total} items done ({res.skipped} before, {res.done} now, "
-          f"{len(res.failed)} failed); manifest {res.manifest}")
+    verb = "rendered" if kind == "render" else "generated"
+    print(f"{verb} {res.skipped + res.done} of {res.total} prompts into {args.out} ({res.skipped} done before this "
+          f"run, {len(res.failed)} failed); manifest {res.manifest}")
     for item, label, why in res.failed:
         print(f"  failed: item {item} {label!r}: {why}")
     return 0 if not res.failed or res.done + res.skipped else 1

@@ -13,6 +13,7 @@ Ctrl-C stops handing out items; what finished is in the manifest.
 from __future__ import annotations
 
 import os
+import signal
 import threading
 import time
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
@@ -45,6 +46,7 @@ def _watch_parent(parent: int) -> None:
 
 
 def _init_worker(threads: int, parent: int) -> None:
+    signal.signal(signal.SIGINT, signal.SIG_IGN)   # Ctrl-C is the batch process's: it stops handing out items
     os.environ.setdefault("TQDM_DISABLE", "1")
     import torch
 
@@ -94,7 +96,7 @@ class DaskCluster:
             raise ShapeMoveError("--dask needs Dask distributed: pip install distributed") from None
         try:
             self.client = Client(address, timeout=timeout, set_as_default=False)
-        except (OSError, TimeoutError, ValueError) as exc:
+        except Exception as exc:  # noqa: BLE001  (OSError, TimeoutError, a malformed address: one sentence)
             raise ShapeMoveError(f"cannot reach the Dask scheduler at {address}: {exc}") from None
         self.jobs = max(1, sum(w.get("nthreads", 1) for w in self.client.scheduler_info()["workers"].values()))
 
@@ -119,7 +121,12 @@ class DaskCluster:
 
         try:
             for fut in ac:
-                record, blobs = fut.result()
+                try:
+                    record, blobs = fut.result()
+                except Exception as exc:  # noqa: BLE001  (workers lost past Dask's retries)
+                    raise ShapeMoveError(f"the Dask cluster could not run an item ({type(exc).__name__}: {exc}); "
+                                         "the items finished so far are in the manifest: run the same command "
+                                         "again to go on") from None
                 for e in record["outputs"]:
                     path = Path(folder) / e["file"]
                     atomic_write_bytes(path, blobs[e["file"]])

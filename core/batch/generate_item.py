@@ -22,7 +22,7 @@ def generator_for(where: dict, retrieval: bool = True):
         gen = Generator(where.get("model"), body=where.get("body_model"))
         gen.set_retrieval(retrieval)
         if where.get("library"):
-            gen.add_library(where["library"])
+            print(f"retrieval memory: {gen.add_library(where['library'])} motions added from {where['library']}")
         _GENERATORS[key] = gen
     return _GENERATORS[key]
 
