@@ -41,6 +41,9 @@ def add_arguments(p):
                         "length and what the words were understood to ask) and generate nothing")
     p.add_argument("--library", type=Path, default=None,
                    help="a folder of your own captioned motions added to the retrieval memory (no retraining)")
+    p.add_argument("--no-library", action="store_true",
+                   help="no captured take competes: the built-in motion library's takes and your --library clips are "
+                        "not played as captured; every motion is generated from the model's codes")
     p.add_argument("--no-retrieval", action="store_true",
                    help="the model's motion memory is not used: no retrieved clips among the candidates, no captured "
                         "clips of a part's action; the T5 writes everything from the prompt alone")
@@ -98,7 +101,7 @@ def run(args) -> int:
         from ..core.plan.explain import plan_json
 
         print(json.dumps(plan_json(args.prompt, args.seconds, loop=args.loop, in_place=args.in_place,
-                                   path=args.path is not None), indent=2))
+                                   path=args.path is not None, by_parts=not args.no_parts), indent=2))
         return 0
     if args.out is None:
         raise ShapeMoveError("give the motion file to write with --out OUT.npz (or --explain to see the plan only)")
@@ -125,6 +128,7 @@ def run(args) -> int:
     animation = animation_of(args)
     gen = loaded_generator(args.model, args.body_model, args.library)
     gen.set_retrieval(not args.no_retrieval)
+    gen.set_captured(not args.no_library)
     if args.library is not None:
         print(f"retrieval memory: {len(gen.library_files)} motions added from {args.library}")
     from ..core.generation.animate import animate
@@ -149,6 +153,8 @@ def run(args) -> int:
 
         for line in plan_lines(args.prompt, motion):
             print(line)
+    if motion.provenance:   # "captured: HDM05 bd kickLFront 003 (CC BY-SA 3.0)" or "generated"
+        print(motion.provenance)
     if motion.part_prompts:
         print(f"two things at once: legs {motion.part_prompts[0]!r}, arms {motion.part_prompts[1]!r}"
               + (" (arms mirrored to the named side)" if motion.arms_mirrored else ""))

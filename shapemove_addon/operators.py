@@ -24,7 +24,7 @@ from .export import FORMATS, export_rig
 from .jobs import report_error
 from .preferences import body_spec, preferences, setting
 from .redecode import HAS_TOKENS_KEY, MOTION_FILE_KEY
-from .rig_state import PHYSICS_KEY, TAKE_NOTES_KEY, current_betas, rig_body_spec, rig_of
+from .rig_state import PHYSICS_KEY, PROVENANCE_KEY, TAKE_NOTES_KEY, current_betas, rig_body_spec, rig_of
 from .animation_rig import ROOT_MOTION_ITEMS, build_animated_rig
 from .scene_build import SLIDER_RANGE
 
@@ -94,6 +94,8 @@ def on_generated(name: str, msg: dict):
     if rig is not None and r.get("parts"):
         rig["shapemove_parts"] = [str(p) for p in r["parts"]][:2]  # two things at once, a side mirrored
     keep_notes(rig, r)   # a library clip played as captured
+    if rig is not None and r.get("provenance"):
+        rig[PROVENANCE_KEY] = str(r["provenance"])   # "captured: HDM05 bd kickLFront 003 (CC BY-SA 3.0)" or "generated"
     return rig
 
 
@@ -207,7 +209,8 @@ class SHAPEMOVE_OT_generate(JobOperator, bpy.types.Operator):
         s = context.scene.shapemove
         prompt = scene_prompt(context)
         params = {**generation_params(context, prompt), "prompt": prompt,
-                  "seconds": s.seconds if s.use_seconds else None, **library_param(context)}
+                  "seconds": s.seconds if s.use_seconds else None, "captured": bool(s.use_captured),
+                  **library_param(context)}
         name = paths.slug(prompt, 24)
 
         job_submit.submit_job("generate", params, kind=self.job, label="generate",

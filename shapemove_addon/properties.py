@@ -106,6 +106,10 @@ class ShapeMoveSceneSettings(bpy.types.PropertyGroup):
                               description="The Library folder's captioned motions join the candidates for the "
                                           "prompt; one the model's codes cannot carry (a fast kick) is played as "
                                           "captured")
+    use_captured: BoolProperty(name="Captured takes", default=True,
+                               description="Captured performances of the asked action (the model's motion library) "
+                                           "compete with the generated motions and play as captured; off: every "
+                                           "motion is generated")
     # shape
     shape_from_text: StringProperty(name="Shape text", default="",
                                     description="e.g. 'a man with a height of 185 cm and a waist circumference of 90 cm'")

@@ -15,6 +15,7 @@ from .scene_build import RIG_MARK
 
 
 PHYSICS_KEY = "shapemove_physics"  # a generated motion's physics figures (the generate job's, stored by the operator)
+PROVENANCE_KEY = "shapemove_provenance"  # where the motion came from: "generated", "captured: HDM05 bd kickLFront 003 (...)"
 TAKE_NOTES_KEY = "shapemove_take_notes"  # a take played from its own rotations, and why (retarget, a library clip)
 
 

@@ -179,11 +179,12 @@ def test_library_clip_reads_motion_files_as_takes_and_refuses_bad_ones(tmp_path)
 
 
 def test_a_library_kick_the_codec_flattens_is_played_as_captured(mocap_root, openbody, tmp_path):
-    """A user's captured front kick in the library: kept for its own caption, its codes would
-    bring the right ankle's 1.0 m rise down to under half (retargeted through the SA-VAE,
-    tests/test_code_search.py), so the window kept is played from the file by its own rotations,
-    feet planted, starting at the origin facing +Z like a decoded motion, with a note; the worker's
-    generate job does the same with "library" (the Generate panel's "Use Library motions")."""
+    """A user's captured front kick in the library: its codes would bring the right ankle's 1.0 m
+    rise down to under half (retargeted through the SA-VAE, tests/test_code_search.py), so it
+    competes as a captured take (``captured_takes.py``): kept for its own caption, its busiest
+    window is played from the file by its own rotations, feet planted, starting at the origin facing
+    +Z like a decoded motion, and says where it came from; the worker's generate job does the same
+    with "library" (the Generate panel's "Use Library motions")."""
     import shutil
 
     import torch
@@ -206,8 +207,8 @@ def test_a_library_kick_the_codec_flattens_is_played_as_captured(mocap_root, ope
     own = Generator(None)
     assert own.add_library(lib) == 1
     m = own.generate_batch([Request(caption, seconds=4, seed=0, retrieval_first=0.0)])[0]
-    assert m.retrieved_clips == ["library:kick"] and m.tokens is None and m.num_frames == 80
-    assert len(m.notes) == 1 and "kick.bvh" in m.notes[0] and not m.warnings
+    assert m.provenance == "captured: kick.bvh (your library)" and m.tokens is None and m.num_frames == 80
+    assert not m.notes and not m.warnings
     lift = lambda y: float(y.max() - y.min())  # noqa: E731   (the right ankle's rise)
     assert lift(src) > 0.9 and lift(m.joints[:, 8, 1]) > 0.9 * lift(src)
     j = m.joints
@@ -220,7 +221,7 @@ def test_a_library_kick_the_codec_flattens_is_played_as_captured(mocap_root, ope
     assert np.abs(v[..., 1].min(1).values.numpy()).max() < 0.005
     r = jobs_shapemove.generate({"prompt": caption, "seconds": 4, "library": str(lib), "out": str(tmp_path / "g.npz")},
                                 lambda *a: None, lambda: False)
-    assert r["tokens"] == 0 and len(r["notes"]) == 1 and "kick.bvh" in r["notes"][0] and not r["warnings"]
+    assert r["tokens"] == 0 and r["provenance"] == "captured: kick.bvh (your library)" and not r["warnings"]
     assert lift(load_motion(tmp_path / "g.npz").joints[:, 8, 1]) > 0.9 * lift(src)
     # a body-shape change plants the take again on the new body (the panel's re-decode job)
     short = [-1.5] + [0.0] * 9
@@ -232,14 +233,11 @@ def test_a_library_kick_the_codec_flattens_is_played_as_captured(mocap_root, ope
     with pytest.raises(ShapeMoveError, match="library folder not found"):
         jobs_shapemove.generate({"prompt": caption, "library": str(tmp_path / "nowhere"), "out": str(tmp_path / "x.npz")},
                                 lambda *a: None, lambda: False)
-    # asked longer than the clip (11.8 s of codes): it competes whole while it covers half the length
-    # asked, and says it is shorter; asked more than twice its length, it does not compete
+    # asked longer than the take (11.8 s): played whole, its last pose held for the rest, and said
     whole = own.generate_batch([Request(caption, seconds=16, seed=0, retrieval_first=0.0)])[0]
-    assert whole.retrieved_clips == ["library:kick"] and whole.num_frames == 236
-    assert any("played whole, shorter than the 16 s asked" in n for n in whole.notes)
+    assert whole.provenance == "captured: kick.bvh (your library)" and whole.num_frames == 320
+    assert any("its last pose is held for the remaining 4.1 s" in n for n in whole.notes)
     assert lift(whole.joints[:, 8, 1]) > 0.9 * lift(src)
-    far = own.generate_batch([Request(caption, seconds=25, seed=0, retrieval_first=0.0)])[0]
-    assert "library:kick" not in far.retrieved_clips and far.num_frames == 500 and not far.notes
 
 
 def test_a_library_kick_loops_and_stays_in_place_as_captured(mocap_root, openbody, tmp_path, monkeypatch):
@@ -271,7 +269,7 @@ def test_a_library_kick_loops_and_stays_in_place_as_captured(mocap_root, openbod
     assert seam_report(m)["jump_ratio"] < 3.0
     r = job(in_place=True, seconds=4.0, library=str(lib))
     m = load_motion(r["path"])
-    assert r["tokens"] == 0 and len(r["notes"]) == 1 and m.num_frames == 80
+    assert r["tokens"] == 0 and m.provenance == "captured: kick.bvh (your library)" and m.num_frames == 80
     assert np.ptp(m.joints[:, 0, [0, 2]], axis=0).max() < 1e-4 and lift(m.joints[:, 8, 1]) > 0.85 * src
     r = job(loop=True, seconds=2.0)                     # the codes' loop: the kick flattened
     assert not r["notes"] and lift(load_motion(r["path"]).joints[:, 8, 1]) < 0.5 * src
@@ -296,9 +294,11 @@ def test_a_library_kick_is_found_for_words_the_training_kicks_are_nearer_to(moca
                                                                            monkeypatch):
     """"a karate front kick" is nearer to the training set's kicks (0.73) than to the user's "a
     person does a high front kick with the right leg" (0.67), "a woman kicks" to "A person kicks."
-    (0.90 against 0.56): without ``library_codes`` the user's kick is never a candidate and the
-    codes' kick barely lifts the ankle; with it, the library kick competes (by its caption, by the
-    action named), is kept and is played as captured. A walk or a punch is not given the kick."""
+    (0.90 against 0.56): the user's kick competes as a captured take all the same (the user's
+    nearest clip by caption and their nearest of the action named, ``TakePool.nearest``), is kept
+    and is played as captured. A walk or a punch is not given the kick. With captured takes off
+    (``--no-library``) the user's clip competes by its codes (``library_codes``); without those,
+    the codes' kick barely lifts the ankle."""
     import shutil
 
     from shapemove.core.generation import generate as generate_module
@@ -315,12 +315,16 @@ def test_a_library_kick_is_found_for_words_the_training_kicks_are_nearer_to(moca
     own = Generator(None)
     own.add_library(lib)
     run = lambda p: own.generate_batch([Request(p, seconds=4, seed=0)])[0]  # noqa: E731
+    mine = "captured: kick.bvh (your library)"
+    m = run("a karate front kick")
+    assert m.provenance == mine and lift(m.joints[:, 8, 1]) > 0.9 * src
+    m = run("a woman kicks")                         # nearest "A person kicks." (0.90): the user's kick by its action
+    assert m.provenance == mine and lift(m.joints[:, 8, 1]) > 0.85 * src
+    assert run("a person walks forward").provenance != mine
+    assert run("a person punches").provenance != mine
+    own.set_captured(False)
     m = run("a karate front kick")
     assert m.retrieved_clips == ["library:kick"] and len(m.notes) == 1 and lift(m.joints[:, 8, 1]) > 0.9 * src
-    m = run("a woman kicks")                         # nearest "A person kicks." (0.90): the user's kick by its action
-    assert m.retrieved_clips == ["library:kick"] and lift(m.joints[:, 8, 1]) > 0.85 * src
-    assert "library:kick" not in run("a person walks forward").retrieved_clips
-    assert "library:kick" not in run("a person punches").retrieved_clips
     monkeypatch.setattr(generate_module, "library_codes", lambda *a, **k: [])
     m = run("a karate front kick")
     assert "library:kick" not in m.retrieved_clips and lift(m.joints[:, 8, 1]) < 0.3 * src

@@ -31,6 +31,7 @@ from ..models.text_encoder import load_text_encoder
 from ..scene.motion_file import Motion
 from ..torch_threads import one_torch_thread
 from .action_clips import ACTION_CLIPS, UNASKED_SECONDS, action_clips
+from .captured_takes import ACTION_BONUS, TakePool, Window, captured_motion, decoded_provenance
 from .course_walk import ACTIONS as COURSE_ACTIONS, course_motion, course_named, walked_straight
 from .decode import decode_features, decode_tokens, redecode
 from .library_takes import captured_window, read_take, window_fit
@@ -52,6 +53,15 @@ from .turn_words import turn_motion
 
 
 LIBRARY_TAKES = 8   # library clips kept read as captured at once (Generator._library_window)
+
+
+class Choice(NamedTuple):
+    """What ``Generator.choose`` kept for one request: a T5 sample's or a memory clip's codes, or a
+    captured take's window."""
+    codes: list[int] | None       # the codes kept (None: a captured take)
+    betas: torch.Tensor           # (10,) the [BETA] head's body
+    kept: str | None              # the memory clip whose codes were kept, None for a T5 sample
+    window: Window | None         # the captured take kept (captured_takes.py)
 
 
 class Chosen(NamedTuple):
@@ -124,6 +134,9 @@ class Generator:
         self._picker = None
         self.library_files: dict[str, Path] = {}   # memory clip id -> the user's file (add_library)
         self._library_takes: dict[str, dict | None] = {}  # library clips read as captured (library_takes.read_take)
+        self._library_file = files.get("library")
+        self._pool: TakePool | None = None
+        self.captured_on = True   # captured takes compete with the samples (captured_takes.py; --no-library: off)
 
     @property
     def picker(self) -> CandidatePicker | None:
@@ -133,6 +146,47 @@ class Generator:
 
             self._picker = CandidatePicker(load_tma(self._tma_file))
         return self._picker
+
+    @property
+    def pool(self) -> TakePool | None:
+        """The captured takes that compete (the model folder's ``library.npz`` and the user's
+        library), loaded on first use; None without the TMA that compares them with a prompt."""
+        if self._pool is None and self.picker is not None:
+            library = None
+            if self._library_file is not None and self._library_file.is_file():
+                from ..data.motion_library import MotionLibrary
+                from ..model_files import sha256_file, verify_file
+
+                verify_file(self._library_file)
+                library = MotionLibrary.load(self._library_file)
+            self._pool = TakePool(self.body, library, self._embed_texts, self.ik_refine_iters)
+            if library is not None:
+                same = library.tma_sha256 and library.tma_sha256 == sha256_file(self._tma_file)
+                self._pool.set_vectors(library.vectors if same else None)
+        return self._pool
+
+    def _embed_texts(self, texts: list[str]) -> np.ndarray:
+        """(N,E) unit TMA text vectors."""
+        from ..models.tma_embed import embed_texts
+
+        with one_torch_thread(), torch.no_grad():
+            return embed_texts(self.picker.model, self.picker.tok, list(texts))
+
+    def set_captured(self, on: bool) -> None:
+        """Captured takes compete with the samples (on, the default) or not (generation only)."""
+        self.captured_on = bool(on)
+
+    def _windows(self, r: Request, lo: int, hi: int, side=None) -> list[Window]:
+        """Windows of the captured takes offered for ``r`` (``captured_takes.TakePool``)."""
+        pool = self.pool if self.captured_on else None
+        if pool is None or not len(pool):
+            return []
+        down = self.vae.cfg.downsample
+        action = self._asked(r)
+        text = self._embed_texts([r.prompt])[0]
+        if r.seconds is None:   # the model's length: a take plays whole, at least UNASKED_SECONDS
+            return pool.windows(text, action, r.seed, self._length(UNASKED_SECONDS)[0] * down, side, hi * down)
+        return pool.windows(text, action, r.seed, lo * down, side)
 
     # -- tokens ------------------------------------------------------------------------------
     def _length(self, seconds: float | None) -> tuple[int, int]:
@@ -152,30 +206,51 @@ class Generator:
         play it (the caller plays it so)."""
         if self.t5 is None:
             raise ShapeMoveError(f"{self.model_dir} has no t5/ model: text-to-motion needs one (train t5)")
-        codes, betas, kept = [], [], []
-        with one_torch_thread():
-            for r in reqs:  # one at a time: each has its own seed, length and temperature
-                g = torch.Generator().manual_seed(int(r.seed))
-                lo, hi = self._length(r.seconds)
-                found = self._action_clips(r, lo, hi)
-                cands, sources, beta = (self._from_action_clips(r, found) if found
-                                        else self._sampled(r, lo, hi, g))
-                best = 0
-                if len(cands) > 1 and self.picker is not None:
-                    feats = []
-                    for c, src in zip(cands, sources):
-                        fit = self._library_window(src, c) if library_as_captured else None
-                        feats.append(decode_features(c, self.vae, beta.numpy()).numpy() if fit is None
-                                     else np.asarray(self._library_takes[src]["new_joint_vecs"][fit.lo:fit.hi]))
-                    best = self.picker.pick(r.prompt, feats)
-                codes.append(cands[best])
-                betas.append(beta)
-                kept.append(sources[best])
-        return Chosen(codes, torch.stack(betas), kept)
+        chosen = [self._choose(r, library_as_captured) for r in reqs]
+        return Chosen([c.codes for c in chosen], torch.stack([c.betas for c in chosen]), [c.kept for c in chosen])
 
-    def _sampled(self, r: Request, lo: int, hi: int, g: torch.Generator):
+    @torch.no_grad()
+    def choose(self, r: Request, side=None) -> Choice:
+        """One request's choice among the T5's samples (and memory clips, as ``tokens_for``) and
+        the captured takes of the asked action and nearest captions (``captured_takes.py``), by the
+        TMA on the finished motions; ``side``: a named side, the takes mirrored to it."""
+        return self._choose(r, True, self.captured_on, side)
+
+    def _choose(self, r: Request, library_as_captured: bool, captured: bool = False, side=None) -> Choice:
+        if self.t5 is None:
+            raise ShapeMoveError(f"{self.model_dir} has no t5/ model: text-to-motion needs one (train t5)")
+        with one_torch_thread():
+            g = torch.Generator().manual_seed(int(r.seed))
+            lo, hi = self._length(r.seconds)
+            found = self._action_clips(r, lo, hi)
+            windows = self._windows(r, lo, hi, side) if captured else []
+            cands, sources, beta = (self._from_action_clips(r, found) if found    # the user's clips: as captured
+                                    else self._sampled(r, lo, hi, g, library=not windows))   # takes, or as codes
+            best = 0
+            if len(cands) + len(windows) > 1 and self.picker is not None:
+                feats = []
+                for c, src in zip(cands, sources):
+                    fit = self._library_window(src, c) if library_as_captured else None
+                    feats.append(decode_features(c, self.vae, beta.numpy()).numpy() if fit is None
+                                 else np.asarray(self._library_takes[src]["new_joint_vecs"][fit.lo:fit.hi]))
+                asked = self._asked(r)
+                bonus = [0.0] * len(cands) + [ACTION_BONUS if asked and w.action == asked else 0.0 for w in windows]
+                best = self.picker.pick(r.prompt, feats + [w.features for w in windows], bonus)
+            if best >= len(cands):
+                return Choice(None, beta, None, windows[best - len(cands)])
+            return Choice(cands[best], beta, sources[best], None)
+
+    @staticmethod
+    def _asked(r: Request) -> str | None:
+        """The action the request asks for: the planner's reading, else the first its words name."""
+        from ..data.actions import find_actions, specific
+
+        return r.action or (specific(find_actions(r.prompt)) or [None])[0]
+
+    def _sampled(self, r: Request, lo: int, hi: int, g: torch.Generator, library: bool = True):
         """(candidate codes, their memory clip or None, betas): best-of-N's T5 samples (some seeded
-        by retrieved clips) and the retrieved clips nearest by caption."""
+        by retrieved clips) and the retrieved clips nearest by caption (``library``: the user's
+        library clips' codes among them)."""
         n = r.candidates if r.temperature > 0 and self.picker is not None else 1
         seeds = self._retrieval_seeds(r, n)
         s = self.default_guidance if r.guidance is None else r.guidance
@@ -191,7 +266,7 @@ class Generator:
             beta = out.betas[0] if beta is None else beta  # [BETA] precedes the codes: one body for all
         sources = [None] * len(cands)
         if n > 1:  # real clips nearest by caption compete with the samples, or replace them
-            found = self._retrieved(r, lo, hi)
+            found = self._retrieved(r, lo, hi, library)
             if found and r.retrieval_first is not None and found[0][1] >= r.retrieval_first:
                 cands, sources = [], []
             for cid, _, c in found:
@@ -219,12 +294,14 @@ class Generator:
         with one_torch_thread():
             return self.t5.predict_betas(self.t5.inputs_for(self.tok, [prompt], [shape_text]))[0]
 
-    def _retrieved(self, r: Request, lo: int, hi: int) -> list[tuple[str, float, list[int]]]:
+    def _retrieved(self, r: Request, lo: int, hi: int, library: bool = True) -> list[tuple[str, float, list[int]]]:
         """(clip id, caption similarity, codes) of the memory's clips nearest to the prompt (``retrieved_candidates.py``),
         when the model folder has a memory and retrieval is on."""
         if not r.retrieved or self.t5.memory is None or not self.t5.memory_enabled:
             return []
         found = retrieved_codes(self.t5.memory, self._text_encoder(), r.prompt, r.retrieved, lo, hi)
+        if not library:
+            return found
         return found + library_codes(self.t5.memory, self._text_encoder(), r.prompt, self.library_files, found, lo, hi)
 
     def offers_library(self, r: Request) -> bool:
@@ -293,6 +370,8 @@ class Generator:
         self.t5.memory.add_clips([f"library:{i}" for i in ids], [[c] for c in captions], tokens, self.tok)
         self._library_takes.clear()
         self.library_files.update({f"library:{i}": Path(f) for i, f in zip(ids, files)})
+        if self.pool is not None:   # and as captured takes, beside the built-in library's (captured_takes.py)
+            self.pool.add_files([f"library:{i}" for i in ids], [Path(f) for f in files], list(captions))
         return len(ids)
 
     def _library_window(self, clip: str | None, codes: list[int]):
@@ -326,6 +405,21 @@ class Generator:
                                      self.ik_refine_iters)
         motion.prompt = prompt
         return motion
+
+    def chosen_motion(self, c: Choice, betas, prompt: str | None = None) -> Motion:
+        """The finished motion of a ``Choice`` on the body ``betas``, with its provenance: a captured
+        take moved by its own rotations (``captured_takes.captured_motion``), a library clip the
+        codes miss played as captured (``library_take``), or the codes decoded."""
+        if c.window is not None:
+            with one_torch_thread():
+                return captured_motion(c.window, self.body, betas, self.ik_refine_iters, prompt)
+        m = self.library_take(c.kept, c.codes, betas, prompt)
+        if m is not None:
+            m.provenance = f"captured: {self.library_files[c.kept].name} (your library)"
+            return m
+        m = self.decode_motion(c.codes, betas, prompt=prompt)
+        m.provenance = decoded_provenance(c.kept)
+        return m
 
     def _text_encoder(self):
         if self.t5 is not None and self.t5.encoder_kind == "minilm":
@@ -407,15 +501,15 @@ class Generator:
             course = self.asks_course(r.prompt, check) if r.by_parts else None   # course_walk.py
             if motion is None:  # one action, no side named: the motion as the model writes it
                 sampled = asked if course is None else dataclasses.replace(asked, prompt=walked_straight(asked.prompt))
-                codes, pred, kept = self.tokens_for([sampled], library_as_captured=True)
-                betas, source = self.body_shape(r, pred[0].numpy())
-                motion = (self.library_take(kept[0], codes[0], betas, r.prompt)   # a library clip as captured
-                          or self.decode_motion(codes[0], betas, prompt=r.prompt))
+                choice = self.choose(sampled)   # samples and captured takes, one choice (captured_takes.py)
+                betas, source = self.body_shape(r, choice.betas.numpy())
+                motion = self.chosen_motion(choice, betas, r.prompt)
+                provenance = motion.provenance
                 if stop is not None:   # stop_words.py: cut, then stand
                     motion = self.stopped(motion, stop[1], r.seconds, metres)
-                motion.shape_source = source
-                motion.retrieved_clips = [c for c in kept if c]
-                self._say_if_short(motion, kept[0], r.seconds)
+                motion.shape_source, motion.provenance = source, provenance
+                motion.retrieved_clips = [choice.kept] if choice.kept else []
+                self._say_if_short(motion, choice.kept, r.seconds)
                 if r.by_parts:  # the codec does not carry turning: a course or a turn the words name, given back
                     motion = (course_motion(motion, self.body, r.prompt, self.ik_refine_iters, course)   # course_walk.py
                               if course is not None else

@@ -29,15 +29,19 @@ def resolve_model_dir(path=None) -> Path:
 
 
 def model_files(d: Path) -> dict:
-    """{"savae", "t5", "tma"} paths of a model folder. No savae.pt is an error; a part the folder's
-    manifest lists but that is gone (e.g. ``tma/tma.pt``) is an error naming it; a part the model
-    works without and never had is a warning (``part_warnings``)."""
-    files = {"savae": d / "savae.pt", "t5": d / "t5", "tma": d / "tma" / "tma.pt"}
+    """{"savae", "t5", "tma", "library"} paths of a model folder (the motion library of captured
+    takes is optional). No savae.pt is an error; a part the folder's manifest lists but that is gone
+    (e.g. ``tma/tma.pt``) is an error naming it; a part the model works without and never had is a
+    warning (``part_warnings``)."""
+    files = {"savae": d / "savae.pt", "t5": d / "t5", "tma": d / "tma" / "tma.pt", "library": d / "library.npz"}
     if not files["savae"].is_file():
         raise ShapeMoveError(f"{d} has no savae.pt (the SA-VAE): train one with `python -m shapemove train vae`")
     if not files["tma"].is_file() and listed_in_manifest(d, "tma/tma.pt"):
         raise ShapeMoveError(f"model file {files['tma']} is missing (listed in {d / 'manifest.json'}): without it "
                              "best-of-N picking is off and the motions change; copy the model folder again")
+    if not files["library"].is_file() and listed_in_manifest(d, "library.npz"):
+        raise ShapeMoveError(f"model file {files['library']} is missing (listed in {d / 'manifest.json'}): without "
+                             "it no captured take competes and the motions change; copy the model folder again")
     return files
 
 

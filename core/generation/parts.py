@@ -27,6 +27,7 @@ from ..constants import FPS
 from ..errors import ShapeMoveError
 from ..motion.features import motion_features
 from ..scene.motion_file import Motion
+from .captured_takes import decoded_provenance
 from .course_walk import ACTIONS as COURSE_ACTIONS, course_motion, course_named, on_course, straight_gait, walked_straight
 from .decode import motion_from_joints
 from .part_compose import compose_arms, mirror_track, needs_mirror
@@ -95,16 +96,15 @@ def generate_by_parts(gen, r) -> Motion | None:
     if plan is None:  # one action, a named side: judged on the planted motion, the one the user sees
         course = course_named(r.prompt)          # "paces back and forth, waving his right hand": its gait
         sampled = dataclasses.replace(r, prompt=walked_straight(r.prompt)) if course else r   # sampled straight
-        codes, pred, kept = gen.tokens_for([sampled], library_as_captured=True)   # (planting, the foot roll above
-        betas, source = gen.body_shape(r, pred[0].numpy())                  # all, changes how far a foot travels)
-        m = gen.library_take(kept[0], codes[0], betas, r.prompt)   # a library clip the codes miss, as captured
-        if m is None or needs_mirror(m.joints, *side):
-            m = gen.decode_motion(codes[0], betas, prompt=r.prompt)
-            if needs_mirror(m.joints, *side):
-                m = assemble(gen.body, betas, _track(codes[0], gen.vae, gen.body, betas, True), None, r.prompt,
-                             gen.ik_refine_iters, tokens=np.asarray(codes[0], np.int32), mirrored=True)
+        choice = gen.choose(sampled, side)   # captured takes, mirrored to the side, compete with the samples
+        betas, source = gen.body_shape(r, choice.betas.numpy())   # (planting, the foot roll above all, changes
+        m = gen.chosen_motion(choice, betas, r.prompt)            # how far a foot travels)
+        if choice.window is None and needs_mirror(m.joints, *side):
+            m = assemble(gen.body, betas, _track(choice.codes, gen.vae, gen.body, betas, True), None, r.prompt,
+                         gen.ik_refine_iters, tokens=np.asarray(choice.codes, np.int32), mirrored=True,
+                         provenance=decoded_provenance(choice.kept))
         m.shape_source = source
-        m.retrieved_clips = [c for c in kept if c]
+        m.retrieved_clips = [choice.kept] if choice.kept else []
         return m if course is None else course_motion(m, gen.body, r.prompt, gen.ik_refine_iters, course)
     course = plan.legs_action if plan.legs_action in COURSE_ACTIONS else course_named(plan.legs_prompt)
     gait = straight_gait(plan.legs_prompt) if course is not None else None   # walked straight, then bent

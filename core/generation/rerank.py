@@ -10,7 +10,8 @@ costs one batched SA-VAE decode and one TMA pass (tens of milliseconds), not a s
 Travel and pace words come first: a candidate whose root travel goes against "forward",
 "backwards", "in place" or "steps to the left" is set aside before the TMA chooses
 (``travel_words``), for "walks quickly" or "a brisk walk" only the fastest candidates compete
-(``pace_words``), and for "jumps twice" or "three squats" only those that leave the floor or go
+(``pace_words``), for a plain "walks" or "runs" those nearest the gait's typical pace
+(``typical_pace``), and for "jumps twice" or "three squats" only those that leave the floor or go
 down the number of times nearest the asked one (``count_words``), since the TMA reads what the
 body does, not which way, how fast or how many times.
 
@@ -25,6 +26,7 @@ import numpy as np
 from .count_words import asked_count, nearest_count
 from .pace_words import asks_fast, fastest, gait_speed
 from .travel_words import allowed
+from .typical_pace import nearest_pace, typical_speed
 
 
 class CandidatePicker:
@@ -39,14 +41,19 @@ class CandidatePicker:
         text = embed_texts(self.model, self.tok, [prompt])[0]
         return embed_motions(self.model, feats, self.mean, self.std) @ text
 
-    def pick(self, prompt: str, feats: list) -> int:
+    def pick(self, prompt: str, feats: list, bonus=None) -> int:
         """Index of the candidate closest to ``prompt`` among those that obey its travel, pace and
-        count words (the first on a tie)."""
+        count words (the first on a tie); ``bonus`` (N,): added to the similarities (a captured
+        take of the asked action, ``captured_takes.ACTION_BONUS``)."""
         keep = allowed(prompt, feats)
+        typical = typical_speed(prompt)
         if asks_fast(prompt):
             keep = fastest(np.array([gait_speed(f) for f in feats]), keep)
+        elif typical is not None:   # a plain gait: its typical pace (typical_pace.py)
+            keep = nearest_pace([gait_speed(f) for f in feats], keep, typical)
         counted = asked_count(prompt)
         if counted is not None:
             count, want = counted
             keep = nearest_count([count(f) for f in feats], want, keep)
-        return int(np.argmax(np.where(keep, self.scores(prompt, feats), -np.inf)))
+        scores = self.scores(prompt, feats) + (0.0 if bonus is None else np.asarray(bonus, np.float64))
+        return int(np.argmax(np.where(keep, scores, -np.inf)))

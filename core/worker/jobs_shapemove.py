@@ -87,7 +87,8 @@ def generate(params, progress, cancel) -> dict:
     """params {"prompt", "shape_text", "betas" (10, optional), "seconds" (optional), "seed",
     "temperature", "top_k", "by_parts" (optional, default true), "model" (folder, optional), "body",
     "library" (optional: a folder of the user's captioned motions added to the retrieval memory; a
-    clip of it kept whose codes miss it is played as captured, ``library_takes.py``), "out" (.npz)}
+    clip of it kept whose codes miss it is played as captured, ``library_takes.py``), "captured"
+    (optional, default true: captured takes compete, ``captured_takes.py``), "out" (.npz)}
     -> the motion file written, its facts, the body's measurements (cm) and what generation by body
     part did ("parts")."""
     from ..generation.generate import Request
@@ -107,6 +108,7 @@ def generate(params, progress, cancel) -> dict:
     progress(0.05, "loading models")
     gen = _generator(param(params, op, "model", str, None), param(params, op, "body", str, None),
                      param(params, op, "library", str, None))
+    gen.set_captured(bool(param(params, op, "captured", bool, True)))
     if cancel():
         raise JobCancelled
     progress(0.2, "writing motion tokens")
@@ -123,7 +125,7 @@ def generate(params, progress, cancel) -> dict:
             "warnings": list(motions[0].warnings),
             "model_warnings": [w for w in motions[0].warnings if w in part_warnings(gen.model_dir)],
             "nearest_actions": list(check.nearest_actions) if check is not None else [],
-            "parts": _parts(motions[0]), "notes": list(motions[0].notes)}
+            "parts": _parts(motions[0]), "notes": list(motions[0].notes), "provenance": motions[0].provenance}
 
 
 def _parts(motion) -> list[str]:

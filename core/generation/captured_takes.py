@@ -1,0 +1,252 @@
+"""Captured takes in the same pool as the T5's samples: one choice among finished motions.
+
+The codec flattens what it carries badly (a front kick's ankle comes back at a fifth of its height,
+docs/codec.md), so a captured performance offered as codes never reaches the user as performed.
+Here the takes themselves compete: the built-in motion library (``data/motion_library.py``,
+``library.npz`` of the model folder) and the user's own library (``Generator.add_library``), both
+in one ``TakePool``. For a prompt:
+
+- the takes of the action the words ask for (``data/actions.py``'s patterns, or the planner's
+  reading for a part) nearest the prompt by caption (the TMA text embedding of the prompt against
+  each take's captions), and the takes nearest by caption whatever their action, ``TAKES`` in
+  all, drawn by the request's seed from the ``POOL`` x as many nearest (another seed, other takes);
+  the user's own clips come first: their nearest by caption and their nearest of the asked action;
+- each gives one window of the requested length (one of its busiest, ``busiest_start``); a take shorter
+  than asked is held on its last pose for the rest (a kick, then standing); with no length asked
+  a take plays whole, at least ``UNASKED_SECONDS``;
+- a named side ("kicks with the right leg") mirrors a take whose other side moves most
+  (``part_compose.needs_mirror``; ``data/mirror.py``'s rotations);
+- each window's features, on the performer's own body (``ClipProcessor.pose_on``), join the
+  samples' decoded features, and the TMA chooses among them all (``rerank.CandidatePicker``), a
+  take of the asked action credited ``ACTION_BONUS``.
+
+A window kept is moved onto the requested body by its own rotations with its feet planted
+(``retarget.planted_retarget``), never through the codes, and says where it came from
+(``Motion.provenance``: "captured: HDM05 bd kickLFront 003 (CC BY-SA 3.0)").
+
+    pool = TakePool(body, MotionLibrary.load(path), embed)    # embed(texts): unit TMA text vectors
+    pool.set_vectors(None)                                    # the captions embedded (or the file's own)
+    windows = pool.windows(embed(["a man throws a jab"])[0], "punch", seed=0, frames=80)
+    motion = captured_motion(windows[0], body, betas)
+"""
+from __future__ import annotations
+
+import random
+from collections import OrderedDict
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..constants import FPS
+from ..errors import ShapeMoveError
+from ..scene.motion_file import Motion
+
+TAKES = 5              # captured windows offered per prompt
+POOL = 2               # drawn by the seed from the POOL x TAKES nearest
+NEAREST = 2            # of them, at most this many by caption alone when the words name an action
+ACTION_BONUS = 0.1     # TMA cosine credited to a take of the asked action
+UNASKED_SECONDS = 4.0  # the least a take plays when the length is the model's
+BUSIEST = 2            # a long take's busiest windows, one drawn by the seed
+KEPT = 16              # takes kept read at once (rotations as matrices)
+USER_FLOOR = 0.5       # TMA caption cosine from which the user's nearest clip is offered whatever its action
+
+
+@dataclass
+class Window:
+    """A stretch of a take, ready to be scored and planted."""
+    rotations: np.ndarray   # (T,24,3,3), the held frames included
+    root: np.ndarray        # (T,3)
+    contacts: np.ndarray    # (T,4)
+    rest: np.ndarray        # (24,3) rest joints of the performer's body
+    features: np.ndarray    # (T-1,263) on the performer's body, for the TMA
+    action: str
+    clip_id: str
+    provenance: str
+    held: int = 0           # frames held on the last pose
+    mirrored: bool = False
+
+
+def hold(rotations, root, contacts, frames: int):
+    """A take shorter than ``frames`` held on its last pose (its contacts, or both feet down when
+    the last frame has none) for the rest."""
+    extra = frames - len(rotations)
+    if extra <= 0:
+        return rotations, root, contacts
+    last = contacts[-1] if contacts[-1].any() else np.ones(4, np.uint8)
+    return (np.concatenate([rotations, np.repeat(rotations[-1:], extra, 0)]),
+            np.concatenate([root, np.repeat(root[-1:], extra, 0)]),
+            np.concatenate([contacts, np.repeat(last[None], extra, 0)]).astype(np.uint8))
+
+
+def mirrored(rotations, root, contacts):
+    """The mirror image of a take (``data/mirror.py``: left and right swapped, x negated)."""
+    from ..data.mirror import mirror_contacts, mirror_rotations
+
+    r = np.asarray(root, np.float32).copy()
+    r[:, 0] *= -1
+    return mirror_rotations(rotations).astype(np.float32), r, mirror_contacts(contacts)
+
+
+class TakePool:
+    """The takes that compete: the built-in library's and the user's files (read when offered)."""
+
+    def __init__(self, body, library=None, embed=None, ik_refine_iters: int = 10):
+        """``library``: a ``MotionLibrary`` or None; ``embed(texts) -> (N,E)`` unit TMA text vectors
+        (the library's own are used when it was made with the same TMA, ``vectors_ok``)."""
+        from .retarget import processor
+
+        self.body, self.library, self.embed = body, library, embed
+        self.proc = processor(body, ik_refine_iters)
+        self.ik_refine_iters = ik_refine_iters
+        n = 0 if library is None else len(library)
+        self.actions: list[str] = list(library.actions) if library is not None else []
+        self.files: list[Path | None] = [None] * n
+        self.ids: list[str] = [str(c) for c in library.a["clip_ids"]] if library is not None else []
+        self.vectors = np.zeros((n, 0), np.float32)
+        self._cache: OrderedDict = OrderedDict()
+
+    def __len__(self) -> int:
+        return len(self.actions)
+
+    def set_vectors(self, vectors: np.ndarray | None) -> None:
+        """The library's caption vectors, or None: embedded here (each take's captions, averaged)."""
+        if self.library is None:
+            return
+        if vectors is None:
+            if self.embed is None:
+                raise ShapeMoveError("the motion library's captions need the model's TMA to be compared with a prompt")
+            vectors = np.stack([_unit(self.embed(self.library.captions(k) or [self.actions[k]]).mean(0))
+                                for k in range(len(self.library))])
+        self.vectors = np.asarray(vectors, np.float32)
+
+    def add_files(self, ids: list[str], paths: list[Path], captions: list[str]) -> None:
+        """The user's captioned clips (read as takes when first offered: ``library_takes.read_take``)."""
+        from ..data.actions import find_actions
+
+        if not ids:
+            return
+        if self.embed is None:
+            raise ShapeMoveError("a library's captions need the model's TMA to be compared with a prompt")
+        v = self.embed(list(captions))
+        self.vectors = v if not len(self.vectors) else np.concatenate([self.vectors, v])
+        self.actions += [(find_actions(c) or [""])[0] for c in captions]
+        self.files += [Path(p) for p in paths]
+        self.ids += list(ids)
+
+    def is_user(self, i: int) -> bool:
+        return self.files[i] is not None
+
+    def take(self, i: int) -> dict:
+        """Take ``i`` as arrays: rotations (T,24,3,3), root, contacts, rest, betas, provenance."""
+        if i in self._cache:
+            self._cache.move_to_end(i)
+            return self._cache[i]
+        import torch
+
+        if self.files[i] is None:
+            t = self.library.take(i)
+            with torch.no_grad():
+                rest = self.body.rest_joints(torch.as_tensor(t.betas)[None])[0].numpy()
+            if abs(t.fps - FPS) > 1e-6:
+                raise ShapeMoveError(f"motion library take {t.clip_id} is at {t.fps:g} fps, not {FPS}")
+            out = {"rotations": t.rotations, "root": t.root, "contacts": t.contacts, "rest": rest, "betas": t.betas,
+                   "provenance": t.provenance}
+        else:
+            from .library_takes import read_take
+
+            t = read_take(self.files[i], self.body, self.ik_refine_iters)
+            out = {k: t[k] for k in ("rotations", "root", "contacts", "rest", "betas")}
+            out["provenance"] = f"captured: {self.files[i].name} (your library)"
+        self._cache[i] = out
+        if len(self._cache) > KEPT:
+            self._cache.popitem(last=False)
+        return out
+
+    def nearest(self, text: np.ndarray, action: str | None, seed: int, count: int = TAKES) -> list[int]:
+        """Takes offered for a prompt whose TMA text vector is ``text`` (see the module docstring)."""
+        if not len(self) or not len(self.vectors):
+            return []
+        sims = self.vectors @ np.asarray(text, np.float32)
+        rng = random.Random(int(seed))
+        chosen: list[int] = []
+
+        def draw(ids, k):
+            ids = [i for i in sorted(ids, key=lambda i: -sims[i]) if i not in chosen][:POOL * k]
+            chosen.extend(ids[j] for j in sorted(rng.sample(range(len(ids)), min(k, len(ids)))))
+
+        user = [i for i in range(len(self)) if self.is_user(i)]
+        if user:   # the user's own: the nearest by caption, and the nearest of the asked action
+            best = max(user, key=lambda i: sims[i])
+            if sims[best] >= USER_FLOOR:
+                chosen.append(best)
+            mine = [i for i in user if action and self.actions[i] == action and i not in chosen]
+            if mine:
+                chosen.append(max(mine, key=lambda i: sims[i]))
+        named = [i for i in range(len(self)) if action and self.actions[i] == action]
+        draw(named, max(0, count - len(chosen) - NEAREST) if named else 0)
+        draw(range(len(self)), max(0, count - len(chosen)))
+        return chosen
+
+    def window(self, i: int, frames: int, seed: int, side=None, longest: int | None = None) -> Window:
+        """Take ``i`` cut to ``frames`` (the seed picks the start), or held to it when shorter;
+        ``longest``: the length is the model's (``frames`` the least), the take plays whole up to
+        ``longest`` frames. ``side``: ("left" | "right", "hand" | "foot") mirrors a take whose
+        other side moves most."""
+        from .part_compose import needs_mirror
+
+        t = self.take(i)
+        n = len(t["rotations"])
+        want = min(max(frames, n), longest) if longest is not None else frames
+        lo = 0 if n <= want else busiest_start(t["rotations"], want, seed)
+        rot, root, con = (np.asarray(t[k][lo:lo + want]) for k in ("rotations", "root", "contacts"))
+        held = max(0, want - len(rot))
+        rot, root, con = hold(rot, root, con, want)
+        joints = self.proc.pose_on(rot, root, t["betas"], 1.0, con)
+        flip = side is not None and needs_mirror(joints, *side)
+        if flip:
+            rot, root, con = mirrored(rot, root, con)
+            joints = self.proc.pose_on(rot, root, t["betas"], 1.0, con)
+        return Window(rot, root, con, t["rest"], self.proc.features(joints, rot, con), self.actions[i], self.ids[i],
+                      t["provenance"] + (", mirrored" if flip else ""), held, flip)
+
+    def windows(self, text: np.ndarray, action: str | None, seed: int, frames: int, side=None,
+                longest: int | None = None, count: int = TAKES) -> list[Window]:
+        return [self.window(i, frames, seed, side, longest) for i in self.nearest(text, action, seed, count)]
+
+
+def busiest_start(rotations, frames: int, seed: int) -> int:
+    """Where a window of ``frames`` starts in a longer take: of the starts a second apart (and the
+    last), one of the ``BUSIEST`` whose rotations change most (a take often starts and ends
+    standing; a kick is a second of a long take), drawn by the seed."""
+    n = len(rotations)
+    starts = sorted(set(range(0, n - frames + 1, int(FPS))) | {n - frames})
+    change = np.linalg.norm(np.diff(np.asarray(rotations)[:, :22].reshape(n, -1), axis=0), axis=1)
+    c = np.concatenate([[0.0], np.cumsum(change)])
+    busy = sorted(starts, key=lambda s: -(c[s + frames - 1] - c[s]))[:BUSIEST]
+    return busy[random.Random(int(seed)).randrange(len(busy))]
+
+
+def decoded_provenance(kept: str | None) -> str:
+    """Where a motion decoded from codes came from: "generated" (a T5 sample), or the codes of the
+    memory clip ``kept``."""
+    return "generated" if kept is None else f"generated from the codes of {kept}"
+
+
+def _unit(v):
+    return v / max(float(np.linalg.norm(v)), 1e-8)
+
+
+def captured_motion(w: Window, body, betas, ik_refine_iters: int = 10, prompt: str | None = None) -> Motion:
+    """The window on the body ``betas`` by its own rotations, feet planted (``planted_retarget``),
+    with its provenance."""
+    from .retarget import planted_retarget
+
+    out = planted_retarget({"rotations": w.rotations, "root": w.root, "rest": w.rest, "contacts": w.contacts},
+                           body, betas, ik_refine_iters)
+    out.prompt = prompt
+    out.provenance = w.provenance
+    if w.held:
+        out.notes.append(f"the captured take lasts {(len(w.rotations) - w.held) / FPS:.1f} s: its last pose is held "
+                         f"for the remaining {w.held / FPS:.1f} s")
+    return out

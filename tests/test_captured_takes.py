@@ -1,0 +1,140 @@
+"""Captured takes compete with the T5's samples and play as performed (generation/captured_takes.py)."""
+from __future__ import annotations
+
+import shutil
+
+import numpy as np
+import pytest
+
+from shapemove.core.data.motion_library import MotionLibrary
+from shapemove.core.errors import ShapeMoveError
+from shapemove.core.generation.captured_takes import TakePool, busiest_start, hold, mirrored
+
+pytestmark = pytest.mark.usefixtures("one_thread")
+
+KICK = "a person does a front kick with the left leg"
+
+
+def lift(y) -> float:
+    return float(np.max(y) - np.min(y))
+
+
+def _rot(n, seed=0):
+    from shapemove.core.geometry.rotations import axis_angle_to_matrix
+
+    return axis_angle_to_matrix(np.random.default_rng(seed).normal(0, 0.3, (n, 24, 3))).astype(np.float32)
+
+
+def test_hold_mirror_and_busiest_window():
+    rot, root = _rot(10), np.cumsum(np.full((10, 3), 0.01, np.float32), 0)
+    con = np.zeros((10, 4), np.uint8)
+    con[-1, 1] = 1
+    r, t, c = hold(rot, root, con, 25)
+    assert len(r) == len(t) == len(c) == 25
+    assert np.array_equal(r[10:], np.repeat(rot[-1:], 15, 0)) and np.array_equal(t[24], root[-1])
+    assert (c[10:] == [0, 1, 0, 0]).all()                         # the last frame's contacts held
+    con[-1] = 0
+    assert (hold(rot, root, con, 12)[2][10:] == 1).all()           # none at the end: both feet down
+    m = mirrored(*mirrored(rot, root, con))
+    assert np.allclose(m[0], rot, atol=1e-5) and np.allclose(m[1], root) and np.array_equal(m[2], con)
+    assert np.allclose(mirrored(rot, root, con)[1][:, 0], -root[:, 0])
+    # a take standing still but for frames 100-139: a 40-frame window starts where it moves
+    still = np.repeat(_rot(1), 300, 0)
+    still[100:140] = _rot(40, 1)
+    starts = {busiest_start(still, 40, seed) for seed in range(6)}
+    assert starts <= {80, 100} and 100 in starts
+
+
+def _take(i, action, n=30):
+    return {"poses": np.zeros((n, 24, 3)), "root": np.zeros((n, 3)), "contacts": np.ones((n, 4), np.uint8),
+            "betas": np.zeros(10), "fps": 20, "clip_id": f"t{i}", "action": action, "source": f"take {i}",
+            "licence": "CC0 (test)", "captions": [f"a person does {action} {i}"]}
+
+
+def test_the_pool_offers_takes_of_the_asked_action_and_the_nearest_captions(openbody):
+    actions = ["kick"] * 8 + ["walk"] * 8 + ["wave"] * 4
+    lib = MotionLibrary.from_takes([_take(i, a) for i, a in enumerate(actions)])
+    unit = lambda v: np.asarray(v, np.float32) / np.linalg.norm(v)  # noqa: E731
+    by_action = {"kick": unit([0.6, 0.8, 0, 0]), "walk": unit([0, 0, 1, 0]), "wave": unit([0.95, 0.31, 0, 0])}
+    pool = TakePool(openbody, lib)
+    pool.set_vectors(np.stack([by_action[a] for a in actions]))   # the waves' captions nearest to the prompt
+    text = np.array([1.0, 0, 0, 0], np.float32)
+    picks = [pool.nearest(text, "kick", seed) for seed in range(8)]
+    for p in picks:
+        assert len(p) == 5 and len(set(p)) == 5
+        assert sorted(actions[i] for i in p) == ["kick"] * 3 + ["wave"] * 2   # the asked action, the nearest captions
+    assert len({tuple(p) for p in picks}) > 1                      # the seed varies which compete
+    plain = pool.nearest(text, None, 0)                            # no action named: by caption only
+    assert len(plain) == 5 and "walk" not in {actions[i] for i in plain}
+    assert pool.take(3)["provenance"] == "captured: take 3 (CC0)"
+
+
+@pytest.fixture(scope="module")
+def kick_model(tiny_dataset, tmp_path_factory):
+    """The default model with the library of the tiny dataset's takes (train + val)."""
+    from shapemove.core.data.library_build import build_library
+    from shapemove.core.generation.model_bundle import DEFAULT_MODEL_DIR
+
+    d = tmp_path_factory.mktemp("model") / "m"
+    shutil.copytree(DEFAULT_MODEL_DIR, d, ignore=shutil.ignore_patterns("library.npz"))
+    build_library(tiny_dataset, d / "library.npz", tma_file=d / "tma" / "tma.pt")
+    return d
+
+
+def test_a_captured_kick_competes_and_plays_as_performed(kick_model, tiny_dataset, openbody):
+    from shapemove.core.generation.animate import Animation, animate
+    from shapemove.core.generation.generate import Generator, Request
+
+    gen = Generator(kick_model, body=openbody)
+    m = gen.generate_batch([Request(KICK, seconds=4, seed=0)])[0]
+    assert m.provenance.startswith("captured: ") and m.tokens is None and m.num_frames == 80
+    src = np.load(tiny_dataset / "new_joints" / "HDM_bd_kickLFront1Reps_001_120.npy")
+    assert lift(src[:, 7, 1]) > 0.8
+    assert lift(m.joints[:, 7, 1]) >= 0.8 * lift(src[:, 7, 1]) and lift(m.joints[:, 8, 1]) < 0.5 * lift(m.joints[:, 7, 1])
+    right = gen.generate_batch([Request("a person does a front kick with the right leg", seconds=4, seed=0)])[0]
+    assert lift(right.joints[:, 8, 1]) > 2 * lift(right.joints[:, 7, 1])      # the right foot kicks
+    assert "kickLFront" not in right.provenance or right.provenance.endswith(", mirrored")   # a left kick mirrored
+    # the edits apply to a captured take
+    for anim in (Animation(in_place=True), Animation(speed=1.5), Animation(stretch=3.0)):
+        e = animate(gen, Request(KICK, seconds=4, seed=0), anim)
+        assert e.num_frames > 20 and np.isfinite(e.joints).all() and lift(e.joints[:, 7, 1]) > 0.5 * lift(src[:, 7, 1])
+    with pytest.raises(ShapeMoveError, match="travels"):   # a kick on the spot follows no path: a sentence
+        animate(gen, Request(KICK, seconds=4, seed=0), Animation(path=[[0, 0], [0, 2], [2, 2]]))
+    held = animate(gen, Request(KICK, seconds=4, seed=0), Animation(in_place=True))
+    assert np.ptp(held.joints[:, 0, [0, 2]], axis=0).max() < 1e-3
+    stop = gen.generate_batch([Request("a person kicks with the left leg and stops", seconds=4, seed=0)])[0]
+    assert stop.num_frames == 80 and np.isfinite(stop.joints).all()
+    gen.set_captured(False)   # --no-library: generation only
+    off = gen.generate_batch([Request(KICK, seconds=4, seed=0)])[0]
+    assert off.provenance == "generated" or off.provenance.startswith("generated from the codes")
+    assert off.tokens is not None
+
+
+def test_the_users_library_kick_rises_as_captured(mocap_root, tmp_path, capsys):
+    """The library kick case: four HDM05 bd front kicks with one caption, ``generate --library``
+    with that caption: the kicking (left) ankle rises at least 0.8x as high as in the capture."""
+    from shapemove.cli import main
+    from shapemove.core.generation.retarget import source_joints
+    from shapemove.core.scene.motion_file import load_motion
+
+    lib = tmp_path / "kicks"
+    lib.mkdir()
+    src = mocap_root / "hdm05" / "bd"
+    shutil.copy(src / "HDM_bd.asf", lib / "HDM_bd.asf")
+    for k in range(1, 5):
+        name = f"HDM_bd_kickLFront1Reps_00{k}_120"
+        shutil.copy(src / f"{name}.amc", lib / f"{name}.amc")
+        (lib / f"{name}.txt").write_text(KICK + "\n")
+    out = tmp_path / "kick.npz"
+    assert main(["generate", "--prompt", KICK, "--library", str(lib), "--seconds", "4", "--out", str(out)]) == 0
+    said = capsys.readouterr().out
+    m = load_motion(out)
+    assert m.provenance.startswith("captured: ") and m.provenance in said
+    kept = [f for f in lib.glob("*.amc") if f.name in m.provenance] or sorted(lib.glob("*.amc"))
+    capture = max(lift(source_joints(f)[0][:, 7, 1]) for f in kept) if len(kept) == 1 else \
+        min(lift(source_joints(f)[0][:, 7, 1]) for f in kept)
+    assert capture > 0.8 and lift(m.joints[:, 7, 1]) >= 0.8 * capture
+    out2 = tmp_path / "gen.npz"
+    assert main(["generate", "--prompt", KICK, "--library", str(lib), "--no-library", "--seconds", "4",
+                 "--out", str(out2)]) == 0
+    assert load_motion(out2).provenance.startswith("generated")
