@@ -22,6 +22,7 @@ from shapemove.core.plan.segments import SEGMENT_SECONDS, plan_segments, split_s
     ("first a person walks forward, then turns around, then sits down",
      ["a person walks forward", "a person turns around", "a person sits down"]),
     ("she first waves, then jogs in place", ["she waves", "she jogs in place"]),
+    ("he waves. then he jogs.", ["he waves", "he jogs"]),
     ("a woman walks in a circle followed by jumping twice", ["a woman walks in a circle", "a woman is jumping twice"]),
     ("the man squats, afterwards he jumps", ["the man squats", "he jumps"]),
     ("a person sits down after walking in a circle", ["a person is walking in a circle", "a person sits down"]),
@@ -41,7 +42,8 @@ def test_ordering_words_make_segments_in_the_order_they_happen(prompt, segments)
     "a person jogs and waves", "a dog runs after the ball", "a person walks next to the wall",
     "a person walks forward and turns around", "A woman jogs along, waving her left hand",
     "a person walks forward and then stops.", "she jogs, then comes to a stop", "a man walks 4 steps then halts",
-    "a woman walks forward waving, then stops", "he runs, then he stops",
+    "a woman walks forward waving, then stops", "he runs, then he stops", "a person walks, then he",
+    "a person walks then 123",
 ])
 def test_and_alone_courses_and_things_at_once_stay_one_segment(prompt):
     assert split_segments(prompt) == [prompt]
@@ -88,6 +90,8 @@ def test_explain_prints_the_plan_as_json_without_a_model(tmp_path, capsys):
     assert out["segments"][1]["understood"]["course"] == "walk in a circle"
     assert len(out["notes"]) == 2 and out == plan_json("after waving, she jogs in a circle", 4, loop=True)
     assert plan_json("a person waves")["segments"][0]["seconds"] is None
+    whole = plan_json("a person walks forward, then sits down", 4, by_parts=False)["segments"]
+    assert whole == [{"text": "a person walks forward, then sits down", "share": 1.0, "seconds": 4.0, "understood": {}}]
 
 
 def test_generate_without_out_or_explain_is_one_sentence(capsys):

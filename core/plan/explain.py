@@ -17,8 +17,13 @@ from .segments import plan_segments
 
 
 def plan_json(prompt: str, seconds: float | None = None, loop: bool = False, in_place: bool = False,
-              path: bool = False) -> dict:
-    """The plan of ``prompt`` (module doc), with the notes of the options it is asked with."""
+              path: bool = False, by_parts: bool = True) -> dict:
+    """The plan of ``prompt`` (module doc), with the notes of the options it is asked with;
+    ``by_parts`` False (``--no-parts``): the prompt whole, one segment, nothing read of its words."""
+    if not by_parts:
+        return {"prompt": str(prompt), "seconds": None if seconds is None else float(seconds),
+                "segments": [{"text": str(prompt), "share": 1.0, "seconds": None if seconds is None else float(seconds),
+                              "understood": {}}]}
     plan = plan_segments(prompt)
     lengths = plan.lengths(seconds) if plan.is_sequence or seconds is not None else [None]
     out = {"prompt": plan.prompt, "seconds": None if seconds is None else float(seconds),

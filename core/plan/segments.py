@@ -92,6 +92,12 @@ def _ordered(piece: str) -> list[str]:
     return [piece]
 
 
+def _says_something(piece: str) -> bool:
+    """Whether a piece holds a word beyond its subject ("then he" and "then 123" do not)."""
+    subject = SUBJECT.match(piece)
+    return bool(re.search(r"[a-z]{2,}", piece[subject.end():] if subject else piece))
+
+
 def _as_prompt(piece: str, subject: str) -> str:
     piece = _tidy(FIRST.sub("", piece, count=1) if FIRST.search(piece) else piece)
     if PARTICIPLE.match(piece):
@@ -110,7 +116,7 @@ def split_segments(prompt: str) -> list[str]:
             pieces[-1] = f"{pieces[-1]}, then {p}"
         else:
             pieces.append(p)
-    ordered = [q for p in pieces if p for q in _ordered(p) if _tidy(q)]
+    ordered = [q for p in pieces if p for q in _ordered(p) if _says_something(_tidy(q))]
     if len(ordered) < 2:
         return [str(prompt).strip()]
     subject = next((_subject(q) for q in ordered if SUBJECT.match(q)), DEFAULT_SUBJECT)
