@@ -60,6 +60,7 @@ train-default: setup
 	$(PY) -m shapemove train head --model $(RUNS)/head/model --data $(BUILT) --config configs/default_head_units.json --out $(RUNS)/head_units --resume
 	rm -rf weights/default && cp -r $(RUNS)/head_units/model weights/default
 	$(PY) tools/build_motion_memory.py --model weights/default --data $(BUILT)
+	$(PY) -m shapemove data library --data $(BUILT) --model weights/default --out weights/default/library.npz
 
 # Evaluation tables of docs/evaluation.md (needs $(BUILT) from train-default); the 1-step SA-VAE is the untrained baseline.
 eval: setup
