@@ -240,3 +240,21 @@ def test_batch_options_are_refused_with_a_sentence(prompts, tmp_path, capsys):
         err = capsys.readouterr().err.strip().splitlines()
         assert len(err) == 1 and said in err[0], err
     assert cli("generate", "--prompts", prompts, "--out", tmp_path / "x.npz") == 2
+
+
+def test_progress_lines_say_done_failed_left_rate_and_time_left():
+    import io
+
+    from shapemove.core.batch.progress import BatchProgress
+
+    out = io.StringIO()
+    p = BatchProgress(10, already=2, label="generate", stream=out, interval=0.0, bar=False)
+    p.t0 -= 4.0                      # 4 s into the run
+    p.update(True)
+    p.update(False)
+    p.update(True)
+    p.close()
+    lines = out.getvalue().splitlines()
+    assert lines[-1].startswith("generate: 4 of 10 done (2 before this run), 1 failed, 5 left, 0.7")
+    assert lines[-1].endswith("items/s, about 7s left")        # 5 left at 3 items / 4 s
+    assert len(lines) == 3                                     # one line per update, none repeated at the end
