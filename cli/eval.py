@@ -194,7 +194,18 @@ def add_speed(sub):
     p.set_defaults(_run=speed_report.from_cli)
 
 
-KINDS = [add_recon, add_generate, add_paraphrase, add_parts, add_shape, add_shape_words, add_retarget, add_speed]
+# -- eval codec-actions (does the codec keep each action? core/eval/codec_actions.py) ---------------
+def add_codec_actions(sub):
+    from ..core.eval import codec_actions
+
+    p = sub.add_parser("codec-actions", help="captured clips of each action judged as captured and as decoded by an SA-VAE",
+                       description=codec_actions.__doc__.splitlines()[0])
+    codec_actions.add_arguments(p)
+    p.set_defaults(_run=codec_actions.from_cli)
+
+
+KINDS = [add_recon, add_generate, add_paraphrase, add_parts, add_shape, add_shape_words, add_retarget, add_speed,
+         add_codec_actions]
 
 
 def add_arguments(p):

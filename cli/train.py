@@ -48,6 +48,8 @@ def add_arguments(p):
             s.add_argument("--init-from", type=Path, default=None,
                            help="fine-tune this trained savae.pt (sets the config's train.init_from; "
                                 "train.freeze names the parts kept as they are)")
+            s.add_argument("--minutes", type=float, default=None,
+                           help="a time budget: the step count is fitted to it once the first steps are timed")
         if kind == "head":
             s.add_argument("--model", type=Path, default=None,
                            help="exported model folder whose T5 stays as it is (default: the shipped model, "

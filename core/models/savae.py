@@ -71,6 +71,8 @@ class TrainSettings:
     init_from: str = ""          # start from this trained savae.pt (its weights and its Mean/Std)
     freeze: tuple = ()           # parts left as they are: "encoder", "quantizer", "shape_embedding", "decoder"
     action_balance: float = 0.0  # clip sampling weight 1 / (clips of its main action) ** this (1 = actions equally)
+    active_windows: float = 0.0  # crop starts: 0 uniform; 1 in proportion to how much the pose moves in the crop
+    resident: bool = False       # every training clip held in the device's memory, batches cut there (a GPU run)
 
 
 PARTS = ("encoder", "quantizer", "shape_embedding", "decoder", "residual_encoder", "residual_decoder",
@@ -183,6 +185,8 @@ class SAVAEConfig:
                                  f"({math.prod(self.levels)} codes), so a token holds both (motion_codes.py)")
         if not 0 <= self.train.action_balance <= 1:
             raise ShapeMoveError(f"train.action_balance must be in [0, 1], got {self.train.action_balance!r}")
+        if not 0 <= self.train.active_windows <= 1:
+            raise ShapeMoveError(f"train.active_windows must be in [0, 1], got {self.train.active_windows!r}")
         if self.decoder_width < 0:
             raise ShapeMoveError(f"decoder_width must be >= 0, got {self.decoder_width!r}")
         if not 0 <= self.residual_dropout <= 1:

@@ -17,6 +17,7 @@ import torch
 from torch.utils.data import Dataset, DistributedSampler
 
 from ..errors import ShapeMoveError
+from .crop_starts import start_weights
 
 CONTACT_ORDER = [0, 2, 1, 3]   # stored contacts (joints 7, 8, 10, 11) -> feature channels (7, 10, 8, 11)
 
@@ -48,10 +49,12 @@ class MotionClips(Dataset):
     """Item ``(index, epoch)`` (or ``index``, epoch 0) -> dict of float32 tensors:
     x (window, D) normalized canonical features, y (window, D) normalized shape-aware features
     (same frames), betas (10,). Clips shorter than ``window`` are left out (``self.skipped``).
+    ``active_windows`` > 0 draws crop starts where the pose moves (``crop_starts.start_weights``).
     ``stats``: (mean, std) to normalize with instead of the folder's Mean/Std (a model fine-tuned
     from a checkpoint keeps the normalization it was trained with)."""
 
-    def __init__(self, root, split: str = "train", window: int = 64, seed: int = 0, stats=None):
+    def __init__(self, root, split: str = "train", window: int = 64, seed: int = 0, stats=None,
+                 active_windows: float = 0.0):
         self.root = Path(root)
         if not self.root.is_dir():
             raise ShapeMoveError(f"dataset folder not found: {self.root}")
@@ -64,6 +67,7 @@ class MotionClips(Dataset):
                 raise ShapeMoveError(f"{self.root}: the model's Mean/Std have {mean.shape[0]} values, the dataset's features {self.mean.shape[0]}")
             self.mean, self.std = mean, std
         self.ids, self.lengths, self.skipped = [], [], []
+        self.start_cdf: list = []   # per clip: cumulative crop-start weights (``crop_starts``), None = uniform
         for cid in read_split(self.root, split):
             try:
                 x = np.load(self.root / "norm_joint_vecs" / f"{cid}.npy", mmap_mode="r")
@@ -77,6 +81,7 @@ class MotionClips(Dataset):
                 continue
             self.ids.append(cid)
             self.lengths.append(int(x.shape[0]))
+            self.start_cdf.append(np.cumsum(start_weights(x, window, active_windows)) if active_windows > 0 else None)
 
     def __len__(self) -> int:
         return len(self.ids)
@@ -89,7 +94,11 @@ class MotionClips(Dataset):
         index, epoch = key if isinstance(key, tuple) else (key, 0)
         cid = self.ids[index]
         rng = np.random.default_rng([self.seed, epoch, index])
-        start = int(rng.integers(0, self.lengths[index] - self.window + 1))
+        cdf = self.start_cdf[index]
+        if cdf is None:
+            start = int(rng.integers(0, self.lengths[index] - self.window + 1))
+        else:
+            start = min(int(np.searchsorted(cdf, rng.random() * cdf[-1], side="right")), len(cdf) - 1)
         x = (self._load("norm_joint_vecs", cid, start) - self.mean) / self.std
         y = (self._load("new_joint_vecs", cid, start) - self.mean) / self.std
         betas = self._load("betas", cid).reshape(-1)

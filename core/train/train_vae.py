@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import copy
 import math
+import time
 from pathlib import Path
 
 import torch
@@ -33,6 +34,7 @@ from .run_log import StepLog
 from .checkpoint import config_differences, load_checkpoint, make_metadata, save_checkpoint, stats_hash
 from .motion_dataset import BatchStream, MotionClips
 from .optimizer_step import optimizer_step
+from .resident_batches import ResidentBatches
 from .resume import restore, rng_state
 
 KIND = "savae"
@@ -73,10 +75,11 @@ def body_soles(body, betas: torch.Tensor) -> torch.Tensor:
 
 
 def batch_losses(model_out: dict, b: dict, model, cfg, body) -> dict:
-    """``vae_losses`` of one batch: target bones and sole offsets of the batch's bodies, the
-    dataset's stored contacts when it has them."""
-    return vae_losses(model_out["recon"], b["y"], model.mean, model.std, cfg.loss, target_bones(body, b["betas"]),
-                      body_soles(body, b["betas"]), b.get("contacts"))
+    """``vae_losses`` of one batch: target bones and sole offsets of the batch's bodies (the batch's
+    own when it carries them, ``ResidentBatches``), the dataset's stored contacts when it has them."""
+    bones = b["bones"] if "bones" in b else target_bones(body, b["betas"])
+    soles = b["soles"] if "soles" in b else body_soles(body, b["betas"])
+    return vae_losses(model_out["recon"], b["y"], model.mean, model.std, cfg.loss, bones, soles, b.get("contacts"))
 
 
 def start_from(cfg: SAVAEConfig, body_name: str) -> SAVAE:
@@ -133,11 +136,13 @@ def evaluate(model: SAVAE, dataset: MotionClips, cfg: SAVAEConfig, device, body=
 
 def train_vae(data, out, config: SAVAEConfig | None = None, steps: int | None = None, resume: bool = False,
               body=None, device: str | None = None, progress=None, cancel=None, verbose: bool = True,
-              init_from=None) -> dict:
+              init_from=None, minutes: float | None = None) -> dict:
     """Train (or resume) an SA-VAE on the dataset folder ``data``; returns the last metrics.
 
     progress(fraction, message) is called on rank 0 every ``log_every`` steps; when cancel()
     returns True training stops after saving ``last.pt`` (resume later with resume=True).
+    ``minutes``: a time budget for a fresh run; the step count is fitted to it once the first
+    ``fitted_steps`` steps are timed (within the warm-up, so the learning-rate schedule never jumps).
     """
     cfg = copy.deepcopy(config) if config is not None else SAVAEConfig.small()
     if steps is not None:
@@ -148,10 +153,19 @@ def train_vae(data, out, config: SAVAEConfig | None = None, steps: int | None = 
     t = cfg.train
     out = Path(out)
     with distributed.process_group(device) as dist:
-        return _train(Path(data), out, cfg, t, resume, body, dist, progress, cancel, verbose)
+        return _train(Path(data), out, cfg, t, resume, body, dist, progress, cancel, verbose, minutes)
 
 
-def _train(data, out, cfg, t, resume, body, dist, progress, cancel, verbose) -> dict:
+def fitted_steps(step: int, elapsed: float, per_step: float, minutes: float, t: TrainSettings) -> int:
+    """Step count that ends a run within ``minutes`` when ``elapsed`` seconds have gone by at ``step``
+    and a step takes ``per_step`` seconds (5 % kept back for validation and checkpoints); never
+    below ``step`` + 1 or above ``t.steps``."""
+    left = minutes * 60 * 0.95 - elapsed
+    return int(min(t.steps, max(step + 1, step + left / max(per_step, 1e-9))))
+
+
+def _train(data, out, cfg, t, resume, body, dist, progress, cancel, verbose, minutes=None) -> dict:
+    started = time.perf_counter()
     if t.batch_size % dist.world_size:
         raise ShapeMoveError(f"batch_size {t.batch_size} must be divisible by the number of processes ({dist.world_size})")
     body = resolve_body(body)
@@ -159,7 +173,7 @@ def _train(data, out, cfg, t, resume, body, dist, progress, cancel, verbose) -> 
     source = start_from(cfg, body_name) if t.init_from else None
     # -- data (normalized as the starting model was, when there is one) ----------------------
     stats = (source.mean.numpy(), source.std.numpy()) if source is not None else None
-    train_set = MotionClips(data, "train", t.window, seed=t.seed, stats=stats)
+    train_set = MotionClips(data, "train", t.window, seed=t.seed, stats=stats, active_windows=t.active_windows)
     val_set = MotionClips(data, "val", t.window, seed=t.seed + 1, stats=stats)
     mean, std = train_set.mean, train_set.std
     # -- model, optimizer, schedule ----------------------------------------------------------
@@ -205,13 +219,20 @@ def _train(data, out, cfg, t, resume, body, dist, progress, cancel, verbose) -> 
     if dist.is_main:
         atomic_write_json(out / "config.json", cfg.to_dict())
     weights = dataset_weights(train_set.root, train_set.ids, t.action_balance) if t.action_balance > 0 else None
-    batches = DataLoader(train_set, batch_sampler=BatchStream(train_set, t.batch_size // dist.world_size, dist.rank,
-                                                              dist.world_size, t.seed, start_step=step,
-                                                              weights=weights),
-                         num_workers=t.num_workers, pin_memory=dist.device.type == "cuda")
+    if t.resident:   # every clip in the device's memory, batches cut there
+        batches = ResidentBatches(train_set, t.batch_size // dist.world_size, t.seed, step, weights, dist.device,
+                                  dist.rank, body_of=lambda betas: (target_bones(body, betas), body_soles(body, betas)))
+    else:
+        batches = DataLoader(train_set, batch_sampler=BatchStream(train_set, t.batch_size // dist.world_size, dist.rank,
+                                                                  dist.world_size, t.seed, start_step=step,
+                                                                  weights=weights),
+                             num_workers=t.num_workers, pin_memory=dist.device.type == "cuda")
     batch_iter = iter(batches)
     log = StepLog(out, t.steps, step, dist, progress, "train vae", verbose)
     model.train()
+    # a time budget: steps 10 to ``probe`` are timed (the first ones set up kernels and caches)
+    probe = max(20, min(200, t.warmup_steps // 2)) if minutes and step == 0 else None
+    timed_from = None
     # -- loop ----------------------------------------------------------------------------------
     while step < t.steps:
         if distributed.broadcast_flag(bool(cancel and dist.is_main and cancel()), dist):
@@ -222,6 +243,12 @@ def _train(data, out, cfg, t, resume, body, dist, progress, cancel, verbose) -> 
         optimizer_step(losses["total"], optimizer, scheduler, trained, t.grad_clip)
         step += 1
         log.bar.update(1)
+        if probe and step == 10:
+            timed_from = time.perf_counter()
+        if step == probe:   # as many steps as fit in the budget (the schedule reads t.steps)
+            now = time.perf_counter()
+            t.steps = fitted_steps(step, now - started, (now - timed_from) / (probe - 10), minutes, t)
+            log.bar.total = t.steps
         done = step == t.steps
         if done or step % t.log_every == 0 or step % t.val_every == 0:
             validate = (lambda: evaluate(raw, val_set, cfg, dist.device, body)) \
@@ -235,4 +262,5 @@ def _train(data, out, cfg, t, resume, body, dist, progress, cancel, verbose) -> 
 def from_cli(args) -> dict:
     """Entry point of `python -m shapemove train vae` (see cli/train.py)."""
     return train_vae(args.data, args.out, SAVAEConfig.load(args.config), steps=args.steps, resume=args.resume,
-                     body=args.body, device=args.device, verbose=not args.quiet, init_from=args.init_from)
+                     body=args.body, device=args.device, verbose=not args.quiet, init_from=args.init_from,
+                     minutes=getattr(args, "minutes", None))
