@@ -261,7 +261,6 @@ class SHAPEMOVE_UL_timeline(bpy.types.UIList):
 
 class SHAPEMOVE_PT_animation(_SettingsPanel, bpy.types.Panel):
     bl_label = "Animation"
-    bl_idname = "SHAPEMOVE_PT_animation"
     SETTINGS = "shapemove_animation"
 
     def draw_settings(self, context, a, col):

@@ -52,9 +52,16 @@ def draw_optional(layout, data, toggle: str, value: str) -> None:
 
 
 class _Panel:
+    """The add-on's panels: in the 3D view's ShapeMove tab, each one's ``bl_idname`` its class name."""
+
     bl_space_type = "VIEW_3D"
     bl_region_type = "UI"
     bl_category = "ShapeMove"
+
+    def __init_subclass__(cls, **kwargs):
+        super().__init_subclass__(**kwargs)
+        if "bl_idname" not in cls.__dict__:
+            cls.bl_idname = cls.__name__
 
 
 class _SubPanel(_Panel):
@@ -82,7 +89,6 @@ class _RigPanel(_SubPanel):
 
 class SHAPEMOVE_PT_main(_Panel, bpy.types.Panel):
     bl_label = "ShapeMove"
-    bl_idname = "SHAPEMOVE_PT_main"
 
     def draw(self, context):
         layout = self.layout
@@ -98,7 +104,6 @@ class SHAPEMOVE_PT_main(_Panel, bpy.types.Panel):
 
 class SHAPEMOVE_PT_generate(_SubPanel, bpy.types.Panel):
     bl_label = "Generate"
-    bl_idname = "SHAPEMOVE_PT_generate"
 
     def draw(self, context):
         s = context.scene.shapemove
@@ -168,7 +173,6 @@ def draw_result(layout, rig) -> None:
 
 class SHAPEMOVE_PT_shape(_RigPanel, bpy.types.Panel):
     bl_label = "Shape"
-    bl_idname = "SHAPEMOVE_PT_shape"
 
     def draw(self, context):
         rig = rig_of(context.active_object)
@@ -201,7 +205,6 @@ class SHAPEMOVE_PT_shape(_RigPanel, bpy.types.Panel):
 
 class SHAPEMOVE_PT_shape_betas(_RigPanel, bpy.types.Panel):
     bl_label = "Betas"
-    bl_idname = "SHAPEMOVE_PT_shape_betas"
     bl_parent_id = "SHAPEMOVE_PT_shape"
     bl_options = {"DEFAULT_CLOSED"}
 
@@ -214,7 +217,6 @@ class SHAPEMOVE_PT_shape_betas(_RigPanel, bpy.types.Panel):
 
 class SHAPEMOVE_PT_retarget(_SettingsPanel, bpy.types.Panel):
     bl_label = "Retarget"
-    bl_idname = "SHAPEMOVE_PT_retarget"
 
     def draw_settings(self, context, s, col):
         col.row().prop(s, "retarget_source", expand=True)
@@ -240,7 +242,6 @@ class SHAPEMOVE_UL_library(bpy.types.UIList):
 
 class SHAPEMOVE_PT_library(_SettingsPanel, bpy.types.Panel):
     bl_label = "Library"
-    bl_idname = "SHAPEMOVE_PT_library"
 
     def draw_settings(self, context, s, col):
         col.prop(s, "library_folder", text="")
@@ -255,7 +256,6 @@ class SHAPEMOVE_PT_library(_SettingsPanel, bpy.types.Panel):
 
 class SHAPEMOVE_PT_train(_SettingsPanel, bpy.types.Panel):
     bl_label = "Train"
-    bl_idname = "SHAPEMOVE_PT_train"
 
     def draw_settings(self, context, s, col):
         col.prop(s, "train_data")
@@ -279,7 +279,6 @@ class SHAPEMOVE_PT_train(_SettingsPanel, bpy.types.Panel):
 
 class SHAPEMOVE_PT_export(_RigPanel, bpy.types.Panel):
     bl_label = "Export"
-    bl_idname = "SHAPEMOVE_PT_export"
     bl_options = {"DEFAULT_CLOSED"}
 
     def draw(self, context):

@@ -256,7 +256,6 @@ class SHAPEMOVE_OT_retarget_rig(ReportingOperator, bpy.types.Operator):
 
 class SHAPEMOVE_PT_your_rig(_SettingsPanel, bpy.types.Panel):
     bl_label = "Your Rig"
-    bl_idname = "SHAPEMOVE_PT_your_rig"
     SETTINGS = "shapemove_rig"
 
     def draw_settings(self, context, s, col):
