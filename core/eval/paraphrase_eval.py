@@ -107,14 +107,15 @@ def eval_paraphrase(model_dir=None, prompts=None, tma=None, seed: int | list[int
                     show_progress: bool = True, candidates: int | None = None, feature_classifier=None,
                     retrieval: bool = True, frequent: int = 20, retrieval_prefix: int | None = None,
                     retrieved: int | None = None, retrieval_first: float | None = None, by_parts: bool = True,
-                    library=None) -> dict:
+                    library=None, captured: bool = True) -> dict:
     """Generate a motion per held-out prompt and classify it (module docstring). ``data``: the built
     dataset whose training clips the kNN classifier reads (default ``default_built_dir()``);
     ``classifier``: an ``ActionClassifier`` to use instead (``feature_classifier`` likewise for the
     TMA-free one); ``candidates``: best-of-N samples per prompt (default: the product's);
     ``retrieval_prefix``: codes of a retrieved clip the seeded candidates start from (default: the
     product's; 0 none, ``retrieval_seeds.py``); ``library``: a folder of captioned motions added to the
-    memory first, as a user's Library (``Generator.add_library``). Returns
+    memory first, as a user's Library (``Generator.add_library``); ``captured``: captured takes compete
+    (the product's default; ``Generator.set_captured``). Returns
     {"motion", "text", "motion_vs_text_prototypes", "motion_features", "reachable", "classifier",
     "unknown_action", "actions", "rows", ...}."""
     from ..generation.generate import Generator, Request
@@ -134,6 +135,7 @@ def eval_paraphrase(model_dir=None, prompts=None, tma=None, seed: int | list[int
         data = built_dir(data, "eval paraphrase classifies generated motions by their nearest training clips")
     gen = generator if generator is not None else Generator(model_dir)
     gen.set_retrieval(retrieval)
+    gen.set_captured(captured)
     if library is not None:
         gen.add_library(library)
     actions = gen.known_actions
@@ -348,6 +350,8 @@ def add_arguments(p) -> None:
     p.add_argument("--library", type=Path, default=None, metavar="DIR",
                    help="a folder of captioned motions added to the memory, as the panel's Library "
                         "(a kept clip of it is judged as what the rig plays)")
+    p.add_argument("--no-library", action="store_true",
+                   help="no captured take competes (generation only, as `generate --no-library`)")
     p.add_argument("--no-parts", action="store_true",
                    help="generate each prompt whole: no composition by body part, no mirroring to a named side")
 
@@ -362,7 +366,7 @@ def from_cli(args) -> int:
                               show_progress=not args.quiet, candidates=args.candidates,
                               retrieval=not args.no_retrieval, retrieval_prefix=args.retrieval_prefix,
                               retrieved=args.retrieved, retrieval_first=args.retrieval_first,
-                              by_parts=not args.no_parts, library=args.library)
+                              by_parts=not args.no_parts, library=args.library, captured=not args.no_library)
     finally:
         progress.close()
     return show_result(format_results(res), res, args.json)

@@ -63,6 +63,12 @@ class Choice(NamedTuple):
     kept: str | None              # the memory clip whose codes were kept, None for a T5 sample
     window: Window | None         # the captured take kept (captured_takes.py)
 
+    @property
+    def clips(self) -> list[str]:
+        """The clip kept ([] for a T5 sample): a memory clip's codes or a captured take (judges leave
+        a kept clip's own takes out, ``eval/paraphrase_eval.py``)."""
+        return [self.window.clip_id] if self.window is not None else ([self.kept] if self.kept else [])
+
 
 class Chosen(NamedTuple):
     """What ``Generator.tokens_for`` chose, per request."""
@@ -508,7 +514,7 @@ class Generator:
                 if stop is not None:   # stop_words.py: cut, then stand
                     motion = self.stopped(motion, stop[1], r.seconds, metres)
                 motion.shape_source, motion.provenance = source, provenance
-                motion.retrieved_clips = [choice.kept] if choice.kept else []
+                motion.retrieved_clips = choice.clips
                 self._say_if_short(motion, choice.kept, r.seconds)
                 if r.by_parts:  # the codec does not carry turning: a course or a turn the words name, given back
                     motion = (course_motion(motion, self.body, r.prompt, self.ik_refine_iters, course)   # course_walk.py

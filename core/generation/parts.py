@@ -104,7 +104,7 @@ def generate_by_parts(gen, r) -> Motion | None:
                          gen.ik_refine_iters, tokens=np.asarray(choice.codes, np.int32), mirrored=True,
                          provenance=decoded_provenance(choice.kept))
         m.shape_source = source
-        m.retrieved_clips = [choice.kept] if choice.kept else []
+        m.retrieved_clips = choice.clips
         return m if course is None else course_motion(m, gen.body, r.prompt, gen.ik_refine_iters, course)
     course = plan.legs_action if plan.legs_action in COURSE_ACTIONS else course_named(plan.legs_prompt)
     gait = straight_gait(plan.legs_prompt) if course is not None else None   # walked straight, then bent

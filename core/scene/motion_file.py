@@ -66,7 +66,7 @@ class Motion:
     warnings: list[str] = field(default_factory=list)  # generate: the prompt check's warnings
     notes: list[str] = field(default_factory=list)     # a take played from its own rotations, and why (retarget, library)
     part_prompts: tuple | None = None       # generate by parts: the (legs, arms) prompts
-    retrieved_clips: list[str] = field(default_factory=list)  # generate: memory clips whose tokens were kept
+    retrieved_clips: list[str] = field(default_factory=list)  # generate: memory clips whose tokens were kept, captured takes played
     prompt_check: object | None = None      # generate: generation.prompts' check of the prompt
 
     @property
