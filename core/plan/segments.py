@@ -10,8 +10,11 @@ Only words that order make segments: "then", "and then", ", then", "after that",
 first). "And" alone never cuts: two things at once ("jogs and waves") are one segment made by body
 part (``generation/parts.py``), and "back and forth", "to and fro", "up and down" are courses.
 "After" / "before" cut only before a participle or a pronoun ("runs after the ball" is one thing).
-A stop after "then" is the gait's own ("walks forward, then stops": one segment that stops,
-``generation/stop_words.py``).
+Both sides of a "before" / "after" must name an action ("jumps and turns before landing" is one),
+and what follows "then" must say what someone does ("bends the knees, then straightens" is one
+squat; ``part_prompts._has_verb``). A stop after "then" is the gait's own ("walks forward, then
+stops": one segment that stops, ``generation/stop_words.py``). "Followed by a jump": "a person does
+a jump".
 A segment without a subject gets the prompt's ("a man walks, then sits" -> "a man sits"); a bare
 participle is said as a clause ("waving" -> "she is waving"). Each segment gets an equal share of
 the length (``SEGMENT_SECONDS`` each when no length is asked).
@@ -21,7 +24,8 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 
-from ..generation.part_prompts import SUBJECT, _subject, _with_subject
+from ..data.actions import find_actions
+from ..generation.part_prompts import SUBJECT, _has_verb, _subject, _with_subject
 from ..generation.stop_words import STOP
 
 # words that put what follows after what precedes ("then"): a cut with that order
@@ -32,7 +36,7 @@ _CLAUSE_AHEAD = r"(?=[a-z'-]+ing\b|(?:he|she|they|someone|somebody|i|we|you)\b)"
 MIDDLE = re.compile(r"\s*,?\s*\b(before|after)\s+" + _CLAUSE_AHEAD)
 LEADING = re.compile(r"^\s*(before|after)\s+" + _CLAUSE_AHEAD)
 FIRST = re.compile(r"\b(?:first(?:ly)?|at first|initially|to begin with|to start with)\b\s*,?\s*")
-PARTICIPLE = re.compile(r"^[a-z'-]{2,}ing\b")
+PARTICIPLE = re.compile(r"^(?!(?:spring|bring|swing|sing|string|ring|thing|sling|sting|wing|cling|fling)\b)[a-z'-]{2,}ing\b")
 DEFAULT_SUBJECT = "a person"
 SEGMENT_SECONDS = 3.0       # a segment's length when the prompt's length is the model's to choose
 MIN_SEGMENT_SECONDS = 0.4   # the shortest segment a timeline takes (``generation.sequence.check_segments``)
@@ -73,6 +77,12 @@ def _main_clause_start(t: str) -> int | None:
     return None
 
 
+def _both_act(a: str, b: str) -> bool:
+    """Whether both sides of a "before" / "after" name an action of the vocabulary: "jumps, turning
+    before landing" and "favouring one leg after twisting an ankle" are one motion."""
+    return bool(find_actions(a)) and bool(find_actions(b))
+
+
 def _ordered(piece: str) -> list[str]:
     """One piece between "then"s cut at a "before" / "after" clause, in the order it happens."""
     lead = LEADING.match(piece)
@@ -80,12 +90,12 @@ def _ordered(piece: str) -> list[str]:
         rest = piece[lead.end():]
         comma = rest.find(",")
         cut = comma if comma >= 0 else _main_clause_start(rest)
-        if cut is not None:
+        if cut is not None and _both_act(rest[:cut], rest[cut:]):
             sub, main = rest[:cut], rest[cut:]
             pair = [sub, main] if lead.group(1) == "after" else [main, sub]
             return [p for part in pair for p in _ordered(_tidy(part))]
     mid = MIDDLE.search(piece)
-    if mid and mid.start() > 0:
+    if mid and mid.start() > 0 and _both_act(piece[:mid.start()], piece[mid.end():]):
         main, sub = piece[:mid.start()], piece[mid.end():]
         pair = [sub, main] if mid.group(1) == "after" else [main, sub]
         return [p for part in pair for p in _ordered(_tidy(part))]
@@ -102,6 +112,8 @@ def _as_prompt(piece: str, subject: str) -> str:
     piece = _tidy(FIRST.sub("", piece, count=1) if FIRST.search(piece) else piece)
     if PARTICIPLE.match(piece):
         return f"{subject} is {piece}"
+    if re.match(r"(?:a|an|the)\s", piece) and not SUBJECT.match(piece):   # "followed by a jump"
+        return f"{subject} does {piece}"
     return _with_subject(piece, subject)
 
 
@@ -112,8 +124,9 @@ def split_segments(prompt: str) -> list[str]:
     pieces = []
     for p in (_tidy(p) for p in THEN.split(t)):
         subject = SUBJECT.match(p)
-        if pieces and p and STOP.match(p[subject.end():] if subject else p):   # "walks forward, then stops": its stop
-            pieces[-1] = f"{pieces[-1]}, then {p}"
+        rest = p[subject.end():] if subject else p
+        if pieces and p and (STOP.match(rest) or not (find_actions(rest) or _has_verb(rest))):
+            pieces[-1] = f"{pieces[-1]}, then {p}"   # the gait's own stop, or no motion of its own ("then straighten")
         else:
             pieces.append(p)
     ordered = [q for p in pieces if p for q in _ordered(p) if _says_something(_tidy(q))]
