@@ -72,6 +72,7 @@ eval: setup
 	$(PY) -m shapemove eval paraphrase --model weights/default --data $(BUILT) --json out/eval_paraphrase.json
 	$(PY) -m shapemove eval paraphrase --model weights/default --data $(BUILT) --prompts configs/heldout_paraphrases_blind.json --json out/eval_paraphrase_blind.json
 	$(PY) -m shapemove eval shape --model weights/default --bodies 200 --json out/eval_shape.json
+	$(PY) -m shapemove eval codec-actions --checkpoint weights/default/savae.pt --data $(BUILT) --split test --json out/eval_codec_actions.json
 	$(PY) tools/eval_report.py
 
 extension: setup

@@ -36,6 +36,7 @@ FAST = [
     (("eval", "paraphrase"), ["--prompts", "tiny_prompts.json", "--quiet"]),
     (("eval", "shape"), ["--bodies", "2", "--quiet"]),
     (("eval", "speed"), ["--max-clips", "1", "--shape-clips", "0", "--quiet"]),
+    (("eval", "codec-actions"), ["--per-action", "1"]),
     (("eval", "shape-words"), ["--texts", "3"]),
     (("demo",), ["--frames", "2"]),
     (("blend",), ["--resolution", "96", "96"]),
