@@ -104,6 +104,10 @@ def test_a_captured_kick_competes_and_plays_as_performed(kick_model, tiny_datase
     assert np.ptp(held.joints[:, 0, [0, 2]], axis=0).max() < 1e-3
     stop = gen.generate_batch([Request("a person kicks with the left leg and stops", seconds=4, seed=0)])[0]
     assert stop.num_frames == 80 and np.isfinite(stop.joints).all()
+    lib = MotionLibrary.load(kick_model / "library.npz")   # caption vectors made at load (another TMA) are the file's
+    again = TakePool(openbody, lib, gen.pool.embed)
+    again.set_vectors(None)
+    assert lib.vectors.shape == again.vectors.shape and np.abs(again.vectors - lib.vectors).max() < 3e-3
     gen.set_captured(False)   # --no-library: generation only
     off = gen.generate_batch([Request(KICK, seconds=4, seed=0)])[0]
     assert off.provenance == "generated" or off.provenance.startswith("generated from the codes")

@@ -21,11 +21,11 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ShapeMoveError
-from .motion_library import MotionLibrary, source_name
+from .motion_library import MotionLibrary, mean_caption_vectors, source_name
 
 SPLITS = ("train", "val")
 FREQUENT = ("walk", "run", "jog", "raise hand", "wave")
-FREQUENT_TAKES = 48
+FREQUENT_TAKES = 96
 
 
 def library_metas(data) -> list[dict]:
@@ -92,12 +92,8 @@ def caption_vectors(tma, takes: list[dict]) -> np.ndarray:
     """(K,E) unit mean TMA text embedding of each take's captions (``tma``: ``load_tma``'s tuple)."""
     from ..models.tma_embed import embed_texts
 
-    model, tok = tma[0], tma[1]
-    out = []
-    for t in takes:
-        v = embed_texts(model, tok, t["captions"] or [t["action"] or "a person moves"]).mean(0)
-        out.append(v / max(float(np.linalg.norm(v)), 1e-8))
-    return np.stack(out).astype(np.float32)
+    return mean_caption_vectors(lambda texts: embed_texts(tma[0], tma[1], texts),
+                                [t["captions"] or [t["action"] or "a person moves"] for t in takes])
 
 
 def build_library(data, out, body=None, tma_file=None, progress=None, cancel=None) -> MotionLibrary:

@@ -171,6 +171,19 @@ class MotionLibrary:
         return path
 
 
+def mean_caption_vectors(embed, captions: list[list[str]]) -> np.ndarray:
+    """(K,E) the unit mean of each take's caption vectors, ``embed(texts) -> (N,E)`` called once for
+    all of them (``captions[k]``: take k's captions, at least one)."""
+    flat = [c for cs in captions for c in cs]
+    e = np.asarray(embed(flat), np.float32)
+    out, i = [], 0
+    for cs in captions:
+        v = e[i:i + len(cs)].mean(0)
+        out.append(v / max(float(np.linalg.norm(v)), 1e-8))
+        i += len(cs)
+    return np.stack(out).astype(np.float32)
+
+
 def check_arrays(a: dict) -> None:
     """ShapeMoveError naming the first array that is missing or of the wrong shape or kind."""
     need = ("format", "rotations", "root", "contacts", "starts", "betas", "fps") + STRINGS

@@ -116,8 +116,10 @@ class TakePool:
         if vectors is None:
             if self.embed is None:
                 raise ShapeMoveError("the motion library's captions need the model's TMA to be compared with a prompt")
-            vectors = np.stack([_unit(self.embed(self.library.captions(k) or [self.actions[k]]).mean(0))
-                                for k in range(len(self.library))])
+            from ..data.motion_library import mean_caption_vectors
+
+            vectors = mean_caption_vectors(self.embed, [self.library.captions(k) or [self.actions[k] or "a person moves"]
+                                                        for k in range(len(self.library))])
         self.vectors = np.asarray(vectors, np.float32)
 
     def add_files(self, ids: list[str], paths: list[Path], captions: list[str]) -> None:
@@ -231,10 +233,6 @@ def decoded_provenance(kept: str | None) -> str:
     """Where a motion decoded from codes came from: "generated" (a T5 sample), or the codes of the
     memory clip ``kept``."""
     return "generated" if kept is None else f"generated from the codes of {kept}"
-
-
-def _unit(v):
-    return v / max(float(np.linalg.norm(v)), 1e-8)
 
 
 def captured_motion(w: Window, body, betas, ik_refine_iters: int = 10, prompt: str | None = None) -> Motion:
