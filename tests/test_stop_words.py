@@ -196,3 +196,22 @@ def test_a_walk_goes_the_distance_asked_and_stands(gen_default):
     t = generate_sequence(gen_default, [("a man walks 3 metres forward", 4.0), ("he waves", 2.0)], seed=0)
     (a, b), _ = t.segment_bounds
     assert abs(gone(t, a, b) - 3.0) < 0.3                                 # before: 2.0-2.1 m, cut at half
+
+
+def test_a_timeline_distance_is_cut_on_its_own_body_and_a_wave_after_it_stands(gen_default):
+    """"a man walks 3 metres forward" 4 s -> "he waves" 2 s on "a 6 ft 2, 200 lb man": the cut was
+    read on the average body, so the tall man's longer strides walked 3.51 m, and his sampled wave
+    shuffled 0.27 m on; the cut is read on the timeline's body (of the codes ``distance_keeps``
+    tries, the one that stands nearest 3 m) and a segment of gestures only stands."""
+    from shapemove.core.generation.sequence import generate_sequence
+    from shapemove.core.generation.stop_words import distance_keeps, from_start
+    from shapemove.core.generation.timeline_words import gestures_only
+
+    assert distance_keeps(5, 20) == [3, 4, 5, 6] and distance_keeps(1, 20) == [1, 2] and distance_keeps(20, 20) == [18, 19, 20]
+    assert gestures_only("he waves") and gestures_only("a person raises the left hand")
+    assert not gestures_only("she waves while walking") and not gestures_only("a person jumps")
+    m = generate_sequence(gen_default, [("a man walks 3 metres forward", 4.0), ("he waves", 2.0)],
+                          shape_text="a 6 ft 2, 200 lb man", seed=0)
+    (a, b), (c, e) = m.segment_bounds
+    assert abs(from_start(m.joints[a:b])[-1] - 3.0) <= 0.15                # within 5 %
+    assert from_start(m.joints[c:e]).max() < 0.1                          # standing while it waves

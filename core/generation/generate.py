@@ -44,7 +44,7 @@ from .on_the_spot import on_the_spot
 from ..plan.segments import MIN_SEGMENT_SECONDS, plan_segments
 from .retrieved_candidates import library_codes, retrieved_codes
 from .stop_words import (DISTANCE_PACE, DISTANCE_SECONDS, STAND_SECONDS, asked_distance, distance_cut,
-                         from_start, standing_after, standing_code, stop_cut, stop_request)
+                         distance_keeps, from_start, standing_after, standing_code, stop_cut, stop_request)
 from .sampling_params import (DEFAULT_GUIDANCE, check_candidates, check_guidance, check_retrieval_first,
                               check_retrieval_prefix, check_retrieved, check_sampling)
 from .request import Request
@@ -573,7 +573,7 @@ class Generator:
             keeps = [] if keep is None else [keep]
         else:
             keep = distance_cut(motion.joints, metres, n, down)
-            keeps = [] if keep is None else sorted({keep, min(n, keep + 1)})
+            keeps = [] if keep is None else distance_keeps(keep, n)
             if keep is None:
                 gone = float(from_start(motion.joints)[-1])
                 motion.notes.append(f"went {gone:.1f} m of the {metres:.1f} m asked in {motion.num_frames / motion.fps:.1f} s: "

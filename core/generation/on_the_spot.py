@@ -30,9 +30,17 @@ def asks_on_the_spot(prompt: str) -> bool:
 def spot_scale(joints, prompt: str, allowed: float = SLACK) -> float:
     """The stride scale that keeps (T,22,3) ``joints`` within ``allowed`` metres of travel when
     ``prompt`` keeps a gait in place and they travel further; 1 otherwise."""
+    if not asks_on_the_spot(prompt):
+        return 1.0
+    return held_scale(joints, allowed)
+
+
+def held_scale(joints, allowed: float) -> float:
+    """The stride scale that keeps (T,22,3) ``joints`` within ``allowed`` metres of root travel
+    along its path (1 when they travel no further)."""
     from .track import travel
 
-    if not asks_on_the_spot(prompt) or len(joints) < 4:
+    if len(joints) < 4:
         return 1.0
     went = float(travel(joints)[-1])
     return allowed / went if went > allowed else 1.0

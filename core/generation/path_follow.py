@@ -26,6 +26,9 @@ from .polyline import MIN_SPEED, Polyline, check_path, follow_track
 from .track import motion_speed, plant, track_of, travel
 
 
+END_SLACK = 0.25   # m short of a path's end that a motion may stop without a warning
+
+
 def read_path(path) -> np.ndarray:
     """A path file (JSON list of [x, z] in metres) -> (N,2)."""
     path = Path(path)
@@ -45,13 +48,17 @@ def read_path(path) -> np.ndarray:
 def follow_path(motion: Motion, body, path, crop: bool = True, ik_refine_iters: int = 10) -> Motion:
     """``motion`` walked along ``path`` ((N,2) [x, z] points or a ``Polyline``), feet re-planted."""
     line = path if isinstance(path, Polyline) else Polyline(path)
-    v = motion_speed(track_of(motion).joints, motion.fps)
+    track = track_of(motion)
+    v = motion_speed(track.joints, motion.fps)
     if v < MIN_SPEED:
         raise ShapeMoveError(f"this motion travels {v:.2f} m/s: following a path needs a motion that moves "
                              "forward, e.g. 'a person walks forward'")
-    out = plant(body, motion.betas, follow_track(track_of(motion), line, crop), ik_refine_iters, prompt=motion.prompt)
-    if crop and travel(out.joints)[-1] < line.length - 0.25:
-        out.warnings = [f"the motion ends {line.length - travel(out.joints)[-1]:.2f} m before the path's end"]
+    out = plant(body, motion.betas, follow_track(track, line, crop), ik_refine_iters, prompt=motion.prompt)
+    # how far along the path the body ends: the distance its own course travelled (follow_track puts
+    # it down there), not the length of the planted root's path, which cuts the rounded corners
+    short = line.length - float(travel(track.joints)[-1])
+    if crop and short > END_SLACK:
+        out.warnings = [f"the motion ends {short:.2f} m before the path's end"]
     return out
 
 

@@ -39,7 +39,9 @@ from .course_walk import walked_straight
 from .decode import decode_features
 from .prompts import check_prompt
 from .sampling_params import DEFAULT_CANDIDATES, check_candidates, check_sampling
-from .stop_words import asked_distance, asks_stand_still, distance_cut, standing_after, stop_cut, stop_request
+from .seam_pace import paced_seams, seam_steps
+from .stop_words import (asked_distance, asks_stand_still, distance_cut, distance_keeps, from_start, standing_after,
+                         stop_cut, stop_request)
 from .token_sampling import body_for, sample_codes
 from .track import Track, decoded_track, plant, rotate_y
 
@@ -77,10 +79,11 @@ def check_segments(segments) -> list[Segment]:
 
 
 def _segment(gen, prompt, shape_text, n, prefix, arms_prefix, betas, seed, temperature, top_k, candidates, guidance,
-             by_parts: bool):
+             by_parts: bool, body=None):
     """(codes, the arms' codes or None, [BETA] prediction) of one segment: two things at once are
     made by part (module doc), standing still is the model's standing code (``stop_words.py``), a
-    gait that stops or counts its steps ("takes three steps forward") stands after them, any other
+    gait that stops or counts its steps ("takes three steps forward") stands after them (counted
+    on the timeline's ``body``, the betas it plays on: a tall body's strides go further), any other
     prompt whole."""
     from .parts import plan_of
 
@@ -101,7 +104,7 @@ def _segment(gen, prompt, shape_text, n, prefix, arms_prefix, betas, seed, tempe
     else:
         arms, _ = _segment_codes(gen, plan.arms_prompt, shape_text, len(codes), arms_prefix, betas, seed + 1,
                                  temperature, top_k, candidates, guidance)
-    keep = None if stop is None else _steps_kept(gen.vae, codes, prefix, stop[1], metres)
+    keep = None if stop is None else _steps_kept(gen.vae, codes, prefix, stop[1], metres, body, gen.rest_code)
     if keep is not None:   # both parts stand after the counted steps (Generator.stopped for one prompt)
         codes = standing_after(codes, keep, gen.rest_code)
         arms = None if arms is None else standing_after(arms, keep, gen.rest_code)
@@ -109,20 +112,32 @@ def _segment(gen, prompt, shape_text, n, prefix, arms_prefix, betas, seed, tempe
 
 
 @torch.no_grad()
-def _steps_kept(vae, codes: list[int], prefix: list[int], steps: int | None, metres: float | None = None) -> int | None:
+def _steps_kept(vae, codes: list[int], prefix: list[int], steps: int | None, metres: float | None = None,
+                body=None, rest: int | None = None) -> int | None:
     """How many of a segment's gait ``codes`` its counted ``steps`` keep (``stop_words.stop_cut``), or
-    its ``metres`` (``stop_words.distance_cut``), read from the foot contacts or the root the decoder
-    gives them after the codes they continue (canonical body); None when the gait strikes fewer times
-    or does not get that far."""
+    its ``metres`` (``stop_words.distance_cut``; with the standing code ``rest``, of the cuts
+    ``distance_keeps`` tries, the one whose motion, standing after it, ends nearest the distance), read from the foot
+    contacts or the root the decoder gives them after the codes they continue, on the betas ``body``
+    (None: the canonical body); None when the gait strikes fewer times or does not get that far."""
     from ..motion.contacts import to_feature_order
     from ..motion.features import joints_from_features
 
     down = vae.cfg.downsample
-    with one_torch_thread():
-        feats = decode_features(list(prefix) + list(codes), vae, np.zeros(10, np.float32)).numpy()
+    betas = np.zeros(10, np.float32) if body is None else np.asarray(body, np.float32)
+
+    def decoded(c):
+        with one_torch_thread():
+            return decode_features(list(prefix) + list(c), vae, betas).numpy()[len(prefix) * down:]
+
+    feats = decoded(codes)
     if metres is not None:
-        return distance_cut(joints_from_features(feats)[len(prefix) * down:], metres, len(codes), down)
-    contacts = to_feature_order(feats[len(prefix) * down:, 259:263] > 0.5)   # the same swap puts them back in 7, 8, 10, 11
+        keep = distance_cut(joints_from_features(feats), metres, len(codes), down)
+        if keep is None or rest is None:
+            return keep
+        gone = {k: float(from_start(joints_from_features(decoded(standing_after(codes, k, rest))))[-1])
+                for k in distance_keeps(keep, len(codes))}
+        return min(sorted(gone), key=lambda k: abs(gone[k] - metres))
+    contacts = to_feature_order(feats[:, 259:263] > 0.5)   # the same swap puts them back in 7, 8, 10, 11
     return stop_cut(contacts, steps, len(codes), down)
 
 
@@ -195,7 +210,7 @@ def _timeline_track(gen, codes_per_segment, betas, arms_per_segment=None) -> tup
 
 def _planted(gen, track: Track, feats, extra: dict, codes_per_segment, prompts, betas, words: bool = True) -> Motion:
     """The timeline's track planted, with its segments; ``words``: each segment's pace and travel
-    words obeyed first (``timeline_words.py``)."""
+    words obeyed first (``timeline_words.py``); the seams paced (``seam_pace.py``)."""
     down = len(track) // sum(len(c) for c in codes_per_segment)
     ends = np.cumsum([len(c) for c in codes_per_segment]) * down
     bounds = np.stack([np.r_[0, ends[:-1]], ends], axis=1).astype(np.int64)
@@ -205,6 +220,9 @@ def _planted(gen, track: Track, feats, extra: dict, codes_per_segment, prompts, 
         worded = worded_joints(track.joints, bounds, prompts)
         if worded is not None:
             track, feats = Track(worded, track.contacts), None
+    paced = paced_seams(track.joints, track.contacts, bounds)   # no seam faster than the segments: the
+    if paced is not None:                                        # decoder's features kept (a re-timing
+        track = Track(*paced)                                    # of the frames around the seams)
     motion = plant(gen.body, betas, track, gen.ik_refine_iters, prompt=" -> ".join(prompts), features=feats, **extra)
     if feats is None:  # composed, spliced or worded: the planted motion's features, as parts.assemble computes them
         from ..motion.features import motion_features
@@ -285,21 +303,23 @@ def generate_sequence(gen, segments, shape_text: str | None = None, betas=None, 
     if shape_text:
         gen.check_text(shape_text, "shape text")
     down = gen.vae.cfg.downsample
-    chosen, arms, source = [], [], None
+    # one body for the whole timeline: the first segment's (the [BETA] head reads it from the same
+    # state a sample's [BETA] is read from), known before any stop is cut
+    body, source = body_for(gen, segs[0].prompt, shape_text, betas,
+                            gen.predicted_betas(segs[0].prompt, shape_text).numpy())
+    chosen, arms = [], []
     for i, s in enumerate(segs):
         if cancel is not None and cancel():
             raise ShapeMoveError("cancelled")
         n = max(1, int(round(s.seconds * FPS / down)))
         prefix = [c for seg in chosen for c in seg][-PREFIX_CODES:]
-        codes, own_arms, pred = _segment(gen, s.prompt, shape_text, n, prefix, _arms_stream(chosen, arms)[-PREFIX_CODES:],
-                                         betas, seed + i, temperature, top_k, candidates, guidance, by_parts)
-        if source is None:   # one body for the whole timeline: the first segment's
-            betas, source = body_for(gen, s.prompt, shape_text, betas, pred)
+        codes, own_arms, _ = _segment(gen, s.prompt, shape_text, n, prefix, _arms_stream(chosen, arms)[-PREFIX_CODES:],
+                                      betas, seed + i, temperature, top_k, candidates, guidance, by_parts, body)
         chosen.append(codes)
         arms.append(own_arms)
         if progress is not None:
             progress((i + 1) / (len(segs) + 1), f"segment {i + 1}/{len(segs)}: {s.prompt}")
-    motion = _assemble(gen, chosen, [s.prompt for s in segs], betas, arms, words=by_parts)
+    motion = _assemble(gen, chosen, [s.prompt for s in segs], body, arms, words=by_parts)
     motion.shape_source = source
     motion.warnings = warnings
     if progress is not None:
@@ -345,7 +365,7 @@ def regenerate_segment(gen, motion: Motion, index: int, seed: int, prompt: str |
     prefix = [c for s in per[:index] for c in s][-PREFIX_CODES:]
     arms_prefix = _arms_stream(per[:index], arms[:index])[-PREFIX_CODES:]
     per[index], arms[index], _ = _segment(gen, seg.prompt, None, n, prefix, arms_prefix, motion.betas, seed, temperature,
-                                          top_k, check_candidates(candidates), guidance, by_parts)
+                                          top_k, check_candidates(candidates), guidance, by_parts, motion.betas)
     prompts[index] = seg.prompt
     # the other segments keep their frames: the decoder reads far around a code, so decoding the
     # new codes as one sequence would also move the neighbours (module doc, ``splice``)
@@ -374,18 +394,14 @@ def scaled_bounds(bounds, num_frames: int) -> np.ndarray:
 
 
 def boundary_report(motion: Motion) -> dict:
-    """Per boundary, the worst joint's jump (its step across the boundary) over the 99th percentile
-    of its per-frame steps inside the segments (``jump_ratio``: the worst over all boundaries)."""
+    """Per boundary, the worst joint's step across it (within ``seam_pace.SEAM`` frames: the
+    decoder's transition takes about a code) over that joint's 99th percentile step inside the
+    segments (``jump_ratio``: the worst over all boundaries)."""
     if motion.segment_bounds is None:
         raise ShapeMoveError("this motion has no segments")
-    J = np.asarray(motion.joints, np.float64)
-    step = np.linalg.norm(np.diff(J, axis=0), axis=-1)          # (T-1,22): step t -> t+1
-    starts = np.asarray(motion.segment_bounds)[1:, 0]
-    inside = np.ones(len(step), bool)
-    inside[starts - 1] = False
-    p99 = np.percentile(step[inside], 99, axis=0)
-    ratios = [float((step[s - 1] / np.maximum(p99, 1e-6)).max()) for s in starts]
-    return {"boundaries": [int(s) for s in starts], "ratios": ratios, "jump_ratio": max(ratios, default=0.0)}
+    starts = [int(s) for s in np.asarray(motion.segment_bounds)[1:, 0]]
+    ratios = seam_steps(motion.joints, starts)
+    return {"boundaries": starts, "ratios": ratios, "jump_ratio": max(ratios, default=0.0)}
 
 
 def segment_scores(gen, motion: Motion) -> np.ndarray:
@@ -394,7 +410,8 @@ def segment_scores(gen, motion: Motion) -> np.ndarray:
     (the model's TMA; biased upward when the TMA also picked the candidates, see ``rerank``)."""
     if gen.picker is None:
         raise ShapeMoveError(f"{gen.model_dir} has no tma/ model to judge the segments with")
-    if motion.features is None or len(motion.features) != motion.num_frames or motion.segment_bounds is None:
-        raise ShapeMoveError("judging segments needs a timeline with its decoder features")
+    if (motion.features is None or not 0 <= motion.num_frames - len(motion.features) <= 1
+            or motion.segment_bounds is None):   # the planted motion's own features are a frame shorter
+        raise ShapeMoveError("judging segments needs a timeline with its features")
     feats = [np.asarray(motion.features[s:e]) for s, e in motion.segment_bounds]
     return np.stack([gen.picker.scores(p, feats) for p in motion.segment_prompts])

@@ -19,8 +19,8 @@ A timeline's segment that only asks to stand still ("stands still", "waits", "pa
   than a gait named: "takes two steps and spins" is left alone).
 - A distance: "walks 3 metres forward", "runs ten meters and stops", "jogs 20 feet" (metres, meters,
   m, feet, ft, yards): the cut is the code where the body is that far from where it started in a
-  straight line (``distance_cut``; of that code and the next, the one whose motion, decoded again,
-  stands nearest the distance). A body's height ("six feet tall", "a six foot man") is no distance.
+  straight line (``distance_cut``; of the codes from two before it to the next, ``distance_keeps``,
+  the one whose motion, decoded again on its body, stands nearest the distance). A body's height ("six feet tall", "a six foot man") is no distance.
   With no length asked, the motion is made long enough for a slow walk to get there.
 - The standing code (``standing_code``): of the codes the memory's real clips hold for at least
   ``REST_RUN`` codes in a row, the one whose repetition decodes with the least joint speed and
@@ -70,6 +70,7 @@ GAITS = {"walk", "run", "jog", "sprint", "sneak", "march", "limp", "walk backwar
 REST_RUN = 4       # codes in a row: a code held this long in a real clip is a candidate standing code
 REST_PROBE = 10    # codes the candidate is repeated for when it is decoded
 MAX_STEPS = 20
+DISTANCE_EARLIER = 2   # codes before a distance's cut also tried (``distance_keeps``)
 STAND_SECONDS = 1.6   # standing after the stop when the model decides the length (none was asked)
 
 
@@ -181,6 +182,13 @@ def distance_cut(joints, metres: float, n: int, down: int) -> int | None:
     ``joints``; None when it never gets that far."""
     far = np.flatnonzero(from_start(joints) >= metres - REACH_SLACK)
     return None if not len(far) else min(n, int(far[0]) // down + 1)
+
+
+def distance_keeps(keep: int, n: int) -> list[int]:
+    """The cuts tried around a distance's ``keep`` (of ``n`` codes): the body slows to a halt over
+    the standing code's first codes, further the faster it went (a run overshoots by about a code
+    and a half), so from two codes before ``keep`` to the one after it."""
+    return sorted({min(n, max(1, k)) for k in range(keep - DISTANCE_EARLIER, keep + 2)})
 
 
 def standing_after(codes, keep: int, rest: int, stand: int | None = None) -> list[int]:

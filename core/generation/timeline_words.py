@@ -11,6 +11,9 @@ the root's path and the feet's reach shortened together, the frames and cadence 
   its travel;
 - a gait asked slowly (a walk as a jog: within a timeline the frames stay where the strips put
   them, so a walk too takes shorter strides rather than being played slower): ``SLOW_SPEED``;
+- a segment whose words name only gestures ("he waves", "raises the right hand": every action
+  named is an arms action, ``compose_parts.ARMS_ACTIONS``) stands where it is: a sampled gesture
+  that shuffles along (0.27 m over a 2 s wave on a tall body) is held to ``STILL_SLACK`` of travel;
 - anything else 1.
 
 The scale eases from one segment's to the next over ``EASE`` frames, so the feet do not jump at a
@@ -28,7 +31,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from .on_the_spot import asks_on_the_spot, spot_scale
+from ..data.actions import find_actions
+from ..data.compose_parts import ARMS_ACTIONS
+from .on_the_spot import asks_on_the_spot, held_scale, spot_scale
 from .pace_words import SLOW_SPEED, asks_slow_flight, asks_slow_steps
 from .course_walk import course_named, course_turn, turns_right
 from .stride_scale import scaled_strides
@@ -37,6 +42,13 @@ from .turn_words import angle_of, eased_turn, turned_by
 
 EASE = 8   # frames over which the stride scale moves from one segment's to the next
 CIRCLE_TRAVEL = 0.5   # m: a course segment that travels less is not bent
+STILL_SLACK = 0.05    # m: the root travel a segment of gestures only keeps
+
+
+def gestures_only(prompt: str) -> bool:
+    """Whether the words name actions and all of them are arms actions ("he waves")."""
+    found = set(find_actions(str(prompt).lower()))
+    return bool(found) and found <= set(ARMS_ACTIONS)
 
 
 def segment_scale(prompt: str, joints: np.ndarray) -> float:
@@ -45,6 +57,8 @@ def segment_scale(prompt: str, joints: np.ndarray) -> float:
         return spot_scale(joints, prompt)
     if asks_slow_steps(prompt) or asks_slow_flight(prompt):
         return SLOW_SPEED
+    if gestures_only(prompt):
+        return held_scale(joints, STILL_SLACK)
     return 1.0
 
 
