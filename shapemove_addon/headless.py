@@ -9,7 +9,7 @@ import bpy
 import numpy as np
 
 from ..core.atomic import atomic_path
-from .preview_render import add_preview_stage, render_frame
+from .preview_render import add_preview_stage, aim_camera, body_share, motion_bounds, render_frame
 from .animation_rig import build_animated_rig
 
 
@@ -51,25 +51,33 @@ def build_scene_file(motion, body, out_blend: Path, preview: Path | None = None,
                      resolution=(320, 320), name: str = "ShapeMove", root_motion: str = "PELVIS") -> dict:
     """New scene with the rig for ``motion`` (a loop cycles, a timeline gets NLA strips, the root
     travel goes where ``root_motion`` says: ``animation_rig``); saves ``out_blend``; with
-    ``preview`` renders ``frames`` evenly spaced frames into one PNG strip. Returns facts about
-    what was built."""
+    ``preview`` renders ``frames`` evenly spaced frames into one PNG strip, the camera framing the
+    body in each (a jog across the room stays large in every panel; ``preview_body_share``: the
+    body's height over each panel's); the saved scene's camera frames the whole motion. Returns
+    facts about what was built."""
     bpy.ops.wm.read_factory_settings(use_empty=True)
     rig = build_animated_rig(bpy.context, motion, body, name=name, root_motion=root_motion)
     scene = bpy.context.scene
     info = {"armature": rig.armature.name, "vertices": len(rig.body.data.vertices),
             "bones": len(rig.armature.data.bones), "frame_start": scene.frame_start, "frame_end": scene.frame_end}
     if preview is not None:
-        add_preview_stage(bpy.context, rig.armature, resolution=tuple(resolution))
+        cam = add_preview_stage(bpy.context, rig.armature, resolution=tuple(resolution))
+        whole = motion_bounds(scene, rig.armature)
         picks = np.unique(np.linspace(scene.frame_start, scene.frame_end, frames).round().astype(int))
+        shares = []
         with tempfile.TemporaryDirectory() as tmp:
             shots = []
             for f in picks:
+                aim_camera(scene, cam, *motion_bounds(scene, rig.armature, frames=[int(f)]))
+                shares.append(body_share(scene, cam, rig.armature, int(f)))
                 png = Path(tmp) / f"f{int(f):05d}.png"
                 render_frame(scene, int(f), png)
                 shots.append(_pixels(png))
         write_strip(shots, preview)
+        aim_camera(scene, cam, *whole)
         scene.frame_set(scene.frame_start)
         info["preview_frames"] = [int(f) for f in picks]
+        info["preview_body_share"] = [round(x, 3) for x in shares]
     save_blend(out_blend)
     return info
 

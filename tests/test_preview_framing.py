@@ -42,3 +42,25 @@ def test_framing_distance_has_a_floor_for_a_tiny_box():
     from shapemove.shapemove_addon.preview_render import framing_distance
 
     assert framing_distance([0, 0, 0], [0.01, 0.01, 0.01], [0.0, 1.0, 0.0], 0.36, 0.27) == 0.5
+
+
+def test_every_preview_panel_frames_the_body(tmp_path):
+    """A jog across the room: framed for the whole motion, the body was a sixth to two fifths of the
+    panel's height (far down the plane in the first frames); each panel's camera frames the body in
+    that frame, so it is at least half the panel's height in every one. The saved scene's camera
+    still frames the whole motion."""
+    import bpy
+
+    from shapemove.core.generation.generate import Generator, Request
+    from shapemove.shapemove_addon.headless import build_scene_file
+    from shapemove.shapemove_addon.preview_render import aim_camera, body_share, motion_bounds
+
+    gen = Generator(None)
+    m = gen.generate_batch([Request("a person jogs forward", seconds=4, seed=0)])[0]
+    info = build_scene_file(m, gen.body, tmp_path / "s.blend", tmp_path / "p.png", frames=3, resolution=(64, 64))
+    assert len(info["preview_body_share"]) == 3 and min(info["preview_body_share"]) >= 0.5, info
+    scene, rig = bpy.context.scene, bpy.data.objects[info["armature"]]
+    whole = [body_share(scene, scene.camera, rig, f) for f in info["preview_frames"]]
+    assert min(whole) < 0.5, whole                                # what one framing for the whole jog gave
+    aim_camera(scene, scene.camera, *motion_bounds(scene, rig, frames=[info["preview_frames"][0]]))
+    assert body_share(scene, scene.camera, rig, info["preview_frames"][0]) >= 0.5
