@@ -54,11 +54,11 @@ def run(args) -> int:
     defaults = {"loop": args.loop, "in_place": args.in_place, "speed": args.speed, "stretch": args.stretch,
                 "root_motion": args.root_motion}
     items, count = read_items(args.prompts, shard, defaults, keys=(*LINE_KEYS, "root_motion"))
-    if not args.dask:   # the workers of a cluster import bpy there
-        try:
-            import bpy  # noqa: F401
-        except ImportError:
-            raise ShapeMoveError("the render command needs the bpy module: pip install bpy==5.0.1") from None
+    if not args.dask:   # the workers of a cluster import bpy there; worker processes import it themselves
+        import importlib.util
+
+        if importlib.util.find_spec("bpy") is None:
+            raise ShapeMoveError("the render command needs the bpy module: pip install bpy==5.0.1")
     where, named, model = where_of(args)
     settings = {**sampling_settings(args), **named, "frames": args.frames,
                 "resolution": [int(v) for v in args.resolution], "video": bool(args.video)}

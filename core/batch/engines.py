@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import os
 import signal
+import sys
 import threading
 import time
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
@@ -45,8 +46,16 @@ def _watch_parent(parent: int) -> None:
             os._exit(1)
 
 
+def _blender_script_path(entry: str) -> bool:
+    parts = Path(entry).parts
+    return "scripts" in parts and ("bpy" in parts or "blender" in parts)
+
+
 def _init_worker(threads: int, parent: int) -> None:
     signal.signal(signal.SIGINT, signal.SIG_IGN)   # Ctrl-C is the batch process's: it stops handing out items
+    # a parent that imported bpy passes on the script folders bpy put on sys.path; their `bpy`
+    # package would shadow the module here ("No module named '_bpy'"): bpy adds them again on import
+    sys.path[:] = [p for p in sys.path if not _blender_script_path(p)]
     os.environ.setdefault("TQDM_DISABLE", "1")
     import torch
 
