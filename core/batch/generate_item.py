@@ -56,7 +56,7 @@ def item_motion(spec: dict):
 def motion_facts(motion) -> dict:
     """{"source", "result"} of a motion for its manifest line."""
     kind = "captured" if motion.notes else "retrieved" if motion.retrieved_clips else "generated"
-    source = {"kind": kind, "retrieved_clips": list(motion.retrieved_clips), "notes": list(motion.notes),
+    source = {"kind": kind, "provenance": getattr(motion, "provenance", None), "retrieved_clips": list(motion.retrieved_clips), "notes": list(motion.notes),
               "warnings": list(motion.warnings), "part_prompts": list(motion.part_prompts or []) or None,
               "mirrored": bool(motion.mirrored)}
     result = {"frames": int(motion.num_frames), "seconds": round(motion.num_frames / motion.fps, 3),
