@@ -7,9 +7,14 @@ soft IK stops short and the heel is dragged forward (stance slide). A real foot 
 stance (a run of the ball joint's contact, ``motion.contacts``) with a planted heel:
 
 * **pivot** ``P``: where the flat foot puts its ball joint: the heel's anchor plus the body's own
-  foot length (ankle to ball, ``L``) toward the ball's anchor, so the ball does not move when the
-  roll starts (``pin_feet`` aims the foot the same way); the ball's target is ``P`` for the whole
-  run (and its fade).
+  foot length (ankle to ball, ``L``) toward the ball's anchor where the heel's run starts, so the
+  ball does not move when the roll starts (``pin_feet`` aims the foot the same way); the ball's
+  target is moved by that much for the whole run (and its fade). A run planted piece by piece
+  along a slide (``plant.anchor_track``) carries the pivot with its ball; taking the ball's anchor
+  at the run's first frame instead put a sliding squat's ball 0.7 m from the foot. A ball planted
+  more than ``MISFIT`` from ``P`` (a heel and a ball planted at the means of runs the decoded foot
+  slid along, 13 cm out of the foot's length) is not rolled over: the move, undone where the
+  run ends, made the foot leap there.
 * **pitch** ``theta``: the foot turns about the horizontal axis through ``P`` across the foot (a
   sagittal rotation); the heel (ankle joint) then lies on a circle of radius ``L`` about ``P``,
   rising and moving forward. Per frame, the smallest ``theta`` that brings the heel within the
@@ -39,6 +44,7 @@ from ..motion.contacts import runs
 
 MAX_ROLL = np.deg2rad(60.0)   # the most the heel is pitched up about the ball
 LIFT_TOL = 0.005              # m: a heel higher than this above its flat height is off the floor
+MISFIT = 0.05                 # m: a ball planted further than this from where the flat foot puts it is not rolled over
 UP = np.array([0.0, 1.0, 0.0])
 
 
@@ -117,15 +123,19 @@ def roll_feet(posed, targets, contacts, weights, rest, reach: float, legs, fade:
             if not over:
                 continue
             s, e = over[-1]                                   # the heel run the foot rolls off
-            A, B = tgt[s, ankle].copy(), tgt[sb, ball].copy()
+            t = np.arange(max(s, sb), eb)
+            A, B = tgt[t[0], ankle].copy(), tgt[t[0], ball].copy()   # the heel and ball planted together
             if np.linalg.norm(B - A) < 1e-6:
                 continue
             P = A + foot * (B - A) / np.linalg.norm(B - A)
+            if np.linalg.norm(P - B) > MISFIT:                # heel and ball planted a foot apart they
+                continue                                      # are not: a foot sliding, nothing to roll over
             _move_ball(tgt, weights[:, kt], c[:, kt], ball, sb, eb, P - B, fade)
             e1, e2, _ = _frame(A, P)
-            t = np.arange(max(s, sb), eb)
-            fwd = (P - A) * [1.0, 0.0, 1.0]
-            ahead = (pos[t, hip] - P) @ fwd > 0               # the hip has passed over the ball
+            P = P + (tgt[t, ball] - tgt[t[0], ball])          # (N,3): a ball planted piece by piece along
+            A = A + (tgt[t, ball] - tgt[t[0], ball])          # a slide (plant.anchor_track) carries the pivot
+            fwd = (P[0] - A[0]) * [1.0, 0.0, 1.0]
+            ahead = ((pos[t, hip] - P) * fwd).sum(-1) > 0     # the hip has passed over the ball
             theta = np.where(ahead, reach_angle(pos[t, hip], P, e1, e2, foot, limb), 0.0)
             on = np.flatnonzero(theta > 0)
             if len(on):                                       # the heel starts rising at mid-stance (the
@@ -139,10 +149,10 @@ def roll_feet(posed, targets, contacts, weights, rest, reach: float, legs, fade:
             rolled = theta > 0
             if not rolled.any():
                 continue
-            t, theta = t[rolled], theta[rolled]
+            t, theta, P = t[rolled], theta[rolled], P[rolled]
             tgt[t, ankle] = P + foot * (np.cos(theta)[:, None] * e1 + np.sin(theta)[:, None] * e2)
             weights[t, kh] = 1.0
-            out_c[t[tgt[t, ankle, 1] - A[1] > LIFT_TOL], kh] = False   # the heel is off the floor
+            out_c[t[tgt[t, ankle, 1] - A[0, 1] > LIFT_TOL], kh] = False   # the heel is off the floor
             axis = np.cross(e1, e2)                           # turning e1 toward e2: the heel up
             toe[t, leg] = theta[:, None] * axis
     return Roll(targets=tgt, weights=weights, contacts=out_c.astype(np.uint8), toe=toe)

@@ -7,8 +7,18 @@ in the capture slide and hover on the body, and a body grounded by its lowest fo
 1. ``plant_targets``: before IK, move the targets of the joints in contact (heels = ankles,
    toes = ball joints, ``core.motion.contacts``) onto one fixed point per contact run: its XZ is
    the run's mean, its height the joint's sole offset on the body (``soles.sole_offsets``), so
-   the sole touches y = 0. The source floor is estimated from the contacts themselves. The
-   change fades out over ``FADE`` frames around each run so the targets stay continuous. IK
+   the sole touches y = 0. A run along which the joint slides further than ``SLIDE`` (a decoded
+   body drifting over a foot it says is planted: 0.4 m in a squat) is planted piece by piece
+   (``anchor_track``): each piece's point within ``PIECE`` of where the joint is, the change
+   from one piece's point to the next spread over ``FADE`` frames. One point for such a run was
+   up to 0.5 m from the foot at the run's ends, and the foot leapt there in a frame (0.76 m where
+   the decoded ankle moved at most 0.04 m). The source floor is estimated from the contacts
+   themselves. Runs of a joint at most ``GAP`` frames apart (a decoder's contact flickering off for
+   a frame: no foot steps that fast) are planted as one (``bridged``): each planted at its own point,
+   the foot moved between them in one frame. The change fades out over ``FADE`` frames around each
+   run so the targets stay continuous; in a gap between two runs the two fades are blended by their
+   weights (taking the nearer run's whole moved the foot from one's change to the other's in a
+   frame). IK
    (``ik.solve_ik``, which weights the ankles and feet most) then lands the feet there.
    ``fade_down=False`` (decoding): the fade moves a foot sideways or up, never down.
 2. ``pin_feet`` (decoding): the whole-body IK spreads its misses over all joints, so a contact
@@ -32,6 +42,9 @@ from ..constants import FPS
 from ..motion.contacts import CONTACT_IDS, runs
 
 FADE = 4          # frames over which a planted target blends back into the mocap target
+SLIDE = 0.3       # m: a contact run's joint sliding further than this is planted piece by piece ...
+PIECE = 0.05      # m: ... each piece as far as the joint slides from the piece's first frame
+GAP = 2           # frames: contact runs of a joint this close are planted as one (no step is that short)
 
 
 def source_floor(joints, contacts, sole_offsets) -> float:
@@ -40,6 +53,42 @@ def source_floor(joints, contacts, sole_offsets) -> float:
     j = np.asarray(joints, dtype=np.float64)[:, CONTACT_IDS, 1] - np.asarray(sole_offsets)[None]
     c = np.asarray(contacts).astype(bool)
     return float(np.median(j[c])) if c.any() else float(j.min())
+
+
+def anchor_track(xz, slide: float = SLIDE, piece_len: float = PIECE, fade: int = FADE) -> np.ndarray:
+    """(n,2) where a contact run's joint is planted each frame, from its (n,2) floor positions
+    ``xz``: one point, the run's mean, unless the joint slides further than ``slide`` from its first
+    frame; then the run cut into pieces along which the joint stays within ``piece_len`` of the
+    piece's first frame, each piece planted at its mean, the steps between pieces spread over
+    ``fade`` frames (a moving mean)."""
+    xz = np.asarray(xz, np.float64)
+    n = len(xz)
+    piece = np.zeros(n, int)
+    if np.linalg.norm(xz - xz[0], axis=1).max() <= slide:
+        return np.repeat(xz.mean(0, keepdims=True), n, axis=0)
+    first = 0
+    for i in range(1, n):
+        if np.linalg.norm(xz[i] - xz[first]) > piece_len:
+            first = i
+            piece[i:] += 1
+    if piece[-1] == 0:
+        return np.repeat(xz.mean(0, keepdims=True), n, axis=0)
+    means = np.stack([xz[piece == k].mean(0) for k in range(piece[-1] + 1)])
+    track = means[piece]
+    pad = np.pad(track, ((fade // 2, fade - 1 - fade // 2), (0, 0)), mode="edge")
+    kernel = np.ones(fade) / fade
+    return np.stack([np.convolve(pad[:, c], kernel, mode="valid") for c in range(2)], axis=1)
+
+
+def bridged(spans, gap: int = GAP) -> list[tuple[int, int]]:
+    """Contact runs [(start, end)] with those apart by at most ``gap`` frames joined into one."""
+    out: list[list[int]] = []
+    for s, e in spans:
+        if out and s - out[-1][1] <= gap:
+            out[-1][1] = e
+        else:
+            out.append([s, e])
+    return [(s, e) for s, e in out]
 
 
 def plant_targets(joints, contacts, sole_offsets, fade: int = FADE, fade_down: bool = True) -> tuple[np.ndarray, float]:
@@ -54,19 +103,25 @@ def plant_targets(joints, contacts, sole_offsets, fade: int = FADE, fade_down: b
     tgt[..., 1] -= floor
     for k, j in enumerate(CONTACT_IDS):
         corr = np.zeros((T, 3))
-        weight = np.zeros(T)
-        for s, e in runs(np.asarray(contacts)[:, k]):
-            anchor = np.r_[tgt[s:e, j, 0].mean(), sole_offsets[k], tgt[s:e, j, 2].mean()]
-            corr[s:e] = anchor[None] - tgt[s:e, j]
-            weight[s:e] = 1.0
+        planted = np.zeros(T, bool)
+        edges: dict[int, list] = {}   # frame outside a run -> [(weight, its run edge's change)]
+        for s, e in bridged(runs(np.asarray(contacts)[:, k])):
+            xz = anchor_track(tgt[s:e, j][:, [0, 2]], fade=max(fade, 1))
+            anchor = np.stack([xz[:, 0], np.full(e - s, float(sole_offsets[k])), xz[:, 1]], axis=1)
+            corr[s:e] = anchor - tgt[s:e, j]
+            planted[s:e] = True
             for d in range(1, fade + 1):  # fade the change of the run's edges out over `fade` frames
                 w = 1.0 - d / (fade + 1)
                 for t, edge in ((s - d, s), (e - 1 + d, e - 1)):
-                    if 0 <= t < T and weight[t] < w:
-                        step = anchor - tgt[edge, j]
+                    if 0 <= t < T:
+                        step = anchor[edge - s] - tgt[edge, j]
                         if not fade_down:
                             step[1] = max(step[1], 0.0)
-                        corr[t], weight[t] = step * w, w
+                        edges.setdefault(t, []).append((w, step))
+        for t, near in edges.items():   # between two runs: their edges' changes blended by weight
+            if not planted[t]:
+                w = np.array([x for x, _ in near])
+                corr[t] = w.max() * (w[:, None] * np.array([x for _, x in near])).sum(0) / w.sum()
         tgt[:, j] += corr
     return tgt, floor
 
@@ -134,7 +189,10 @@ def pin_feet(rotations, transl, rest, parents, targets, weights, soft_reach: flo
         h, k, a, b = pos[t, hip], pos[t, knee], pos[t, ankle], pos[t, foot]
         wh, wt = w[t, kh, None], w[t, kt, None]
         heel = (wh >= wt) & (wh > 0)                            # heel-led (else the ball leads: toe-off)
-        want = np.where(heel, a + wh * (tgt[t, ankle] - a), a + wt * (tgt[t, foot] - b))
+        lead = np.clip(1.0 - np.maximum(wt - wh, 0.0), 0.0, 1.0)   # the heel's share, moving from heel-led
+        want = lead * (a + wh * (tgt[t, ankle] - a)) + (1 - lead) * (a + wt * (tgt[t, foot] - b))   # to ball-led
+        # as the heel's weight fades below the ball's (switching at once moved the ankle by the two
+        # targets' disagreement in one frame)
         l1, l2 = np.linalg.norm(rest[knee] - rest[hip]), np.linalg.norm(rest[ankle] - rest[knee])
         v = want - h
         d = np.linalg.norm(v, axis=-1, keepdims=True).clip(1e-9)

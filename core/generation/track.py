@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 import torch
 
-from ..body.plant import contacts_from_features, plant_motion
+from ..body.plant import anchor_track, contacts_from_features, plant_motion
 from ..constants import FPS
 from ..geometry.rotations import matrix_to_axis_angle
 from ..errors import ShapeMoveError
@@ -120,8 +120,8 @@ def lock_stance(motion: Motion) -> Motion:
 
     ``plant.pin_feet`` is a soft two-bone IK: a leg near full stretch (heel strike, push-off)
     stops short of its target, so a planted foot still drifts ~0.5 mm per frame. Here each frame
-    with a contact is shifted in XZ by the mean offset of its planted joints from their run's
-    mean position; frames without contact take the shift interpolated between their neighbours
+    with a contact is shifted in XZ by the mean offset of its planted joints from where their run
+    is planted (``plant.anchor_track``: the run's mean, or its pieces' along a slide); frames without contact take the shift interpolated between their neighbours
     (so the body's path stays smooth). Rotations, heights and the contacts are unchanged."""
     c = np.asarray(motion.contacts).astype(bool) if motion.contacts is not None else None
     if c is None or not c.any():
@@ -131,7 +131,7 @@ def lock_stance(motion: Motion) -> Motion:
     for k, joint in enumerate(CONTACT_IDS):
         for s, e in runs(c[:, k]):
             xz = J[s:e, joint][:, [0, 2]]
-            res[s:e, k] = xz.mean(0) - xz
+            res[s:e, k] = anchor_track(xz) - xz   # the run's point (its pieces' where it slides: plant.py)
     support = c.any(1)
     shift = (res * c[..., None]).sum(1) / np.maximum(c.sum(1), 1)[:, None]
     t = np.arange(len(J))
