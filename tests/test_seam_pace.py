@@ -40,18 +40,18 @@ def test_a_jump_at_a_seam_is_spread_over_the_frames_around_it():
     assert paced_seams(_track(jump=0.0), contacts, bounds) is None   # a smooth seam is left alone
 
 
-def test_a_walk_then_a_wave_has_no_pop_at_the_seam():
-    """"a person walks forward" 3 s -> "a person waves with the right hand" 3 s (seed 0): the
-    decoder raises the right wrist 24 cm in one frame at the seam (2.2x its p99 step inside the
-    segments); played, the worst step near the seam is at most 1.5x."""
+def test_a_sit_then_a_wave_has_no_pop_at_the_seam():
+    """"a person sits down" 3 s -> "a person waves with the right hand" 2 s (seed 7): the decoder
+    swings the arm up at the seam at 2.7x its joints' 99th-percentile step inside the segments;
+    played, the worst step near the seam is at most 1.5x."""
     from shapemove.core.generation.generate import Generator
     from shapemove.core.generation.seam_pace import seam_steps
     from shapemove.core.generation.sequence import boundary_report, generate_sequence
     from shapemove.core.generation.track import decoded_track
 
     gen = Generator(None)
-    m = generate_sequence(gen, [("a person walks forward", 3.0), ("a person waves with the right hand", 3.0)], seed=0)
+    m = generate_sequence(gen, [("a person sits down", 3.0), ("a person waves with the right hand", 2.0)], seed=7)
     track, _ = decoded_track([int(t) for t in m.tokens], gen.vae, gen.body, m.betas)
     assert seam_steps(track.joints, [60])[0] > 1.8
     assert boundary_report(m)["jump_ratio"] <= 1.5
-    assert m.segment_bounds.tolist() == [[0, 60], [60, 120]]
+    assert m.segment_bounds.tolist() == [[0, 60], [60, 100]]
