@@ -97,7 +97,7 @@ def test_a_captured_kick_competes_and_plays_as_performed(kick_model, tiny_datase
     # the edits apply to a captured take
     for anim in (Animation(in_place=True), Animation(speed=1.5), Animation(stretch=3.0)):
         e = animate(gen, Request(KICK, seconds=4, seed=0), anim)
-        assert e.num_frames > 20 and np.isfinite(e.joints).all() and lift(e.joints[:, 7, 1]) > 0.5 * lift(src[:, 7, 1])
+        assert e.provenance == m.provenance and e.num_frames > 20 and np.isfinite(e.joints).all() and lift(e.joints[:, 7, 1]) > 0.5 * lift(src[:, 7, 1])
     with pytest.raises(ShapeMoveError, match="travels"):   # a kick on the spot follows no path: a sentence
         animate(gen, Request(KICK, seconds=4, seed=0), Animation(path=[[0, 0], [0, 2], [2, 2]]))
     held = animate(gen, Request(KICK, seconds=4, seed=0), Animation(in_place=True))

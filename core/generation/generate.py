@@ -501,6 +501,7 @@ class Generator:
             asked = dataclasses.replace(r, prompt=stop[0], seconds=r.seconds if r.seconds or not metres else
                                         min(DISTANCE_SECONDS, metres / DISTANCE_PACE + 1.0)) if stop else r
             motion = generate_by_parts(self, asked) if r.by_parts else None
+            came_from = motion.provenance if motion is not None else None   # kept through the edits below
             if motion is not None and stop is not None:
                 motion.prompt = r.prompt
                 motion = self.stopped(motion, stop[1], r.seconds, metres)   # both parts stop (stop_words.py)
@@ -510,10 +511,10 @@ class Generator:
                 choice = self.choose(sampled)   # samples and captured takes, one choice (captured_takes.py)
                 betas, source = self.body_shape(r, choice.betas.numpy())
                 motion = self.chosen_motion(choice, betas, r.prompt)
-                provenance = motion.provenance
+                came_from = motion.provenance
                 if stop is not None:   # stop_words.py: cut, then stand
                     motion = self.stopped(motion, stop[1], r.seconds, metres)
-                motion.shape_source, motion.provenance = source, provenance
+                motion.shape_source = source
                 motion.retrieved_clips = choice.clips
                 self._say_if_short(motion, choice.kept, r.seconds)
                 if r.by_parts:  # the codec does not carry turning: a course or a turn the words name, given back
@@ -523,6 +524,7 @@ class Generator:
                     motion = slow_motion(motion, self.body, r.prompt, self.ik_refine_iters)      # slow_steps.py
             if r.by_parts:   # "jogs in place": the data's gaits all travel; stepped on the spot instead
                 motion = on_the_spot(motion, self.body, r.prompt, self.ik_refine_iters)        # on_the_spot.py
+            motion.provenance = motion.provenance or came_from or "generated"
             motion.warnings = [check.warning] if check is not None and check.warning else []
             if r.candidates > 1 and r.temperature > 0:  # best-of-N wanted: say when the model cannot pick
                 motion.warnings += part_warnings(self.model_dir)
