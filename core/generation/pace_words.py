@@ -42,11 +42,6 @@ def _gaits(prompt: str) -> set:
     return {sp[2] for sp in action_spans(prompt) if sp[2] in LEGS}
 
 
-def names_pace(prompt: str) -> bool:
-    """Whether the prompt names a pace, fast or slow ("quickly", "at a leisurely pace")."""
-    return bool(_FAST.search(prompt) or _SLOW.search(prompt))
-
-
 def asks_fast(prompt: str) -> bool:
     """Whether the prompt asks a gait to go fast (and names no slow pace beside it)."""
     return bool(_FAST.search(prompt)) and not _SLOW.search(prompt) and bool(_gaits(prompt))

@@ -10,8 +10,7 @@ costs one batched SA-VAE decode and one TMA pass (tens of milliseconds), not a s
 Travel and pace words come first: a candidate whose root travel goes against "forward",
 "backwards", "in place" or "steps to the left" is set aside before the TMA chooses
 (``travel_words``), for "walks quickly" or "a brisk walk" only the fastest candidates compete
-(``pace_words``), for a plain "walks" or "runs" those nearest the gait's typical pace
-(``typical_pace``), and for "jumps twice" or "three squats" only those that leave the floor or go
+(``pace_words``), and for "jumps twice" or "three squats" only those that leave the floor or go
 down the number of times nearest the asked one (``count_words``), since the TMA reads what the
 body does, not which way, how fast or how many times.
 
@@ -26,7 +25,6 @@ import numpy as np
 from .count_words import asked_count, nearest_count
 from .pace_words import asks_fast, fastest, gait_speed
 from .travel_words import allowed
-from .typical_pace import nearest_pace, typical_speed
 
 
 class CandidatePicker:
@@ -46,11 +44,8 @@ class CandidatePicker:
         count words (the first on a tie); ``bonus`` (N,): added to the similarities (a captured
         take of the asked action, ``captured_takes.ACTION_BONUS``)."""
         keep = allowed(prompt, feats)
-        typical = typical_speed(prompt)
         if asks_fast(prompt):
             keep = fastest(np.array([gait_speed(f) for f in feats]), keep)
-        elif typical is not None:   # a plain gait: its typical pace (typical_pace.py)
-            keep = nearest_pace([gait_speed(f) for f in feats], keep, typical)
         counted = asked_count(prompt)
         if counted is not None:
             count, want = counted
