@@ -184,7 +184,7 @@ def test_a_path_end_warning_reads_where_the_body_ends(gen, walk):
     a = (went - 0.05) / 3
     u = np.array([[0.0, 0.0], [0.0, a], [a, a], [a, 0.0]])
     m = follow_path(walk, gen.body, u)
-    assert m.warnings == [] and np.linalg.norm(m.joints[-1, 0, [0, 2]] - u[-1]) < 0.1
+    assert m.warnings == [] and np.linalg.norm(m.joints[-1, 0, [0, 2]] - u[-1]) < 0.15   # the pelvis at the end
     assert 3 * a - travel(m.joints)[-1] > 0.25                  # what the warning used to read
     m = follow_path(walk, gen.body, [[0.0, 0.0], [0.0, went], [1.0, went]])
     assert m.warnings == ["the motion ends 1.00 m before the path's end"]
