@@ -74,10 +74,12 @@ def kick_model(tiny_dataset, tmp_path_factory):
     """The default model with the library of the tiny dataset's takes (train + val)."""
     from shapemove.core.data.library_build import build_library
     from shapemove.core.generation.model_bundle import DEFAULT_MODEL_DIR
+    from shapemove.core.model_files import add_to_manifest
 
     d = tmp_path_factory.mktemp("model") / "m"
     shutil.copytree(DEFAULT_MODEL_DIR, d, ignore=shutil.ignore_patterns("library.npz"))
     build_library(tiny_dataset, d / "library.npz", tma_file=d / "tma" / "tma.pt")
+    add_to_manifest(d, [d / "library.npz"])   # the copied manifest lists the shipped library
     return d
 
 
