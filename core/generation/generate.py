@@ -216,11 +216,12 @@ class Generator:
         return Chosen([c.codes for c in chosen], torch.stack([c.betas for c in chosen]), [c.kept for c in chosen])
 
     @torch.no_grad()
-    def choose(self, r: Request, side=None) -> Choice:
+    def choose(self, r: Request, side=None, captured: bool = True) -> Choice:
         """One request's choice among the T5's samples (and memory clips, as ``tokens_for``) and
         the captured takes of the asked action and nearest captions (``captured_takes.py``), by the
-        TMA on the finished motions; ``side``: a named side, the takes mirrored to it."""
-        return self._choose(r, True, self.captured_on, side)
+        TMA on the finished motions; ``side``: a named side, the takes mirrored to it. ``captured``
+        False: the samples alone (an edit that needs the codes follows: a stop, a distance)."""
+        return self._choose(r, True, self.captured_on and captured, side)
 
     def _choose(self, r: Request, library_as_captured: bool, captured: bool = False, side=None) -> Choice:
         if self.t5 is None:
@@ -508,7 +509,9 @@ class Generator:
             course = self.asks_course(r.prompt, check) if r.by_parts else None   # course_walk.py
             if motion is None:  # one action, no side named: the motion as the model writes it
                 sampled = asked if course is None else dataclasses.replace(asked, prompt=walked_straight(asked.prompt))
-                choice = self.choose(sampled)   # samples and captured takes, one choice (captured_takes.py)
+                # samples and captured takes, one choice (captured_takes.py); a stop or a distance is cut
+                # in the codes (stop_words.py), so it is asked of the samples alone
+                choice = self.choose(sampled, captured=stop is None)
                 betas, source = self.body_shape(r, choice.betas.numpy())
                 motion = self.chosen_motion(choice, betas, r.prompt)
                 came_from = motion.provenance
