@@ -71,6 +71,7 @@ def test_a_jog_asked_in_place_steps_on_the_spot(openbody):
     from shapemove.core.generation.generate import Generator, Request
 
     gen = Generator(None)
+    gen.set_captured(False)   # the codec's jog, which travels, against the same jog stepped on the spot
     whole = gen.generate_batch([Request("a person jogs in place", seconds=4, seed=0, by_parts=False)])[0]
     m = gen.generate_batch([Request("a person jogs in place", seconds=4, seed=0)])[0]
     went = lambda mm: float(np.linalg.norm(mm.joints[-1, 0, [0, 2]] - mm.joints[0, 0, [0, 2]]))  # noqa: E731

@@ -25,7 +25,9 @@ def test_windows_cut_a_clip_to_the_requested_length():
 def gen():
     from shapemove.core.generation.generate import Generator
 
-    return Generator(None)
+    g = Generator(None)
+    g.set_captured(False)   # the retrieval memory's candidates, which these tests are about
+    return g
 
 
 @pytest.fixture()
@@ -146,6 +148,7 @@ def test_a_users_library_becomes_retrieved_candidates(gen, tmp_path):
     m = gen.generate_batch([Request(text, seconds=5, seed=0, by_parts=False)])[0]
     save_motion(lib / "jacks.npz", m)
     own = Generator(None)
+    own.set_captured(False)
     before = len(own.t5.memory)
     assert before > 1000 and own.add_library(lib) == 1 and len(own.t5.memory) == before + 1
     out = own.generate_batch([Request("someone does jumping jacks on a purple trampoline", seconds=4, seed=0,
@@ -312,7 +315,14 @@ def test_a_library_kick_is_found_for_words_the_training_kicks_are_nearer_to(moca
     (lib / "kick.txt").write_text("a person does a high front kick with the right leg\n")
     lift = lambda y: float(y.max() - y.min())  # noqa: E731   (the right ankle's rise)
     src = lift(source_joints(kick, openbody)[0][:, 8, 1])
-    own = Generator(None)
+    from shapemove.core.generation.model_bundle import resolve_model_dir
+    from shapemove.core.model_files import write_manifest
+
+    model = tmp_path / "model"     # the default model without its built-in library: the user's kick alone
+    shutil.copytree(resolve_model_dir(None), model)
+    (model / "library.npz").unlink(missing_ok=True)
+    write_manifest(model)
+    own = Generator(model)
     own.add_library(lib)
     run = lambda p: own.generate_batch([Request(p, seconds=4, seed=0)])[0]  # noqa: E731
     mine = "captured: kick.bvh (your library)"
@@ -347,6 +357,7 @@ def test_a_model_folder_with_a_memory_retrieves_from_it(gen, tmp_path):
     mem.save(model / "t5")
     write_manifest(model)
     own = Generator(model)
+    own.set_captured(False)
     assert own.t5.memory_k == 0 and own.t5.memory.clip_ids == ["punch_9"]
     m = own.generate_batch([Request("someone punches", seconds=4, seed=0, retrieval_first=0.0)])[0]
     assert m.retrieved_clips == ["punch_9"]

@@ -247,7 +247,7 @@ def test_stdout_has_only_protocol_lines_when_a_job_prints():
 
 
 def test_queued_job_cancels_at_once(shared):
-    j1 = shared.submit("measure", {"betas": [0.0] * 10})
+    j1 = shared.submit("measure", {"betas": [0.4321] * 10})   # a body measured nowhere else (measure keeps bodies)
     j2 = shared.submit("body_info", {})
     assert shared.cancel(j2)
     msgs = wait_for(shared, ended(j1), timeout=90)

@@ -49,7 +49,7 @@ from .sampling_params import (DEFAULT_GUIDANCE, check_candidates, check_guidance
                               check_retrieval_prefix, check_retrieved, check_sampling)
 from .request import Request
 from .slow_steps import slow_motion
-from .turn_words import turn_motion
+from .turn_words import angle_of, turn_motion
 
 
 LIBRARY_TAKES = 8   # library clips kept read as captured at once (Generator._library_window)
@@ -510,8 +510,10 @@ class Generator:
             if motion is None:  # one action, no side named: the motion as the model writes it
                 sampled = asked if course is None else dataclasses.replace(asked, prompt=walked_straight(asked.prompt))
                 # samples and captured takes, one choice (captured_takes.py); a stop or a distance is cut
-                # in the codes (stop_words.py), so it is asked of the samples alone
-                choice = self.choose(sampled, captured=stop is None)
+                # in the codes (stop_words.py), a course is a plain gait bent and a turn is given back to
+                # the decoded motion, so those are asked of the samples alone
+                turn = angle_of(r.prompt) if r.by_parts else None   # turn_words.py: given back after
+                choice = self.choose(sampled, captured=stop is None and course is None and turn is None)
                 betas, source = self.body_shape(r, choice.betas.numpy())
                 motion = self.chosen_motion(choice, betas, r.prompt)
                 came_from = motion.provenance

@@ -53,7 +53,7 @@ def test_panels_register_and_draw_in_the_factory_scene(installed):
     assert ops["SHAPEMOVE_PT_train"] == ["shapemove.train", "shapemove.train"]
     assert [d["props"] for d in panels["SHAPEMOVE_PT_train"] if d["kind"] == "operator"] == [{"resume": False}, {"resume": True}]
     props = [d["prop"] for d in panels["SHAPEMOVE_PT_generate"] if d["kind"] == "prop"]
-    assert props == ["prompt", "shape_text", "use_seconds", "seconds", "seed", "temperature", "by_parts"]
+    assert props == ["prompt", "shape_text", "use_seconds", "seconds", "seed", "temperature", "by_parts", "use_captured"]
     prefs = [d["prop"] for d in draw_preferences() if d["kind"] == "prop"]
     assert prefs == ["body_model", "python_env", "models_dir", "active_model", "device"]
 
