@@ -3,8 +3,9 @@ as they finish (in any order); the caller is the one manifest writer.
 
 - ``InProcess``: one after another in this process (``--jobs 1``).
 - ``ProcessPool(jobs)``: ``jobs`` worker processes (spawned, so each imports torch and loads the
-  model once and keeps it: the task caches it per process); an item is handed out when a worker
-  frees up (at most two per worker queued); workers write their files into the batch folder.
+  model once and keeps it: the task caches it per process), each on cores / jobs torch threads;
+  an item is handed out when a worker frees up (at most two per worker queued); workers write
+  their files into the batch folder.
 - ``DaskCluster(address)``: items as tasks on a running Dask distributed cluster; a task returns its
   files' bytes (``item_run.run_remote``) and they are written here, so the workers need no shared
   disk, only this package and the model folder (the default model ships inside the package).
@@ -51,8 +52,25 @@ def _blender_script_path(entry: str) -> bool:
     return "scripts" in parts and ("bpy" in parts or "blender" in parts)
 
 
+def cores() -> int:
+    """The cores this process may run on."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:   # not on Linux
+        return os.cpu_count() or 1
+
+
+def threads_per_worker(jobs: int) -> int:
+    """Each of ``jobs`` workers runs torch (and its BLAS) on cores / jobs threads, so N workers
+    share the cores without oversubscribing them, and one worker (or ``--jobs 1``, this process,
+    torch's default) has them all."""
+    return max(1, cores() // jobs)
+
+
 def _init_worker(threads: int, parent: int) -> None:
     signal.signal(signal.SIGINT, signal.SIG_IGN)   # Ctrl-C is the batch process's: it stops handing out items
+    for name in ("OMP_NUM_THREADS", "MKL_NUM_THREADS", "OPENBLAS_NUM_THREADS"):
+        os.environ[name] = str(threads)
     # a parent that imported bpy passes on the script folders bpy put on sys.path; their `bpy`
     # package would shadow the module here ("No module named '_bpy'"): bpy adds them again on import
     sys.path[:] = [p for p in sys.path if not _blender_script_path(p)]
@@ -72,7 +90,7 @@ class ProcessPool:
     def run(self, task, specs, folder):
         import multiprocessing
 
-        threads = max(1, (os.cpu_count() or 1) // self.jobs)
+        threads = threads_per_worker(self.jobs)
         pool = ProcessPoolExecutor(self.jobs, mp_context=multiprocessing.get_context("spawn"),
                                    initializer=_init_worker, initargs=(threads, os.getpid()))
         specs, running = iter(specs), set()

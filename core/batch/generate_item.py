@@ -1,7 +1,7 @@
 """The item task of ``generate --prompts`` (motions only, no Blender): an item's options and the
-batch's settings to a motion file ``{stem}.npz``. Each process keeps its generators (one per
-model, body model, library and retrieval setting), so a worker loads the model once; a lock lets
-a multi-threaded Dask worker share them."""
+batch's settings to a motion file ``{stem}.npz``. Each process keeps its loaded generator
+(``generation/loaded_generator.py``), so a worker loads the model once; a lock lets a
+multi-threaded Dask worker share it."""
 from __future__ import annotations
 
 import threading
@@ -9,22 +9,21 @@ from pathlib import Path
 
 from ..scene.motion_file import save_motion
 
-_GENERATORS: dict = {}
 LOCK = threading.Lock()   # held around an item's generation (a Dask worker may run items on threads)
 
 
 def generator_for(where: dict, retrieval: bool = True):
-    """The process's generator for ``where`` ({"model", "body_model", "library"} paths or None)."""
-    from ..generation.generate import Generator
+    """The process's generator for ``where`` ({"model", "body_model", "library"} paths or None):
+    the one ``loaded_generator`` keeps, with retrieval as the batch's settings say."""
+    from ..generation.loaded_generator import loaded_generator
 
-    key = (where.get("model"), where.get("body_model"), where.get("library"), retrieval)
-    if key not in _GENERATORS:
-        gen = Generator(where.get("model"), body=where.get("body_model"))
-        gen.set_retrieval(retrieval)
-        if where.get("library"):
-            print(f"retrieval memory: {gen.add_library(where['library'])} motions added from {where['library']}")
-        _GENERATORS[key] = gen
-    return _GENERATORS[key]
+    def said(gen, clips):
+        if clips is not None:
+            print(f"retrieval memory: {clips} motions added from {where['library']}")
+
+    gen = loaded_generator(where.get("model"), where.get("body_model"), where.get("library"), on_load=said)
+    gen.set_retrieval(retrieval)
+    return gen
 
 
 def item_motion(spec: dict):

@@ -32,7 +32,8 @@ def item_specs(kind: str, items, count: int, settings: dict, model: dict, where:
 
 def remove_leftovers(folder: Path, stems) -> int:
     """Remove the temporary files (``NAME.PID.tmp``, core/atomic.py) a killed run left of the
-    items about to run; a finished file never has that name, so none is mistaken for one."""
+    items about to run (and of its manifest, ``stems`` holding the manifest's name); a finished
+    file never has that name, so none is mistaken for one."""
     stems, removed = set(stems), 0
     if folder.is_dir():
         for p in folder.iterdir():
@@ -51,7 +52,7 @@ def run_batch(kind: str, task, items, count: int, settings: dict, model: dict, w
     manifest = folder / manifest_name(shard)
     done_before = finished_items(manifest, {s["item"]: s["key"] for s in specs})
     todo = [s for s in specs if s["item"] not in done_before]
-    remove_leftovers(folder, [s["stem"] for s in todo])
+    remove_leftovers(folder, [s["stem"] for s in todo] + [manifest.name.split(".")[0]])
     result = BatchResult(manifest, len(specs), len(specs) - len(todo))
     progress = BatchProgress(len(specs), result.skipped, label=kind, stream=progress_stream, interval=interval)
     labels = {it.index: it.label for it in items}
