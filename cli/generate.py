@@ -2,7 +2,8 @@
 [--seed N] [--temperature T] [--loop] [--in-place] [--path PATH.json] [--speed X | --stretch S]
 --out OUT.npz`: text -> body shape + motion file (animation options: docs/animation.md). A prompt of
 motions in order ("walks forward, then sits down") is made as a timeline of them (``core/plan/``);
-``--explain`` prints the plan as JSON and generates nothing."""
+``--explain`` prints the plan as JSON and generates nothing; ``--plan PLAN.json`` generates from that
+JSON, edited."""
 from __future__ import annotations
 
 from pathlib import Path
@@ -38,7 +39,11 @@ def add_arguments(p):
     p.add_argument("--out", type=Path, default=None, help="the motion file to write (.npz)")
     p.add_argument("--explain", action="store_true",
                    help="print the plan of the prompt as JSON (its segments in order, each with its share of the "
-                        "length and what the words were understood to ask) and generate nothing")
+                        "length and what the words were understood to ask) and generate nothing; with --out PLAN.json "
+                        "the plan is written there, to edit and generate from with --plan")
+    p.add_argument("--plan", type=Path, default=None, metavar="PLAN.json",
+                   help="generate from a plan: the JSON --explain prints, edited (actions, side, course, distance, "
+                        "count, seconds per segment...: docs/prompts.md); takes the place of --prompt")
     p.add_argument("--library", type=Path, default=None,
                    help="a folder of your own captioned motions added to the retrieval memory (no retraining)")
     p.add_argument("--no-library", action="store_true",
@@ -93,6 +98,20 @@ def run(args) -> int:
     from ..core.generation.generate import parse_betas
     from ..core.generation.loaded_generator import loaded_generator
 
+    plan = None
+    if getattr(args, "plan", None) is not None:   # an edited plan: its prompt is the one generated
+        from ..core.plan.plan import MAX_PLAN_BYTES, plan_from_json
+
+        if args.prompt is not None or args.prompts is not None:
+            raise ShapeMoveError("--plan takes the place of --prompt / --prompts: give one of them")
+        if not args.plan.is_file():
+            raise ShapeMoveError(f"plan file not found: {args.plan}")
+        if args.plan.stat().st_size > MAX_PLAN_BYTES:
+            raise ShapeMoveError(f"plan file {args.plan} is larger than {MAX_PLAN_BYTES // 1024} KB")
+        plan = plan_from_json(args.plan.read_text(encoding="utf-8", errors="replace"), args.seconds)
+        args.prompt = plan.segments[0].text if not plan.is_sequence else plan.prompt
+        if args.seconds is None and plan.seconds is not None:
+            args.seconds = plan.seconds
     if args.explain:   # the plan, without loading any model
         import json
 
@@ -100,11 +119,27 @@ def run(args) -> int:
             raise ShapeMoveError("--explain shows the plan of one --prompt TEXT")
         from ..core.plan.explain import plan_json
 
-        print(json.dumps(plan_json(args.prompt, args.seconds, loop=args.loop, in_place=args.in_place,
-                                   path=args.path is not None, by_parts=not args.no_parts), indent=2))
+        if plan is not None:
+            from ..core.plan.plan import plan_to_json
+
+            shown = plan_to_json(plan)
+        else:
+            shown = plan_json(args.prompt, args.seconds, loop=args.loop, in_place=args.in_place,
+                              path=args.path is not None, by_parts=not args.no_parts)
+        if args.out is not None:   # kept to edit and generate from (--plan)
+            from ..core.atomic import atomic_write_json
+
+            if args.out.suffix.lower() != ".json":
+                raise ShapeMoveError(f"with --explain, --out is the plan file to write (.json), got {args.out}")
+            atomic_write_json(ensure_parent(args.out), shown)
+            print(f"wrote the plan to {args.out} (edit it, then: generate --plan {args.out} --out OUT.npz)")
+        else:
+            print(json.dumps(shown, indent=2))
         return 0
     if args.out is None:
         raise ShapeMoveError("give the motion file to write with --out OUT.npz (or --explain to see the plan only)")
+    if args.prompt is None and args.prompts is None and getattr(args, "plan", None) is None:
+        raise ShapeMoveError("give --prompt TEXT, --plan PLAN.json (one motion) or --prompts FILE (a batch)")
     if args.prompts is not None:
         from .generate_batch import run_generate_batch
 
@@ -136,7 +171,7 @@ def run(args) -> int:
 
     motion = animate(gen, Request(args.prompt, args.shape_text, betas, args.seconds, args.seed, args.temperature,
                                   args.top_k, args.shape_from, candidates, guidance, prefix, retrieved, first,
-                                  not args.no_parts), animation)
+                                  not args.no_parts, plan=plan), animation)
     save_motion(args.out, motion)
     import sys
 
@@ -151,7 +186,7 @@ def run(args) -> int:
     if not args.no_parts:
         from ..core.plan.explain import plan_lines
 
-        for line in plan_lines(args.prompt, motion):
+        for line in plan_lines(args.prompt, motion, plan):
             print(line)
     if motion.provenance:   # "captured: HDM05 bd kickLFront 003 (CC BY-SA 3.0)" or "generated"
         print(motion.provenance)

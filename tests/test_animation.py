@@ -237,6 +237,7 @@ def test_timeline_segments_obey_their_pace_and_travel_words(gen):
     and decoded again for a new body the edits hold."""
     from shapemove.core.generation.sequence import boundary_report, generate_sequence
     from shapemove.core.generation.timeline_words import segment_scale, worded_joints
+    from shapemove.core.plan.words import read_words
 
     segs = [("a person walks forward", 2.0), ("a person jogs in place", 3.0), ("a person walks forward slowly", 2.0)]
     plain = generate_sequence(gen, segs, seed=0, by_parts=False)    # no word edits
@@ -255,9 +256,9 @@ def test_timeline_segments_obey_their_pace_and_travel_words(gen):
     again = gen.redecode(m, np.full(10, 0.6, np.float32))
     assert again.segment_prompts == m.segment_prompts and travel(again)[1] < 0.15 * t0[1]
     # the scales the words ask: none for a plain walk (no edit at all), SLOW_SPEED, the spot's
-    assert segment_scale("a person walks forward", plain.joints[:40]) == 1.0
-    assert segment_scale("a person walks forward slowly", plain.joints[100:]) == 0.8
-    assert segment_scale("a person jogs in place", plain.joints[40:100]) == pytest.approx(0.5 / t0[1], rel=0.1)  # its path
+    assert segment_scale(read_words("a person walks forward"), plain.joints[:40]) == 1.0
+    assert segment_scale(read_words("a person walks forward slowly"), plain.joints[100:]) == 0.8
+    assert segment_scale(read_words("a person jogs in place"), plain.joints[40:100]) == pytest.approx(0.5 / t0[1], rel=0.1)  # its path
     assert worded_joints(plain.joints, [[0, 140]], ["a person walks forward"]) is None
 
 

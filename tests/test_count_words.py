@@ -5,7 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from shapemove.core.generation.count_words import DIP, LIFT, MIN_RUN, asked_count, dips, flights, nearest_count
+from shapemove.core.generation.count_words import DIP, LIFT, MIN_RUN, counter, dips, flights, nearest_count
+from shapemove.core.plan.reader import asked_count
 
 
 @pytest.mark.parametrize("text, want", [
@@ -29,7 +30,7 @@ def test_the_words_that_count_jumps_and_squats(text, want):
     got = asked_count(text)
     assert (got and got[1]) == want
     if want is not None:
-        assert got[0] is (dips if "squat" in text else flights)
+        assert counter(got[0]) is (dips if "squat" in text else flights)
 
 
 def _features(heights) -> np.ndarray:

@@ -4,8 +4,16 @@ import numpy as np
 import pytest
 
 from shapemove.core.generation.course_walk import (BACK_AND_FORTH, CIRCLE, DIAGONAL, EIGHT, MAX_RADIUS, MIN_RADIUS, U_RADIUS,
-                                                   ZIG, ZIG_ANGLE, ZIGZAG, on_course, course_line, course_named,
-                                                   course_turn, radius_for, straight_gait, turns_right)
+                                                   ZIG, ZIG_ANGLE, ZIGZAG, course_line, course_turn, radius_for)
+from shapemove.core.generation.course_walk import on_course as _on_course
+from shapemove.core.plan.reader import course_named, straight_gait, turns_right
+from shapemove.core.plan.words import read_words
+
+
+def on_course(track, text, course=None):
+    """The track walked along the course the plan reads in ``text`` (``course``: read elsewhere)."""
+    w = read_words(text)
+    return _on_course(track, course or w.course, w.course_right)
 from shapemove.core.generation.track import Track, headings, root_centre
 
 
@@ -197,7 +205,7 @@ def test_a_straight_walk_goes_round_the_eight():
     assert turn.max() > 1.8 * np.pi and turn[-1] < turn.max() - 1.5 * np.pi    # round one way, then most of the way back
     c = root_centre(bent.joints)
     assert c[:, 0].max() > 1.8 and c[:, 0].min() < -1.8                       # both loops, either side of the start
-    read = on_course(walk, "a person walks", course=EIGHT)                      # the caller read the eight elsewhere
+    read = on_course(walk, "a person walks", EIGHT)                      # the caller read the eight elsewhere
     assert np.allclose(root_centre(read.joints), c)
 
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from shapemove.core.generation.on_the_spot import asks_on_the_spot
+from shapemove.core.plan.reader import asks_on_the_spot
 from shapemove.core.generation.stride_scale import scaled_strides
 
 pytestmark = pytest.mark.usefixtures("one_thread")

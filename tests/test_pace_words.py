@@ -2,7 +2,9 @@
 import numpy as np
 import pytest
 
-from shapemove.core.generation.pace_words import asks_fast, fastest, gait_speed
+from shapemove.core.generation.pace_words import fastest, gait_speed
+from shapemove.core.plan.reader import asks_fast
+from shapemove.core.plan.words import read_words
 
 
 @pytest.mark.parametrize("prompt, expected", [
@@ -76,7 +78,7 @@ def test_the_pace_sets_ask_one_gait_slow_plain_and_fast():
     from pathlib import Path
 
     from shapemove.core.data.actions import action_spans
-    from shapemove.core.generation.part_prompts import LEGS
+    from shapemove.core.plan.part_prompts import LEGS
 
     root = Path(__file__).resolve().parents[1]
     for name in ("tuning_pace.json", "heldout_pace_blind.json"):
@@ -100,7 +102,7 @@ def test_the_pace_sets_ask_one_gait_slow_plain_and_fast():
     ("a person waves slowly", False),
 ])
 def test_asks_slow_steps_reads_a_stepping_gaits_slow_pace(prompt, expected):
-    from shapemove.core.generation.pace_words import asks_slow_steps
+    from shapemove.core.plan.reader import asks_slow_steps
 
     assert asks_slow_steps(prompt) == expected
 
@@ -115,7 +117,7 @@ def test_asks_slow_steps_reads_a_stepping_gaits_slow_pace(prompt, expected):
     ("someone waves slowly", False),
 ])
 def test_asks_slow_flight_reads_a_jog_or_runs_slow_pace(prompt, expected):
-    from shapemove.core.generation.pace_words import asks_slow_flight
+    from shapemove.core.plan.reader import asks_slow_flight
 
     assert asks_slow_flight(prompt) == expected
 
@@ -127,8 +129,8 @@ def test_slow_motion_plays_a_walk_at_the_slow_speed_over_the_same_length():
 
     gen = Generator("weights/default")
     walk = gen.generate_batch([Request("a person walks forward", seconds=4.0, seed=0)])[0]
-    assert slow_motion(walk, gen.body, "a person walks forward") is walk
-    slow = slow_motion(walk, gen.body, "a person walks forward slowly")
+    assert slow_motion(walk, gen.body, read_words("a person walks forward")) is walk
+    slow = slow_motion(walk, gen.body, read_words("a person walks forward slowly"))
     assert slow.num_frames == walk.num_frames and slow.tokens is None   # an edit: no tokens kept
     # the slowed walk covers what the walk covered in its first SLOW_SPEED of the time
     keep = int(round(walk.num_frames * SLOW_SPEED))
@@ -150,7 +152,7 @@ def test_slow_motion_gives_a_jog_shorter_strides_at_the_same_cadence():
 
     gen = Generator("weights/default")
     jog = gen.generate_batch([Request("a person jogs forward", seconds=4.0, seed=0)])[0]
-    slow = slow_motion(jog, gen.body, "a person jogs forward slowly")
+    slow = slow_motion(jog, gen.body, read_words("a person jogs forward slowly"))
     assert slow.num_frames == jog.num_frames and slow.tokens is None
     path = lambda j: np.linalg.norm(np.diff(j[:, 0, [0, 2]], axis=0), axis=1).sum()  # noqa: E731
     assert path(jog.joints) > 4.0 and path(slow.joints) == pytest.approx(SLOW_SPEED * path(jog.joints), rel=0.05)

@@ -179,7 +179,7 @@ def test_bad_by_parts_fields_are_refused(gen, tmp_path):
 
 
 def test_clauses_the_patterns_miss_are_named_by_the_nearest_caption(gen):
-    from shapemove.core.generation.part_prompts import clauses, plan_parts
+    from shapemove.core.plan.part_prompts import clauses, plan_parts
     from shapemove.core.generation.parts import plan_of
 
     text = "a man marches with his right arm raised"

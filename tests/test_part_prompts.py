@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from shapemove.core.generation.part_prompts import named_side, plan_parts
+from shapemove.core.plan.part_prompts import named_side, plan_parts
 
 
 @pytest.mark.parametrize("text, legs, arms, acts", [

@@ -5,7 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from shapemove.core.generation.stop_words import asked_distance, distance_cut, standing_after, stop_cut, stop_request
+from shapemove.core.generation.stop_words import distance_cut, standing_after, stop_cut
+from shapemove.core.plan.reader import asked_distance, stop_request
 
 
 @pytest.mark.parametrize("text, want", [
@@ -110,7 +111,7 @@ def test_a_timeline_segment_that_stands_still_stands(gen_default):
     middle segment walked on (seed 0: 1.1-1.3 m/s); it is now the model's standing code, so the body
     halts early in the segment, stands, and walks on after it. Regenerate Strip keeps it."""
     from shapemove.core.generation.sequence import boundary_report, generate_sequence, regenerate_segment
-    from shapemove.core.generation.stop_words import asks_stand_still
+    from shapemove.core.plan.reader import asks_stand_still
 
     assert asks_stand_still("a person stands still") and asks_stand_still("she waits")
     assert not asks_stand_still("she stands up") and not asks_stand_still("a man walks and stops")
@@ -205,7 +206,7 @@ def test_a_timeline_distance_is_cut_on_its_own_body_and_a_wave_after_it_stands(g
     tries, the one that stands nearest 3 m) and a segment of gestures only stands."""
     from shapemove.core.generation.sequence import generate_sequence
     from shapemove.core.generation.stop_words import distance_keeps, from_start
-    from shapemove.core.generation.timeline_words import gestures_only
+    from shapemove.core.plan.reader import gestures_only
 
     assert distance_keeps(5, 20) == [3, 4, 5, 6] and distance_keeps(1, 20) == [1, 2] and distance_keeps(20, 20) == [18, 19, 20]
     assert gestures_only("he waves") and gestures_only("a person raises the left hand")

@@ -2,7 +2,13 @@
 import numpy as np
 import pytest
 
-from shapemove.core.generation.travel_words import SLACK, Travel, allowed, body_frame_travel, obeys, travel_of
+from shapemove.core.generation.travel_words import SLACK, body_frame_travel, obeys
+from shapemove.core.generation.travel_words import allowed as _allowed
+from shapemove.core.plan.reader import Travel, travel_of
+
+
+def allowed(prompt, feats):
+    return _allowed(travel_of(prompt), feats)
 
 
 @pytest.mark.parametrize("prompt, expected", [

@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 
 from shapemove.core.generation.track import Track, headings, root_centre
-from shapemove.core.generation.turn_words import angle_of, turned
+from shapemove.core.generation.turn_words import turned
+from shapemove.core.plan.reader import angle_of
 
 from test_course_walk import _straight_walk
 

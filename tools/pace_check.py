@@ -46,7 +46,7 @@ def main(argv=None) -> int:
     from shapemove.core.eval.gait import mean_speed
     from shapemove.core.motion.features import motion_features
     from shapemove.core.generation.generate import Generator, Request
-    from shapemove.core.generation.part_prompts import LEGS
+    from shapemove.core.plan.part_prompts import LEGS
 
     gen = Generator(args.model)
     judges = _judges(gen, args.data) if args.data else {}

@@ -89,7 +89,7 @@ def animate(gen, req, a: Animation, progress=None, cancel=None) -> Motion:
         if not out:
             raise ShapeMoveError("cancelled")
         motion = out[0]
-    keep = (motion.warnings, motion.shape_source, motion.prompt_check, motion.notes, motion.provenance)
+    keep = (motion.warnings, motion.shape_source, motion.prompt_check, motion.notes, motion.provenance, motion.plan)
     if a.path is None and (a.speed is not None or a.stretch is not None):
         motion = time_warp(motion, gen.body, speed=a.speed, seconds=a.stretch, ik_refine_iters=gen.ik_refine_iters)
     if a.in_place:
@@ -97,6 +97,7 @@ def animate(gen, req, a: Animation, progress=None, cancel=None) -> Motion:
     motion.warnings = list(keep[0]) + [w for w in motion.warnings if w not in keep[0]]
     motion.shape_source, motion.prompt_check, motion.notes = keep[1], keep[2], list(keep[3])
     motion.provenance = motion.provenance or keep[4]   # a captured take stays captured through the edits
+    motion.plan = keep[5]
     if req.by_parts:   # the words an option overrides, said (plan/option_conflicts.py)
         motion.notes += option_notes(req.prompt, loop=a.loop, in_place=a.in_place, path=a.path is not None)
     return motion

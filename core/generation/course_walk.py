@@ -31,67 +31,33 @@ the next segment goes on the way the course leaves it. Left first unless the wor
   timeline the segments after it go on that way.
 
 The gait is generated without the course's words when the rest still names one ("a person walks in
-a figure eight" -> "a person walks"; "paces", "zigzags" -> "walks"; ``straight_gait``): the captured
+a figure eight" -> "a person walks"; "paces", "zigzags" -> "walks"; ``plan.reader.straight_gait``): the captured
 circles and eights the model learnt them from turn, and decoded without their turning they walk at
 0.3-0.6 m/s (a plain walk 1.1 m/s), so a 10 s eight went half round one loop. A motion that does
 not travel (a wave, a sit, "rocks back and forth") is left as it is.
 
-    track = on_course(track, "a woman walks around in a circle, waving")
-    track = on_course(track, "a man paces back and forth")
+    w = read_words("a woman walks around in a circle, waving")     # plan/words.py
+    track = on_course(track, w.course, w.course_right)
 """
 from __future__ import annotations
 
-import re
 from dataclasses import dataclass
 from typing import Callable
 
 import numpy as np
 
 from ..constants import FPS
-from ..data.actions import find_actions
-from ..data.compose_parts import LEGS_ACTIONS
+from ..plan.vocabulary import (BACK_AND_FORTH_COURSE as BACK_AND_FORTH, CIRCLE, COURSE_ACTIONS as ACTIONS,
+                               DIAGONAL_COURSE as DIAGONAL, EIGHT, ZIGZAG_COURSE as ZIGZAG)
 from .polyline import MIN_SPEED, Polyline, follow_track
 from .track import Track, motion_speed, travel
 
-CIRCLE = "walk in a circle"
-EIGHT = "walk in a figure eight"
-BACK_AND_FORTH = "back and forth"
-ZIGZAG = "zigzag"
-DIAGONAL = "diagonal"
-ACTIONS = (CIRCLE, EIGHT)            # the courses that are actions of the data (``data.actions``)
 MIN_RADIUS, MAX_RADIUS = 1.0, 3.0   # m: a circle's, an eight's loops'
 U_RADIUS = 0.3                      # m: back and forth's U-turns
 LEG_MIN, LEG_MAX = 1.0, 5.0         # m: back and forth's legs
 ZIG, ZIG_ANGLE, ZIG_TURN = 1.5, np.pi / 4, 0.15   # m, radians, share of a leg
 DIAGONAL_ANGLE, DIAGONAL_EASE = np.pi / 4, 0.6   # radians, m
 STEP = 0.005                        # m: a course's heading integrated at this step
-
-CLOCKWISE = re.compile(r"(?<![-\w])(?:clockwise|to the right|rightward)\b")
-COUNTER = re.compile(r"\b(?:counter|anti)[- ]?clockwise\b")
-# "paces" is back and forth only where nothing sends it on: "paces the room", "is pacing nervously", "paces
-# back and forth", "she paces." -- not "paces ahead at a steady clip", "paces along the road"
-_TO_AND_FRO = r"back and forth|to and fro|backwards and forwards"
-_UP_AND_DOWN = r"up and down the (?:room|hall|hallway|corridor|street|platform|stage)"
-_PACE = (r"\bpac(?:es|ing)\b(?=\s+(?:(?:around|about|round)\s+)?(?:the|a|his|her|their)\s+(?:[\w-]+\s+)?(?:room|floor|halls?|"
-         r"hallway|corridor|office|cell|stage|platform|deck|yard|kitchen|ward|lobby)\b|\s+(?:nervously|impatiently|"
-         r"anxiously|restlessly|worriedly|around|about|back and forth|to and fro|up and down)\b|\s*(?:[,.;!]|$))")
-_BACK_AND_FORTH = re.compile(rf"\b(?:{_TO_AND_FRO}|{_UP_AND_DOWN})\b|{_PACE}", re.I)
-_ZIGZAG = re.compile(r"\bzig[- ]?zag(?:s|ging|ged)?\b", re.I)
-_DIAGONAL = re.compile(r"\bdiagonal(?:ly)?\b|\bat an angle\b", re.I)
-_COURSE_VERB = re.compile(rf"{_PACE}|\bzig[- ]?zag(?:s|ging|ged)\b", re.I)   # the course as the verb: "walks"
-# the course in words, cut out for its gait: "in a circle", "around in circles", "a figure-8 path",
-# "in a zigzag", "back and forth", "up and down the room"
-COURSE_WORDS = re.compile(
-    r"(?:\s+(?:around|round|along|on|in|into|through|doing|making|tracing|following))*\s+(?:(?:a|an|the)\s+)?"
-    r"(?:(?:small|big|large|wide|tight|full)\s+)?(?:figure[- ]?(?:of[- ])?(?:8|eight)|circles?|zig[- ]?zag)"
-    r"(?:[- ]shaped)?(?:\s+(?:path|route|pattern|course|shape|loop|line))?\b"
-    rf"|\s+(?:{_TO_AND_FRO}|diagonally|at an angle)\b|\s+{_UP_AND_DOWN}\b", re.I)
-# circles the arms make, not the walk: "rotating your arms in circles", "swinging the arms around in circles"
-_ARM_CIRCLES = re.compile(r"\b(?:arms?|hands?|fists?|wrists?)\b(?:\s+[\w-]+){0,2}?\s+(?:(?:a)?round\s+)?in\s+"
-                          r"(?:(?:big|small|wide|large)\s+)?circles?\b", re.I)
-TURN_WAY = re.compile(r"\s+(?:(?:counter|anti)[- ]?)?clockwise\b|\s+(?:to the (?:right|left)|rightwards?|leftwards?)\b",
-                      re.I)   # the course's way round, not the gait's ("runs in a circle to the right")
-
 
 def radius_for(distance: float) -> float:
     """The radius (m) of a circle once round in ``distance`` metres, within MIN..MAX_RADIUS."""
@@ -160,53 +126,6 @@ COURSES = {
 }
 
 
-def course_named(text: str) -> str | None:
-    """The course the words name (``EIGHT`` before ``CIRCLE``: "a figure eight" is not a circle;
-    not the circles the arms make: "walks forward rotating the arms in circles"; back and forth and a
-    zigzag only with a gait to walk it, or as the verb: "sways back and forth" names none), else
-    None."""
-    acts = find_actions(text)
-    if EIGHT in acts or (CIRCLE in acts and not _ARM_CIRCLES.search(str(text))):
-        return EIGHT if EIGHT in acts else CIRCLE
-    gait = any(a in LEGS_ACTIONS for a in acts) or _COURSE_VERB.search(str(text)) is not None
-    for name, words in ((BACK_AND_FORTH, _BACK_AND_FORTH), (ZIGZAG, _ZIGZAG), (DIAGONAL, _DIAGONAL)):
-        if gait and words.search(str(text)):
-            return name
-    return None
-
-
-def straight_gait(text: str) -> tuple[str, str] | None:
-    """(the words without the course they name and its way round, the gait left in them) --
-    "someone jogs in a figure eight clockwise, waving" -> ("someone jogs, waving", "jog"), "a man
-    paces back and forth" -> ("a man walks", "walk") -- or None when the words name no course
-    (``course_named``) or what is left names no gait ("goes around in a circle")."""
-    text = str(text)
-    if course_named(text) is None:
-        return None
-    straight = _COURSE_VERB.sub(_walk_verb, COURSE_WORDS.sub("", text))
-    straight = re.sub(r"\s+([,.;])", r"\1", TURN_WAY.sub("", straight)).strip()
-    gaits = [a for a in find_actions(straight) if a in LEGS_ACTIONS and a not in ACTIONS]
-    return (straight, gaits[0]) if gaits else None
-
-
-def _walk_verb(m: re.Match) -> str:
-    """"paces" -> "walks", "pacing" / "zigzagging" -> "walking", "zigzagged" -> "walked"."""
-    word = m.group(0).lower()
-    return "walking" if word.endswith("ing") else "walked" if word.endswith("ed") else "walks"
-
-
-def walked_straight(text: str) -> str:
-    """The words a course's gait is sampled from (``straight_gait``'s), else ``text`` itself."""
-    gait = straight_gait(text)
-    return gait[0] if gait else text
-
-
-def turns_right(text: str) -> bool:
-    """Clockwise seen from above: "clockwise", "to the right" (not "counter-clockwise")."""
-    t = str(text).lower()
-    return bool(CLOCKWISE.search(COUNTER.sub(" ", t)))
-
-
 def course_line(distance: float, course: str, right: bool) -> Polyline:
     """``course`` from the origin, heading +Z, as long as ``distance`` metres need (at least one
     period and a quarter more): its heading integrated every ``STEP`` m."""
@@ -229,21 +148,19 @@ def course_turn(own: np.ndarray, s: np.ndarray, course: str, right: bool) -> np.
     return c.yaw(s, period, right) - (own[-1] - own[0]) * np.asarray(s, np.float64) / total
 
 
-def on_course(track: Track, text: str, fps: float = FPS, course: str | None = None) -> Track:
-    """``track`` walked along the course ``text`` asks for (``course``, when given, says which: the
-    caller may have read it from the nearest known caption; else the words', else a circle);
-    unchanged when it does not travel."""
+def on_course(track: Track, course: str | None, right: bool = False, fps: float = FPS) -> Track:
+    """``track`` walked along ``course`` (the plan's, or the action of the nearest known caption;
+    None: a circle), clockwise when ``right``; unchanged when it does not travel."""
     if motion_speed(track.joints, fps) < MIN_SPEED:
         return track
-    course = course or course_named(text) or CIRCLE
-    return follow_track(track, course_line(float(travel(track.joints)[-1]), course, turns_right(text)), crop=False)
+    return follow_track(track, course_line(float(travel(track.joints)[-1]), course or CIRCLE, right), crop=False)
 
 
-def course_motion(motion, body, text: str, ik_refine_iters: int = 10, course: str | None = None):
-    """A generated ``Motion`` walked along the course ``text`` asks for (``course``: as ``on_course``;
-    ``track.replanted``: an edit, no tokens kept); the motion itself when it does not travel."""
+def course_motion(motion, body, course: str | None, right: bool = False, ik_refine_iters: int = 10):
+    """A generated ``Motion`` walked along ``course`` (as ``on_course``; ``track.replanted``: an edit,
+    no tokens kept); the motion itself when it does not travel."""
     from .track import replanted, track_of
 
     tr = track_of(motion)
-    bent = on_course(tr, text, motion.fps, course)
+    bent = on_course(tr, course, right, motion.fps)
     return motion if bent is tr else replanted(motion, body, bent, ik_refine_iters)

@@ -32,7 +32,7 @@ from ..scene.motion_file import Motion
 from ..torch_threads import one_torch_thread
 from .action_clips import ACTION_CLIPS, UNASKED_SECONDS, action_clips
 from .captured_takes import ACTION_BONUS, TakePool, Window, captured_motion, decoded_provenance
-from .course_walk import ACTIONS as COURSE_ACTIONS, course_motion, course_named, walked_straight
+from .course_walk import ACTIONS as COURSE_ACTIONS, course_motion
 from .decode import decode_features, decode_tokens, redecode
 from .library_takes import captured_window, read_take, window_fit
 from .model_bundle import model_files, part_warnings, resolve_model_dir
@@ -41,15 +41,18 @@ from .prompts import check_prompt
 from .rerank import CandidatePicker
 from .retrieval_seeds import seed_prefixes, seeded_count
 from .on_the_spot import on_the_spot
-from ..plan.segments import MIN_SEGMENT_SECONDS, plan_segments
+from ..plan.plan import plan_text, read_plan
+from ..plan.reader import without_numbers
+from ..plan.segments import MIN_SEGMENT_SECONDS
+from ..plan.words import read_words
 from .retrieved_candidates import library_codes, retrieved_codes
-from .stop_words import (DISTANCE_PACE, DISTANCE_SECONDS, STAND_SECONDS, asked_distance, distance_cut,
-                         distance_keeps, from_start, standing_after, standing_code, stop_cut, stop_request)
+from .stop_words import (DISTANCE_PACE, DISTANCE_SECONDS, STAND_SECONDS, distance_cut, distance_keeps, from_start,
+                         standing_after, standing_code, stop_cut)
 from .sampling_params import (DEFAULT_GUIDANCE, check_candidates, check_guidance, check_retrieval_first,
                               check_retrieval_prefix, check_retrieved, check_sampling)
 from .request import Request
 from .slow_steps import slow_motion
-from .turn_words import angle_of, turn_motion
+from .turn_words import turn_motion
 
 
 LIBRARY_TAKES = 8   # library clips kept read as captured at once (Generator._library_window)
@@ -105,9 +108,7 @@ def body_from_prompt(body, prompt: str) -> tuple[np.ndarray, str]:
     from ..body.shape_from_measurements import betas_for_shape_words
     from ..text.shape_words import ShapeWords, parse_shape_words
 
-    import re
-
-    words_only = re.sub(r"\d+(?:[.,]\d+)?(?:\s*(?:[a-z]+\.?|'|\"))?", " ", str(prompt).lower())  # "10 m", "5 seconds"
+    words_only = without_numbers(prompt)   # "10 m", "5 seconds"
     try:
         said = parse_shape_words(words_only)
     except ShapeMoveError:  # a prompt is no shape text: what does not read as one is ignored
@@ -242,7 +243,7 @@ class Generator:
                                  else np.asarray(self._library_takes[src]["new_joint_vecs"][fit.lo:fit.hi]))
                 asked = self._asked(r)
                 bonus = [0.0] * len(cands) + [ACTION_BONUS if asked and w.action == asked else 0.0 for w in windows]
-                best = self.picker.pick(r.prompt, feats + [w.features for w in windows], bonus)
+                best = self.picker.pick(r.prompt, feats + [w.features for w in windows], bonus, r.words)
             if best >= len(cands):
                 return Choice(None, beta, None, windows[best - len(cands)])
             return Choice(cands[best], beta, sources[best], None)
@@ -326,13 +327,13 @@ class Generator:
         return seed_prefixes(self.t5.memory, self.tok, r.prompt, seeded_count(n), r.retrieval_prefix)
 
     @staticmethod
-    def asks_course(prompt: str, check) -> str | None:
-        """The course a prompt asks to walk (``course_walk.COURSES``), or None: in the
-        action patterns' words, or by its nearest training caption ("pace around in a loop"), read
-        from its ``check_text`` (None: no known captions) as ``parts.clause_classifier`` reads a
-        clause's."""
-        named = course_named(prompt)
-        if named is not None or check is None or check.similarity < CLAUSE_NEAR:
+    def asks_course(words, check, edited: bool = False) -> str | None:
+        """The course a prompt asks to walk (``course_walk.COURSES``), or None: the plan's
+        (``words``: a ``plan.words.Words``; ``edited``: the user's plan, taken as it is), or by its
+        nearest training caption ("pace around in a loop"), read from its ``check_text`` (None: no
+        known captions) as ``parts.clause_classifier`` reads a clause's."""
+        named = words.course
+        if edited or named is not None or check is None or check.similarity < CLAUSE_NEAR:
             return named
         return check.nearest_action if check.nearest_action in COURSE_ACTIONS else None
 
@@ -488,31 +489,37 @@ class Generator:
         for i, (r, check) in enumerate(zip(reqs, checks)):
             if cancel is not None and cancel():
                 break
-            plan = plan_segments(r.prompt) if r.by_parts else None   # "walks forward, then sits down"
+            plan = (r.plan or read_plan(r.prompt)) if r.by_parts else None   # "walks forward, then sits down"
             if plan is not None and plan.is_sequence:
                 motion = self.planned_sequence(r, plan)
+                motion.plan = plan_text(plan)
                 motion.warnings = [check.warning] if check is not None and check.warning else []
                 motion.prompt_check = check
                 out.append(motion)
                 if progress is not None:
                     progress((i + 1) / len(reqs), r.prompt)
                 continue
-            stop = stop_request(r.prompt) if r.by_parts else None   # "takes three steps and stops"
-            metres = asked_distance(r.prompt) if stop else None      # "walks 3 metres": that far, then stands
+            words = plan.segments[0].words if plan is not None else None   # what the words ask (plan/words.py)
+            edited = r.plan is not None
+            stop = (words.gait_text, words.steps) if words is not None and words.stop else None   # "takes three steps"
+            metres = words.distance_m if stop else None      # "walks 3 metres": that far, then stands
             asked = dataclasses.replace(r, prompt=stop[0], seconds=r.seconds if r.seconds or not metres else
                                         min(DISTANCE_SECONDS, metres / DISTANCE_PACE + 1.0)) if stop else r
-            motion = generate_by_parts(self, asked) if r.by_parts else None
+            asked = dataclasses.replace(asked, plan=None, words=None)
+            by_parts = words is not None and (words.parts is not None or words.side is not None or not edited)
+            motion = generate_by_parts(self, asked, words if edited else None) if by_parts else None
             came_from = motion.provenance if motion is not None else None   # kept through the edits below
             if motion is not None and stop is not None:
                 motion.prompt = r.prompt
                 motion = self.stopped(motion, stop[1], r.seconds, metres)   # both parts stop (stop_words.py)
-            course = self.asks_course(r.prompt, check) if r.by_parts else None   # course_walk.py
+            course = self.asks_course(words, check, edited) if words is not None else None   # course_walk.py
             if motion is None:  # one action, no side named: the motion as the model writes it
-                sampled = asked if course is None else dataclasses.replace(asked, prompt=walked_straight(asked.prompt))
+                sampled = asked if course is None else dataclasses.replace(asked, prompt=read_words(asked.prompt).straight_text)
+                sampled = dataclasses.replace(sampled, words=words) if edited else sampled
                 # samples and captured takes, one choice (captured_takes.py); a stop or a distance is cut
                 # in the codes (stop_words.py), a course is a plain gait bent and a turn is given back to
                 # the decoded motion, so those are asked of the samples alone
-                turn = angle_of(r.prompt) if r.by_parts else None   # turn_words.py: given back after
+                turn = words.turn if words is not None else None   # turn_words.py: given back after
                 choice = self.choose(sampled, captured=stop is None and course is None and turn is None)
                 betas, source = self.body_shape(r, choice.betas.numpy())
                 motion = self.chosen_motion(choice, betas, r.prompt)
@@ -522,13 +529,14 @@ class Generator:
                 motion.shape_source = source
                 motion.retrieved_clips = choice.clips
                 self._say_if_short(motion, choice.kept, r.seconds)
-                if r.by_parts:  # the codec does not carry turning: a course or a turn the words name, given back
-                    motion = (course_motion(motion, self.body, r.prompt, self.ik_refine_iters, course)   # course_walk.py
-                              if course is not None else
-                              turn_motion(motion, self.body, r.prompt, self.ik_refine_iters))           # turn_words.py
-                    motion = slow_motion(motion, self.body, r.prompt, self.ik_refine_iters)      # slow_steps.py
-            if r.by_parts:   # "jogs in place": the data's gaits all travel; stepped on the spot instead
-                motion = on_the_spot(motion, self.body, r.prompt, self.ik_refine_iters)        # on_the_spot.py
+                if words is not None:  # the codec does not carry turning: a course or a turn the words name, given back
+                    motion = (course_motion(motion, self.body, course, words.course_right, self.ik_refine_iters)
+                              if course is not None else                                          # course_walk.py
+                              turn_motion(motion, self.body, turn, self.ik_refine_iters))         # turn_words.py
+                    motion = slow_motion(motion, self.body, words, self.ik_refine_iters)      # slow_steps.py
+            if words is not None:   # "jogs in place": the data's gaits all travel; stepped on the spot instead
+                motion = on_the_spot(motion, self.body, words.in_place, self.ik_refine_iters)   # on_the_spot.py
+            motion.plan = plan_text(plan) if plan is not None else None
             motion.provenance = motion.provenance or came_from or "generated"
             motion.warnings = [check.warning] if check is not None and check.warning else []
             if r.candidates > 1 and r.temperature > 0:  # best-of-N wanted: say when the model cannot pick

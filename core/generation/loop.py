@@ -31,6 +31,7 @@ from ..constants import FPS
 from ..errors import ShapeMoveError
 from ..motion.skeleton_ops import facing_directions, heading_angles
 from ..scene.motion_file import Motion, make_motion
+from ..plan.words import read_words
 from .on_the_spot import LOOP_ALLOWED, spot_track
 from .prompts import check_prompt
 from .sampling_params import DEFAULT_CANDIDATES, check_candidates, check_sampling
@@ -279,7 +280,7 @@ def generate_loop(gen, req, progress=None, cancel=None) -> Motion:
         if cancel is not None and cancel():
             raise ShapeMoveError("cancelled")
         track, _ = decoded_track(codes, gen.vae, gen.body, betas)
-        track = spot_track(track, req.prompt, LOOP_ALLOWED) or track   # "jogs in place": on the spot (on_the_spot.py)
+        track = spot_track(track, read_words(req.prompt).in_place, LOOP_ALLOWED) or track   # "jogs in place": on the spot (on_the_spot.py)
         try:
             found.append((track, best_cut(track.joints, FPS, period)))
         except ShapeMoveError:

@@ -1,11 +1,11 @@
 """The pace the words ask of a gait: "walks quickly", "a brisk walk", "runs as fast as they can",
 "walks slowly".
 
-The TMA that chooses among the candidates (``rerank.CandidatePicker``) hardly tells a brisk walk
+The words are read by the plan (``plan/words.py``: ``Words.pace``, ``Words.slow_flight``). The TMA that chooses among the candidates (``rerank.CandidatePicker``) hardly tells a brisk walk
 from a slow one, and the clips retrieved for "walks quickly" by caption can be slow ones: the
 default model gave "a person walks quickly" 0.51 m/s against 1.08 m/s for "a person walks"
 (``tools/pace_check.py``). So when a prompt names a gait (the legs actions of
-``part_prompts.LEGS``: walk, jog, run, march, sneak, ...) and a fast pace, only the fastest third
+``plan/part_prompts.LEGS``: walk, jog, run, march, sneak, ...) and a fast pace, only the fastest third
 of the candidates compete. Speed is the root's mean horizontal speed along its path, read from
 the features' root velocities.
 
@@ -20,50 +20,12 @@ the TMA, since its root speed says nothing of a hand's.
 """
 from __future__ import annotations
 
-import re
-
 import numpy as np
 
 from ..constants import FPS
-from ..data.actions import action_spans
-from .part_prompts import LEGS
 
 FAST_SHARE = 1 / 3  # the fastest third of the candidates compete for a fast pace
 SLOW_SPEED = 0.8    # a stepping gait asked slowly is played at this speed
-STEPPING = LEGS - {"jog", "run", "sprint"}   # gaits without a flight phase
-
-_FAST = re.compile(r"\b(quick(?:ly)?|fast(?:er)?|brisk(?:ly)?|rapid(?:ly)?|swift(?:ly)?|hurried(?:ly)?|hurr(?:y|ies|ying)|"
-                   r"hast(?:y|ily)|speedy|full speed|top speed|flat out|as fast as)\b", re.I)
-_SLOW = re.compile(r"\b(slow(?:ly|er)?|leisurely|lazily|sluggish(?:ly)?|unhurried(?:ly)?|"
-                   r"(?:easy|gentle|relaxed|snail's|leisurely|slow) pace)\b", re.I)
-
-
-def _gaits(prompt: str) -> set:
-    return {sp[2] for sp in action_spans(prompt) if sp[2] in LEGS}
-
-
-def asks_fast(prompt: str) -> bool:
-    """Whether the prompt asks a gait to go fast (and names no slow pace beside it)."""
-    return bool(_FAST.search(prompt)) and not _SLOW.search(prompt) and bool(_gaits(prompt))
-
-
-def _slow_gaits(prompt: str) -> set:
-    """The gaits the prompt asks to go slowly (a slow pace named, no fast one); empty otherwise."""
-    return _gaits(prompt) if _SLOW.search(prompt) and not _FAST.search(prompt) else set()
-
-
-def asks_slow_steps(prompt: str) -> bool:
-    """Whether the prompt asks a stepping gait (and no other gait) to go slowly, naming no fast pace."""
-    gaits = _slow_gaits(prompt)
-    return bool(gaits) and gaits <= STEPPING
-
-
-def asks_slow_flight(prompt: str) -> bool:
-    """Whether the prompt asks a gait with a flight phase (a jog, a run) to go slowly, naming no fast
-    pace: its strides are shortened instead (``slow_steps``)."""
-    gaits = _slow_gaits(prompt)
-    return bool(gaits) and not gaits <= STEPPING
-
 
 def gait_speed(features: np.ndarray) -> float:
     """Mean horizontal root speed (m/s) along the path of a (T, 263) feature clip."""

@@ -27,3 +27,5 @@ class Request:
     retrieval_first: float | None = DEFAULT_RETRIEVAL_FIRST  # caption similarity from which only retrieved clips compete
     by_parts: bool = True  # two things at once composed by body part, a named side mirrored (parts.py)
     action: str | None = None  # the action the prompt names (the planner's reading): its captured clips compete alone
+    plan: object | None = None  # an edited plan (``plan.plan.Plan``, ``generate --plan``): acted on instead of the prompt's reading
+    words: object | None = None  # the reading the candidates are chosen by (``plan.words.Words``; None: the prompt's)

@@ -22,8 +22,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from .count_words import asked_count, nearest_count
-from .pace_words import asks_fast, fastest, gait_speed
+from ..plan.words import read_words
+from .count_words import counter, nearest_count
+from .pace_words import fastest, gait_speed
 from .travel_words import allowed
 
 
@@ -39,16 +40,17 @@ class CandidatePicker:
         text = embed_texts(self.model, self.tok, [prompt])[0]
         return embed_motions(self.model, feats, self.mean, self.std) @ text
 
-    def pick(self, prompt: str, feats: list, bonus=None) -> int:
-        """Index of the candidate closest to ``prompt`` among those that obey its travel, pace and
-        count words (the first on a tie); ``bonus`` (N,): added to the similarities (a captured
-        take of the asked action, ``captured_takes.ACTION_BONUS``)."""
-        keep = allowed(prompt, feats)
-        if asks_fast(prompt):
+    def pick(self, prompt: str, feats: list, bonus=None, words=None) -> int:
+        """Index of the candidate closest to ``prompt`` among those that obey the travel, pace and
+        count of its plan (``words``: a ``plan.words.Words``, else the prompt's reading; the first on
+        a tie); ``bonus`` (N,): added to the similarities (a captured take of the asked action,
+        ``captured_takes.ACTION_BONUS``)."""
+        words = read_words(prompt) if words is None else words
+        keep = allowed(words.travel, feats)
+        if words.pace == "fast":
             keep = fastest(np.array([gait_speed(f) for f in feats]), keep)
-        counted = asked_count(prompt)
-        if counted is not None:
-            count, want = counted
-            keep = nearest_count([count(f) for f in feats], want, keep)
+        if words.count is not None:
+            action, want = words.count
+            keep = nearest_count([counter(action)(f) for f in feats], want, keep)
         scores = self.scores(prompt, feats) + (0.0 if bonus is None else np.asarray(bonus, np.float64))
         return int(np.argmax(np.where(keep, scores, -np.inf)))

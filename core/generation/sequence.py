@@ -35,13 +35,12 @@ from ..constants import FPS
 from ..errors import ShapeMoveError
 from ..scene.motion_file import Motion
 from ..torch_threads import one_torch_thread
-from .course_walk import walked_straight
 from .decode import decode_features
 from .prompts import check_prompt
 from .sampling_params import DEFAULT_CANDIDATES, check_candidates, check_sampling
 from .seam_pace import paced_seams, seam_steps
-from .stop_words import (asked_distance, asks_stand_still, distance_cut, distance_keeps, from_start, standing_after,
-                         stop_cut, stop_request)
+from ..plan.words import read_words
+from .stop_words import distance_cut, distance_keeps, from_start, standing_after, stop_cut
 from .token_sampling import body_for, sample_codes
 from .track import Track, decoded_track, plant, rotate_y
 
@@ -87,16 +86,17 @@ def _segment(gen, prompt, shape_text, n, prefix, arms_prefix, betas, seed, tempe
     prompt whole."""
     from .parts import plan_of
 
-    if by_parts and asks_stand_still(prompt) and gen.rest_code is not None:   # no caption stands still: nothing
+    words = read_words(prompt)
+    if by_parts and words.stand_still and gen.rest_code is not None:   # no caption stands still: nothing
         pred = gen.predicted_betas(prompt, shape_text).numpy().astype(np.float32)  # to sample (stop_words.py)
         return [gen.rest_code] * n, None, pred
-    stop = stop_request(prompt) if by_parts else None   # the standing code is found only when one is asked
-    stop = stop if stop is not None and gen.rest_code is not None else None
-    metres = asked_distance(prompt) if stop is not None else None   # "walks 3 metres": that far, then stands
+    stop = (words.gait_text, words.steps) if by_parts and words.stop else None   # the standing code is found
+    stop = stop if stop is not None and gen.rest_code is not None else None      # only when one is asked
+    metres = words.distance_m if stop is not None else None   # "walks 3 metres": that far, then stands
     prompt = prompt if stop is None else stop[0]
     plan, side = plan_of(prompt, gen) if by_parts else (None, None)
     legs = prompt if plan is None else plan.legs_prompt
-    legs = walked_straight(legs) if by_parts else legs   # a course's gait, bent by timeline_words
+    legs = read_words(legs).straight_text if by_parts else legs   # a course's gait, bent by timeline_words
     codes, pred = _segment_codes(gen, legs, shape_text, n, prefix, betas, seed, temperature, top_k, candidates,
                                  guidance)
     if plan is None:

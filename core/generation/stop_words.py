@@ -9,7 +9,7 @@ without its stop clause, its codes are cut after the step the words count (or at
 when they name no count), and the model's standing code fills the rest of the length (``STAND_SECONDS``
 of it when no length was asked); the whole is decoded again as one sequence. The motion keeps those tokens, so a new body decodes the same stop.
 A timeline's segment that only asks to stand still ("stands still", "waits", "pauses";
-``asks_stand_still``) is that code too (``sequence._segment``).
+``plan.words.Words.stand_still``) is that code too (``sequence._segment``).
 
 - The stop: "and stops", "then stops", "comes to a stop", "halts", "stands still", "stops walking"
   after the gait ("stops" alone, or "without stopping", "non-stop": nothing).
@@ -26,104 +26,25 @@ A timeline's segment that only asks to stand still ("stands still", "waits", "pa
   ``REST_RUN`` codes in a row, the one whose repetition decodes with the least joint speed and
   root travel, wrists below the shoulders (arms down); found once per model.
 
-    prompt, steps = stop_request("a man takes three steps forward and stops")   # ("a man takes three steps forward", 3)
+    w = read_words("a man takes three steps forward and stops")   # plan/words.py
+    w.gait_text, w.steps                                          # ("a man takes three steps forward", 3)
 """
 from __future__ import annotations
 
-import re
 from collections import Counter
 
 import numpy as np
 import torch
 
-from ..data.actions import find_actions
-from ..data.compose_parts import ARMS_ACTIONS
 from ..motion.contacts import runs
-from .count_words import NUMBER_WORDS, NUMBERS, QUANTITY
 
-STOP = re.compile(r"\s*(?:,\s*)?(?:\b(?:and|then)\s+)*(?:\b(?:he|she|they|it)\s+)?"
-                  r"\b(?:stops?(?:\s+(?:walking|running|jogging|moving))?|halts?|comes? to a (?:stop|halt)|"
-                  r"stands? still|stays? still)\b(?:\s+(?:there|still))?\s*\.?\s*$")
-NEGATED = re.compile(r"\b(?:without stopping|non-?stop|never stops?|doesn't stop|does not stop)\b")
-COUNT = re.compile(r"\b(" + NUMBER_WORDS + r"|\d{1,2})\s+"
-                   r"(?:\w+\s+)?(?:steps?|strides?|paces?)\b")
-# a count alone ("takes three steps forward", no stop word): "a" only right before the step ("a man steps
-# aside" counts nothing)
-COUNT_ALONE = re.compile(r"\b(" + QUANTITY + r"|\d{1,2})\s+(?:\w+\s+)?(?:steps?|strides?|paces?)\b|"
-                         r"\b(a)\s+(?:single\s+|small\s+|big\s+|quick\s+|short\s+|long\s+)?step\b")   # not "a brisk pace"
-STILL = re.compile(r"\b(?:stands?|standing) (?:still|there|idle|motionless|quietly|around)\b|\b(?:stays?|staying) "
-                   r"(?:still|put)\b|\b(?:waits?|waiting|pauses?|pausing|stops?|halts?|idles?|idling|rests?|resting)\b|"
-                   r"\b(?:holds?|holding) still\b")
-UNITS = {"m": 1.0, "metre": 1.0, "meter": 1.0, "metres": 1.0, "meters": 1.0, "feet": 0.3048, "foot": 0.3048,
-         "ft": 0.3048, "yard": 0.9144, "yards": 0.9144, "yd": 0.9144, "yds": 0.9144}
-DISTANCE = re.compile(r"\b(\d{1,3}(?:\.\d+)?|" + NUMBER_WORDS +
-                      r")\s*(" + "|".join(sorted(UNITS, key=len, reverse=True)) + r")\b"
-                      r"(?![-\s]*(?:tall|high|in height|long|wide|deep|man|woman|person|guy|girl|boy|lady|kid|child|"
-                      r"giant|figure|athlete|soldier|dancer|player)\b)")
-SPOKEN_DISTANCE = re.compile(r"\s*\b(?:(?:for|about|around|some|roughly|nearly|almost|another)\s+)*" + DISTANCE.pattern,
-                             re.I)   # "for about 5 m": what the gait is sampled without
-MAX_METRES = 100.0
 REACH_SLACK = 0.1          # m: a gait this close to the distance has got there
 DISTANCE_PACE = 0.7        # m/s: with no length asked, a distance is given time for this slow a walk ...
 DISTANCE_SECONDS = 60.0    # ... up to this long (the longest length a prompt may ask)
-GAITS = {"walk", "run", "jog", "sprint", "sneak", "march", "limp", "walk backward", "sidestep", "zombie walk"}
 REST_RUN = 4       # codes in a row: a code held this long in a real clip is a candidate standing code
 REST_PROBE = 10    # codes the candidate is repeated for when it is decoded
-MAX_STEPS = 20
 DISTANCE_EARLIER = 2   # codes before a distance's cut also tried (``distance_keeps``)
 STAND_SECONDS = 1.6   # standing after the stop when the model decides the length (none was asked)
-
-
-def stop_request(text: str) -> tuple[str, int | None] | None:
-    """(the prompt without its stop clause or distance, the steps it counts or None) when ``text``
-    asks a gait to stop, counts the steps of a gait and asks nothing else ("takes three steps
-    forward": the whole prompt, 3), or gives a gait a distance ("walks 3 metres forward": "walks
-    forward", None; ``asked_distance`` says how far); None otherwise."""
-    t = str(text)
-    low = t.lower()
-    if NEGATED.search(low):
-        return None
-    match = STOP.search(low)
-    if match is None:
-        counted = COUNT_ALONE.search(low)
-        others = set(find_actions(low)) - GAITS
-        if counted is not None and not others:
-            gait = t.strip().rstrip(".")
-        elif counted is None and asked_distance(low) is not None and not others - set(ARMS_ACTIONS):
-            gait = t.strip().rstrip(".")   # "walks 3 metres forward (waving)": both parts stop there
-        else:
-            return None   # no count or distance, or another action beside them ("takes two steps and spins")
-    else:
-        gait = t[:match.start()].strip().rstrip(",")
-        counted = COUNT.search(gait.lower())
-        if not gait or (counted is None and not set(find_actions(gait.lower())) & GAITS):
-            return None   # "a person stops", "she waves and stops": no gait to stop
-    gait = re.sub(r"\s+([,.;])", r"\1", SPOKEN_DISTANCE.sub("", gait)).strip() or gait   # the cut goes that far
-    steps = None
-    if counted is not None:
-        word = counted.group(1) or counted.group(2)
-        steps = int(word) if word.isdigit() else NUMBERS[word]
-        steps = steps if 1 <= steps <= MAX_STEPS else None
-    return gait, steps
-
-
-def asked_distance(text: str) -> float | None:
-    """Metres a gait is asked to go ("walks 3 metres", "ten feet", "2.5 m"), when the words name a
-    gait and a distance of at most ``MAX_METRES``; else None."""
-    low = str(text).lower()
-    m = DISTANCE.search(low)
-    if m is None or not set(find_actions(low)) & GAITS:
-        return None
-    n = float(m.group(1)) if m.group(1)[0].isdigit() else NUMBERS[m.group(1)]
-    metres = n * UNITS[m.group(2)]
-    return metres if 0 < metres <= MAX_METRES else None
-
-
-def asks_stand_still(text: str) -> bool:
-    """Whether a prompt only asks the body to stand still ("a person stands still", "she waits",
-    "he pauses"): a still word and no action (a timeline's segment of standing)."""
-    t = str(text).lower()
-    return bool(STILL.search(t)) and not find_actions(t) and stop_request(t) is None and not NEGATED.search(t)
 
 
 def standing_code(memory, vae) -> int | None:

@@ -12,16 +12,16 @@ the root's path and the feet's reach shortened together, the frames and cadence 
 - a gait asked slowly (a walk as a jog: within a timeline the frames stay where the strips put
   them, so a walk too takes shorter strides rather than being played slower): ``SLOW_SPEED``;
 - a segment whose words name only gestures ("he waves", "raises the right hand": every action
-  named is an arms action, ``compose_parts.ARMS_ACTIONS``) stands where it is: a sampled gesture
+  named is an arms action, ``plan.words.Words.gestures_only``) stands where it is: a sampled gesture
   that shuffles along (0.27 m over a 2 s wave on a tall body) is held to ``STILL_SLACK`` of travel;
 - anything else 1.
 
 The scale eases from one segment's to the next over ``EASE`` frames, so the feet do not jump at a
-boundary. A segment that names a turn ("turns around", "turns left", "spins"; ``turn_words.angle_of``)
+boundary. A segment that names a turn ("turns around", "turns left", "spins"; ``plan.words.Words.turn``)
 turns the body that far over its own frames (what it turns by itself counted, eased as a single
 prompt's turn) and every later segment goes on in the new direction: "walks forward" -> "turns
 around" -> "walks forward" comes back. A segment that walks a course (a circle, a figure eight, back
-and forth, a zigzag, a diagonal: ``course_walk.course_named``) is turned along it over a whole number of the
+and forth, a zigzag, a diagonal: ``plan.words.Words.course``) is turned along it over a whole number of the
 course's periods fitted to its travel (``course_walk.course_turn``: a circle once round, its travel /
 2 pi the radius; left first unless the words say clockwise or to the right), so it leaves the way the
 course ends and the next segment goes on from there; one that barely travels (under
@@ -31,33 +31,27 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..data.actions import find_actions
-from ..data.compose_parts import ARMS_ACTIONS
-from .on_the_spot import asks_on_the_spot, held_scale, spot_scale
-from .pace_words import SLOW_SPEED, asks_slow_flight, asks_slow_steps
-from .course_walk import course_named, course_turn, turns_right
+from ..plan.words import read_words
+from .on_the_spot import held_scale, spot_scale
+from .pace_words import SLOW_SPEED
+from .course_walk import course_turn
 from .stride_scale import scaled_strides
 from .track import headings, travel
-from .turn_words import angle_of, eased_turn, turned_by
+from .turn_words import eased_turn, turned_by
 
 EASE = 8   # frames over which the stride scale moves from one segment's to the next
 CIRCLE_TRAVEL = 0.5   # m: a course segment that travels less is not bent
 STILL_SLACK = 0.05    # m: the root travel a segment of gestures only keeps
 
 
-def gestures_only(prompt: str) -> bool:
-    """Whether the words name actions and all of them are arms actions ("he waves")."""
-    found = set(find_actions(str(prompt).lower()))
-    return bool(found) and found <= set(ARMS_ACTIONS)
-
-
-def segment_scale(prompt: str, joints: np.ndarray) -> float:
-    """The stride scale the words of one segment ask of its (T,22,3) joints (module doc)."""
-    if asks_on_the_spot(prompt):
-        return spot_scale(joints, prompt)
-    if asks_slow_steps(prompt) or asks_slow_flight(prompt):
+def segment_scale(words, joints: np.ndarray) -> float:
+    """The stride scale the plan's ``words`` (``plan.words.Words``) of one segment ask of its
+    (T,22,3) joints (module doc)."""
+    if words.in_place:
+        return spot_scale(joints, True)
+    if words.pace == "slow":
         return SLOW_SPEED
-    if gestures_only(prompt):
+    if words.gestures_only:
         return held_scale(joints, STILL_SLACK)
     return 1.0
 
@@ -72,12 +66,13 @@ def turn_profile(joints: np.ndarray, bounds, prompts) -> np.ndarray | None:
         phi[a:] = total
         if b - a < 2:
             continue
-        angle, course, turn = angle_of(prompt), course_named(prompt), None
+        w = read_words(prompt)
+        angle, course, turn = w.turn, w.course, None
         s = travel(joints[a:b]) if angle is None and course is not None else None
         if angle is not None:
             turn = eased_turn(own[a:b], angle)
         elif s is not None and s[-1] >= CIRCLE_TRAVEL:
-            turn = course_turn(own[a:b], s, course, turns_right(prompt))
+            turn = course_turn(own[a:b], s, course, w.course_right)
         if turn is not None:
             phi[a:b] += turn
             total += turn[-1]
@@ -92,7 +87,7 @@ def worded_joints(joints: np.ndarray, bounds, prompts) -> np.ndarray | None:
     J = np.asarray(joints, np.float64)
     scale = np.ones(len(J))
     for (a, b), prompt in zip(np.asarray(bounds), prompts):
-        scale[a:b] = segment_scale(prompt, J[a:b])
+        scale[a:b] = segment_scale(read_words(prompt), J[a:b])
     phi = turn_profile(J, bounds, prompts)
     if (scale >= 1.0).all() and phi is None:
         return None

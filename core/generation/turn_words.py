@@ -15,50 +15,15 @@ decoded track is turned by it about the pelvis, eased in and out over the middle
 - "turns his head", "turns the page": a part or a thing turns, not the body; "without turning
   around": no turn. Both are left alone.
 
-    track = turned(track, angle_of("a person turns around to the right"))
+    track = turned(track, read_words("a person turns around to the right").turn)   # plan/words.py
 """
 from __future__ import annotations
 
-import re
-
 import numpy as np
 
-from ..data.actions import find_actions, specific
 from .track import Track, headings, root_centre, rotate_y
 
 TURN_SPAN = (0.2, 0.8)    # the share of the motion over which the body turns
-WHOLE = re.compile(r"\b(?:spins?|spinning|full (?:turn|circle|rotation)|360|all the way (?:a)?round|pirouettes?)\b")
-HALF = re.compile(r"\b(?:turns? (?:a)?round|turning (?:a)?round|turns? back|turning back|about[- ]face|u-turn|180|"
-                  r"face the other way|the other direction)\b")
-QUARTER = re.compile(r"\b(?:quarter turn|90|turns? (?:to (?:the|his|her|their) )?(?:left|right)|turning (?:to the )?(?:left|right))\b")
-RIGHT = re.compile(r"\b(?:right|clockwise|rightward)\b")
-COUNTER = re.compile(r"\b(?:counter|anti)[- ]?clockwise\b")
-NOT_BODY = re.compile(r"\bturn(?:s|ing|ed)? (?:his|her|their|the|its|one's|a) (?!body\b|whole\b)\w+")
-TWICE = re.compile(r"\b(?:twice|two times|two full)\b")
-NEGATED = re.compile(r"\b(?:without|not|no|never|don't|doesn't|do not|does not|stop)\s+(?:\w+\s+)?(?:turn|spin)")
-
-
-def angle_of(text: str) -> float | None:
-    """The yaw (radians, + = left) a prompt of one turn or spin asks the body to turn; None when
-    the prompt asks for something else too, turns a part or a thing, or names no amount."""
-    t = " " + str(text).lower() + " "
-    acts = set(specific(find_actions(t)))
-    if not acts or not acts <= {"turn", "spin"} or NOT_BODY.search(t) or NEGATED.search(t):
-        return None
-    if WHOLE.search(t) or "spin" in acts:
-        a = 2 * np.pi
-    elif HALF.search(t):
-        a = np.pi
-    elif QUARTER.search(t):
-        a = np.pi / 2
-    else:
-        return None
-    if TWICE.search(t):
-        a *= 2
-    right = bool(RIGHT.search(COUNTER.sub(" ", t)))
-    return float(-a if right else a)
-
-
 def eased_turn(own: np.ndarray, angle: float) -> np.ndarray:
     """(T,) yaw to add to frames whose own unwrapped heading is ``own`` so that over them the body
     turns ``angle`` in all (what it turns by itself is counted), eased (smoothstep) over
@@ -87,10 +52,9 @@ def turned(track: Track, angle: float) -> Track:
     return Track(turned_by(track.joints, phi), track.contacts)
 
 
-def turn_motion(motion, body, text: str, ik_refine_iters: int = 10):
-    """A generated ``Motion`` turned as far as ``text`` says (``track.replanted``: an edit, no
-    tokens kept); the motion itself when the text names no turn of the body."""
+def turn_motion(motion, body, angle: float | None, ik_refine_iters: int = 10):
+    """A generated ``Motion`` turned by ``angle`` (radians, + = left: the plan's ``Words.turn``;
+    ``track.replanted``: an edit, no tokens kept); the motion itself when it is None."""
     from .track import replanted, track_of
 
-    angle = angle_of(text)
     return motion if angle is None else replanted(motion, body, turned(track_of(motion), angle), ik_refine_iters)

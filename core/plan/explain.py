@@ -12,8 +12,8 @@ A single segment's seconds are null when the length is the model's to choose.
 from __future__ import annotations
 
 from .option_conflicts import option_notes
-from .reading import said, understood
-from .segments import plan_segments
+from .plan import plan_to_json, read_plan
+from .reading import said
 
 
 def plan_json(prompt: str, seconds: float | None = None, loop: bool = False, in_place: bool = False,
@@ -24,26 +24,21 @@ def plan_json(prompt: str, seconds: float | None = None, loop: bool = False, in_
         return {"prompt": str(prompt), "seconds": None if seconds is None else float(seconds),
                 "segments": [{"text": str(prompt), "share": 1.0, "seconds": None if seconds is None else float(seconds),
                               "understood": {}}]}
-    plan = plan_segments(prompt)
-    lengths = plan.lengths(seconds) if plan.is_sequence or seconds is not None else [None]
-    out = {"prompt": plan.prompt, "seconds": None if seconds is None else float(seconds),
-           "segments": [{"text": s.text, "share": round(s.share, 4),
-                         "seconds": None if sec is None else round(sec, 3), "understood": understood(s.text)}
-                        for s, sec in zip(plan.segments, lengths)]}
+    out = plan_to_json(read_plan(prompt, seconds))
     notes = option_notes(prompt, loop=loop, in_place=in_place, path=path)
     if notes:
         out["notes"] = notes
     return out
 
 
-def plan_lines(prompt: str, motion=None) -> list[str]:
-    """One line per segment of ``prompt``'s plan: its text, its seconds (from ``motion``'s segments
-    when it is a timeline of them) and what was understood of it."""
-    plan = plan_segments(prompt)
+def plan_lines(prompt: str, motion=None, plan=None) -> list[str]:
+    """One line per segment of ``prompt``'s plan (``plan``: an edited one): its text, its seconds (from
+    ``motion``'s segments when it is a timeline of them) and what was understood of it."""
+    plan = read_plan(prompt) if plan is None else plan
     if not plan.is_sequence:
-        return [f"understood: {said(understood(plan.segments[0].text))}"]
+        return [f"understood: {said(plan.segments[0].words.understood())}"]
     bounds = getattr(motion, "segment_bounds", None)
     spans = ([f"{(int(e) - int(s)) / motion.fps:.1f} s" for s, e in bounds]
              if bounds is not None and len(bounds) == len(plan.segments) else [f"{s.share:.0%}" for s in plan.segments])
-    return [f"understood {i} of {len(plan.segments)} ({span}): {s.text!r}: {said(understood(s.text))}"
+    return [f"understood {i} of {len(plan.segments)} ({span}): {s.text!r}: {said(s.words.understood())}"
             for i, (s, span) in enumerate(zip(plan.segments, spans), 1)]

@@ -10,10 +10,8 @@ said as notes (``Motion.notes``, printed by the command line as ``note:`` lines)
 """
 from __future__ import annotations
 
-from .reading import understood
 from .segments import plan_segments
-
-COURSE_NAMES = {"walk in a circle": "in a circle", "walk in a figure eight": "in a figure eight"}
+from .vocabulary import COURSE_NAMES
 
 
 def _course(reading: dict) -> str:
@@ -29,7 +27,7 @@ def option_notes(prompt: str, loop: bool = False, in_place: bool = False, path: 
     if loop and plan.is_sequence:
         notes.append(f"--loop won over the order of {len(plan.segments)} motions: the prompt is looped as one motion "
                      "(leave out --loop for one after the other)")
-    for reading in (understood(s.text) for s in plan.segments):
+    for reading in (s.words.understood() for s in plan.segments):
         if loop and "course" in reading:
             notes.append(f"--loop won over '{_course(reading)}': a loop repeats one straight cycle "
                          "(leave out --loop to walk the course)")

@@ -11,7 +11,7 @@ captions, labels and prompts). A prompt is **two things at once** when it names 
 (``LEGS``: walk, jog, run, march, sneak, limp, sidestep, walk backward, in a circle, ...) and an
 arm gesture (``ARMS``: wave, punch, throw, raise a hand, beckon, reach up, arm circles, ...) and
 no order between them ("then", "after", "before": a sequence is the timeline's job,
-``sequence.py``). The text is cut between the two at the connector that joins them (",", "while",
+``generation/sequence.py``). The text is cut between the two at the connector that joins them (",", "while",
 "as", "and", "with", ...; else where the second action starts); each clause becomes its own
 prompt, the one without a subject getting "a person".
 
@@ -26,25 +26,11 @@ from dataclasses import dataclass
 
 from ..data.actions import action_spans, split_words
 from ..data.compose_parts import ARMS_ACTIONS, LEGS_ACTIONS
+from .vocabulary import CONNECTOR, DIRECTION, FOOT_WORDS, HAND_WORDS, ORDER_WORDS, SIDE, SUBJECT
 
 LEGS = frozenset(LEGS_ACTIONS) | {"sprint", "walk in a figure eight"}   # not "zombie walk": its arms are the action
 ARMS = frozenset(ARMS_ACTIONS)
 FOOT_ACTIONS = frozenset({"kick", "spin kick", "kick ball", "hop"})
-SEQUENCE = re.compile(r"\b(then|after|afterwards|before|followed by|next|finally|later)\b")
-# "and" joins two clauses, not the pairs "back and forth", "to and fro", "up and down", "round and round"
-CONNECTOR = re.compile(r",|;|\b(?:while|whilst|as|and(?!\s+(?:forth|fro|forwards|down|round)\b)|with|at the same time|"
-                       r"all the while|meanwhile|simultaneously)\b")
-SUBJECT = re.compile(r"^(?:(?:a|an|the|this|that|one|some|my|our|his|her|their|your)\s+(?:[\w-]+,?\s+){0,3}?)?"
-                     r"(?:person|man|woman|boy|girl|guy|lady|kid|child|someone|somebody|he|she|they|people|"
-                     r"soldier|dancer|athlete|figure|character|actor|player|runner|walker|human|i|you|we)\b")
-HAND_WORDS = r"hand|hands|arm|arms|fist|fists|palm|elbow|shoulder|wrist|finger|fingers"
-FOOT_WORDS = r"foot|feet|leg|legs|knee|knees|heel|toe|toes|shin|ankle|thigh"
-SIDE = re.compile(r"\b(left|right)\b(?:(?:-|\s+)(?:(?:hand(?:ed)?|arm(?:ed)?|foot(?:ed)?|leg(?:ged)?)\b|"
-                  r"(?:\w+\s+){0,1}?(" + HAND_WORDS + "|" + FOOT_WORDS + r")\b))?")
-DIRECTION = re.compile(r"\b(?:to|towards?|on) (?:the|his|her|their|your|its) (?:left|right)\b|"
-                       r"\b(?:turn|turns|turning|turned|veer|veers|steer|steers|bear|bears|head|heads|go|goes|"
-                       r"walk|walks|step|steps|move|moves|look|looks|curve|curves|spin|spins|rotate|rotates)"
-                       r"\s+(?:to\s+)?(?:left|right)\b")
 
 
 @dataclass(frozen=True)
@@ -143,7 +129,7 @@ def plan_parts(text: str, classify=None) -> PartPlan | None:
     ``classify(clauses) -> actions`` (an action name or None each) names the action of clauses the
     action patterns do not recognise (``parts.clause_classifier``: the nearest training caption)."""
     t = split_words(text).strip()
-    if SEQUENCE.search(t):
+    if ORDER_WORDS.search(t):
         return None
     spans = action_spans(t)
     legs = max((sp for sp in spans if sp[2] in LEGS), key=lambda sp: (sp[1] - sp[0], -sp[0]), default=None)

@@ -13,7 +13,7 @@ part (``generation/parts.py``), and "back and forth", "to and fro", "up and down
 Both sides of a "before" / "after" must name an action ("jumps and turns before landing" is one),
 and what follows "then" must say what someone does ("bends the knees, then straightens" is one
 squat; ``part_prompts._has_verb``). A stop after "then" is the gait's own ("walks forward, then
-stops": one segment that stops, ``generation/stop_words.py``). "Followed by a jump": "a person does
+stops": one segment that stops, ``vocabulary.STOP``). "Followed by a jump": "a person does
 a jump".
 A segment without a subject gets the prompt's ("a man walks, then sits" -> "a man sits"); a bare
 participle is said as a clause ("waving" -> "she is waving"). Each segment gets an equal share of
@@ -22,45 +22,14 @@ the length (``SEGMENT_SECONDS`` each when no length is asked).
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
 
 from ..data.actions import find_actions
-from ..generation.part_prompts import SUBJECT, _has_verb, _subject, _with_subject
-from ..generation.stop_words import STOP
+from .part_prompts import SUBJECT, _has_verb, _subject, _with_subject
+from .vocabulary import BEFORE_AFTER as MIDDLE, FIRST, LEADING_BEFORE_AFTER as LEADING, PARTICIPLE, STOP, THEN
 
-# words that put what follows after what precedes ("then"): a cut with that order
-THEN = re.compile(r"\s*(?:[,;.]\s*)?\b(?:and\s+)?(?:then|after\s+that|afterwards?|next(?!\s+to\b)|finally|followed\s+by|"
-                  r"and\s+(?:finally|afterwards?))\b\s*,?\s*")
-# "before" / "after" in front of a clause: a participle or a pronoun follows ("runs after the ball" is no cut)
-_CLAUSE_AHEAD = r"(?=[a-z'-]+ing\b|(?:he|she|they|someone|somebody|i|we|you)\b)"
-MIDDLE = re.compile(r"\s*,?\s*\b(before|after)\s+" + _CLAUSE_AHEAD)
-LEADING = re.compile(r"^\s*(before|after)\s+" + _CLAUSE_AHEAD)
-FIRST = re.compile(r"\b(?:first(?:ly)?|at first|initially|to begin with|to start with)\b\s*,?\s*")
-PARTICIPLE = re.compile(r"^(?!(?:spring|bring|swing|sing|string|ring|thing|sling|sting|wing|cling|fling)\b)[a-z'-]{2,}ing\b")
 DEFAULT_SUBJECT = "a person"
 SEGMENT_SECONDS = 3.0       # a segment's length when the prompt's length is the model's to choose
 MIN_SEGMENT_SECONDS = 0.4   # the shortest segment a timeline takes (``generation.sequence.check_segments``)
-
-
-@dataclass(frozen=True)
-class PlannedSegment:
-    text: str       # the segment's own prompt, with a subject
-    share: float    # its share of the whole length (the shares add up to 1)
-
-
-@dataclass(frozen=True)
-class Plan:
-    prompt: str
-    segments: tuple[PlannedSegment, ...]
-
-    @property
-    def is_sequence(self) -> bool:
-        return len(self.segments) > 1
-
-    def lengths(self, total: float | None) -> list[float]:
-        """Each segment's seconds of a motion ``total`` seconds long (None: ``SEGMENT_SECONDS`` each)."""
-        total = SEGMENT_SECONDS * len(self.segments) if total is None else float(total)
-        return [s.share * total for s in self.segments]
 
 
 def _tidy(piece: str) -> str:
@@ -136,7 +105,9 @@ def split_segments(prompt: str) -> list[str]:
     return [_as_prompt(q, _subject(q) if SUBJECT.match(q) else subject) for q in ordered]
 
 
-def plan_segments(prompt: str) -> Plan:
-    """The typed plan of ``prompt``: its ordered segments, each with an equal share of the length."""
-    texts = split_segments(prompt)
-    return Plan(str(prompt), tuple(PlannedSegment(t, 1.0 / len(texts)) for t in texts))
+def plan_segments(prompt: str):
+    """The typed plan of ``prompt`` (``plan.read_plan``): its ordered segments, each with an equal
+    share of the length and the reading of its words."""
+    from .plan import read_plan
+
+    return read_plan(prompt)

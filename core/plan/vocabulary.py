@@ -1,0 +1,204 @@
+"""The words a prompt is read by: one table of word classes, each defined once.
+
+Every class is a compiled pattern (or a table) and a line in ``WORD_CLASSES`` that says what it
+means to the plan (``plan.py``), with an example prompt that ``tests/test_plan_vocabulary.py``
+reads. The actions themselves (walk, wave, kick, ...) are the dataset's action patterns
+(``data/actions.py``: one vocabulary for captions, labels and prompts); the words below say how,
+where, how far, how many times, in which order and with which side.
+
+Only ``core/plan`` matches these against a prompt (``reader.py``, ``part_prompts.py``,
+``segments.py``); everything downstream reads the plan they make.
+"""
+from __future__ import annotations
+
+import re
+from typing import NamedTuple
+
+# -- numbers ------------------------------------------------------------------------------------
+NUMBERS = {"a": 1, "one": 1, "a single": 1, "two": 2, "a couple of": 2, "a couple": 2, "three": 3, "a few": 3,
+           "four": 4, "five": 5, "six": 6, "seven": 7, "eight": 8, "nine": 9, "ten": 10}   # "three steps" too
+TIMES = {"once": 1, "twice": 2, "thrice": 3}
+# the number words as a regex alternation, longest first; QUANTITY without "a" ("a person jumps" counts nothing)
+NUMBER_WORDS = "|".join(sorted(map(re.escape, NUMBERS), key=len, reverse=True))
+QUANTITY = "|".join(sorted(map(re.escape, set(NUMBERS) - {"a"}), key=len, reverse=True))
+
+# -- a count of a countable action ("jumps twice", "does three squats") ----------------------------
+COUNT_TIMES = re.compile(rf"\b(?:(once|twice|thrice)|({QUANTITY}|\d{{1,2}})\s+(?:times\b|(?:\w+\s+)?(?:jump|hop|leap|squat)\w*))",
+                         re.I)
+# the countable actions and what counts them (``generation/count_words.MEASURES``)
+COUNTED = {"jump": "flights", "jump forward": "flights", "spin jump": "flights", "hop": "flights",
+           "jumping jacks": "flights", "squat": "dips"}
+MAX_COUNT = 12
+
+# -- pace -------------------------------------------------------------------------------------
+FAST = re.compile(r"\b(quick(?:ly)?|fast(?:er)?|brisk(?:ly)?|rapid(?:ly)?|swift(?:ly)?|hurried(?:ly)?|hurr(?:y|ies|ying)|"
+                  r"hast(?:y|ily)|speedy|full speed|top speed|flat out|as fast as)\b", re.I)
+SLOW = re.compile(r"\b(slow(?:ly|er)?|leisurely|lazily|sluggish(?:ly)?|unhurried(?:ly)?|"
+                  r"(?:easy|gentle|relaxed|snail's|leisurely|slow) pace)\b", re.I)
+
+# -- stop, steps, distance, standing still ------------------------------------------------------
+STOP = re.compile(r"\s*(?:,\s*)?(?:\b(?:and|then)\s+)*(?:\b(?:he|she|they|it)\s+)?"
+                  r"\b(?:stops?(?:\s+(?:walking|running|jogging|moving))?|halts?|comes? to a (?:stop|halt)|"
+                  r"stands? still|stays? still)\b(?:\s+(?:there|still))?\s*\.?\s*$")
+NOT_STOPPING = re.compile(r"\b(?:without stopping|non-?stop|never stops?|doesn't stop|does not stop)\b")
+STEPS = re.compile(r"\b(" + NUMBER_WORDS + r"|\d{1,2})\s+"
+                   r"(?:\w+\s+)?(?:steps?|strides?|paces?)\b")
+# a count alone ("takes three steps forward", no stop word): "a" only right before the step ("a man steps
+# aside" counts nothing)
+STEPS_ALONE = re.compile(r"\b(" + QUANTITY + r"|\d{1,2})\s+(?:\w+\s+)?(?:steps?|strides?|paces?)\b|"
+                         r"\b(a)\s+(?:single\s+|small\s+|big\s+|quick\s+|short\s+|long\s+)?step\b")   # not "a brisk pace"
+STILL = re.compile(r"\b(?:stands?|standing) (?:still|there|idle|motionless|quietly|around)\b|\b(?:stays?|staying) "
+                   r"(?:still|put)\b|\b(?:waits?|waiting|pauses?|pausing|stops?|halts?|idles?|idling|rests?|resting)\b|"
+                   r"\b(?:holds?|holding) still\b")
+UNITS = {"m": 1.0, "metre": 1.0, "meter": 1.0, "metres": 1.0, "meters": 1.0, "feet": 0.3048, "foot": 0.3048,
+         "ft": 0.3048, "yard": 0.9144, "yards": 0.9144, "yd": 0.9144, "yds": 0.9144}
+DISTANCE = re.compile(r"\b(\d{1,3}(?:\.\d+)?|" + NUMBER_WORDS +
+                      r")\s*(" + "|".join(sorted(UNITS, key=len, reverse=True)) + r")\b"
+                      r"(?![-\s]*(?:tall|high|in height|long|wide|deep|man|woman|person|guy|girl|boy|lady|kid|child|"
+                      r"giant|figure|athlete|soldier|dancer|player)\b)")
+SPOKEN_DISTANCE = re.compile(r"\s*\b(?:(?:for|about|around|some|roughly|nearly|almost|another)\s+)*" + DISTANCE.pattern,
+                             re.I)   # "for about 5 m": what the gait is sampled without
+GAITS = {"walk", "run", "jog", "sprint", "sneak", "march", "limp", "walk backward", "sidestep", "zombie walk"}
+MAX_METRES = 100.0
+MAX_STEPS = 20
+NUMBER = re.compile(r"\d+(?:[.,]\d+)?(?:\s*(?:[a-z]+\.?|'|\"))?")   # "10 m", "5 seconds": not a body's words
+
+# -- courses ----------------------------------------------------------------------------------
+CLOCKWISE = re.compile(r"(?<![-\w])(?:clockwise|to the right|rightward)\b")
+COUNTER_CLOCKWISE = re.compile(r"\b(?:counter|anti)[- ]?clockwise\b")
+# "paces" is back and forth only where nothing sends it on: "paces the room", "is pacing nervously", "paces
+# back and forth", "she paces." -- not "paces ahead at a steady clip", "paces along the road"
+_TO_AND_FRO = r"back and forth|to and fro|backwards and forwards"
+_UP_AND_DOWN = r"up and down the (?:room|hall|hallway|corridor|street|platform|stage)"
+_PACE = (r"\bpac(?:es|ing)\b(?=\s+(?:(?:around|about|round)\s+)?(?:the|a|his|her|their)\s+(?:[\w-]+\s+)?(?:room|floor|halls?|"
+         r"hallway|corridor|office|cell|stage|platform|deck|yard|kitchen|ward|lobby)\b|\s+(?:nervously|impatiently|"
+         r"anxiously|restlessly|worriedly|around|about|back and forth|to and fro|up and down)\b|\s*(?:[,.;!]|$))")
+BACK_AND_FORTH = re.compile(rf"\b(?:{_TO_AND_FRO}|{_UP_AND_DOWN})\b|{_PACE}", re.I)
+ZIGZAG = re.compile(r"\bzig[- ]?zag(?:s|ging|ged)?\b", re.I)
+DIAGONAL = re.compile(r"\bdiagonal(?:ly)?\b|\bat an angle\b", re.I)
+COURSE_VERB = re.compile(rf"{_PACE}|\bzig[- ]?zag(?:s|ging|ged)\b", re.I)   # the course as the verb: "walks"
+# the course in words, cut out for its gait: "in a circle", "around in circles", "a figure-8 path",
+# "in a zigzag", "back and forth", "up and down the room"
+COURSE_WORDS = re.compile(
+    r"(?:\s+(?:around|round|along|on|in|into|through|doing|making|tracing|following))*\s+(?:(?:a|an|the)\s+)?"
+    r"(?:(?:small|big|large|wide|tight|full)\s+)?(?:figure[- ]?(?:of[- ])?(?:8|eight)|circles?|zig[- ]?zag)"
+    r"(?:[- ]shaped)?(?:\s+(?:path|route|pattern|course|shape|loop|line))?\b"
+    rf"|\s+(?:{_TO_AND_FRO}|diagonally|at an angle)\b|\s+{_UP_AND_DOWN}\b", re.I)
+# circles the arms make, not the walk: "rotating your arms in circles", "swinging the arms around in circles"
+ARM_CIRCLES = re.compile(r"\b(?:arms?|hands?|fists?|wrists?)\b(?:\s+[\w-]+){0,2}?\s+(?:(?:a)?round\s+)?in\s+"
+                         r"(?:(?:big|small|wide|large)\s+)?circles?\b", re.I)
+COURSE_WAY = re.compile(r"\s+(?:(?:counter|anti)[- ]?)?clockwise\b|\s+(?:to the (?:right|left)|rightwards?|leftwards?)\b",
+                        re.I)   # the course's way round, not the gait's ("runs in a circle to the right")
+# the courses by name (``generation/course_walk.COURSES`` draws them)
+CIRCLE = "walk in a circle"
+EIGHT = "walk in a figure eight"
+BACK_AND_FORTH_COURSE = "back and forth"
+ZIGZAG_COURSE = "zigzag"
+DIAGONAL_COURSE = "diagonal"
+COURSE_ACTIONS = (CIRCLE, EIGHT)     # the courses that are actions of the data (``data.actions``)
+COURSE_NAMES = {CIRCLE: "in a circle", EIGHT: "in a figure eight"}   # as people say them
+
+# -- turns ------------------------------------------------------------------------------------
+TURN_WHOLE = re.compile(r"\b(?:spins?|spinning|full (?:turn|circle|rotation)|360|all the way (?:a)?round|pirouettes?)\b")
+TURN_HALF = re.compile(r"\b(?:turns? (?:a)?round|turning (?:a)?round|turns? back|turning back|about[- ]face|u-turn|180|"
+                       r"face the other way|the other direction)\b")
+TURN_QUARTER = re.compile(r"\b(?:quarter turn|90|turns? (?:to (?:the|his|her|their) )?(?:left|right)|"
+                          r"turning (?:to the )?(?:left|right))\b")
+TURN_RIGHT = re.compile(r"\b(?:right|clockwise|rightward)\b")
+TURN_NOT_BODY = re.compile(r"\bturn(?:s|ing|ed)? (?:his|her|their|the|its|one's|a) (?!body\b|whole\b)\w+")
+TURN_TWICE = re.compile(r"\b(?:twice|two times|two full)\b")
+TURN_NEGATED = re.compile(r"\b(?:without|not|no|never|don't|doesn't|do not|does not|stop)\s+(?:\w+\s+)?(?:turn|spin)")
+
+# -- travel -----------------------------------------------------------------------------------
+FORWARD = re.compile(r"\b(forwards?|ahead|onwards?|toward(?:s)? (?:the )?(?:camera|viewer))\b", re.I)
+BACKWARD = re.compile(r"\b(backwards?|in reverse|backs? (?:up|away)|backing (?:up|away)|retreat\w*|"
+                      r"(?:steps?|stepping) back(?! and forth))\b", re.I)
+IN_PLACE = re.compile(r"\b(in place|on the spot)\b", re.I)
+# a side named for travel: a verb of going, then within three words "to the left" / "to his right"
+_GOING = (r"\b(?:steps?|stepping|shuffl\w*|walk\w*|mov\w*|slid\w*|glid\w*|crab\w*|strafe\w*|side-?step\w*|run\w*|"
+          r"jog\w*|hop\w*|go(?:es|ing)?)\b")
+TRAVEL_SIDE = re.compile(_GOING + r"(?:\W+\w+){0,3}?\W+(?:to|towards?|over to) (?:the|his|her|their|its|your) (left|right)\b",
+                         re.I)
+SIDEWAYS = re.compile(_GOING + r"(?:\W+\w+){0,3}?\W+(sideways|sidewards)\b", re.I)
+
+# -- body parts, sides, subjects, clauses -----------------------------------------------------------
+# "and" joins two clauses, not the pairs "back and forth", "to and fro", "up and down", "round and round"
+CONNECTOR = re.compile(r",|;|\b(?:while|whilst|as|and(?!\s+(?:forth|fro|forwards|down|round)\b)|with|at the same time|"
+                       r"all the while|meanwhile|simultaneously)\b")
+SUBJECT = re.compile(r"^(?:(?:a|an|the|this|that|one|some|my|our|his|her|their|your)\s+(?:[\w-]+,?\s+){0,3}?)?"
+                     r"(?:person|man|woman|boy|girl|guy|lady|kid|child|someone|somebody|he|she|they|people|"
+                     r"soldier|dancer|athlete|figure|character|actor|player|runner|walker|human|i|you|we)\b")
+HAND_WORDS = r"hand|hands|arm|arms|fist|fists|palm|elbow|shoulder|wrist|finger|fingers"
+FOOT_WORDS = r"foot|feet|leg|legs|knee|knees|heel|toe|toes|shin|ankle|thigh"
+SIDE = re.compile(r"\b(left|right)\b(?:(?:-|\s+)(?:(?:hand(?:ed)?|arm(?:ed)?|foot(?:ed)?|leg(?:ged)?)\b|"
+                  r"(?:\w+\s+){0,1}?(" + HAND_WORDS + "|" + FOOT_WORDS + r")\b))?")
+DIRECTION = re.compile(r"\b(?:to|towards?|on) (?:the|his|her|their|your|its) (?:left|right)\b|"
+                       r"\b(?:turn|turns|turning|turned|veer|veers|steer|steers|bear|bears|head|heads|go|goes|"
+                       r"walk|walks|step|steps|move|moves|look|looks|curve|curves|spin|spins|rotate|rotates)"
+                       r"\s+(?:to\s+)?(?:left|right)\b")
+ORDER_WORDS = re.compile(r"\b(then|after|afterwards|before|followed by|next|finally|later)\b")   # no two at once
+
+# -- order: segments ----------------------------------------------------------------------------
+# words that put what follows after what precedes ("then"): a cut with that order
+THEN = re.compile(r"\s*(?:[,;.]\s*)?\b(?:and\s+)?(?:then|after\s+that|afterwards?|next(?!\s+to\b)|finally|followed\s+by|"
+                  r"and\s+(?:finally|afterwards?))\b\s*,?\s*")
+# "before" / "after" in front of a clause: a participle or a pronoun follows ("runs after the ball" is no cut)
+_CLAUSE_AHEAD = r"(?=[a-z'-]+ing\b|(?:he|she|they|someone|somebody|i|we|you)\b)"
+BEFORE_AFTER = re.compile(r"\s*,?\s*\b(before|after)\s+" + _CLAUSE_AHEAD)
+LEADING_BEFORE_AFTER = re.compile(r"^\s*(before|after)\s+" + _CLAUSE_AHEAD)
+FIRST = re.compile(r"\b(?:first(?:ly)?|at first|initially|to begin with|to start with)\b\s*,?\s*")
+PARTICIPLE = re.compile(r"^(?!(?:spring|bring|swing|sing|string|ring|thing|sling|sting|wing|cling|fling)\b)[a-z'-]{2,}ing\b")
+
+# -- words no reader needs to act on (the model reads them with the rest) ---------------------------
+SMALL_WORDS = frozenset(
+    "a an the this that these those his her their its my your our one some is are was were be being been it he she "
+    "they him them who while whilst as and or with of to in on at for from by into onto up down out over around "
+    "round about then after before again also just very really while does do did doing does has have having "
+    "himself herself themselves itself s".split())
+WORD = re.compile(r"[a-z][a-z'-]*")
+
+
+class WordClass(NamedTuple):
+    name: str        # the plan's field it fills (``plan.Words``)
+    words: str       # the words, as people say them
+    meaning: str     # what the plan makes of them
+    example: str     # a prompt that has them (read by ``tests/test_plan_vocabulary.py``)
+    expect: dict     # what the example's plan holds (``Words.understood``)
+
+
+WORD_CLASSES = (
+    WordClass("actions", "walk, run, jog, sit down, wave, kick, jump, squat, throw, ... (data/actions.py)",
+              "the legs and arms action the model is asked for", "a person sits down", {"actions": ["sit"]}),
+    WordClass("legs + arms", "a gait and a gesture joined by 'and', 'while', ',', 'as', 'with'",
+              "two things at once: the legs and the arms generated each from its own words",
+              "a woman jogs while waving", {"legs": "a woman jogs", "arms": "a person waving"}),
+    WordClass("side", "left / right with a hand or foot word, or with an action of one part",
+              "the motion mirrored so that side moves", "a man kicks with his left foot", {"side": "left foot"}),
+    WordClass("course", "in a circle, in a figure eight, back and forth, zigzag, diagonally (clockwise / to the right)",
+              "the gait walked straight, then bent along the course", "a man walks in a circle clockwise",
+              {"course": CIRCLE, "course_way": "right"}),
+    WordClass("turn", "turns around / back (180), turns left / right, a quarter turn (90), spins, a full turn (360), twice",
+              "the body turned that far about the pelvis", "someone turns around", {"turn_degrees": 180}),
+    WordClass("travel", "forward, backwards, steps to the left, sideways",
+              "candidates travelling against the words set aside", "a person walks backwards",
+              {"travel": "backward"}),
+    WordClass("in place", "in place, on the spot (with a gait)", "the gait's strides shortened to stay on the spot",
+              "a person jogs in place", {"in_place": True}),
+    WordClass("distance", "3 metres, ten meters, 20 feet, 5 yards (with a gait)",
+              "the gait cut where it is that far from its start, then standing", "a man walks 3 metres forward",
+              {"distance_m": 3.0, "stop": True}),
+    WordClass("steps", "three steps, a couple of steps, a step", "the gait cut after that many foot strikes, then standing",
+              "she takes three steps forward", {"steps": 3, "stop": True}),
+    WordClass("stop", "and stops, then halts, comes to a stop (after a gait)", "the gait cut halfway, then standing",
+              "a person walks forward and stops", {"stop": True}),
+    WordClass("stand still", "stands still, waits, pauses (and no action)", "the model's standing code",
+              "a person stands still", {"stand_still": True}),
+    WordClass("count", "once, twice, three times, five jumping jacks (jumps, hops, squats)",
+              "the candidates whose count is nearest the asked one compete", "a man jumps twice", {"count": 2}),
+    WordClass("pace", "quickly, briskly, fast / slowly, at a leisurely pace (with a gait)",
+              "fast: the fastest third of the candidates; slow: played slower or shorter strides",
+              "a woman walks slowly", {"pace": "slow"}),
+    WordClass("order", "then, and then, after that, finally, followed by, after / before + a clause",
+              "segments one after the other, each its share of the length", "a person walks forward, then sits down",
+              {"segments": 2}),
+)

@@ -1,0 +1,70 @@
+"""`generate --plan PLAN.json`: the JSON `--explain` prints, edited, is read back field by field
+(a wrong field is named), generated from, and kept in the motion file."""
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from shapemove.cli import main
+from shapemove.core.errors import ShapeMoveError
+from shapemove.core.plan.explain import plan_json
+from shapemove.core.plan.plan import plan_from_json, plan_to_json
+from shapemove.core.scene.motion_file import load_motion
+
+
+@pytest.mark.parametrize("prompt", ["a person walks forward, then sits down", "a man walks 3 metres forward and stops",
+                                    "a woman jogs in a circle clockwise and waves", "someone kicks with the left leg",
+                                    "a man jumps twice", "someone turns around to the right"])
+def test_an_unedited_plan_reads_back_as_it_was_printed(prompt):
+    printed = plan_json(prompt, 4)
+    assert plan_to_json(plan_from_json(json.dumps(printed)))["segments"] == printed["segments"]
+
+
+def test_edited_fields_are_what_the_plan_holds():
+    edited = plan_json("a person walks forward", 4)
+    edited["segments"][0]["understood"]["actions"] = ["run"]
+    plan = plan_from_json(edited)
+    assert plan.segments[0].text == "a person runs forward" and plan.segments[0].words.actions[0] == "run"
+    edited = plan_json("a person walks forward", 4)
+    edited["segments"][0]["understood"].update(course="walk in a circle", course_way="right", distance_m=5)
+    w = plan_from_json(edited).segments[0].words
+    assert (w.course, w.course_right, w.distance_m, w.stop) == ("walk in a circle", True, 5.0, True)
+    del edited["segments"][0]["understood"]["travel"]
+    assert not plan_from_json(edited).segments[0].words.travel.named   # a field removed asks nothing
+
+
+@pytest.mark.parametrize("plan, field", [
+    ({"segments": [{"text": "a man walks", "understood": {"course": "square"}}]}, "segments[0].understood.course"),
+    ({"segments": [{"text": "a man walks", "seconds": 0.1}]}, "segments[0].seconds"),
+    ({"segments": [{"text": "a man walks", "understood": {"count": 2}}]}, "segments[0].understood.count"),
+    ({"segments": [{"text": "a man walks", "understood": {"colour": "red"}}]}, "segments[0].understood.colour"),
+    ({"segments": [{"text": "a man walks", "understood": {"side": "left ear"}}]}, "segments[0].understood.side"),
+    ({"segments": [{"text": "a man walks", "understood": {"actions": ["levitate"]}}]}, "segments[0].understood.actions[0]"),
+    ({"segments": [{"text": "a man walks", "understood": {"steps": 3, "stop": False}}]}, "segments[0].understood.stop"),
+    ({"segments": [{"text": ""}]}, "segments[0].text"),
+    ({"segments": []}, "segments"),
+    ({"segments": [{"text": "a man walks"}, {"text": "a man sits", "understood": {"course": "zigzag"}}]},
+     "segments[1].understood.course"),
+])
+def test_a_wrong_field_is_named(plan, field):
+    with pytest.raises(ShapeMoveError) as err:
+        plan_from_json(plan)
+    assert str(err.value).startswith(f"plan: {field}: "), str(err.value)
+
+
+def test_generate_from_an_edited_plan_keeps_it_in_the_motion_file(tmp_path, capsys):
+    edited = plan_json("a person walks forward, then sits down", 2.5)
+    edited["segments"][0]["seconds"], edited["segments"][1]["seconds"] = 1.0, 1.5
+    edited["segments"][1]["understood"]["actions"] = ["wave"]
+    (tmp_path / "plan.json").write_text(json.dumps(edited))
+    out = tmp_path / "m.npz"
+    assert main(["generate", "--plan", str(tmp_path / "plan.json"), "--candidates", "1", "--out", str(out)]) == 0
+    said = capsys.readouterr().out
+    assert "understood 2 of 2" in said and "wave" in said
+    m = load_motion(out)
+    kept = json.loads(m.plan)
+    assert [s["text"] for s in kept["segments"]] == ["a person walks forward", "a person waves"]
+    assert [(int(b) - int(a)) / m.fps for a, b in m.segment_bounds] == pytest.approx([1.0, 1.5], abs=0.21)
+    assert main(["generate", "--plan", str(tmp_path / "nope.json"), "--out", str(out)]) != 0
+    assert "plan file not found" in capsys.readouterr().err
