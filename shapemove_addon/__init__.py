@@ -6,10 +6,10 @@ from __future__ import annotations
 
 import bpy
 
-from . import animation_ui, jobs, operators, panels, preferences, properties, rig_retarget, shape_sync
+from . import animation_ui, jobs, operators, panels, plan_ui, preferences, properties, rig_retarget, shape_sync
 
-classes = (*properties.classes, *preferences.classes, *jobs.classes, *operators.classes, *panels.classes,
-           *rig_retarget.classes, *animation_ui.classes)
+classes = (*properties.classes, *preferences.classes, *jobs.classes, *operators.classes, *plan_ui.classes,
+           *panels.classes, *rig_retarget.classes, *animation_ui.classes)
 
 
 def register():

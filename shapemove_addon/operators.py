@@ -79,8 +79,9 @@ def set_whole_shape(rig, betas, context) -> None:
     shape_sync.set_betas(rig, betas, context)
 
 
-def on_generated(name: str, msg: dict):
-    """The generate job's answer: build the rig, with its measurements and physics figures."""
+def on_generated(name: str, msg: dict, prompt: str | None = None):
+    """The generate job's answer: build the rig, with its measurements and physics figures; the plan
+    it was made from shown under the prompt (``prompt``: the one generated; ``plan_ui.py``)."""
     if msg.get("cancelled"):
         return None
     r = msg["result"]
@@ -96,6 +97,14 @@ def on_generated(name: str, msg: dict):
     keep_notes(rig, r)   # a library clip played as captured
     if rig is not None and r.get("provenance"):
         rig[PROVENANCE_KEY] = str(r["provenance"])   # "captured: HDM05 bd kickLFront 003 (CC BY-SA 3.0)" or "generated"
+    if r.get("plan"):   # the plan it was made from, under the prompt to change and generate again
+        import json
+
+        from .plan_ui import show_plan
+
+        plan = json.loads(r["plan"])
+        s = bpy.context.scene.shapemove
+        show_plan(s, plan, prompt or s.prompt)
     return rig
 
 
@@ -208,13 +217,15 @@ class SHAPEMOVE_OT_generate(JobOperator, bpy.types.Operator):
     def start(self, context):
         s = context.scene.shapemove
         prompt = scene_prompt(context)
+        from .plan_ui import plan_param
+
         params = {**generation_params(context, prompt), "prompt": prompt,
                   "seconds": s.seconds if s.use_seconds else None, "captured": bool(s.use_captured),
-                  **library_param(context)}
+                  **library_param(context), **plan_param(s)}
         name = paths.slug(prompt, 24)
 
         job_submit.submit_job("generate", params, kind=self.job, label="generate",
-                              on_result=lambda msg: on_generated(name, msg))
+                              on_result=lambda msg: on_generated(name, msg, prompt))
         return "generating..."
 
 

@@ -11,6 +11,7 @@ import bpy
 from ..core.constants import NUM_BETAS
 from ..core.generation.model_bundle import known_actions
 from . import job_submit, jobs, semantic_shape
+from .plan_ui import draw_plan
 from .preferences import setting
 from .redecode import HAS_TOKENS_KEY
 from .rig_state import PHYSICS_KEY, PROVENANCE_KEY, TAKE_NOTES_KEY, rig_of
@@ -109,6 +110,7 @@ class SHAPEMOVE_PT_generate(_SubPanel, bpy.types.Panel):
         s = context.scene.shapemove
         col = self.layout.column()
         col.prop(s, "prompt", text="")
+        draw_plan(col, s)   # the plan's fields under the prompt (plan_ui.py)
         known = known_actions(setting("active_model") or None, 10)  # what the model was trained on
         if known:
             col.label(text="Knows: " + ", ".join(known), icon="INFO")

@@ -84,6 +84,28 @@ class ShapeMoveLibraryItem(bpy.types.PropertyGroup):
     caption: StringProperty(name="Caption")
 
 
+_SIDES = [("NONE", "No side", "No side named"), ("left hand", "Left hand", ""), ("right hand", "Right hand", ""),
+          ("left foot", "Left foot", ""), ("right foot", "Right foot", "")]
+_COURSES = [("NONE", "No course", "Straight, as the words go"), ("walk in a circle", "Circle", ""),
+            ("walk in a figure eight", "Figure eight", ""), ("back and forth", "Back and forth", ""),
+            ("zigzag", "Zigzag", ""), ("diagonal", "Diagonal", "")]
+
+
+class ShapeMovePlanSegment(bpy.types.PropertyGroup):
+    """One segment of the plan shown under the prompt (``plan_ui.py``; ``core/plan/panel_fields.py``)."""
+    text: StringProperty(name="Text", description="What the model reads for this segment")
+    action: StringProperty(name="Action", description="The action asked (walk, run, sit, wave, kick, jump, ...)")
+    side: EnumProperty(name="Side", items=_SIDES, default="NONE", description="The side that moves most")
+    course: EnumProperty(name="Course", items=_COURSES, default="NONE", description="The course the gait walks")
+    course_way: EnumProperty(name="Way", items=[("left", "Left", "Counter-clockwise"), ("right", "Right", "Clockwise")],
+                             default="left")
+    distance: FloatProperty(name="Distance", default=0.0, min=0.0, max=100.0, precision=1, subtype="DISTANCE",
+                            description="Metres the gait goes, then stands (0: no distance)")
+    count: IntProperty(name="Count", default=0, min=0, max=12, description="Jumps, hops or squats (0: no count)")
+    seconds: FloatProperty(name="Seconds", default=0.0, min=0.0, max=60.0, precision=1,
+                           description="This segment's length (0: its share of the motion's length)")
+
+
 def _is_rig(self, obj):
     return rig_of(obj) is obj
 
@@ -110,6 +132,10 @@ class ShapeMoveSceneSettings(bpy.types.PropertyGroup):
                                description="Captured performances of the asked action (the model's motion library) "
                                            "compete with the generated motions and play as captured; off: every "
                                            "motion is generated")
+    # the plan of the prompt, shown under it as fields (plan_ui.py)
+    plan_segments: CollectionProperty(type=ShapeMovePlanSegment)
+    plan_prompt: StringProperty(name="Plan of", default="", description="The prompt the plan was read from")
+    plan_base: StringProperty(name="Plan", default="", description="The plan as read (JSON), the fields put into it")
     # shape
     shape_from_text: StringProperty(name="Shape text", default="",
                                     description="e.g. 'a man with a height of 185 cm and a waist circumference of 90 cm'")
@@ -160,7 +186,7 @@ class ShapeMoveSceneSettings(bpy.types.PropertyGroup):
                ("BVH", "BVH", "Skeleton animation only")])
 
 
-classes = (ShapeMoveObjectProperties, ShapeMoveLibraryItem, ShapeMoveSceneSettings)
+classes = (ShapeMoveObjectProperties, ShapeMoveLibraryItem, ShapeMovePlanSegment, ShapeMoveSceneSettings)
 
 
 def register():

@@ -88,13 +88,22 @@ def generate(params, progress, cancel) -> dict:
     "temperature", "top_k", "by_parts" (optional, default true), "model" (folder, optional), "body",
     "library" (optional: a folder of the user's captioned motions added to the retrieval memory; a
     clip of it kept whose codes miss it is played as captured, ``library_takes.py``), "captured"
-    (optional, default true: captured takes compete, ``captured_takes.py``), "out" (.npz)}
-    -> the motion file written, its facts, the body's measurements (cm) and what generation by body
-    part did ("parts")."""
+    (optional, default true: captured takes compete, ``captured_takes.py``), "plan" (optional: an
+    edited plan, the JSON ``generate --explain`` prints, generated from in place of "prompt";
+    ``plan/plan.py``), "out" (.npz)}
+    -> the motion file written, its facts, the body's measurements (cm), what generation by body
+    part did ("parts") and the plan it was made from ("plan", JSON)."""
     from ..generation.generate import Request
 
     op = "generate"
     out = _out_path(params, op)
+    plan = None
+    if params.get("plan") is not None:   # the panel's edited plan (plan/panel_fields.py)
+        from ..plan.plan import plan_from_json
+
+        plan = plan_from_json(param(params, op, "plan", str), param(params, op, "seconds", (int, float), None))
+        params = {**params, "prompt": plan.segments[0].text if not plan.is_sequence else plan.prompt,
+                  "seconds": plan.seconds if plan.seconds is not None else params.get("seconds")}
     req = Request(prompt=param(params, op, "prompt", str), shape_text=param(params, op, "shape_text", str, None) or None,
                   betas=_betas(params, op), seconds=param(params, op, "seconds", (int, float), None),
                   seed=int(param(params, op, "seed", int, 0)),
@@ -105,6 +114,7 @@ def generate(params, progress, cancel) -> dict:
     if params.get("guidance") is not None:
         req.guidance = float(param(params, op, "guidance", (int, float)))
     req.by_parts = bool(param(params, op, "by_parts", bool, True))
+    req.plan = plan
     progress(0.05, "loading models")
     gen = _generator(param(params, op, "model", str, None), param(params, op, "body", str, None),
                      param(params, op, "library", str, None))
@@ -125,7 +135,8 @@ def generate(params, progress, cancel) -> dict:
             "warnings": list(motions[0].warnings),
             "model_warnings": [w for w in motions[0].warnings if w in part_warnings(gen.model_dir)],
             "nearest_actions": list(check.nearest_actions) if check is not None else [],
-            "parts": _parts(motions[0]), "notes": list(motions[0].notes), "provenance": motions[0].provenance}
+            "parts": _parts(motions[0]), "notes": list(motions[0].notes), "provenance": motions[0].provenance,
+            "plan": motions[0].plan}
 
 
 def _parts(motion) -> list[str]:

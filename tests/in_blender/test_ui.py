@@ -47,7 +47,7 @@ def test_panels_register_and_draw_in_the_factory_scene(installed):
     # rig panels hide without a rig; the others draw their inputs and start buttons
     assert panels["SHAPEMOVE_PT_shape"] is None and panels["SHAPEMOVE_PT_export"] is None
     ops = {p: [d["op"] for d in items if d["kind"] == "operator"] for p, items in panels.items() if items}
-    assert ops["SHAPEMOVE_PT_generate"] == ["shapemove.generate"]
+    assert ops["SHAPEMOVE_PT_generate"] == ["shapemove.read_plan", "shapemove.generate"]   # the plan, then generate
     assert ops["SHAPEMOVE_PT_retarget"] == ["shapemove.retarget"]
     assert ops["SHAPEMOVE_PT_library"] == ["shapemove.library_search"]
     assert ops["SHAPEMOVE_PT_train"] == ["shapemove.train", "shapemove.train"]

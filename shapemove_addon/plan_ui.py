@@ -1,0 +1,112 @@
+"""The plan of the prompt under it in the Generate panel: one box per segment with the fields the
+user can change (text, action, side, course and its way, distance, count, seconds), before or after
+generating; Generate (and generating again) uses the plan as edited.
+
+"Read Plan" reads the prompt in this process (``core/plan``: pure Python, milliseconds); a
+generation's answer shows the plan it was made from (the motion file's ``plan``). The fields are
+put into the plan as read (``core/plan/panel_fields.py``) and sent to the worker with the job
+(``jobs_shapemove.generate``'s "plan"), which checks it and names a wrong field. Editing the prompt
+leaves the plan of the old one aside: Generate then reads the new prompt.
+"""
+from __future__ import annotations
+
+import json
+
+import bpy
+
+from ..core.errors import ShapeMoveError
+from ..core.plan.panel_fields import edited_plan, plan_fields
+from .operators import ReportingOperator
+
+
+def show_plan(s, plan: dict, prompt: str) -> None:
+    """Put ``plan`` (``--explain``'s JSON) into the scene settings ``s`` as fields, read from ``prompt``."""
+    s.plan_segments.clear()
+    for f in plan_fields(plan):
+        item = s.plan_segments.add()
+        item.text, item.action = f["text"], f["action"]
+        item.side = f["side"] or "NONE"
+        item.course = f["course"] or "NONE"
+        item.course_way = f["course_way"]
+        item.distance, item.count, item.seconds = f["distance"], f["count"], f["seconds"]
+    s.plan_base = json.dumps(plan)
+    s.plan_prompt = prompt
+
+
+def _fields(s) -> list[dict]:
+    return [{"text": i.text.strip(), "action": i.action.strip(), "side": "" if i.side == "NONE" else i.side,
+             "course": "" if i.course == "NONE" else i.course, "course_way": i.course_way,
+             "distance": round(float(i.distance), 3), "count": int(i.count), "seconds": round(float(i.seconds), 3)}
+            for i in s.plan_segments]
+
+
+def plan_param(s) -> dict:
+    """{"plan": JSON} of the edited plan when one is shown for the current prompt, else {}."""
+    if not s.plan_segments or not s.plan_base or s.plan_prompt.strip() != s.prompt.strip():
+        return {}
+    try:
+        base = json.loads(s.plan_base)
+    except ValueError:
+        return {}
+    return {"plan": json.dumps(edited_plan(base, _fields(s)))}
+
+
+def draw_plan(layout, s) -> None:
+    """The plan's fields under the prompt (module doc), or the button that reads it."""
+    row = layout.row(align=True)
+    row.operator("shapemove.read_plan", icon="VIEWZOOM", text="Read Plan" if not s.plan_segments else "Read Again")
+    if not s.plan_segments:
+        return
+    row.operator("shapemove.clear_plan", icon="X", text="")
+    if s.plan_prompt.strip() != s.prompt.strip():
+        layout.label(text="The prompt changed: Generate reads it anew", icon="INFO")
+        return
+    for n, item in enumerate(s.plan_segments, 1):
+        box = layout.box()
+        box.label(text=f"Segment {n} of {len(s.plan_segments)}" if len(s.plan_segments) > 1 else "Plan")
+        box.prop(item, "text", text="")
+        row = box.row(align=True)
+        row.prop(item, "action")
+        row.prop(item, "seconds")
+        row = box.row(align=True)
+        row.prop(item, "side", text="")
+        row.prop(item, "course", text="")
+        if item.course != "NONE":
+            row.prop(item, "course_way", text="")
+        row = box.row(align=True)
+        row.prop(item, "distance")
+        row.prop(item, "count")
+
+
+class SHAPEMOVE_OT_read_plan(ReportingOperator, bpy.types.Operator):
+    """Read the prompt into its plan: the segments in order and what each asks, as fields to change"""
+
+    bl_idname = "shapemove.read_plan"
+    bl_label = "Read Plan"
+
+    def start(self, context):
+        from ..core.plan.explain import plan_json
+
+        s = context.scene.shapemove
+        prompt = s.prompt.strip()
+        if not prompt:
+            raise ShapeMoveError("the prompt is empty: describe a motion, e.g. 'a person jogs forward and waves'")
+        show_plan(s, plan_json(prompt, s.seconds if s.use_seconds else None), prompt)
+        n = len(s.plan_segments)
+        return f"plan: {n} segment{'s' if n > 1 else ''}"
+
+
+class SHAPEMOVE_OT_clear_plan(bpy.types.Operator):
+    """Forget the plan: Generate reads the prompt as it is"""
+
+    bl_idname = "shapemove.clear_plan"
+    bl_label = "Clear Plan"
+
+    def execute(self, context):
+        s = context.scene.shapemove
+        s.plan_segments.clear()
+        s.plan_base = s.plan_prompt = ""
+        return {"FINISHED"}
+
+
+classes = (SHAPEMOVE_OT_read_plan, SHAPEMOVE_OT_clear_plan)

@@ -1,0 +1,102 @@
+"""The plan under the prompt in the Generate panel (issue 54): Read Plan shows each segment's
+fields, the user changes them, Generate sends the edited plan, the worker's generate job makes the
+motion from it, and its answer shows the plan it was made from, to change and generate again.
+Real bpy in this process; the job runs in this process with the embedded default model, as the
+worker runs it."""
+from __future__ import annotations
+
+import json
+from types import SimpleNamespace
+
+import pytest
+
+bpy = pytest.importorskip("bpy", reason="needs the bpy module (pip install bpy==5.0.1)")
+pytestmark = pytest.mark.blender
+
+
+class Layout:
+    """Records labels and the properties drawn; accepts the calls a panel makes."""
+
+    def __init__(self, log):
+        self.log = log
+
+    def label(self, text="", icon="NONE", **_):
+        self.log.append(text)
+
+    def _child(self, *_, **__):
+        return Layout(self.log)
+
+    box = column = row = grid_flow = split = _child
+
+    def prop(self, data, name, *_, **__):
+        self.log.append(f"prop:{name}")
+
+    def operator(self, idname, *_, **__):
+        self.log.append(f"op:{idname}")
+        return SimpleNamespace()
+
+    def progress(self, *_, **__):
+        pass
+
+
+@pytest.fixture()
+def addon():
+    import shapemove
+
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    shapemove.register()
+    yield
+    shapemove.unregister()
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+
+
+def _run_job(params):
+    from shapemove.core.worker.jobs_shapemove import generate
+
+    return generate(params, lambda *_: None, lambda: False)
+
+
+def test_the_plan_is_shown_edited_and_generated_from(addon, tmp_path, monkeypatch):
+    from shapemove.shapemove_addon import job_submit, operators, panels, paths
+
+    s = bpy.context.scene.shapemove
+    s.prompt = "a man walks 2 metres forward, then waves"
+    assert bpy.ops.shapemove.read_plan() == {"FINISHED"}
+    assert [(i.text, i.action, i.distance) for i in s.plan_segments] == [
+        ("a man walks 2 metres forward", "walk", 2.0), ("a man waves", "wave", 0.0)]
+    log: list = []
+    panels.SHAPEMOVE_PT_generate.draw(SimpleNamespace(layout=Layout(log)), bpy.context)
+    assert "Segment 2 of 2" in log and log.count("prop:distance") == 2 and "op:shapemove.read_plan" in log
+
+    s.plan_segments[0].seconds, s.plan_segments[1].seconds = 1.0, 1.2   # the user's changes
+    s.plan_segments[1].action = "jump"
+    sent = []
+    monkeypatch.setattr(job_submit, "submit_job", lambda op, params, **kw: sent.append((params, kw["on_result"])))
+    monkeypatch.setattr(paths, "new_motion_path", lambda label: tmp_path / f"{len(sent)}.npz")
+    assert bpy.ops.shapemove.generate() == {"FINISHED"}
+    params, on_result = sent[-1]
+    plan = json.loads(params["plan"])
+    assert [seg["seconds"] for seg in plan["segments"]] == [1.0, 1.2]
+    assert plan["segments"][1]["understood"]["actions"] == ["jump"]
+
+    params["candidates"] = 1
+    result = _run_job(params)
+    rig = on_result({"result": result})
+    assert rig is not None
+    made = json.loads(result["plan"])
+    assert [seg["text"] for seg in made["segments"]] == ["a man walks 2 metres forward", "a man jumps"]
+    assert result["frames"] == pytest.approx(44, abs=2)   # 1.0 + 1.2 s at 20 fps
+    assert [i.action for i in s.plan_segments] == ["walk", "jump"]   # shown as made, to change again
+
+    s.plan_segments[1].course = "zigzag"   # a timeline's segment is made from its text: the job names the field
+    monkeypatch.setattr(operators, "on_generated", lambda *a, **k: None)
+    assert bpy.ops.shapemove.generate() == {"FINISHED"}
+    from shapemove.core.errors import ShapeMoveError
+
+    with pytest.raises(ShapeMoveError, match=r"segments\[1\]\.understood\.course"):
+        _run_job(sent[-1][0])
+
+    s.prompt = "a person sits down"   # another prompt: the old plan is left aside
+    assert bpy.ops.shapemove.generate() == {"FINISHED"}
+    assert "plan" not in sent[-1][0]
+    assert bpy.ops.shapemove.clear_plan() == {"FINISHED"} and len(s.plan_segments) == 0
