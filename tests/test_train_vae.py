@@ -328,3 +328,27 @@ def test_torchrun_two_processes(data_dir, tmp_path):
     log = [json.loads(line) for line in (tmp_path / "ddp" / "log.jsonl").read_text().splitlines()]
     assert [r["step"] for r in log] == [1, 2, 3]                        # rank 0 alone writes the log
     print(f"torchrun 2 processes, 3 steps: {time.time() - t0:.1f} s")
+
+
+def test_a_run_fitted_to_minutes_resumes_to_the_same_count(data_dir, body, tmp_path, monkeypatch):
+    """--minutes fits the step count once (after the first timed steps: here fitted to 30 whatever
+    this machine's speed); a resumed run with --minutes ends at that count, not at the config's
+    ceiling (its learning-rate schedule does not jump)."""
+    import shapemove.core.train.train_vae as tv
+
+    monkeypatch.setattr(tv, "fitted_steps", lambda step, *a: 30)
+    cfg = tiny_config(steps=5000, warmup_steps=40, log_every=1000, val_every=100000, ckpt_every=100000)
+    calls = []
+
+    def cancel_after_25():
+        calls.append(1)
+        return len(calls) > 25
+
+    run = tmp_path / "fitted"
+    train_vae(data_dir, run, cfg, body=body, device="cpu", verbose=False, minutes=1.0, cancel=cancel_after_25)
+    ckpt = load_checkpoint(run / "last.pt")
+    assert ckpt["step"] == 25 and ckpt["total_steps"] == 30
+    done = train_vae(data_dir, run, cfg, body=body, device="cpu", verbose=False, resume=True, minutes=1.0)
+    assert done["step"] == 30 and load_checkpoint(run / "last.pt")["step"] == 30
+    # an explicit --steps still extends it
+    assert train_vae(data_dir, run, cfg, body=body, device="cpu", verbose=False, resume=True, steps=32)["step"] == 32

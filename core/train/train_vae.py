@@ -142,7 +142,8 @@ def train_vae(data, out, config: SAVAEConfig | None = None, steps: int | None = 
     progress(fraction, message) is called on rank 0 every ``log_every`` steps; when cancel()
     returns True training stops after saving ``last.pt`` (resume later with resume=True).
     ``minutes``: a time budget for a fresh run; the step count is fitted to it once the first
-    ``fitted_steps`` steps are timed (within the warm-up, so the learning-rate schedule never jumps).
+    ``fitted_steps`` steps are timed (within the warm-up, so the learning-rate schedule never jumps),
+    and kept in ``last.pt``: resumed with ``minutes`` (and no ``steps``), the run ends at that count.
     """
     cfg = copy.deepcopy(config) if config is not None else SAVAEConfig.small()
     if steps is not None:
@@ -153,7 +154,7 @@ def train_vae(data, out, config: SAVAEConfig | None = None, steps: int | None = 
     t = cfg.train
     out = Path(out)
     with distributed.process_group(device) as dist:
-        return _train(Path(data), out, cfg, t, resume, body, dist, progress, cancel, verbose, minutes)
+        return _train(Path(data), out, cfg, t, resume, body, dist, progress, cancel, verbose, minutes, steps)
 
 
 def fitted_steps(step: int, elapsed: float, per_step: float, minutes: float, t: TrainSettings) -> int:
@@ -164,7 +165,7 @@ def fitted_steps(step: int, elapsed: float, per_step: float, minutes: float, t: 
     return int(min(t.steps, max(step + 1, step + left / max(per_step, 1e-9))))
 
 
-def _train(data, out, cfg, t, resume, body, dist, progress, cancel, verbose, minutes=None) -> dict:
+def _train(data, out, cfg, t, resume, body, dist, progress, cancel, verbose, minutes=None, steps_given=None) -> dict:
     started = time.perf_counter()
     if t.batch_size % dist.world_size:
         raise ShapeMoveError(f"batch_size {t.batch_size} must be divisible by the number of processes ({dist.world_size})")
@@ -201,6 +202,8 @@ def _train(data, out, cfg, t, resume, body, dist, progress, cancel, verbose, min
         ckpt = load_checkpoint(last, map_location="cpu", kind=KIND, body=body_name, config=cfg.to_dict(),
                                ignore=RESUME_IGNORES, stats_hash_=stats_hash(mean, std))
         step = restore(ckpt, model, optimizer, scheduler)
+        if minutes and steps_given is None and ckpt.get("total_steps"):
+            t.steps = int(ckpt["total_steps"])   # a run fitted to a budget keeps its schedule's length
     elif resume and dist.is_main and verbose:
         print(f"no checkpoint in {out}: starting from scratch")
     raw = model
@@ -212,7 +215,8 @@ def _train(data, out, cfg, t, resume, body, dist, progress, cancel, verbose, min
             return
         meta = make_metadata(KIND, cfg.to_dict(), body_name, mean, std, step)
         save_checkpoint(last, {"model": raw.state_dict(), "optimizer": optimizer.state_dict(),
-                               "scheduler": scheduler.state_dict(), "step": step, "rng": rng_state()}, meta)
+                               "scheduler": scheduler.state_dict(), "step": step, "rng": rng_state(),
+                               "total_steps": t.steps}, meta)
         if final:
             save_checkpoint(out / "savae.pt", {"model": raw.state_dict()}, meta)
 
