@@ -1,8 +1,11 @@
 """No traceback for any valid prompt or file (issue 54): a table of prompts of every kind the
 generator reads (courses, distances, counts, stops, paces, sides, two things at once, turns, in
 place, plain actions, sequences in one prompt), with and without --loop / --in-place / --path /
---speed, through the entry points of `generate`, `sequence`, `retarget` (on the project's own motion
-files) and `demo`, with the embedded default model: each exits 0 with no "Traceback" in its output.
+--speed, through the entry points of `generate`, `sequence`, `retarget` and `blend` (on the
+project's own motion files), `render` (a batch of every kind, a line that cannot be made reported)
+and `demo`, with the embedded default model: each exits 0 with no "Traceback" in its output; and
+through the panel's operators (Read Plan on every prompt of the table; Generate, Generate Animated,
+Generate Timeline, Regenerate Strip with their jobs run in this process as the worker runs them).
 1 to 2 s motions and one candidate keep the table fast; the commands reuse the process's loaded
 model (generation/loaded_generator.py) as they do inside the worker."""
 from __future__ import annotations
@@ -105,14 +108,21 @@ def test_sequence(folder, capsys):
           "--in-place", "--out", str(folder / "seq_in_place.npz")], capsys)
 
 
-def test_retarget_reads_our_own_motion_files(folder, capsys):
+@pytest.fixture(scope="module")
+def own_files(folder):
+    """The project's own motion files of every make: a course, a loop, a timeline, one held in place."""
     made = {}
     for name, argv in (("course", ["--prompt", "a man walks in a figure eight", "--seconds", "2"]),
                        ("loop", ["--prompt", "a person walks forward", "--seconds", "2", "--loop"]),
                        ("timeline", ["--prompt", "a person walks forward, then sits down", "--seconds", "2"]),
                        ("held", ["--prompt", "a person jogs forward", "--seconds", "2", "--in-place"])):
         made[name] = folder / f"own_{name}.npz"
-        _run(["generate", *argv, *FAST, "--out", str(made[name])], capsys)
+        assert main(["generate", *argv, *FAST, "--out", str(made[name])]) == 0
+    return made
+
+
+def test_retarget_reads_our_own_motion_files(folder, own_files, capsys):
+    made = own_files
     for name, path in made.items():
         out = folder / f"retargeted_{name}.npz"
         said = _run(["retarget", "--motion", str(path), "--betas", "1.5,-1", "--no-search", "--out", str(out)], capsys)
@@ -132,3 +142,88 @@ def test_demo_on_motions_without_tokens(folder, capsys):
         said = _run(["demo", "--prompt", prompt, "--seconds", "1", "--frames", "1", "--out", str(folder / "demo")],
                     capsys)
         assert "0 tokens" in said and "understood" in said
+
+
+@pytest.mark.blender
+def test_blend_builds_our_own_motion_files(folder, own_files, capsys):
+    from conftest import need_module
+
+    need_module("bpy", "blend builds its scene with the bpy module")
+    for name, path in own_files.items():
+        out = folder / f"own_{name}.blend"
+        _run(["blend", "--motion", str(path), "--out", str(out)], capsys)
+        assert out.stat().st_size > 0
+
+
+@pytest.mark.blender
+def test_render_a_batch_of_every_kind(folder, capsys):
+    from conftest import need_module
+
+    need_module("bpy", "render builds its scenes with the bpy module")
+    lines = [{"prompt": "a man walks in a circle", "seconds": 1}, {"prompt": "someone turns around", "seconds": 1, "loop": True},
+             {"prompt": "a person walks forward, then sits down", "seconds": 1.5},
+             {"prompt": "she runs ten meters and stops", "seconds": 1, "in_place": True},
+             {"prompt": "a woman jogs along, waving her left hand", "seconds": 1, "speed": 1.5},
+             {"prompt": "a person walks forward, then sits down, then waves", "seconds": 0.5}]   # too short: reported
+    (folder / "batch.jsonl").write_text("\n".join(json.dumps(x) for x in lines) + "\n")
+    said = _run(["render", "--prompts", str(folder / "batch.jsonl"), "--out", str(folder / "rendered"),
+                 "--frames", "1", "--resolution", "48", "48"], capsys)
+    assert "rendered 5 of 6 prompts" in said and "under the 0.4 s one needs" in said
+    assert len(list((folder / "rendered").glob("*.blend"))) == 5
+
+
+@pytest.mark.blender
+def test_the_panels_operators(folder, monkeypatch):
+    """Read Plan on every prompt of the table; Generate (from the plan read, and after the prompt
+    changed), Generate Animated, Generate Timeline and Regenerate Strip, their jobs run here."""
+    from conftest import need_module
+
+    need_module("bpy", "the panel's operators need the bpy module")
+    import bpy
+
+    import shapemove
+    from shapemove.core.worker.ops import default_jobs
+    from shapemove.shapemove_addon import job_submit, paths
+
+    jobs = default_jobs()
+    answered = []
+
+    def submit(op, params, *, kind=None, label=None, on_result=None, on_error=None, on_progress=None):
+        params = {**params, **({"candidates": 1} if op == "generate" else {})}
+        result = jobs[op](params, lambda *_: None, lambda: False)
+        answered.append((op, on_result({"id": len(answered), "result": result}) if on_result else None))
+        return str(len(answered))
+
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    shapemove.register()
+    try:
+        monkeypatch.setattr(job_submit, "submit_job", submit)
+        monkeypatch.setattr(paths, "new_motion_path", lambda label: folder / f"panel_{len(answered):02d}.npz")
+        s, a = bpy.context.scene.shapemove, bpy.context.scene.shapemove_animation
+        s.use_seconds, s.seconds = True, 1.0
+        for prompt, _, _ in TABLE:
+            s.prompt = prompt
+            assert bpy.ops.shapemove.read_plan() == {"FINISHED"} and len(s.plan_segments) >= 1
+        for prompt in ("a man walks in a figure eight", "someone turns around", "a person jogs in place",
+                       "she takes three steps forward", "a person walks forward, then sits down"):
+            s.prompt = prompt
+            if "then" in prompt:
+                s.seconds = 2.0
+                bpy.ops.shapemove.read_plan()
+            assert bpy.ops.shapemove.generate() == {"FINISHED"}
+            assert answered[-1][1] is not None, prompt    # the rig was built
+        s.prompt, s.seconds = "a person walks forward", 1.0   # a plan read, then the prompt changed
+        assert bpy.ops.shapemove.generate() == {"FINISHED"} and answered[-1][1] is not None
+        a.loop = True
+        assert bpy.ops.shapemove.animate() == {"FINISHED"}
+        a.loop = False
+        for prompt in ("a person walks in a circle", "a man waves"):
+            s.prompt = prompt
+            bpy.ops.shapemove.timeline_add()
+        a.timeline[0].seconds = a.timeline[1].seconds = 1.0
+        assert bpy.ops.shapemove.sequence() == {"FINISHED"}
+        assert bpy.ops.shapemove.regenerate_strip() == {"FINISHED"}
+        assert [op for op, _ in answered] == ["generate"] * 6 + ["animate", "sequence", "sequence"]
+    finally:
+        shapemove.unregister()
+        bpy.ops.wm.read_factory_settings(use_empty=True)

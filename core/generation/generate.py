@@ -250,10 +250,12 @@ class Generator:
 
     @staticmethod
     def _asked(r: Request) -> str | None:
-        """The action the request asks for: the planner's reading, else the first its words name."""
-        from ..data.actions import find_actions, specific
+        """The action the request asks for: the planner's reading, else the first its words name
+        (``plan.words.Words.actions``, an edited plan's when it has one)."""
+        from ..data.actions import specific
 
-        return r.action or (specific(find_actions(r.prompt)) or [None])[0]
+        actions = (r.words if r.words is not None else read_words(r.prompt)).actions
+        return r.action or (specific(list(actions)) or [None])[0]
 
     def _sampled(self, r: Request, lo: int, hi: int, g: torch.Generator, library: bool = True):
         """(candidate codes, their memory clip or None, betas): best-of-N's T5 samples (some seeded

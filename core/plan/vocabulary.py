@@ -154,7 +154,9 @@ SMALL_WORDS = frozenset(
     "a an the this that these those his her their its my your our one some is are was were be being been it he she "
     "they him them who while whilst as and or with of to in on at for from by into onto up down out over around "
     "round about then after before again also just very really while does do did doing does has have having "
-    "himself herself themselves itself s".split())
+    "himself herself themselves itself s me us let make makes show shows like can could will would should may might "
+    "must both other others off again so there here all each every no not but if when than too had get gets getting "
+    "along".split())
 WORD = re.compile(r"[a-z][a-z'-]*")
 
 
