@@ -58,3 +58,36 @@ def test_four_squats_on_a_tall_body_do_not_leap():
     assert planted.max() < 0.2, planted.max(0).round(2)                  # 0.72 m in a frame before (now 0.11)
     assert (planted.max(0) / np.maximum(decoded.max(0), 1e-6)).max() < 3.5  # 16.5 before (now 2.5)
     assert m.ik_error_cm < 5.0                                           # 7.4 cm before (now 3.8)
+
+
+def test_planting_changes_are_eased_not_jumped():
+    """A change that jumps (a foot planted 0.3 m from where the decoded one is) moves at most
+    ``rate`` a frame, spread over both sides of the jump; ``lifted`` never goes below what it is
+    given; ``fixed`` frames keep their change exactly."""
+    from shapemove.core.body.plant import eased, lifted
+
+    jump = np.r_[np.zeros(10), np.full(10, 0.3)][:, None]
+    e = eased(jump, 0.05)
+    assert np.abs(np.diff(e[:, 0])).max() <= 0.05 + 1e-12
+    assert e[9, 0] > 0.0 and e[10, 0] < 0.3                         # eased before and after the jump
+    assert e[0, 0] == 0.0 and e[-1, 0] == pytest.approx(0.3)
+    keep = np.r_[np.zeros(10, bool), np.ones(10, bool)]
+    f = eased(jump, 0.05, fixed=keep)
+    assert np.allclose(f[10:, 0], 0.3) and np.abs(np.diff(f[:, 0])).max() <= 0.05 + 1e-12
+    down = np.r_[np.zeros(5), np.full(5, -0.04), np.zeros(5)]       # a foot pulled 4 cm onto the floor
+    v = lifted(down, 0.01)
+    assert (v >= down - 1e-12).all() and np.abs(np.diff(v)).max() <= 0.01 + 1e-12
+    assert (v[[4, 10]] == 0).all()                                  # the swing foot beside it is not lowered
+
+
+def test_a_turned_foot_reads_its_own_pitch():
+    """The pitch of a foot is measured in its own vertical plane: a flat foot turned a quarter
+    about the vertical is still flat (read against the planted heading it was 60 degrees up)."""
+    from shapemove.core.body.foot_roll import pitch_of
+
+    e1 = np.array([0.0, 0.05, -1.0]) / np.linalg.norm([0.0, 0.05, -1.0])   # ball -> heel, a little up
+    ball = np.zeros((2, 3))
+    ankle = np.stack([0.15 * e1, 0.15 * np.array([e1[2], e1[1], 0.0])])   # as planted; turned a quarter
+    np.testing.assert_allclose(pitch_of(ankle, ball, e1), [0.0, 0.0], atol=1e-9)
+    up = 0.15 * np.array([0.0, np.sin(0.3 + np.arcsin(e1[1])), -np.cos(0.3 + np.arcsin(e1[1]))])
+    assert pitch_of(up[None], ball[:1], e1)[0] == pytest.approx(0.3)

@@ -22,8 +22,10 @@ stance (a run of the ball joint's contact, ``motion.contacts``) with a planted h
   exactly), once the hip has passed over the ball (a body standing on straight legs does not
   roll); the pitch of the first such frame is reached by a ramp from mid-stance (the frame where
   the hip is closest to the heel), so the heel does not jump up. After the heel's contact ends,
-  at least the pitch the IK pose already has (the decoder's own toe-off). It never decreases
-  within a stance: a heel that rose stays up until the foot leaves.
+  at least the pitch the IK pose already has (the decoder's own toe-off). It changes by at most
+  ``ROLL_STEP`` a frame and never decreases within a stance (a heel that rose stays up until the
+  foot leaves), unless the heel lands again before the foot leaves (a step walked backwards lands
+  toe first): then it comes down to the floor by the frame it lands.
 * **steering**: the leg pass (``pin_feet``) still steers a rolled heel, onto its rolled target,
   with full weight (also after the decoder released the heel, until the ball leaves).
 * **contacts**: the contacts the planted Motion reports follow what its heels do: a heel stays
@@ -44,6 +46,7 @@ from ..motion.contacts import runs
 
 MAX_ROLL = np.deg2rad(60.0)   # the most the heel is pitched up about the ball
 LIFT_TOL = 0.005              # m: a heel higher than this above its flat height is off the floor
+ROLL_STEP = np.deg2rad(10.0)  # the most the heel's pitch changes in a frame
 MISFIT = 0.05                 # m: a ball planted further than this from where the flat foot puts it is not rolled over
 UP = np.array([0.0, 1.0, 0.0])
 
@@ -87,11 +90,14 @@ def reach_angle(hip, pivot, e1, e2, foot: float, reach: float) -> np.ndarray:
     return np.clip(theta, 0.0, MAX_ROLL)
 
 
-def pitch_of(ankle, ball, e1, e2) -> np.ndarray:
-    """(N,3) ankle and ball positions -> (N,) pitch (rad) of the foot about the pivot's axis,
-    relative to the flat foot (e1): how far the heel is already turned up."""
+def pitch_of(ankle, ball, e1) -> np.ndarray:
+    """(N,3) ankle and ball positions -> (N,) pitch (rad) of the foot relative to the flat foot (e1,
+    from the ball to the heel): how far the heel is already turned up, in the foot's own vertical
+    plane whichever way it faces (measured against e1's direction instead, a foot turned a
+    quarter away from its planted heading, on a circle, read as pitched by 60 degrees)."""
     v = np.asarray(ankle, np.float64) - np.asarray(ball, np.float64)
-    return np.arctan2(v @ e2, v @ e1)
+    level = np.arctan2(v[:, 1], np.linalg.norm(v[:, [0, 2]], axis=1))
+    return level - np.arctan2(e1[1], np.linalg.norm(e1[[0, 2]]))
 
 
 def roll_feet(posed, targets, contacts, weights, rest, reach: float, legs, fade: int) -> Roll:
@@ -143,19 +149,41 @@ def roll_feet(posed, targets, contacts, weights, rest, reach: float, legs, fade:
                 if mid < on[0]:
                     theta[mid:on[0]] = theta[on[0]] * np.arange(on[0] - mid) / (on[0] - mid)
             after = t >= e                                    # the decoder already lifted the heel
-            theta = np.where(after, np.maximum(theta, np.clip(pitch_of(pos[t, ankle], pos[t, ball], e1, e2),
+            theta = np.where(after, np.maximum(theta, np.clip(pitch_of(pos[t, ankle], pos[t, ball], e1),
                                                               0.0, MAX_ROLL)), theta)
             theta = np.maximum.accumulate(theta)
+            for i in range(1, len(theta)):                    # the heel rises at most ROLL_STEP a frame
+                theta[i] = min(theta[i], theta[i - 1] + ROLL_STEP)
+            again = [hs for hs, _ in heel_runs if e < hs <= eb + fade]
+            if again:                                         # the heel lands again before the foot leaves
+                theta = np.minimum(theta, ROLL_STEP * np.clip(again[0] - t, 0, None))   # (a step walked
+                # backwards, toe first): it comes down to the floor by then
             rolled = theta > 0
             if not rolled.any():
                 continue
             t, theta, P = t[rolled], theta[rolled], P[rolled]
-            tgt[t, ankle] = P + foot * (np.cos(theta)[:, None] * e1 + np.sin(theta)[:, None] * e2)
+            u1, u2 = _headed(e1, tgt[t, ankle] - P)           # the foot turned as its heel's target turns
+            tgt[t, ankle] = P + foot * (np.cos(theta)[:, None] * u1 + np.sin(theta)[:, None] * u2)
             weights[t, kh] = 1.0
             out_c[t[tgt[t, ankle, 1] - A[0, 1] > LIFT_TOL], kh] = False   # the heel is off the floor
-            axis = np.cross(e1, e2)                           # turning e1 toward e2: the heel up
+            axis = np.cross(u1, u2)                           # turning e1 toward e2: the heel up
             toe[t, leg] = theta[:, None] * axis
     return Roll(targets=tgt, weights=weights, contacts=out_c.astype(np.uint8), toe=toe)
+
+
+def _headed(e1, heel) -> tuple[np.ndarray, np.ndarray]:
+    """The flat foot's direction e1 (3,) (pivot to heel) per frame (N,3), turned about the vertical
+    toward the heel's own target ``heel`` (N,3, from the pivot): a decoded foot may turn on its
+    ball (a turn on the spot) or along a slide planted piece by piece (shuffling round a circle);
+    held to e1, the heel was pinned a quarter turn away from the foot and leapt 0.3 m when the ball
+    left. And the unit vectors up across it (e2 per frame)."""
+    flat = np.linalg.norm(e1[[0, 2]])
+    h = np.asarray(heel, np.float64)[:, [0, 2]]
+    n = np.linalg.norm(h, axis=1, keepdims=True)
+    own = np.where(n > 1e-3, h / np.maximum(n, 1e-12), e1[[0, 2]] / max(flat, 1e-12))
+    u1 = np.stack([own[:, 0] * flat, np.full(len(own), e1[1]), own[:, 1] * flat], axis=1)
+    u2 = UP[None] - (u1 @ UP)[:, None] * u1
+    return u1, u2 / np.linalg.norm(u2, axis=1, keepdims=True).clip(1e-12)
 
 
 def _move_ball(tgt, w, on, ball: int, s: int, e: int, shift, fade: int) -> None:

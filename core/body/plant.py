@@ -42,6 +42,10 @@ from ..constants import FPS
 from ..motion.contacts import CONTACT_IDS, runs
 
 FADE = 4          # frames over which a planted target blends back into the mocap target
+EASE = 0.3        # of a contact joint's largest decoded step: the most its planting change moves in a frame
+MIN_EASE = 0.002  # m: ... at least (a foot the decoder holds still can still be put on the floor)
+LEG_EASE = EASE / 2   # of the ankle's largest step: the most ``pin_feet``'s move of a leg changes in a frame
+# where no joint of it stays planted (the knee swings about twice as far as the ankle is moved)
 SLIDE = 0.3       # m: a contact run's joint sliding further than this is planted piece by piece ...
 PIECE = 0.05      # m: ... each piece as far as the joint slides from the piece's first frame
 GAP = 2           # frames: contact runs of a joint this close are planted as one (no step is that short)
@@ -80,6 +84,53 @@ def anchor_track(xz, slide: float = SLIDE, piece_len: float = PIECE, fade: int =
     return np.stack([np.convolve(pad[:, c], kernel, mode="valid") for c in range(2)], axis=1)
 
 
+def eased(change, rate: float, free=None, fixed=None) -> np.ndarray:
+    """(T,D) a change per frame -> the same with no step between frames longer than ``rate`` (m)
+    plus ``free`` (T-1,) (where it may move as fast as asked: within a run, the change that holds a
+    foot still while the decoded one slides): the mean of the change limited from the start
+    forwards and from the end backwards (each moves at most that far a frame toward the change, so
+    their mean does too), a jump eased over the frames on both sides of it, not after it.
+    ``fixed`` (T,) bool: those frames keep their change exactly and only the others are eased,
+    forwards and then backwards (a foot lands on its plant exactly, moving toward it beforehand)."""
+    x = np.asarray(change, np.float64)
+    allow = rate + (np.zeros(max(len(x) - 1, 0)) if free is None else np.asarray(free, np.float64))
+    if fixed is not None:
+        out = x.copy()
+        keep = np.asarray(fixed, bool)
+        for t in range(1, len(x)):
+            if not keep[t]:
+                out[t] = _toward(out[t - 1], out[t], allow[t - 1])
+        for t in range(len(x) - 2, -1, -1):
+            if not keep[t]:
+                out[t] = _toward(out[t + 1], out[t], allow[t])
+        return out
+    fwd, bwd = x.copy(), x.copy()
+    for t in range(1, len(x)):
+        fwd[t] = _toward(fwd[t - 1], x[t], allow[t - 1])
+    for t in range(len(x) - 2, -1, -1):
+        bwd[t] = _toward(bwd[t + 1], x[t], allow[t])
+    return (fwd + bwd) / 2
+
+
+def _toward(prev, want, most: float):
+    d = want - prev
+    n = float(np.linalg.norm(d))
+    return want if n <= most else prev + d * (most / n)
+
+
+def lifted(change, rate: float, free=None) -> np.ndarray:
+    """(T,) a vertical change -> the least one at or above it that moves at most ``rate`` (m) plus
+    ``free`` (T-1,) a frame: a foot pulled down onto the floor is let up (or down) gradually at a
+    run's edges, never lowered further than asked (the swing foot beside a run keeps its height)."""
+    v = np.asarray(change, np.float64).copy()
+    allow = rate + (np.zeros(max(len(v) - 1, 0)) if free is None else np.asarray(free, np.float64))
+    for t in range(1, len(v)):
+        v[t] = max(v[t], v[t - 1] - allow[t - 1])
+    for t in range(len(v) - 2, -1, -1):
+        v[t] = max(v[t], v[t + 1] - allow[t])
+    return v
+
+
 def bridged(spans, gap: int = GAP) -> list[tuple[int, int]]:
     """Contact runs [(start, end)] with those apart by at most ``gap`` frames joined into one."""
     out: list[list[int]] = []
@@ -105,7 +156,9 @@ def plant_targets(joints, contacts, sole_offsets, fade: int = FADE, fade_down: b
         corr = np.zeros((T, 3))
         planted = np.zeros(T, bool)
         edges: dict[int, list] = {}   # frame outside a run -> [(weight, its run edge's change)]
+        run_of = np.full(T, -1)
         for s, e in bridged(runs(np.asarray(contacts)[:, k])):
+            run_of[s:e] = s
             xz = anchor_track(tgt[s:e, j][:, [0, 2]], fade=max(fade, 1))
             anchor = np.stack([xz[:, 0], np.full(e - s, float(sole_offsets[k])), xz[:, 1]], axis=1)
             corr[s:e] = anchor - tgt[s:e, j]
@@ -122,6 +175,14 @@ def plant_targets(joints, contacts, sole_offsets, fade: int = FADE, fade_down: b
             if not planted[t]:
                 w = np.array([x for x, _ in near])
                 corr[t] = w.max() * (w[:, None] * np.array([x for _, x in near])).sum(0) / w.sum()
+        if planted.any() and T > 1:   # no planting change faster than the joint's own decoded steps allow
+            rate = max(EASE * float(np.linalg.norm(np.diff(tgt[:, j], axis=0), axis=1).max()), MIN_EASE) / np.sqrt(2)
+            held = planted[1:] & planted[:-1] & (run_of[1:] == run_of[:-1])   # steps within one run
+            free_xz = np.where(held, np.linalg.norm(np.diff(corr[:, [0, 2]], axis=0), axis=1), 0.0)
+            free_y = np.where(held, np.abs(np.diff(corr[:, 1])), 0.0)
+            corr[:, [0, 2]] = eased(corr[:, [0, 2]], rate, free_xz)
+            corr[:, 1] = (lifted(corr[:, 1], rate, free_y) if not fade_down
+                          else eased(corr[:, 1:2], rate, free_y)[:, 0])
         tgt[:, j] += corr
     return tgt, floor
 
@@ -186,13 +247,23 @@ def pin_feet(rotations, transl, rest, parents, targets, weights, soft_reach: flo
         t = np.flatnonzero((w[:, kh] > 0) | (w[:, kt] > 0))
         if not len(t):
             continue
+        wh, wt = w[t, kh, None], w[t, kt, None]
+        a = pos[t, ankle]
+        lead = np.clip(1.0 - np.maximum(wt - wh, 0.0), 0.0, 1.0)   # the heel's share, moving from heel-led
+        want = lead * (a + wh * (tgt[t, ankle] - a)) + (1 - lead) * (a + wt * (tgt[t, foot] - pos[t, foot]))
+        # to ball-led as the heel's weight fades below the ball's (switching at once moved the ankle by
+        # the two targets' disagreement in one frame)
+        move = np.zeros((len(rot), 3))
+        move[t] = want - a
+        rate = LEG_EASE * float(np.linalg.norm(np.diff(tgt[:, ankle], axis=0), axis=1).max()) if len(rot) > 1 else 0.0
+        move = eased(move, max(rate, MIN_EASE), fixed=np.maximum(w[:, kh], w[:, kt]) >= 1.0)   # planted: exact
+        # elsewhere it changes no faster than the targets' own steps allow (a rolled heel let go at
+        # once when its ball left moved the ankle and knee 0.12 m in a frame)
+        t = np.flatnonzero((np.linalg.norm(move, axis=1) > 1e-9) | (w[:, kh] > 0) | (w[:, kt] > 0))
         h, k, a, b = pos[t, hip], pos[t, knee], pos[t, ankle], pos[t, foot]
         wh, wt = w[t, kh, None], w[t, kt, None]
         heel = (wh >= wt) & (wh > 0)                            # heel-led (else the ball leads: toe-off)
-        lead = np.clip(1.0 - np.maximum(wt - wh, 0.0), 0.0, 1.0)   # the heel's share, moving from heel-led
-        want = lead * (a + wh * (tgt[t, ankle] - a)) + (1 - lead) * (a + wt * (tgt[t, foot] - b))   # to ball-led
-        # as the heel's weight fades below the ball's (switching at once moved the ankle by the two
-        # targets' disagreement in one frame)
+        want = a + move[t]
         l1, l2 = np.linalg.norm(rest[knee] - rest[hip]), np.linalg.norm(rest[ankle] - rest[knee])
         v = want - h
         d = np.linalg.norm(v, axis=-1, keepdims=True).clip(1e-9)
@@ -367,6 +438,9 @@ def plant_motion(body, betas, joints, contacts, refine_iters: int = 10, gate: bo
         from ..motion.skeleton_ops import gaussian_smooth
 
         shift = np.maximum(np.minimum(gaussian_smooth(shift, smooth), shift), -low)
+    if len(j) > 1:   # where the foot that grounds the body changes (a heel landing after its toe) the
+        # body is let down over frames, never under the floor (at once, it dropped 4 cm in a frame)
+        shift = lifted(shift, max(EASE * float(np.linalg.norm(np.diff(j[:, 0], axis=0), axis=1).max()), MIN_EASE))
     transl[:, 1] += shift
     posed = _posed(ik, rest, body.parents)   # error against the input joints (floor removed)
     posed[..., 1] += shift[:, None]

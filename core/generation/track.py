@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 import torch
 
-from ..body.plant import anchor_track, contacts_from_features, plant_motion
+from ..body.plant import EASE, MIN_EASE, anchor_track, contacts_from_features, eased, plant_motion
 from ..constants import FPS
 from ..geometry.rotations import matrix_to_axis_angle
 from ..errors import ShapeMoveError
@@ -122,7 +122,8 @@ def lock_stance(motion: Motion) -> Motion:
     stops short of its target, so a planted foot still drifts ~0.5 mm per frame. Here each frame
     with a contact is shifted in XZ by the mean offset of its planted joints from where their run
     is planted (``plant.anchor_track``: the run's mean, or its pieces' along a slide); frames without contact take the shift interpolated between their neighbours
-    (so the body's path stays smooth). Rotations, heights and the contacts are unchanged."""
+    (so the body's path stays smooth), and the shift moves no faster in a frame than ``plant.EASE``
+    of the pelvis's largest step (``plant.eased``). Rotations, heights and the contacts are unchanged."""
     c = np.asarray(motion.contacts).astype(bool) if motion.contacts is not None else None
     if c is None or not c.any():
         return motion
@@ -136,6 +137,9 @@ def lock_stance(motion: Motion) -> Motion:
     shift = (res * c[..., None]).sum(1) / np.maximum(c.sum(1), 1)[:, None]
     t = np.arange(len(J))
     shift = np.stack([np.interp(t, t[support], shift[support, i]) for i in range(2)], axis=1)
+    fastest = float(np.linalg.norm(np.diff(J[:, 0], axis=0), axis=1).max()) if len(J) > 1 else 0.0
+    shift = eased(shift, max(EASE * fastest, MIN_EASE))   # where the planted feet change, the shift
+    # from one foot's miss to the other's spread over frames (at once, the body leapt 0.16 m in a frame)
     d = np.zeros((len(J), 3))
     d[:, [0, 2]] = shift
     out = dataclasses.replace(motion, transl=(motion.transl + d).astype(np.float32),
