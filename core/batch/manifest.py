@@ -15,7 +15,8 @@ A line (``"format": "shapemove-batch/1"``):
                          kept) or "captured" (a library take played as captured), with notes and warnings
   result                 the motion's facts: frames, seconds, betas, shape source, IK error
   outputs                [{"file", "bytes", "sha256"}] relative to the manifest's folder
-  timing                 {"seconds", "started" (UTC), "worker" (host:pid)}: the only fields that differ
+  timing                 {"seconds", "cpu_seconds" (the worker process's), "started" (UTC), "worker"
+                         (host:pid)}: the only fields that differ
                          between two runs of the same line
 A ``--shard I/N`` run writes ``manifest-I-of-N.jsonl`` so shards can share one folder.
 """
