@@ -88,12 +88,30 @@ def test_the_plan_is_shown_edited_and_generated_from(addon, tmp_path, monkeypatc
     assert result["frames"] == pytest.approx(44, abs=2)   # 1.0 + 1.2 s at 20 fps
     assert [i.action for i in s.plan_segments] == ["walk", "jump"]   # shown as made, to change again
 
-    s.plan_segments[1].course = "zigzag"   # a timeline's segment is made from its text: the job names the field
+    import numpy as np
+
+    from shapemove.core.generation.track import headings
+    from shapemove.core.scene.motion_file import load_motion
+
+    s.plan_segments[0].course, s.plan_segments[0].distance = "walk in a circle", 0.0   # the walk goes round
+    assert bpy.ops.shapemove.generate() == {"FINISHED"}
+    circled = _run_job({**sent[-1][0], "candidates": 1})
+    assert json.loads(circled["plan"])["segments"][0]["understood"]["course"] == "walk in a circle"
+
+    def turned(path) -> float:   # radians the first segment turns
+        m = load_motion(path)
+        a, b = m.segment_bounds[0]
+        h = np.unwrap(headings(m.joints))
+        return abs(float(h[b - 1] - h[a]))
+
+    assert turned(circled["path"]) > 3.0 > 1.5 > turned(result["path"])
+
+    s.plan_segments[0].count = 2   # no jump, hop or squat in a walk: the job names the field
     monkeypatch.setattr(operators, "on_generated", lambda *a, **k: None)
     assert bpy.ops.shapemove.generate() == {"FINISHED"}
     from shapemove.core.errors import ShapeMoveError
 
-    with pytest.raises(ShapeMoveError, match=r"segments\[1\]\.understood\.course"):
+    with pytest.raises(ShapeMoveError, match=r"segments\[0\]\.understood\.count"):
         _run_job(sent[-1][0])
 
     s.prompt = "a person sits down"   # another prompt: the old plan is left aside

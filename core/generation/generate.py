@@ -560,7 +560,8 @@ class Generator:
             raise ShapeMoveError(f"{r.prompt!r} is {len(lengths)} motions in order: {r.seconds:g} s gives each "
                                  f"{min(lengths):.2f} s, under the {MIN_SEGMENT_SECONDS:g} s one needs; ask for more seconds")
         motion = generate_sequence(self, [(s.text, sec) for s, sec in zip(plan.segments, lengths)], r.shape_text,
-                                   r.betas, r.seed, r.temperature, r.top_k, r.candidates, r.guidance, by_parts=True)
+                                   r.betas, r.seed, r.temperature, r.top_k, r.candidates, r.guidance, by_parts=True,
+                                   readings=[s.words for s in plan.segments] if r.plan is not None else None)
         motion.prompt = r.prompt
         return motion
 
@@ -660,6 +661,7 @@ class Generator:
         contacts) is planted again on the new body (``retarget.replant``), a loop likewise, as a
         loop (``loop.replant_loop``). A motion held in place (``in_place.py``) is held in place again."""
         out = self._redecoded(motion, betas)
+        out.plan = out.plan or motion.plan   # the plan it was made from
         if motion.held_in_place and not out.held_in_place:
             from .in_place import in_place
 

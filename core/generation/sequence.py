@@ -78,15 +78,17 @@ def check_segments(segments) -> list[Segment]:
 
 
 def _segment(gen, prompt, shape_text, n, prefix, arms_prefix, betas, seed, temperature, top_k, candidates, guidance,
-             by_parts: bool, body=None):
+             by_parts: bool, body=None, words=None):
     """(codes, the arms' codes or None, [BETA] prediction) of one segment: two things at once are
     made by part (module doc), standing still is the model's standing code (``stop_words.py``), a
     gait that stops or counts its steps ("takes three steps forward") stands after them (counted
     on the timeline's ``body``, the betas it plays on: a tall body's strides go further), any other
-    prompt whole."""
+    prompt whole. ``words``: an edited plan's reading of the segment (``plan.words.Words``), acted on
+    as it is; None: its text's."""
     from .parts import plan_of
 
-    words = read_words(prompt)
+    edited = words is not None
+    words = read_words(prompt) if words is None else words
     if by_parts and words.stand_still and gen.rest_code is not None:   # no caption stands still: nothing
         pred = gen.predicted_betas(prompt, shape_text).numpy().astype(np.float32)  # to sample (stop_words.py)
         return [gen.rest_code] * n, None, pred
@@ -94,11 +96,11 @@ def _segment(gen, prompt, shape_text, n, prefix, arms_prefix, betas, seed, tempe
     stop = stop if stop is not None and gen.rest_code is not None else None      # only when one is asked
     metres = words.distance_m if stop is not None else None   # "walks 3 metres": that far, then stands
     prompt = prompt if stop is None else stop[0]
-    plan, side = plan_of(prompt, gen) if by_parts else (None, None)
+    plan, side = ((words.parts, words.side) if edited else plan_of(prompt, gen)) if by_parts else (None, None)
     legs = prompt if plan is None else plan.legs_prompt
     legs = read_words(legs).straight_text if by_parts else legs   # a course's gait, bent by timeline_words
     codes, pred = _segment_codes(gen, legs, shape_text, n, prefix, betas, seed, temperature, top_k, candidates,
-                                 guidance)
+                                 guidance, words if edited and plan is None else None)
     if plan is None:
         codes, arms = (_on_side(gen.vae, codes, prefix, side) if side is not None else codes), None
     else:
@@ -170,7 +172,8 @@ def _arms_stream(codes_per_segment, arms_per_segment) -> list[int]:
     return [c for seg, a in zip(codes_per_segment, arms_per_segment) for c in (seg if a is None else a)]
 
 
-def _segment_codes(gen, prompt, shape_text, n, prefix, betas, seed, temperature, top_k, candidates, guidance):
+def _segment_codes(gen, prompt, shape_text, n, prefix, betas, seed, temperature, top_k, candidates, guidance,
+                   words=None):
     cands, pred = sample_codes(gen, prompt, shape_text, candidates, n, n, seed, temperature, top_k, guidance,
                                prefix=prefix)
     best = 0
@@ -178,7 +181,7 @@ def _segment_codes(gen, prompt, shape_text, n, prefix, betas, seed, temperature,
         b = pred if betas is None else betas
         skip = len(prefix) * gen.vae.cfg.downsample   # judge the segment's own frames
         feats = [f[skip:] for f in _batch_features(gen.vae, [list(prefix) + c for c in cands], b)]
-        best = gen.picker.pick(prompt, feats)
+        best = gen.picker.pick(prompt, feats, words=words)
     return cands[best], pred
 
 
@@ -208,16 +211,18 @@ def _timeline_track(gen, codes_per_segment, betas, arms_per_segment=None) -> tup
     return track, feats, extra
 
 
-def _planted(gen, track: Track, feats, extra: dict, codes_per_segment, prompts, betas, words: bool = True) -> Motion:
+def _planted(gen, track: Track, feats, extra: dict, codes_per_segment, prompts, betas, words: bool = True,
+             readings=None) -> Motion:
     """The timeline's track planted, with its segments; ``words``: each segment's pace and travel
-    words obeyed first (``timeline_words.py``); the seams paced (``seam_pace.py``)."""
+    words obeyed first (``timeline_words.py``; ``readings``: an edited plan's, per segment, else
+    their texts'); the seams paced (``seam_pace.py``)."""
     down = len(track) // sum(len(c) for c in codes_per_segment)
     ends = np.cumsum([len(c) for c in codes_per_segment]) * down
     bounds = np.stack([np.r_[0, ends[:-1]], ends], axis=1).astype(np.int64)
     if words:
         from .timeline_words import worded_joints
 
-        worded = worded_joints(track.joints, bounds, prompts)
+        worded = worded_joints(track.joints, bounds, prompts, readings)
         if worded is not None:
             track, feats = Track(worded, track.contacts), None
     paced = paced_seams(track.joints, track.contacts, bounds)   # no seam faster than the segments: the
@@ -233,9 +238,26 @@ def _planted(gen, track: Track, feats, extra: dict, codes_per_segment, prompts, 
     return motion
 
 
-def _assemble(gen, codes_per_segment, prompts, betas, arms_per_segment=None, words: bool = True) -> Motion:
+def _assemble(gen, codes_per_segment, prompts, betas, arms_per_segment=None, words: bool = True,
+              readings=None) -> Motion:
     track, feats, extra = _timeline_track(gen, codes_per_segment, betas, arms_per_segment)
-    return _planted(gen, track, feats, extra, codes_per_segment, prompts, betas, words)
+    return _planted(gen, track, feats, extra, codes_per_segment, prompts, betas, words, readings)
+
+
+def plan_readings(motion: Motion) -> list | None:
+    """The readings of a timeline's segments in the plan it was made from (``Motion.plan``, an edited
+    plan's fields kept), None without one or when it does not match the segments."""
+    if not motion.plan or motion.segment_prompts is None:
+        return None
+    from ..plan.plan import plan_from_json
+
+    try:
+        plan = plan_from_json(motion.plan)
+    except ShapeMoveError:
+        return None
+    if [s.text for s in plan.segments] != list(motion.segment_prompts):
+        return None
+    return [s.words for s in plan.segments]
 
 
 def redecode_timeline(gen, motion: Motion, betas) -> Motion:
@@ -244,8 +266,9 @@ def redecode_timeline(gen, motion: Motion, betas) -> Motion:
     from .decode import check_betas
 
     arms = segment_codes(motion, arms=True) if motion.arms_tokens is not None else None
-    out = _assemble(gen, segment_codes(motion), list(motion.segment_prompts), check_betas(betas), arms)
-    out.shape_source = "given"
+    out = _assemble(gen, segment_codes(motion), list(motion.segment_prompts), check_betas(betas), arms,
+                    readings=plan_readings(motion))
+    out.shape_source, out.plan = "given", motion.plan
     return out
 
 
@@ -288,9 +311,11 @@ def splice(old: Track, new: Track, start: int, old_end: int, new_end: int, blend
 
 def generate_sequence(gen, segments, shape_text: str | None = None, betas=None, seed: int = 0,
                       temperature: float = 1.0, top_k: int | None = 50, candidates: int = DEFAULT_CANDIDATES,
-                      guidance: float | None = None, progress=None, cancel=None, by_parts: bool = True) -> Motion:
+                      guidance: float | None = None, progress=None, cancel=None, by_parts: bool = True,
+                      readings=None) -> Motion:
     """``segments``: [(prompt, seconds)] or ``Segment``s -> one Motion with segment_bounds;
-    ``by_parts``: segments of two things at once made by body part (module doc)."""
+    ``by_parts``: segments of two things at once made by body part (module doc); ``readings``: an
+    edited plan's reading of each segment (``plan.words.Words``), acted on instead of their texts'."""
     segs = check_segments(segments)
     shape_text = check_prompt(shape_text, "shape text", allow_empty=True) or None
     seed, temperature, top_k = check_sampling(seed, temperature, top_k)
@@ -314,12 +339,13 @@ def generate_sequence(gen, segments, shape_text: str | None = None, betas=None, 
         n = max(1, int(round(s.seconds * FPS / down)))
         prefix = [c for seg in chosen for c in seg][-PREFIX_CODES:]
         codes, own_arms, _ = _segment(gen, s.prompt, shape_text, n, prefix, _arms_stream(chosen, arms)[-PREFIX_CODES:],
-                                      betas, seed + i, temperature, top_k, candidates, guidance, by_parts, body)
+                                      betas, seed + i, temperature, top_k, candidates, guidance, by_parts, body,
+                                      None if readings is None else readings[i])
         chosen.append(codes)
         arms.append(own_arms)
         if progress is not None:
             progress((i + 1) / (len(segs) + 1), f"segment {i + 1}/{len(segs)}: {s.prompt}")
-    motion = _assemble(gen, chosen, [s.prompt for s in segs], body, arms, words=by_parts)
+    motion = _assemble(gen, chosen, [s.prompt for s in segs], body, arms, words=by_parts, readings=readings)
     motion.shape_source = source
     motion.warnings = warnings
     if progress is not None:
@@ -364,8 +390,13 @@ def regenerate_segment(gen, motion: Motion, index: int, seed: int, prompt: str |
     n = max(1, int(round(seg.seconds * FPS / gen.vae.cfg.downsample)))
     prefix = [c for s in per[:index] for c in s][-PREFIX_CODES:]
     arms_prefix = _arms_stream(per[:index], arms[:index])[-PREFIX_CODES:]
+    readings = plan_readings(motion)
+    if readings is not None and seg.prompt != prompts[index]:   # a new prompt: its own words
+        readings[index] = read_words(seg.prompt)
     per[index], arms[index], _ = _segment(gen, seg.prompt, None, n, prefix, arms_prefix, motion.betas, seed, temperature,
-                                          top_k, check_candidates(candidates), guidance, by_parts, motion.betas)
+                                          top_k, check_candidates(candidates), guidance, by_parts, motion.betas,
+                                          None if readings is None else readings[index])
+    same_plan = seg.prompt == prompts[index]
     prompts[index] = seg.prompt
     # the other segments keep their frames: the decoder reads far around a code, so decoding the
     # new codes as one sequence would also move the neighbours (module doc, ``splice``)
@@ -375,8 +406,8 @@ def regenerate_segment(gen, motion: Motion, index: int, seed: int, prompt: str |
     start = sum(len(c) for c in per[:index]) * down
     old_end = start + len(old_per[index]) * down
     track = splice(before, after, start, old_end, start + len(per[index]) * down)
-    out = _planted(gen, track, None, extra, per, prompts, motion.betas, words=by_parts)
-    out.shape_source = "given"
+    out = _planted(gen, track, None, extra, per, prompts, motion.betas, words=by_parts, readings=readings)
+    out.shape_source, out.plan = "given", motion.plan if same_plan else None
     if motion.held_in_place:   # a timeline held in place stays so
         from .in_place import in_place
 

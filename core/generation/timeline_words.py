@@ -56,17 +56,17 @@ def segment_scale(words, joints: np.ndarray) -> float:
     return 1.0
 
 
-def turn_profile(joints: np.ndarray, bounds, prompts) -> np.ndarray | None:
+def turn_profile(joints: np.ndarray, bounds, prompts, readings=None) -> np.ndarray | None:
     """(T,) yaw each frame of a timeline is turned by so that every segment naming a turn or a circle
     turns that far and the segments after it keep the new heading; None when no segment does."""
     own = np.unwrap(headings(joints))
     phi = np.zeros(len(own))
     total, turns = 0.0, False
-    for (a, b), prompt in zip(np.asarray(bounds), prompts):
+    readings = [read_words(p) for p in prompts] if readings is None else readings
+    for (a, b), w in zip(np.asarray(bounds), readings):
         phi[a:] = total
         if b - a < 2:
             continue
-        w = read_words(prompt)
         angle, course, turn = w.turn, w.course, None
         s = travel(joints[a:b]) if angle is None and course is not None else None
         if angle is not None:
@@ -81,14 +81,16 @@ def turn_profile(joints: np.ndarray, bounds, prompts) -> np.ndarray | None:
     return phi if turns else None
 
 
-def worded_joints(joints: np.ndarray, bounds, prompts) -> np.ndarray | None:
+def worded_joints(joints: np.ndarray, bounds, prompts, readings=None) -> np.ndarray | None:
     """(T,22,3) joints of a timeline with each segment's strides scaled and turns made as its words
-    ask (``bounds``: (S,2) frames, ``prompts``: S texts); None when no segment asks for anything."""
+    ask (``bounds``: (S,2) frames, ``prompts``: S texts; ``readings``: an edited plan's reading of each,
+    else the texts'); None when no segment asks for anything."""
     J = np.asarray(joints, np.float64)
     scale = np.ones(len(J))
-    for (a, b), prompt in zip(np.asarray(bounds), prompts):
-        scale[a:b] = segment_scale(read_words(prompt), J[a:b])
-    phi = turn_profile(J, bounds, prompts)
+    readings = [read_words(p) for p in prompts] if readings is None else readings
+    for (a, b), w in zip(np.asarray(bounds), readings):
+        scale[a:b] = segment_scale(w, J[a:b])
+    phi = turn_profile(J, bounds, prompts, readings)
     if (scale >= 1.0).all() and phi is None:
         return None
     if (scale < 1.0).any():

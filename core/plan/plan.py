@@ -12,10 +12,9 @@ back, edited, and says which field is wrong when one is. In a segment's ``unders
 may change, add or remove: ``actions`` (the first is the segment's action: a new one replaces the
 action's words in the text the model reads), ``side`` ("left hand"), ``course`` and ``course_way``,
 ``turn_degrees``, ``travel``, ``in_place``, ``distance_m``, ``steps``, ``stop``, ``stand_still``,
-``count``, ``pace``; a segment's ``text`` and ``seconds`` too. A field left out asks nothing. In a
-plan of several segments each segment is made from its text (a timeline's strips are regenerated and
-re-decoded from their texts): its ``text``, ``seconds`` and ``actions`` are changed, and a field
-its text does not say is refused with the field named.
+``count``, ``pace``; a segment's ``text`` and ``seconds`` too. A field left out asks nothing. The
+motion keeps the plan (``Motion.plan``), so a timeline re-decoded for a new body or a strip
+regenerated acts on its edited segments again (``generation/sequence.plan_readings``).
 """
 from __future__ import annotations
 
@@ -248,16 +247,6 @@ def plan_from_json(data, seconds: float | None = None) -> Plan:
         sec = None if seg.get("seconds") is None else _number(seg["seconds"], f"{where}.seconds",
                                                               MIN_SEGMENT_SECONDS, MAX_SECONDS)
         text, words = _edited_words(seg, where, text)
-        if len(segs) > 1:   # a timeline's segment is made from its text: a field its text does not say is refused
-            own = read_words(text).understood()
-            for key, value in words.understood().items():
-                if key != "unused" and own.get(key) != value:
-                    raise _bad(f"{where}.understood.{key}", f"in a plan of several segments each is made from its "
-                               f"text: say {key} in the segment's text ({text!r} reads {own.get(key)!r})")
-            for key in own:
-                if key not in words.understood():
-                    raise _bad(f"{where}.understood.{key}", f"in a plan of several segments each is made from its "
-                               f"text: remove it from the segment's text ({text!r})")
         out.append(Segment(text, 1.0 / len(segs), words, sec))
     prompt = data.get("prompt")
     prompt = _text(prompt, "prompt", 2000) if prompt is not None else ", then ".join(s.text for s in out)
