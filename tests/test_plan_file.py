@@ -92,3 +92,31 @@ def test_an_edited_timeline_keeps_its_edits_on_a_new_body(tmp_path):
     again = loaded_generator(None, None).redecode(m, np.r_[1.5, -1.0, np.zeros(8)].astype(np.float32))
     assert turned(m) < -3.0 and turned(again) < -3.0   # clockwise, once round, on both bodies
     assert again.plan == m.plan
+
+
+def test_a_plan_of_any_shape_is_read_or_refused_in_a_sentence():
+    """Fields of every type in every place of a plan: read, or a ShapeMoveError, never a traceback."""
+    import copy
+    import random
+
+    rng = random.Random(0)
+    values = [None, True, 0, -1, 1e9, float("nan"), "x", "", [], {}, [1], {"a": 1}, 3.5, "left hand", ["walk"], ["run", "x"]]
+    keys = ["actions", "legs", "arms", "course", "course_way", "turn_degrees", "travel", "in_place", "distance_m",
+            "steps", "stop", "stand_still", "count", "pace", "side", "unused"]
+    bases = [plan_json(p, 4) for p in ("a person walks forward, then sits down", "a woman jogs while waving her left hand",
+                                       "a man jumps twice", "someone kicks with the left leg")]
+    refused = 0
+    for _ in range(600):
+        plan = copy.deepcopy(rng.choice(bases))
+        seg, r = rng.choice(plan["segments"]), rng.random()
+        if r < 0.6:
+            seg["understood"][rng.choice(keys)] = rng.choice(values)
+        elif r < 0.75:
+            seg[rng.choice(["text", "seconds", "understood"])] = rng.choice(values)
+        else:
+            plan[rng.choice(["seconds", "segments", "prompt"])] = rng.choice(values)
+        try:
+            plan_from_json(json.dumps(plan))
+        except ShapeMoveError:
+            refused += 1
+    assert 200 < refused < 600   # many refused, many read
