@@ -52,6 +52,7 @@ from .sampling_params import (DEFAULT_GUIDANCE, check_candidates, check_guidance
                               check_retrieval_prefix, check_retrieved, check_sampling)
 from .request import Request
 from .slow_steps import slow_motion
+from .typical_pace import load_typical_speeds, typical_paced
 from .turn_words import turn_motion
 
 
@@ -536,6 +537,7 @@ class Generator:
                               if course is not None else                                          # course_walk.py
                               turn_motion(motion, self.body, turn, self.ik_refine_iters))         # turn_words.py
                     motion = slow_motion(motion, self.body, words, self.ik_refine_iters)      # slow_steps.py
+                    motion = typical_paced(motion, self.body, words, self.typical_speeds, self.ik_refine_iters)
             if words is not None:   # "jogs in place": the data's gaits all travel; stepped on the spot instead
                 motion = on_the_spot(motion, self.body, words.in_place, self.ik_refine_iters)   # on_the_spot.py
             motion.plan = plan_text(plan) if plan is not None else None
@@ -564,6 +566,11 @@ class Generator:
                                    readings=[s.words for s in plan.segments] if r.plan is not None else None)
         motion.prompt = r.prompt
         return motion
+
+    @cached_property
+    def typical_speeds(self) -> dict[str, float]:
+        """{gait: typical speed on the average body} of the model folder's table (``typical_pace.py``)."""
+        return load_typical_speeds(self.model_dir)
 
     @cached_property
     def rest_code(self) -> int | None:

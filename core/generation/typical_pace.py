@@ -1,0 +1,154 @@
+"""The typical pace of a gait: a prompt that names one walk, jog or run and asks nothing of its pace
+("a person runs forward", "a man walks") goes at the pace the training data's plain captures of
+that gait go at, on the body asked for.
+
+The T5's samples and the captured takes of a plain gait spread widely in speed (walks from 0.8 to
+1.2 m/s, jogs at 2.1-2.4 m/s against 1.56 captured), and the TMA that chooses among them hardly
+tells a brisk one from a slow one. So after the choice, a motion whose root speed
+(``eval.gait.mean_speed``) is more than ``TOLERANCE`` off its gait's typical speed is brought to
+it (by at most ``MAX_CHANGE``):
+
+- faster: played faster, the gait walking on in its own stride where its frames run out
+  (``continued``: the stride ``loop.best_cut`` finds most alike at its ends, repeated);
+- slower, a walk (no flight phase): played slower, the way the words' "slowly" is done
+  (``slow_steps.py``: the first share of its joint track resampled to the whole length);
+- slower, a jog or a run: its cadence and flights kept, shorter strides
+  (``stride_scale.scaled_strides``).
+
+The feet are planted again (``track.replanted``). Nothing is retimed when the words ask a pace ("quickly"),
+a distance, a number of steps, a stop, a course, a turn, a direction other than forward, a count,
+two things at once or a side (``plan.words.Words``); the user's ``--speed`` applies after.
+
+The typical speeds are a table in the model folder (``TABLE``, listed in its manifest), written
+by ``python tools/typical_pace.py --data data/built --model weights/default``: per gait the median
+speed of the training split's straight captures of it in the performer's plain way (``style:
+normal``; for jog, which has none, its unstyled captures) on the average body. On another body the
+speed is scaled by its leg's length against the average body's (a taller walker's strides are
+longer at the same cadence, as the dataset's average-body copies scale strides by the pelvis's
+height). A model folder without the table retimes nothing.
+"""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import ShapeMoveError
+
+FORMAT = "shapemove-typical-pace/1"
+TABLE = "typical_pace.json"
+MAX_BYTES = 64 << 10
+GAITS = ("walk", "jog", "run")
+FLIGHT = ("jog", "run")     # keep their cadence; shorter strides instead
+TOLERANCE = 0.03            # a motion within this share of its typical speed is left as it is
+MAX_CHANGE = 1.5            # the most a motion's speed is changed by (either way)
+MOVING = 0.2                # m/s: a motion slower than this is not a gait going anywhere: left as it is
+STRIDE = (0.7, 2.0)         # s: the length of the stride a faster gait walks on in (``continued``)
+
+
+def load_typical_speeds(model_dir) -> dict[str, float]:
+    """{gait: typical speed (m/s) on the average body} from ``model_dir/TABLE``; {} without one.
+    A damaged table is a ShapeMoveError naming the file."""
+    from ..io.limits import read_bounded
+    from ..model_files import verify_file
+
+    path = Path(model_dir) / TABLE
+    if not path.is_file():
+        return {}
+    verify_file(path)
+    try:
+        data = json.loads(read_bounded(path, MAX_BYTES, "typical pace").decode("utf-8"))
+        speeds = {str(g): float(row["speed"]) for g, row in data["gaits"].items()}
+    except (ValueError, KeyError, TypeError, AttributeError) as e:
+        raise ShapeMoveError(f"{path}: not a typical pace table ({e}); write it again with "
+                             "python tools/typical_pace.py --data DATA --model MODEL") from None
+    if data.get("format") != FORMAT or not all(0.2 < s < 10.0 for s in speeds.values()):
+        raise ShapeMoveError(f"{path}: not a typical pace table of format {FORMAT} with speeds in m/s")
+    return speeds
+
+
+def plain_gait(words) -> str | None:
+    """The one gait of ``GAITS`` the words (``plan.words.Words``) name when they ask nothing else of
+    it (module doc); None otherwise."""
+    if words is None or len(words.actions) != 1 or words.actions[0] not in GAITS:
+        return None
+    asked = (words.pace, words.stop, words.steps, words.distance_m, words.course, words.turn, words.count,
+             words.parts, words.side)
+    if any(a not in (None, False) for a in asked) or words.in_place or words.stand_still:
+        return None
+    if words.travel.forward < 0 or words.travel.side or words.travel.sideways:
+        return None
+    return words.actions[0]
+
+
+def body_speed(typical: float, body, betas) -> float:
+    """``typical`` (m/s on the average body) on the body ``betas``: scaled by its leg's length
+    (hip to ankle, rest pose) against the average body's."""
+    import torch
+
+    with torch.no_grad():
+        b = torch.as_tensor(np.asarray(betas, np.float32).reshape(1, -1))
+        rest = body.rest_joints(torch.cat([torch.zeros_like(b), b]))[:, :22].numpy()
+    leg = rest[:, 1, 1] - rest[:, 7, 1]
+    return typical * float(leg[1] / leg[0])
+
+
+def typical_paced(motion, body, words, speeds: dict, ik_refine_iters: int = 10):
+    """``motion`` brought to its plain gait's typical speed on its body (module doc); the motion
+    itself when the words ask more than a plain gait, the table lacks the gait, or it is within
+    ``TOLERANCE`` of typical."""
+    from ..eval.gait import mean_speed
+    from .stride_scale import scaled_strides
+    from .track import Track, replanted, resample, track_of
+
+    gait = plain_gait(words)
+    if gait is None or gait not in speeds or motion.num_frames < 4 or motion.network_joints is None:
+        return motion
+    want = body_speed(speeds[gait], body, motion.betas)
+    speed = mean_speed(motion.joints, motion.fps)
+    if speed < MOVING or abs(want / speed - 1.0) <= TOLERANCE:
+        return motion
+    share = float(np.clip(want / speed, 1.0 / MAX_CHANGE, MAX_CHANGE))
+    track = track_of(motion)
+    n = len(track.joints)
+    if share < 1.0 and gait in FLIGHT:
+        return replanted(motion, body, Track(scaled_strides(track.joints, share), track.contacts), ik_refine_iters)
+    source = track if share < 1.0 else continued(track, int(np.ceil(n * MAX_CHANGE)) + 1, motion.fps)
+    if source is None:
+        return motion
+    # the frames played: as many as bring the track's own speed to the share of it asked (a gait
+    # walking on in its steady stride goes faster than one that starts from standing)
+    goal = share * mean_speed(track.joints, motion.fps)
+    lo, hi = 2, len(source.joints)
+    while hi - lo > 1:
+        mid = (lo + hi) // 2
+        if mean_speed(resample(Track(source.joints[:mid], source.contacts[:mid]), n).joints, motion.fps) < goal:
+            lo = mid
+        else:
+            hi = mid
+    return replanted(motion, body, resample(Track(source.joints[:hi], source.contacts[:hi]), n), ik_refine_iters)
+
+
+def continued(track, frames: int, fps: float):
+    """``track`` (a gait) made ``frames`` long by walking on in its own cycle: its frames up to the
+    start of its most self-alike stride (``loop.best_cut``, ``STRIDE`` s), then that stride
+    (``loop.make_cycle``: its heading's drift removed, its end blended into its start) repeated,
+    each copy moved on by the stride's advance; None when the track holds no such stride."""
+    from ..errors import ShapeMoveError as _Error
+    from .loop import best_cut, make_cycle
+    from .track import Track
+
+    T = len(track.joints)
+    try:
+        cut = best_cut(track.joints, fps, period=(STRIDE[0], min(STRIDE[1], 0.6 * T / fps)))
+    except _Error:
+        return None
+    cycle, advance = make_cycle(track, cut)
+    joints, contacts = [track.joints[:cut.start]], [track.contacts[:cut.start]]
+    have, k = cut.start, 0
+    while have < frames:
+        joints.append(cycle.joints + k * advance)
+        contacts.append(cycle.contacts)
+        have, k = have + len(cycle.joints), k + 1
+    return Track(np.concatenate(joints)[:frames], np.concatenate(contacts)[:frames])
