@@ -272,7 +272,10 @@ def pin_feet(rotations, transl, rest, parents, targets, weights, soft_reach: flo
         dc = dc.clip(abs(l1 - l2) + 1e-4, reach - 1e-4)
         vh = v / d
         a2 = h + vh * dc                                        # where the ankle goes (reachable)
-        side = (k - h) - ((k - h) * vh).sum(-1, keepdims=True) * vh   # the knee's bend direction
+        ua = (a - h) / np.linalg.norm(a - h, axis=-1, keepdims=True).clip(1e-9)
+        side = (k - h) - ((k - h) * ua).sum(-1, keepdims=True) * ua    # the knee's bend direction, off the
+        side = side - (side * vh).sum(-1, keepdims=True) * vh          # pose's own leg (off the line to the
+        # target instead, it flipped where the target passed the knee: 0.38 m in a frame)
         lateral = G[t, hip][:, :, 0]                            # straight leg: bend about the hip's x axis
         fallback = np.cross(lateral, vh)
         fallback *= np.sign((fallback * (k - h)).sum(-1, keepdims=True) + 1e-12)
