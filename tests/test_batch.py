@@ -302,3 +302,22 @@ def test_progress_lines_say_done_failed_left_rate_and_time_left():
     assert lines[-1].startswith("generate: 4 of 10 done (2 before this run), 1 failed, 5 left, 0.7")
     assert lines[-1].endswith("items/s, about 7s left")        # 5 left at 3 items / 4 s
     assert len(lines) == 3                                     # one line per update, none repeated at the end
+
+
+def test_a_batch_worker_and_the_extension_worker_share_one_loaded_model(tmp_path):
+    """generate_item.generator_for hands out loaded_generator's model (one cache per process), with
+    the batch's retrieval setting; a changed manifest.json loads the model folder again."""
+    import shutil
+
+    from shapemove.core.batch.generate_item import generator_for
+    from shapemove.core.generation.loaded_generator import loaded_generator
+
+    model = tmp_path / "model"
+    shutil.copytree(ROOT / "weights" / "default", model)
+    gen = loaded_generator(model)
+    batch = generator_for({"model": str(model), "body_model": None, "library": None}, retrieval=False)
+    assert batch is gen and gen.t5.memory_enabled is False
+    assert loaded_generator(model) is gen and gen.t5.memory_enabled is True   # a hand-out turns retrieval on again
+    st = (model / "manifest.json").stat()
+    os.utime(model / "manifest.json", ns=(st.st_atime_ns, st.st_mtime_ns + 10**9))
+    assert loaded_generator(model) is not gen                           # the folder changed: loaded again
