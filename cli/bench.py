@@ -1,4 +1,4 @@
-"""`python -m shapemove bench [all|ik|keys|sliders|generate|train|long_take|timeline|animation|seams|batch|plant_leaps|gait_pace] [--json OUT]`.
+"""`python -m shapemove bench [all|ik|keys|sliders|generate|train|long_take|timeline|animation|seams|batch|plant_leaps|gait_pace|distances] [--json OUT]`.
 
 Each benchmark lives in ``bench/<name>.py`` with ``run(quick: bool) -> dict`` and prints its own
 baseline (measured in the same run) and the ratio. ``all`` runs them in order and merges the dicts.
@@ -10,7 +10,7 @@ from pathlib import Path
 
 from ..core.atomic import atomic_write_json
 
-BENCHES = ["ik", "keys", "sliders", "generate", "train", "long_take", "timeline", "animation", "seams", "batch", "plant_leaps", "gait_pace"]
+BENCHES = ["ik", "keys", "sliders", "generate", "train", "long_take", "timeline", "animation", "seams", "batch", "plant_leaps", "gait_pace", "distances"]
 
 
 def add_arguments(p):

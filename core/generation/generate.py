@@ -47,7 +47,7 @@ from ..plan.segments import MIN_SEGMENT_SECONDS
 from ..plan.words import read_words
 from .retrieved_candidates import library_codes, retrieved_codes
 from .stop_words import (DISTANCE_PACE, DISTANCE_SECONDS, STAND_SECONDS, distance_cut, distance_keeps, from_start,
-                         standing_after, standing_code, stop_cut)
+                         standing_after, standing_code, stop_cut, shortened_to)
 from .sampling_params import (DEFAULT_GUIDANCE, check_candidates, check_guidance, check_retrieval_first,
                               check_retrieval_prefix, check_retrieved, check_sampling)
 from .request import Request
@@ -618,6 +618,8 @@ class Generator:
         if best is not motion:
             best.shape_source, best.retrieved_clips = motion.shape_source, list(motion.retrieved_clips)
             best.part_prompts = motion.part_prompts
+            if metres is not None:   # past the mark by more than the cut's grain: shorter strides
+                best = shortened_to(best, self.body, metres, self.ik_refine_iters)
         return best
 
     def _say_if_short(self, motion: Motion, clip: str | None, seconds: float | None) -> None:

@@ -117,3 +117,23 @@ def standing_after(codes, keep: int, rest: int, stand: int | None = None) -> lis
     instead when given: a length the model chose)."""
     codes = [int(c) for c in codes]
     return codes[:keep] + [rest] * (len(codes) - keep if stand is None else stand)
+
+
+OVERSHOOT = 0.04   # a cut gait that stands further than this share past the distance takes shorter strides
+# (it then keeps no tokens: a cut within it keeps them, so a new body decodes it again)
+
+
+def shortened_to(motion, body, metres: float, ik_refine_iters: int = 10):
+    """``motion`` (a gait cut at the code nearest ``metres``, then standing) brought back to the
+    distance where it overshoots by more than ``OVERSHOOT``: its root's steps and the feet's reach
+    shortened together (``stride_scale.scaled_strides``, its cadence kept) and the feet planted
+    again (``track.replanted``). A code is a fifth of a second, so the cut alone lands up to a
+    quarter of a stride past the mark (3.25 m of 3 m on "an old man"). Unchanged otherwise."""
+    from .stride_scale import scaled_strides
+    from .track import Track, replanted, track_of
+
+    gone = float(from_start(motion.joints)[-1])
+    if gone <= metres * (1 + OVERSHOOT) or motion.num_frames < 4:
+        return motion
+    track = track_of(motion)
+    return replanted(motion, body, Track(scaled_strides(track.joints, metres / gone), track.contacts), ik_refine_iters)
