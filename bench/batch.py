@@ -1,12 +1,13 @@
 """Batches of prompts (issue 55's targets), every ratio measured in one run:
 
-- items per second with 2 worker processes against 1 on the same 40 prompts, for
+- items per second with ``--jobs 2`` against ``--jobs 1`` on the same 40 prompts, for
   ``generate --prompts`` (4 s motions, the default 8 candidates) and for ``render`` (2 frames at
-  160x160): both runs start their workers, load the model and run the same items, and each item's
+  160x160), each the command run as a user runs it (a new process that loads the model, and with
+  ``--jobs 2`` starts two workers that each load it) on the same items, and each item's
   files are checked to be the same (the ``.blend`` excepted: docs/batches.md). Two ratios: over
   the whole batch (starting the workers included), and once every worker has finished its first
   item (the rate a long batch runs at; from the manifest's timings);
-- per-item time in a warm worker (items 1 to 8 of the 1-worker generate batch, from the manifest's
+- per-item time in a warm batch (items 1 to 8 of the `--jobs 1` generate batch, from the manifest's
   timings) against the same items generated in this process with the model loaded, one after
   another after item 0 as the worker ran them (the warm single prompt: the same work and caches
   without the pool, the hashing and the manifest);
@@ -18,6 +19,8 @@ from __future__ import annotations
 
 import json
 import os
+import subprocess
+import sys
 import tempfile
 import time
 from datetime import datetime
@@ -25,10 +28,8 @@ from pathlib import Path
 
 PROMPTS = ["a person walks forward", "someone waves with the right hand", "a person jumps", "a person squats",
            "a man runs forward", "a woman kicks with the left leg", "a person sits down", "someone turns around"]
-SETTINGS = {"temperature": 1.0, "top_k": 50, "shape_from": "auto", "candidates": 8, "guidance": None,
-            "retrieval_prefix": 2, "retrieved": 2, "retrieval_first": None, "retrieval": True, "parts": True,
-            "library": None, "body_model": "openbody"}
-RENDER = {"frames": 2, "resolution": [160, 160], "video": False}
+CANDIDATES = 8
+RENDER = {"frames": 2, "resolution": [160, 160]}
 SECONDS = 4.0
 SAME_ITEMS = 8
 
@@ -51,31 +52,21 @@ def warm_rate(records: list[dict]) -> float:
 
 
 def _batch(kind: str, folder: Path, prompts: Path, jobs: int) -> tuple[float, list[dict]]:
-    from ..core.batch.engines import ProcessPool
-    from ..core.batch.items import LINE_KEYS, read_items
+    """(wall seconds, records by item) of ``generate``/``render --prompts PROMPTS --jobs JOBS`` run
+    as a user runs it, in a new process."""
     from ..core.batch.manifest import read_manifest
-    from ..core.batch.model_identity import model_identity
-    from ..core.batch.runner import run_batch
-    from ..core.generation.model_bundle import resolve_model_dir
 
-    if kind == "render":
-        from ..cli.render_item import render_item as task
-
-        items, count = read_items(prompts, defaults={"seconds": SECONDS}, keys=(*LINE_KEYS, "root_motion"))
-        settings = {**SETTINGS, **RENDER}
-    else:
-        from ..core.batch.generate_item import generate_item as task
-
-        items, count = read_items(prompts, defaults={"seconds": SECONDS})
-        settings = SETTINGS
-    where = {"model": None, "library": None, "body_model": None}
+    extra = ["--candidates", str(CANDIDATES)] if kind == "generate" else \
+        ["--frames", str(RENDER["frames"]), "--resolution", *map(str, RENDER["resolution"])]
+    cmd = [sys.executable, "-m", "shapemove", kind, "--prompts", str(prompts), "--out", str(folder),
+           "--jobs", str(jobs), *extra]
     t0 = time.perf_counter()
-    res = run_batch(kind, task, items, count, settings, model_identity(resolve_model_dir()), where, folder,
-                    ProcessPool(jobs), interval=1e9)
+    res = subprocess.run(cmd, capture_output=True, text=True, env={**os.environ, "TQDM_DISABLE": "1"})
     wall = time.perf_counter() - t0
-    if res.failed:
-        raise RuntimeError(f"batch items failed: {res.failed}")
-    return wall, sorted(read_manifest(res.manifest)[0], key=lambda r: r["item"])
+    records = sorted(read_manifest(folder / "manifest.jsonl")[0], key=lambda r: r["item"])
+    if res.returncode != 0 or any(r["status"] != "done" for r in records):
+        raise RuntimeError(f"{' '.join(cmd)} failed ({res.returncode}): {res.stderr.strip()[-800:]}")
+    return wall, records
 
 
 def _same_files(a: list[dict], b: list[dict]) -> bool:
@@ -128,10 +119,10 @@ def _two_against_one(kind: str, tmp: Path, prompts: Path, n: int, goal: float) -
     two, recs2 = _batch(kind, tmp / f"{kind}2", prompts, 2)
     same = _same_files(recs1, recs2)
     whole, warm = one / two, warm_rate(recs2) / warm_rate(recs1)
-    print(f"{kind}, {n} prompts: 1 worker {one:.1f} s ({n / one:.2f} items/s), 2 workers {two:.1f} s "
+    print(f"{kind}, {n} prompts: --jobs 1 {one:.1f} s ({n / one:.2f} items/s), --jobs 2 {two:.1f} s "
           f"({n / two:.2f} items/s): {whole:.2f}x over the whole batch; once the workers are warm "
           f"{warm_rate(recs1):.2f} -> {warm_rate(recs2):.2f} items/s, {warm:.2f}x (goal >= {goal}x); "
-          f"files identical: {same}; CPU per item {_cpu_per_item(recs1):.2f} s with 1 worker, "
+          f"files identical: {same}; CPU per item {_cpu_per_item(recs1):.2f} s with --jobs 1, "
           f"{_cpu_per_item(recs2):.2f} s with 2   [load average {os.getloadavg()[0]:.1f}]")
     return {f"batch_{kind}_jobs1_s": one, f"batch_{kind}_jobs2_s": two, f"batch_{kind}_jobs2_over_jobs1": whole,
             f"batch_{kind}_warm_jobs2_over_jobs1": warm, f"batch_{kind}_identical": same,
@@ -148,7 +139,8 @@ def run(quick: bool = False) -> dict:
     with tempfile.TemporaryDirectory(prefix="shapemove_bench_batch_") as tmp:
         tmp = Path(tmp)
         prompts = tmp / "prompts.jsonl"
-        prompts.write_text("".join(json.dumps({"prompt": PROMPTS[i % len(PROMPTS)]}) + "\n" for i in range(n)))
+        prompts.write_text("".join(json.dumps({"prompt": PROMPTS[i % len(PROMPTS)], "seconds": SECONDS}) + "\n"
+                                   for i in range(n)))
         got, recs1 = _two_against_one("generate", tmp, prompts, n, 1.6)
         out.update(got)
         if not quick:
@@ -159,9 +151,9 @@ def run(quick: bool = False) -> dict:
         alone = _alone(tmp, recs1[:1 + SAME_ITEMS])
         single, single_cpu = sum(a[0] for a in alone), sum(a[1] for a in alone)
         read = _read_10k(tmp)
-    print(f"items 1-{len(warm)} in a warm worker {per_item:.2f} s ({per_item_cpu:.2f} CPU s) vs the same prompts "
-          f"in this process after item 0 {single:.2f} s ({single_cpu:.2f} CPU s): {per_item / single:.2f}x wall, "
-          f"{per_item_cpu / single_cpu:.2f}x CPU (goal <= 1.3x)")
+    print(f"items 1-{len(warm)} in the warm --jobs 1 batch {per_item:.2f} s ({per_item_cpu:.2f} CPU s) vs the "
+          f"same prompts in this process after item 0 {single:.2f} s ({single_cpu:.2f} CPU s): "
+          f"{per_item / single:.2f}x wall, {per_item_cpu / single_cpu:.2f}x CPU (goal <= 1.3x)")
     print(f"10,000-line .jsonl read, checked and sharded: {read:.2f} s (goal < 2 s)   "
           f"[load average {os.getloadavg()[0]:.1f}]")
     out.update({"batch_item_warm_s": per_item, "batch_single_warm_s": single,
