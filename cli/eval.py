@@ -131,6 +131,16 @@ def add_parts(sub):
     p.set_defaults(_run=parts_eval.from_cli)
 
 
+def add_sequences(sub):
+    from ..core.eval import sequence_eval
+
+    p = sub.add_parser("sequences", help="held-out one-prompt sequences ('X, then Y'): each segment judged by "
+                       "body part or raw features, their order, the plan's split",
+                       description=sequence_eval.__doc__.splitlines()[0])
+    sequence_eval.add_arguments(p)
+    p.set_defaults(_run=sequence_eval.from_cli)
+
+
 # -- eval retarget (HUMOS's application: SA-VAE retargeting against naive) ----------------------------
 RETARGET_BODIES = {"a very tall, heavy-set man": "height 195 cm, waist 110 cm", "a short, slim woman": "height 152 cm, waist 64 cm"}
 
@@ -204,8 +214,8 @@ def add_codec_actions(sub):
     p.set_defaults(_run=codec_actions.from_cli)
 
 
-KINDS = [add_recon, add_generate, add_paraphrase, add_parts, add_shape, add_shape_words, add_retarget, add_speed,
-         add_codec_actions]
+KINDS = [add_recon, add_generate, add_paraphrase, add_parts, add_sequences, add_shape, add_shape_words, add_retarget,
+         add_speed, add_codec_actions]
 
 
 def add_arguments(p):

@@ -34,6 +34,7 @@ FAST = [
     (("eval", "generate"), ["--max-clips", "2", "--quiet"]),
     (("eval", "retarget"), ["--max-clips", "1"]),
     (("eval", "paraphrase"), ["--prompts", "tiny_prompts.json", "--quiet"]),
+    (("eval", "sequences"), ["--max-prompts", "1", "--quiet"]),
     (("eval", "shape"), ["--bodies", "2", "--quiet"]),
     (("eval", "speed"), ["--max-clips", "1", "--shape-clips", "0", "--quiet"]),
     (("eval", "codec-actions"), ["--per-action", "1"]),
