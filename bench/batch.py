@@ -13,8 +13,9 @@
   without the pool, the hashing and the manifest);
 - a 10,000-line ``.jsonl`` read, checked and sharded (wall seconds; torch already imported).
 ``--quick``: 8 prompts, generate only. The machine is shared, so wall time includes waiting for a
-core: the load average is printed with the figures, and the CPU seconds of an item (the
-manifest's ``timing.cpu_seconds``) with 1 and 2 workers and alone, which waiting does not count."""
+core: the load average is printed with the figures, the CPU seconds of an item (the manifest's
+``timing.cpu_seconds``) with 1 and 2 workers and alone, which waiting does not count, and the
+cores the warm batch got (items per second x CPU seconds per item)."""
 from __future__ import annotations
 
 import json
@@ -119,15 +120,19 @@ def _two_against_one(kind: str, tmp: Path, prompts: Path, n: int, goal: float) -
     two, recs2 = _batch(kind, tmp / f"{kind}2", prompts, 2)
     same = _same_files(recs1, recs2)
     whole, warm = one / two, warm_rate(recs2) / warm_rate(recs1)
+    # items per second x CPU seconds per item: the cores the batch had (all of them, 2 here, when idle)
+    cores1, cores2 = warm_rate(recs1) * _cpu_per_item(recs1), warm_rate(recs2) * _cpu_per_item(recs2)
     print(f"{kind}, {n} prompts: --jobs 1 {one:.1f} s ({n / one:.2f} items/s), --jobs 2 {two:.1f} s "
           f"({n / two:.2f} items/s): {whole:.2f}x over the whole batch; once the workers are warm "
           f"{warm_rate(recs1):.2f} -> {warm_rate(recs2):.2f} items/s, {warm:.2f}x (goal >= {goal}x); "
           f"files identical: {same}; CPU per item {_cpu_per_item(recs1):.2f} s with --jobs 1, "
-          f"{_cpu_per_item(recs2):.2f} s with 2   [load average {os.getloadavg()[0]:.1f}]")
+          f"{_cpu_per_item(recs2):.2f} s with 2; cores the warm batch got {cores1:.2f} and {cores2:.2f}   "
+          f"[load average {os.getloadavg()[0]:.1f}]")
     return {f"batch_{kind}_jobs1_s": one, f"batch_{kind}_jobs2_s": two, f"batch_{kind}_jobs2_over_jobs1": whole,
             f"batch_{kind}_warm_jobs2_over_jobs1": warm, f"batch_{kind}_identical": same,
             f"batch_{kind}_cpu_per_item_jobs1_s": _cpu_per_item(recs1),
-            f"batch_{kind}_cpu_per_item_jobs2_s": _cpu_per_item(recs2)}, recs1
+            f"batch_{kind}_cpu_per_item_jobs2_s": _cpu_per_item(recs2), f"batch_{kind}_cores_jobs1": cores1,
+            f"batch_{kind}_cores_jobs2": cores2}, recs1
 
 
 def run(quick: bool = False) -> dict:
