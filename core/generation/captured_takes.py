@@ -6,14 +6,15 @@ Here the takes themselves compete: the built-in motion library (``data/motion_li
 ``library.npz`` of the model folder) and the user's own library (``Generator.add_library``), both
 in one ``TakePool``. For a prompt:
 
-- the takes of the action the words ask for (``data/actions.py``'s patterns, or the planner's
-  reading for a part) nearest the prompt by caption (the TMA text embedding of the prompt against
+- the takes of the action the words ask for (the plan's reading, or the planner's reading for a
+  part) nearest the prompt by caption (the TMA text embedding of the prompt against
   each take's captions), and the takes nearest by caption whatever their action, ``TAKES`` in
   all, drawn by the request's seed from the ``POOL`` x as many nearest (another seed, other takes);
   the user's own clips come first: their nearest by caption and their nearest of the asked action;
 - each gives one window of the requested length (one of its busiest, ``busiest_start``); a take shorter
-  than asked is held on its last pose for the rest (a kick, then standing); with no length asked
-  a take plays whole, at least ``UNASKED_SECONDS``;
+  than asked plays on as a loop of its own cycle where it repeats (``take_loop.py``: jumping jacks,
+  arm circles), else it is held on its last pose for the rest (a kick, then standing); with no
+  length asked a take plays whole, at least ``UNASKED_SECONDS``;
 - a named side ("kicks with the right leg") mirrors a take whose other side moves most
   (``part_compose.needs_mirror``; ``data/mirror.py``'s rotations);
 - each window's features, on the performer's own body (``ClipProcessor.pose_on``), join the
@@ -41,6 +42,7 @@ import numpy as np
 from ..constants import FPS
 from ..errors import ShapeMoveError
 from ..scene.motion_file import Motion
+from .take_loop import looped_take
 
 TAKES = 5              # captured windows offered per prompt
 POOL = 2               # drawn by the seed from the POOL x TAKES nearest
@@ -65,6 +67,7 @@ class Window:
     provenance: str
     held: int = 0           # frames held on the last pose
     mirrored: bool = False
+    looped: int = 0         # frames of the take's own cycle played again (take_loop.py)
 
 
 def hold(rotations, root, contacts, frames: int):
@@ -202,15 +205,21 @@ class TakePool:
         want = min(max(frames, n), longest) if longest is not None else frames
         lo = 0 if n <= want else busiest_start(t["rotations"], want, seed)
         rot, root, con = (np.asarray(t[k][lo:lo + want]) for k in ("rotations", "root", "contacts"))
-        held = max(0, want - len(rot))
-        rot, root, con = hold(rot, root, con, want)
+        held = looped = 0
+        if len(rot) < want:   # a take that repeats plays on as a loop, another is held on its last pose
+            again = looped_take(rot, root, con, self.proc.pose_on(rot, root, t["betas"], 1.0, con), want)
+            if again is not None:
+                rot, root, con, first = again
+                looped = want - first
+            held = want - len(rot)
+            rot, root, con = hold(rot, root, con, want)
         joints = self.proc.pose_on(rot, root, t["betas"], 1.0, con)
         flip = side is not None and needs_mirror(joints, *side)
         if flip:
             rot, root, con = mirrored(rot, root, con)
             joints = self.proc.pose_on(rot, root, t["betas"], 1.0, con)
         return Window(rot, root, con, t["rest"], self.proc.features(joints, rot, con), self.actions[i], self.ids[i],
-                      t["provenance"] + (", mirrored" if flip else ""), held, flip)
+                      t["provenance"] + (", mirrored" if flip else ""), held, flip, looped)
 
     def windows(self, text: np.ndarray, action: str | None, seed: int, frames: int, side=None,
                 longest: int | None = None, count: int = TAKES) -> list[Window]:
@@ -244,6 +253,9 @@ def captured_motion(w: Window, body, betas, ik_refine_iters: int = 10, prompt: s
                            body, betas, ik_refine_iters)
     out.prompt = prompt
     out.provenance = w.provenance
+    if w.looped:
+        out.notes.append(f"the captured take lasts {(len(w.rotations) - w.looped) / FPS:.1f} s: its own cycle "
+                         f"repeats for the remaining {w.looped / FPS:.1f} s")
     if w.held:
         out.notes.append(f"the captured take lasts {(len(w.rotations) - w.held) / FPS:.1f} s: its last pose is held "
                          f"for the remaining {w.held / FPS:.1f} s")

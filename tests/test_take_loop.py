@@ -1,0 +1,44 @@
+"""A captured take shorter than asked plays on as a loop where it repeats (generation/take_loop.py)."""
+from __future__ import annotations
+
+import numpy as np
+import torch
+
+from shapemove.core.generation.take_loop import looped_take
+
+
+def _take(openbody, arms, forward=0.05):
+    """A standing body whose wrists and elbows follow ``arms`` (T,) metres up and down, walking
+    ``forward`` m a frame; rotations carry their frame number, for the test to read the order."""
+    rest = openbody.rest_joints(torch.zeros(1, 10))[0, :22].numpy().astype(np.float64)
+    T = len(arms)
+    J = np.repeat(rest[None], T, 0)
+    J[:, 18:22, 1] += np.asarray(arms)[:, None]
+    J[:, :, 2] += forward * np.arange(T)[:, None]
+    rot = np.zeros((T, 24, 3, 3), np.float32)
+    rot[:, 0, 0, 0] = np.arange(T)
+    root = J[:, 0].astype(np.float32)
+    return rot, root, np.zeros((T, 4), np.uint8), J
+
+
+def test_a_repeating_take_loops_and_a_single_gesture_is_held(openbody):
+    t = np.arange(90)
+    still = np.zeros(15)
+    arms = np.concatenate([still, 0.2 * np.sin(2 * np.pi * t / 20), still])   # 4.5 cycles of 1 s, standing around
+    rot, root, con, J = _take(openbody, arms)
+    out = looped_take(rot, root, con, J, 300)
+    assert out is not None
+    r, rt, c, first = out
+    assert len(r) == len(rt) == len(c) == 300 and first <= len(rot)
+    order = r[:, 0, 0, 0].astype(int)
+    assert np.array_equal(order[:first], np.arange(first))               # the take as performed, then
+    period = int(first - order[first])                                     # its cycle again and again
+    assert period % 20 == 0 and 15 <= order[first] < first <= 15 + 90
+    assert np.array_equal(order[first:first + period], np.arange(order[first], first))
+    assert np.allclose(np.diff(rt[:, 2]), 0.05, atol=1e-4)                # the root walks on at its pace
+    assert len(rot) > 0 and looped_take(rot, root, con, J, len(rot)) is None   # long enough: nothing to do
+
+    kick = np.concatenate([np.zeros(30), 0.6 * np.sin(np.pi * np.arange(20) / 20), np.zeros(30)])
+    assert looped_take(*_take(openbody, kick, 0.0), 300) is None          # one gesture: held, not repeated
+    rise = np.linspace(0.0, 0.8, 80)
+    assert looped_take(*_take(openbody, rise, 0.0), 300) is None          # never comes back: held
