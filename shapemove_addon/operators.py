@@ -100,7 +100,7 @@ def on_generated(name: str, msg: dict, prompt: str | None = None):
     if r.get("plan"):   # the plan it was made from, under the prompt to change and generate again
         import json
 
-        from .plan_ui import show_plan
+        from .plan_fields import show_plan
 
         plan = json.loads(r["plan"])
         s = bpy.context.scene.shapemove
@@ -217,7 +217,7 @@ class SHAPEMOVE_OT_generate(JobOperator, bpy.types.Operator):
     def start(self, context):
         s = context.scene.shapemove
         prompt = scene_prompt(context)
-        from .plan_ui import plan_param
+        from .plan_fields import plan_param
 
         params = {**generation_params(context, prompt), "prompt": prompt,
                   "seconds": s.seconds if s.use_seconds else None, "captured": bool(s.use_captured),

@@ -9,7 +9,8 @@ from shapemove.cli import main
 from shapemove.core.plan.explain import plan_json, plan_lines
 from shapemove.core.plan.option_conflicts import option_notes
 from shapemove.core.plan.reading import understood
-from shapemove.core.plan.segments import SEGMENT_SECONDS, plan_segments, split_segments
+from shapemove.core.plan.plan import read_plan
+from shapemove.core.plan.segments import SEGMENT_SECONDS, split_segments
 
 
 @pytest.mark.parametrize("prompt, segments", [
@@ -35,7 +36,7 @@ from shapemove.core.plan.segments import SEGMENT_SECONDS, plan_segments, split_s
 ])
 def test_ordering_words_make_segments_in_the_order_they_happen(prompt, segments):
     assert split_segments(prompt) == segments
-    plan = plan_segments(prompt)
+    plan = read_plan(prompt)
     assert plan.is_sequence and [s.text for s in plan.segments] == segments
     assert sum(s.share for s in plan.segments) == pytest.approx(1.0)
 
@@ -52,11 +53,11 @@ def test_ordering_words_make_segments_in_the_order_they_happen(prompt, segments)
 ])
 def test_and_alone_courses_and_things_at_once_stay_one_segment(prompt):
     assert split_segments(prompt) == [prompt]
-    assert not plan_segments(prompt).is_sequence
+    assert not read_plan(prompt).is_sequence
 
 
 def test_lengths_share_the_seconds_or_take_a_default_each():
-    plan = plan_segments("a person walks forward, then turns around, then sits down")
+    plan = read_plan("a person walks forward, then turns around, then sits down")
     assert plan.lengths(6.0) == pytest.approx([2.0, 2.0, 2.0])
     assert plan.lengths(None) == pytest.approx([SEGMENT_SECONDS] * 3)
 
@@ -122,6 +123,6 @@ def test_held_out_sequences_are_cut_in_order():
     rows = json.loads((Path(__file__).resolve().parents[1] / "configs" / "heldout_sequences.json").read_text())["prompts"]
     right = 0
     for prompt, want in rows:
-        segments = [s.text for s in plan_segments(prompt).segments]
+        segments = [s.text for s in read_plan(prompt).segments]
         right += len(segments) == len(want) and all(w in s for w, s in zip(want, segments))
     assert len(rows) >= 40 and right >= 37

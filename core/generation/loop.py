@@ -22,7 +22,6 @@ carry (``library_takes.py``) is looped as captured (``loop_motion`` of ``Generat
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
 
 import numpy as np
 import torch
@@ -36,69 +35,15 @@ from .on_the_spot import LOOP_ALLOWED, spot_track
 from .prompts import check_prompt
 from .sampling_params import DEFAULT_CANDIDATES, check_candidates, check_sampling
 from .token_sampling import body_for, sample_codes
+from .loop_cut import EDGE, MIN_PERIOD, Cut, _local, best_cut  # noqa: F401  (where a motion loops)
 from .track import Track, decoded_track, headings, plant, rotate_y, track_of, yaw_matrix
 
-MIN_PERIOD = 1.0       # s: the shortest cycle (two steps of a walk)
 BLEND = 6              # frames over which the seam's last offset is blended in
-VELOCITY_WEIGHT = 4.0  # a velocity mismatch of 1 cm/frame costs as much as 4 cm of pose
-SEAM_SPEED = 1.0       # x its mean step: a joint faster than this at the seam frame is penalised
-FAST_WEIGHT = 0.2      # m of cost per unit of speed ratio above SEAM_SPEED
 PLANTED_TRIES = 3      # the best cuts planted until one's seam is good (``seam_report``)
 GOOD_SEAM = 1.5        # worst joint's wrap jump over its mean step that ends the search (the target)
-EDGE = 2               # frames at each end of a decoded clip that a cut avoids
 LOOP_MIN_SECONDS = 4.0  # candidates are at least this long, so a cycle has room
 PART_SECONDS = 6.0     # a by-part motion's length when the loop's length is not asked for
 PART_TRIES = 3         # by-part motions (seeds seed, seed + 2, ...) whose cycles compete
-
-
-@dataclass
-class Cut:
-    start: int
-    end: int
-    cost: float   # m: mean joint distance of the two poses + weighted velocity distance
-
-    @property
-    def period(self) -> int:
-        return self.end - self.start
-
-
-def _local(joints, heading) -> tuple[np.ndarray, np.ndarray]:
-    """Pose relative to the root's XZ and the heading, and backward velocity in that frame."""
-    J = np.asarray(joints, np.float64)
-    rel = J.copy()
-    rel[..., [0, 2]] -= J[:, :1, [0, 2]]
-    pose = rotate_y(rel, -heading)
-    vel = np.zeros_like(J)
-    vel[1:] = rotate_y(J[1:] - J[:-1], -heading[1:])
-    return pose, vel
-
-
-def best_cut(joints, fps: float = FPS, period: tuple[float, float] | None = None) -> Cut:
-    """The frames a < b whose pose and velocity are most alike, b - a within ``period`` (s)
-    (default: at least ``MIN_PERIOD`` and 40 % of the clip)."""
-    J = np.asarray(joints, np.float64)
-    T = len(J)
-    lo, hi = period if period is not None else (max(MIN_PERIOD, 0.4 * T / fps), T / fps)
-    lo_f, hi_f = max(2, int(round(lo * fps))), int(round(hi * fps))
-    pose, vel = _local(J, headings(J))
-    first, last = max(1, EDGE), T - 1 - EDGE
-    idx = np.arange(first, last + 1)
-    if len(idx) < 2 or idx[-1] - idx[0] < lo_f:
-        raise ShapeMoveError(f"a {T / fps:.1f} s motion is too short for a loop of at least {lo:.1f} s")
-    P, V = pose[idx], vel[idx]
-    d = np.linalg.norm(P[:, None] - P[None], axis=-1).mean(-1) + \
-        VELOCITY_WEIGHT * np.linalg.norm(V[:, None] - V[None], axis=-1).mean(-1)
-    # the seam's step is the step into frame b: a frame where some joint moves much faster than
-    # its mean (a swinging foot) would make the wrap look like a pop, so such ends cost more
-    speed = np.linalg.norm(vel, axis=-1)                                  # (T,22)
-    fast = np.maximum(speed / np.maximum(speed[1:].mean(0), 1e-4) - SEAM_SPEED, 0.0).max(1)
-    d += FAST_WEIGHT * fast[idx][None, :]
-    gap = idx[None] - idx[:, None]
-    d[(gap < lo_f) | (gap > hi_f)] = np.inf
-    i, j = np.unravel_index(np.argmin(d), d.shape)
-    if not np.isfinite(d[i, j]):
-        raise ShapeMoveError(f"no loop of {lo:.1f}..{hi:.1f} s fits in this {T / fps:.1f} s motion")
-    return Cut(int(idx[i]), int(idx[j]), float(d[i, j]))
 
 
 def _smoothstep(x):

@@ -1,7 +1,7 @@
 """A captured take shorter than asked, played on as a loop where the take itself repeats.
 
 A take of jumping jacks, arm circles or a dribble that lasts 3 s, asked for 10 s, is not held on
-its last pose for 7 s: its own cycle plays again. The cycle is ``loop.best_cut``'s (the two frames
+its last pose for 7 s: its own cycle plays again. The cycle is ``loop_cut.best_cut``'s (the two frames
 a < b whose pose relative to the root and whose velocities are most alike), with two conditions
 that say the take repeats rather than merely starts and ends alike:
 
@@ -39,7 +39,7 @@ def looped_take(rotations, root, contacts, joints, frames: int):
     """(rotations, root, contacts, first) of a take (T,24,3,3), (T,3), (T,4) whose posed ``joints``
     (T,J,3) repeat, played on to ``frames`` (> T) frames: ``first`` frames of the take as performed,
     then its cycle repeated; None when the take does not repeat (module doc) or is long enough."""
-    from .loop import best_cut
+    from .loop_cut import best_cut
     from .track import headings
 
     n = len(rotations)

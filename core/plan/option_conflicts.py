@@ -10,7 +10,7 @@ said as notes (``Motion.notes``, printed by the command line as ``note:`` lines)
 """
 from __future__ import annotations
 
-from .segments import plan_segments
+from .plan import read_plan
 from .vocabulary import COURSE_NAMES
 
 
@@ -22,7 +22,7 @@ def option_notes(prompt: str, loop: bool = False, in_place: bool = False, path: 
     """One note per request of ``prompt`` that an option overrides (module doc); [] when none does."""
     if not (loop or in_place or path):
         return []
-    plan = plan_segments(prompt)
+    plan = read_plan(prompt)
     notes = []
     if loop and plan.is_sequence:
         notes.append(f"--loop won over the order of {len(plan.segments)} motions: the prompt is looped as one motion "

@@ -1,6 +1,6 @@
 """A prompt's ordered segments: "a person walks forward, then sits down" is two.
 
-    plan = plan_segments("after waving, she jogs")
+    plan = read_plan("after waving, she jogs")       # plan.py, from split_segments here
     [s.text for s in plan.segments]  -> ["she is waving", "she jogs"]
     plan.lengths(6.0)                -> [3.0, 3.0]
 
@@ -103,11 +103,3 @@ def split_segments(prompt: str) -> list[str]:
         return [str(prompt).strip()]
     subject = next((_subject(q) for q in ordered if SUBJECT.match(q)), DEFAULT_SUBJECT)
     return [_as_prompt(q, _subject(q) if SUBJECT.match(q) else subject) for q in ordered]
-
-
-def plan_segments(prompt: str):
-    """The typed plan of ``prompt`` (``plan.read_plan``): its ordered segments, each with an equal
-    share of the length and the reading of its words."""
-    from .plan import read_plan
-
-    return read_plan(prompt)
