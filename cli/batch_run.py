@@ -49,7 +49,8 @@ def sampling_settings(args) -> dict:
             "retrieval_prefix": check_retrieval_prefix(given("retrieval_prefix", DEFAULT_RETRIEVAL_PREFIX)),
             "retrieved": check_retrieved(given("retrieved", DEFAULT_RETRIEVED)),
             "retrieval_first": check_retrieval_first(given("retrieval_first", DEFAULT_RETRIEVAL_FIRST)),
-            "retrieval": not getattr(args, "no_retrieval", False), "parts": not getattr(args, "no_parts", False)}
+            "retrieval": not getattr(args, "no_retrieval", False), "parts": not getattr(args, "no_parts", False),
+            "captured": not getattr(args, "no_library", False)}
 
 
 def where_of(args) -> tuple[dict, dict, dict]:

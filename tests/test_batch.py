@@ -315,9 +315,23 @@ def test_a_batch_worker_and_the_extension_worker_share_one_loaded_model(tmp_path
     model = tmp_path / "model"
     shutil.copytree(ROOT / "weights" / "default", model)
     gen = loaded_generator(model)
-    batch = generator_for({"model": str(model), "body_model": None, "library": None}, retrieval=False)
-    assert batch is gen and gen.t5.memory_enabled is False
+    batch = generator_for({"model": str(model), "body_model": None, "library": None}, retrieval=False,
+                          captured=False)
+    assert batch is gen and gen.t5.memory_enabled is False and gen.captured_on is False   # --no-library
     assert loaded_generator(model) is gen and gen.t5.memory_enabled is True   # a hand-out turns retrieval on again
+    assert gen.captured_on is True
+    from shapemove.core.batch.generate_item import motion_facts
+    from shapemove.core.scene.motion_file import Motion
+
+    import numpy as np
+
+    m = Motion(joints=np.zeros((2, 22, 3), np.float32), betas=np.zeros(10, np.float32),
+               poses=np.zeros((2, 24, 3), np.float32), transl=np.zeros((2, 3), np.float32), fps=20.0,
+               body_model="openbody")
+    m.provenance = "captured: HDM05 bd kickLFront 003 (CC BY-SA 3.0)"
+    assert motion_facts(m)["source"]["kind"] == "captured"   # a built-in library take, no notes
+    m.provenance = "generated"
+    assert motion_facts(m)["source"]["kind"] == "generated"
     st = (model / "manifest.json").stat()
     os.utime(model / "manifest.json", ns=(st.st_atime_ns, st.st_mtime_ns + 10**9))
     assert loaded_generator(model) is not gen                           # the folder changed: loaded again

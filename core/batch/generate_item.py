@@ -12,9 +12,10 @@ from ..scene.motion_file import save_motion
 LOCK = threading.Lock()   # held around an item's generation (a Dask worker may run items on threads)
 
 
-def generator_for(where: dict, retrieval: bool = True):
+def generator_for(where: dict, retrieval: bool = True, captured: bool = True):
     """The process's generator for ``where`` ({"model", "body_model", "library"} paths or None):
-    the one ``loaded_generator`` keeps, with retrieval as the batch's settings say."""
+    the one ``loaded_generator`` keeps, with retrieval and captured takes as the batch's settings
+    say (``--no-retrieval``, ``--no-library``)."""
     from ..generation.loaded_generator import loaded_generator
 
     def said(gen, clips):
@@ -23,6 +24,7 @@ def generator_for(where: dict, retrieval: bool = True):
 
     gen = loaded_generator(where.get("model"), where.get("body_model"), where.get("library"), on_load=said)
     gen.set_retrieval(retrieval)
+    gen.set_captured(captured)
     return gen
 
 
@@ -36,7 +38,7 @@ def item_motion(spec: dict):
     from ..generation.sequence import generate_sequence
 
     o, s = spec["options"], spec["settings"]
-    gen = generator_for(spec["where"], s["retrieval"])
+    gen = generator_for(spec["where"], s["retrieval"], s.get("captured", True))
     betas = np.asarray(o["betas"], np.float32) if o.get("betas") is not None else None
     if o.get("sequence"):
         motion = generate_sequence(gen, [(x["prompt"], x["seconds"]) for x in o["sequence"]], o.get("shape_text"),
@@ -54,7 +56,8 @@ def item_motion(spec: dict):
 
 def motion_facts(motion) -> dict:
     """{"source", "result"} of a motion for its manifest line."""
-    kind = "captured" if motion.notes else "retrieved" if motion.retrieved_clips else "generated"
+    provenance = getattr(motion, "provenance", None) or ""
+    kind = "captured" if provenance.startswith("captured") else "retrieved" if motion.retrieved_clips else "generated"
     source = {"kind": kind, "provenance": getattr(motion, "provenance", None), "retrieved_clips": list(motion.retrieved_clips), "notes": list(motion.notes),
               "warnings": list(motion.warnings), "part_prompts": list(motion.part_prompts or []) or None,
               "mirrored": bool(motion.mirrored)}

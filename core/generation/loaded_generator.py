@@ -6,8 +6,8 @@ once per request.
 A changed model or library loads it again: the model folder is stamped by its ``manifest.json``
 (which lists every weight file's SHA-256, and loading checks the files against it; a folder
 without one by all its files), so a hand-out stats one file, not the whole folder. One model set
-is kept at a time. Each hand-out turns retrieval on (``Generator.set_retrieval``): a request that
-turns it off does so for itself.
+is kept at a time. Each hand-out turns retrieval and captured takes on (``Generator.set_retrieval``,
+``set_captured``): a request that turns one off does so for itself.
 """
 from __future__ import annotations
 
@@ -55,4 +55,5 @@ def loaded_generator(model=None, body=None, library=None, on_load=None):
             on_load(gen, clips)
     gen = _LOADED[key]
     gen.set_retrieval(True)
+    gen.set_captured(True)
     return gen
