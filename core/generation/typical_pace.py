@@ -4,17 +4,14 @@ that gait go at, on the body asked for.
 
 The T5's samples and the captured takes of a plain gait spread widely in speed (walks from 0.8 to
 1.2 m/s, jogs at 2.1-2.4 m/s against 1.56 captured), and the TMA that chooses among them hardly
-tells a brisk one from a slow one. So after the choice, a motion whose root speed
-(``eval.gait.mean_speed``) is more than ``TOLERANCE`` off its gait's typical speed is brought to
-it (by at most ``MAX_CHANGE``):
-
-- faster: played faster, the gait walking on in its own stride where its frames run out
-  (``continued``: the stride ``loop.best_cut`` finds most alike at its ends, repeated);
-- slower, a walk (no flight phase): played slower, the way the words' "slowly" is done
-  (``slow_steps.py``: the first share of its joint track resampled to the whole length);
-- slower, a jog or a run: its cadence and flights kept, shorter strides
-  (``stride_scale.scaled_strides``).
-
+tells a brisk one from a slow one. So after the choice, a motion whose root speed (``eval.gait.mean_speed``) is more than ``TOLERANCE``
+above its gait's typical speed is brought down to it (by at most ``MAX_CHANGE``): a walk (no
+flight phase) is played slower, the way the words' "slowly" is done (``slow_steps.py``: the first
+share of its joint track resampled to the whole length); a jog or a run keeps its cadence and its
+flights and takes shorter strides (``stride_scale.scaled_strides``). A motion slower than typical
+is kept as it is: playing a walk faster, walking on in its own stride where its frames ran out,
+changed the walks that path following and speed edits are made from past their bars (an s-curve
+followed 0.75 m off, a walk at 2x sliding 0.77 mm a frame), so a slow chosen walk stays slow.
 The feet are planted again (``track.replanted``). Nothing is retimed when the words ask a pace ("quickly"),
 a distance, a number of steps, a stop, a course, a turn, a direction other than forward, a count,
 two things at once or a side (``plan.words.Words``); the user's ``--speed`` applies after.
@@ -44,7 +41,6 @@ FLIGHT = ("jog", "run")     # keep their cadence; shorter strides instead
 TOLERANCE = 0.03            # a motion within this share of its typical speed is left as it is
 MAX_CHANGE = 1.5            # the most a motion's speed is changed by (either way)
 MOVING = 0.2                # m/s: a motion slower than this is not a gait going anywhere: left as it is
-STRIDE = (0.7, 2.0)         # s: the length of the stride a faster gait walks on in (``continued``)
 
 
 def load_typical_speeds(model_dir) -> dict[str, float]:
@@ -95,9 +91,9 @@ def body_speed(typical: float, body, betas) -> float:
 
 
 def typical_paced(motion, body, words, speeds: dict, ik_refine_iters: int = 10):
-    """``motion`` brought to its plain gait's typical speed on its body (module doc); the motion
-    itself when the words ask more than a plain gait, the table lacks the gait, or it is within
-    ``TOLERANCE`` of typical."""
+    """``motion`` brought down to its plain gait's typical speed on its body (module doc); the
+    motion itself when the words ask more than a plain gait, the table lacks the gait, or it is no
+    more than ``TOLERANCE`` above typical."""
     from ..eval.gait import mean_speed
     from .stride_scale import scaled_strides
     from .track import Track, replanted, resample, track_of
@@ -107,48 +103,20 @@ def typical_paced(motion, body, words, speeds: dict, ik_refine_iters: int = 10):
         return motion
     want = body_speed(speeds[gait], body, motion.betas)
     speed = mean_speed(motion.joints, motion.fps)
-    if speed < MOVING or abs(want / speed - 1.0) <= TOLERANCE:
+    if speed < MOVING or speed <= want * (1 + TOLERANCE):
         return motion
-    share = float(np.clip(want / speed, 1.0 / MAX_CHANGE, MAX_CHANGE))
+    share = max(want / speed, 1.0 / MAX_CHANGE)
     track = track_of(motion)
-    n = len(track.joints)
-    if share < 1.0 and gait in FLIGHT:
+    if gait in FLIGHT:
         return replanted(motion, body, Track(scaled_strides(track.joints, share), track.contacts), ik_refine_iters)
-    source = track if share < 1.0 else continued(track, int(np.ceil(n * MAX_CHANGE)) + 1, motion.fps)
-    if source is None:
-        return motion
-    # the frames played: as many as bring the track's own speed to the share of it asked (a gait
-    # walking on in its steady stride goes faster than one that starts from standing)
+    # a walk played slower: as many of its frames as bring the track's own speed to the share asked
+    n = len(track.joints)
     goal = share * mean_speed(track.joints, motion.fps)
-    lo, hi = 2, len(source.joints)
+    lo, hi = 2, n
     while hi - lo > 1:
         mid = (lo + hi) // 2
-        if mean_speed(resample(Track(source.joints[:mid], source.contacts[:mid]), n).joints, motion.fps) < goal:
+        if mean_speed(resample(Track(track.joints[:mid], track.contacts[:mid]), n).joints, motion.fps) < goal:
             lo = mid
         else:
             hi = mid
-    return replanted(motion, body, resample(Track(source.joints[:hi], source.contacts[:hi]), n), ik_refine_iters)
-
-
-def continued(track, frames: int, fps: float):
-    """``track`` (a gait) made ``frames`` long by walking on in its own cycle: its frames up to the
-    start of its most self-alike stride (``loop.best_cut``, ``STRIDE`` s), then that stride
-    (``loop.make_cycle``: its heading's drift removed, its end blended into its start) repeated,
-    each copy moved on by the stride's advance; None when the track holds no such stride."""
-    from ..errors import ShapeMoveError as _Error
-    from .loop import best_cut, make_cycle
-    from .track import Track
-
-    T = len(track.joints)
-    try:
-        cut = best_cut(track.joints, fps, period=(STRIDE[0], min(STRIDE[1], 0.6 * T / fps)))
-    except _Error:
-        return None
-    cycle, advance = make_cycle(track, cut)
-    joints, contacts = [track.joints[:cut.start]], [track.contacts[:cut.start]]
-    have, k = cut.start, 0
-    while have < frames:
-        joints.append(cycle.joints + k * advance)
-        contacts.append(cycle.contacts)
-        have, k = have + len(cycle.joints), k + 1
-    return Track(np.concatenate(joints)[:frames], np.concatenate(contacts)[:frames])
+    return replanted(motion, body, resample(Track(track.joints[:hi], track.contacts[:hi]), n), ik_refine_iters)
