@@ -2,8 +2,9 @@
 
 KIND is vae (SA-VAE), t5, tma or head (a new [BETA] head for ``--model DIR``, the T5 frozen). Each kind
 lives in ``core/train/train_KIND.py`` and defines
-``from_cli(args) -> dict`` (the final metrics) reading the common arguments below (add a kind to
-``KINDS``). Several processes: ``torchrun --nproc_per_node N -m
+``from_cli(args, cancel) -> dict`` (the final metrics) reading the common arguments below (add a
+kind to ``KINDS``); ``cancel()`` turns True on Ctrl-C or ``kill`` (``core/train/stop_signal.py``):
+the run stops at the end of its step with ``last.pt`` written. Several processes: ``torchrun --nproc_per_node N -m
 shapemove train vae ...`` (DistributedDataParallel; gloo on CPU, nccl on GPU).
 """
 from __future__ import annotations
@@ -61,8 +62,15 @@ def add_arguments(p):
 
 
 def run(args) -> int:
+    from ..core.train.stop_signal import stop_requested
+
     check_run_folder(args.out, args.kind, resume=args.resume, force=args.force)
-    metrics = _module(args.kind).from_cli(args)
+    with stop_requested() as stop:   # Ctrl-C / kill: last.pt written at the end of the step
+        metrics = _module(args.kind).from_cli(args, cancel=stop)
+        stopped = stop()
+    if stopped:
+        print(f"stopped at step {(metrics or {}).get('step', '?')}: {args.out}/last.pt holds the run; "
+              f"the same command with --resume continues it")
     if int(os.environ.get("RANK", 0)) == 0 and metrics:
         print(json.dumps(metrics, indent=1))
     return 0

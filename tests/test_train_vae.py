@@ -352,3 +352,34 @@ def test_a_run_fitted_to_minutes_resumes_to_the_same_count(data_dir, body, tmp_p
     assert done["step"] == 30 and load_checkpoint(run / "last.pt")["step"] == 30
     # an explicit --steps still extends it
     assert train_vae(data_dir, run, cfg, body=body, device="cpu", verbose=False, resume=True, steps=32)["step"] == 32
+
+
+@pytest.mark.slow  # ~15 s: a fresh Python process importing torch
+def test_kill_stops_training_at_the_end_of_a_step_with_last_pt(data_dir, tmp_path):
+    """SIGTERM (and Ctrl-C) stop `train vae` after the step in hand with last.pt written, long
+    before its next checkpoint; --resume continues from there."""
+    import signal
+    import subprocess
+    import time
+
+    cfg_path = tmp_path / "cfg.json"
+    cfg_path.write_text(json.dumps({"base": "small", "width": 16, "depth": 1, "shape_hidden": 16,
+                                    "train": {"steps": 100000, "batch_size": 2, "warmup_steps": 1, "log_every": 1,
+                                              "ckpt_every": 100000, "val_every": 100000}}))
+    run = tmp_path / "run"
+    cmd = [sys.executable, "-m", "shapemove", "train", "vae", "--data", str(data_dir), "--config", str(cfg_path),
+           "--out", str(run), "--device", "cpu", "--quiet"]
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    log = run / "log.jsonl"
+    deadline = time.time() + 120
+    while time.time() < deadline and not (log.is_file() and len(log.read_text().splitlines()) >= 3):
+        time.sleep(0.2)
+    proc.send_signal(signal.SIGTERM)
+    out, err = proc.communicate(timeout=120)
+    assert proc.returncode == 0, err
+    assert "stopping after this step" in err and "--resume continues it" in out
+    step = load_checkpoint(run / "last.pt")["step"]
+    assert 3 <= step < 100000 and not (run / "savae.pt").exists()
+    again = subprocess.run(cmd + ["--resume", "--steps", str(step + 2)], capture_output=True, text=True, timeout=180)
+    assert again.returncode == 0, again.stderr
+    assert load_checkpoint(run / "last.pt")["step"] == step + 2 and (run / "savae.pt").exists()

@@ -443,10 +443,10 @@ def train_head(model_dir, data, out, config: HeadTrainConfig | None = None, resu
     return finish(save, log.bar, step, c.steps, dist, log.metrics)
 
 
-def from_cli(args) -> dict:
+def from_cli(args, cancel=None) -> dict:
     c = HeadTrainConfig.load(args.config)
     res = train_head(args.model, args.data, args.out, c, resume=args.resume, steps=args.steps,
-                     verbose=not args.quiet)
+                     verbose=not args.quiet, cancel=cancel)
     if (Path(args.out) / "model").is_dir() and res.get("step", 0) >= c.steps:
         res["model"] = str(Path(args.out) / "model")
     return res

@@ -291,7 +291,7 @@ def _train(data, vae_path, out, c, base_model, resume, dist, progress, cancel, v
     return finish(save, log.bar, step, total, dist, log.metrics)
 
 
-def from_cli(args) -> dict:
+def from_cli(args, cancel=None) -> dict:
     c = T5TrainConfig.load(args.config)
     return train_t5(args.data, args.vae, args.out, c, base_model=args.base_model, resume=args.resume,
-                    steps=args.steps, device=args.device, verbose=not args.quiet)
+                    steps=args.steps, device=args.device, verbose=not args.quiet, cancel=cancel)

@@ -285,10 +285,10 @@ def _train(data, out, c, resume, body_name, dist, progress, cancel, verbose) -> 
     return finish(save, log.bar, step, c.steps, dist, log.metrics)
 
 
-def from_cli(args) -> dict:
+def from_cli(args, cancel=None) -> dict:
     """Entry point of `python -m shapemove train tma` (cli/train.py): reads args.data, args.out,
     args.config (small|paper|tiny|JSON), args.steps, args.resume, args.device, args.body, args.quiet
     and, when the parser has them, args.batch_size and args.lr."""
     return train_tma(args.data, args.out, args.config, steps=args.steps, batch_size=getattr(args, "batch_size", None),
                      lr=getattr(args, "lr", None), resume=args.resume, body=getattr(args, "body", None),
-                     device=args.device, verbose=not args.quiet)
+                     device=args.device, verbose=not args.quiet, cancel=cancel)

@@ -263,8 +263,8 @@ def _train(data, out, cfg, t, resume, body, dist, progress, cancel, verbose, min
     return finish(save, log.bar, step, t.steps, dist, log.metrics)
 
 
-def from_cli(args) -> dict:
+def from_cli(args, cancel=None) -> dict:
     """Entry point of `python -m shapemove train vae` (see cli/train.py)."""
     return train_vae(args.data, args.out, SAVAEConfig.load(args.config), steps=args.steps, resume=args.resume,
                      body=args.body, device=args.device, verbose=not args.quiet, init_from=args.init_from,
-                     minutes=getattr(args, "minutes", None))
+                     minutes=getattr(args, "minutes", None), cancel=cancel)
