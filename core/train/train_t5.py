@@ -75,7 +75,7 @@ class T5TrainConfig(OptimizerSettings):
     @classmethod
     def tiny(cls) -> "T5TrainConfig":
         return cls(size=asdict(T5Size.tiny()), steps=20, batch_size=4, warmup_steps=2, log_every=5, ckpt_every=10,
-                   vocab_size=300, max_codes=16)
+                   vocab_size=300, max_codes=16, head_synthetic_bodies=48)
 
     def validate(self, base_model=None) -> None:
         if self.encoder not in ("minilm", "t5"):
