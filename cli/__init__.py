@@ -15,7 +15,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "body": ("body", "body model facts and the bodies shape texts describe: `body info|shape|render`"),
     "data": ("data", "build a training dataset from motion capture: `data build`"),
     "train": ("train", "train a model: `train vae|t5|tma`"),
-    "eval": ("eval", "evaluate: `eval recon|generate`"),
+    "eval": ("eval", "evaluate: `eval KIND` (recon, generate, retarget, paraphrase, parts, sequences, shape, ...)"),
     "retarget": ("retarget", "move a motion onto another body through the SA-VAE"),
     "retarget-rig": ("retarget_rig", "bake a motion onto your own armature in a .blend (Rigify, Mixamo, CC, ...)"),
     "generate": ("generate", "text prompt -> body shape and motion (.npz)"),

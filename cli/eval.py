@@ -94,53 +94,6 @@ def _exit_code(result) -> int:
     return result if isinstance(result, int) and not isinstance(result, bool) else 0
 
 
-def add_shape(sub):
-    from ..core.eval import shape_eval
-
-    p = sub.add_parser("shape", help="the [BETA] head on numeric shape texts and size words of new bodies",
-                       description=shape_eval.__doc__.splitlines()[0])
-    shape_eval.add_arguments(p)
-    p.set_defaults(_run=shape_eval.from_cli)
-
-
-def add_shape_words(sub):
-    from ..core.eval import shape_words_eval
-
-    p = sub.add_parser("shape-words", help="bodies the text describes: gender, age, muscle, height and weight "
-                       "(issue #25), on the parser + fit path or the [BETA] head",
-                       description=shape_words_eval.__doc__.splitlines()[0])
-    shape_words_eval.add_arguments(p)
-    p.set_defaults(_run=shape_words_eval.from_cli)
-
-
-def add_paraphrase(sub):
-    from ..core.eval import paraphrase_eval
-
-    p = sub.add_parser("paraphrase", help="held-out paraphrases: generated motion's action (5 nearest training clips in TMA motion space), per action",
-                       description=paraphrase_eval.__doc__.splitlines()[0])
-    paraphrase_eval.add_arguments(p)
-    p.set_defaults(_run=paraphrase_eval.from_cli)
-
-
-def add_parts(sub):
-    from ..core.eval import parts_eval
-
-    p = sub.add_parser("parts", help="held-out left/right and two-things prompts, judged by body part (legs, arms, side)",
-                       description=parts_eval.__doc__.splitlines()[0])
-    parts_eval.add_arguments(p)
-    p.set_defaults(_run=parts_eval.from_cli)
-
-
-def add_sequences(sub):
-    from ..core.eval import sequence_eval
-
-    p = sub.add_parser("sequences", help="held-out one-prompt sequences ('X, then Y'): each segment judged by "
-                       "body part or raw features, their order, the plan's split",
-                       description=sequence_eval.__doc__.splitlines()[0])
-    sequence_eval.add_arguments(p)
-    p.set_defaults(_run=sequence_eval.from_cli)
-
-
 # -- eval retarget (HUMOS's application: SA-VAE retargeting against naive) ----------------------------
 RETARGET_BODIES = {"a very tall, heavy-set man": "height 195 cm, waist 110 cm", "a short, slim woman": "height 152 cm, waist 64 cm"}
 
@@ -194,28 +147,35 @@ def run_retarget(args) -> int:
     return 0
 
 
-# -- eval speed (issue #24: does the codec keep locomotion's root speed? core/eval/speed.py) ----------
-def add_speed(sub):
-    from ..core.eval import speed_report
+# the evaluations whose module defines add_arguments(p) and from_cli(args): (command, module, help)
+MODULE_KINDS = [
+    ('shape', 'shape_eval',
+     "the [BETA] head on numeric shape texts and size words of new bodies"),
+    ('shape-words', 'shape_words_eval',
+     "bodies the text describes: gender, age, muscle, height and weight (issue #25), on the parser + fit path or the [BETA] head"),
+    ('paraphrase', 'paraphrase_eval',
+     "held-out paraphrases: generated motion's action (5 nearest training clips in TMA motion space), per action"),
+    ('parts', 'parts_eval',
+     "held-out left/right and two-things prompts, judged by body part (legs, arms, side)"),
+    ('sequences', 'sequence_eval',
+     "held-out one-prompt sequences ('X, then Y'): each segment judged by body part or raw features, their order, the plan's split"),
+    ('speed', 'speed_report',
+     "root speed of decoded and generated walks/jogs/runs against the real clips"),
+    ('codec-actions', 'codec_actions',
+     "captured clips of each action judged as captured and as decoded by an SA-VAE"),
+]
 
-    p = sub.add_parser("speed", help="root speed of decoded and generated walks/jogs/runs against the real clips",
-                       description=speed_report.__doc__.splitlines()[0])
-    speed_report.add_arguments(p)
-    p.set_defaults(_run=speed_report.from_cli)
+
+def _module_kind(command: str, module: str, help_text: str):
+    def add(sub):
+        mod = importlib.import_module(f"...core.eval.{module}", __name__)
+        p = sub.add_parser(command, help=help_text, description=mod.__doc__.splitlines()[0])
+        mod.add_arguments(p)
+        p.set_defaults(_run=mod.from_cli)
+    return add
 
 
-# -- eval codec-actions (does the codec keep each action? core/eval/codec_actions.py) ---------------
-def add_codec_actions(sub):
-    from ..core.eval import codec_actions
-
-    p = sub.add_parser("codec-actions", help="captured clips of each action judged as captured and as decoded by an SA-VAE",
-                       description=codec_actions.__doc__.splitlines()[0])
-    codec_actions.add_arguments(p)
-    p.set_defaults(_run=codec_actions.from_cli)
-
-
-KINDS = [add_recon, add_generate, add_paraphrase, add_parts, add_sequences, add_shape, add_shape_words, add_retarget,
-         add_speed, add_codec_actions]
+KINDS = [add_recon, add_generate, add_retarget, *(_module_kind(*k) for k in MODULE_KINDS)]
 
 
 def add_arguments(p):

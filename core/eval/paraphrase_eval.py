@@ -50,13 +50,11 @@ MAX_PROMPTS_BYTES = 4 << 20
 
 def load_prompts(path=None) -> list[dict]:
     """The held-out prompts [{text, action, also: [..]}] of a JSON file ({"prompts": [...]} or a list)."""
-    from ..io.limits import read_json
+    from .report import prompt_items
 
-    path = Path(path) if path else DEFAULT_PROMPTS
-    doc = read_json(path, "paraphrase prompt list", MAX_PROMPTS_BYTES)
-    items = doc.get("prompts") if isinstance(doc, dict) else doc
+    path, items = prompt_items(path, DEFAULT_PROMPTS, "paraphrase prompt list", MAX_PROMPTS_BYTES)
     out = []
-    for i, it in enumerate(items if isinstance(items, list) else []):
+    for i, it in enumerate(items):
         if not (isinstance(it, dict) and isinstance(it.get("text"), str) and isinstance(it.get("action"), str)):
             raise ShapeMoveError(f"{path}: prompt {i} must be {{\"text\": ..., \"action\": ...}}")
         also = it.get("also") or []
@@ -323,6 +321,8 @@ def format_results(res: dict) -> str:
 
 def add_arguments(p) -> None:
     """Options of `python -m shapemove eval paraphrase`."""
+    from .report import add_output_arguments
+
     p.add_argument("--model", type=Path, default=None, help="model folder (default: the embedded default model)")
     p.add_argument("--prompts", type=Path, default=None, help="held-out prompts (default configs/heldout_paraphrases.json)")
     p.add_argument("--data", type=Path, default=None,
@@ -338,8 +338,7 @@ def add_arguments(p) -> None:
                         "(one seed moves a 150-prompt set by about 5 prompts: compare models on two or more)")
     p.add_argument("--candidates", type=int, default=None,
                    help="token samples per prompt, the TMA keeps the closest (default: the product's, 8; 1 = none)")
-    p.add_argument("--json", type=Path, default=None, help="write the results here")
-    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    add_output_arguments(p)
     p.add_argument("--no-retrieval", action="store_true", help="the decoder reads no retrieved clips (to compare)")
     p.add_argument("--retrieval-prefix", type=int, default=None, metavar="CODES",
                    help="codes of a retrieved clip half the candidates start from (default: the product's; 0: none)")
@@ -357,16 +356,12 @@ def add_arguments(p) -> None:
 
 
 def from_cli(args) -> int:
-    from .report import PercentBar, show_result
+    from .report import run_and_show
 
-    progress = PercentBar("eval paraphrase", args.quiet)  # opened at the first prompt, after the classifier's bars
-    try:
-        seconds = None if args.model_length else args.seconds
-        res = eval_paraphrase(args.model, args.prompts, args.tma, args.seed, seconds, progress, data=args.data,
-                              show_progress=not args.quiet, candidates=args.candidates,
-                              retrieval=not args.no_retrieval, retrieval_prefix=args.retrieval_prefix,
-                              retrieved=args.retrieved, retrieval_first=args.retrieval_first,
-                              by_parts=not args.no_parts, library=args.library, captured=not args.no_library)
-    finally:
-        progress.close()
-    return show_result(format_results(res), res, args.json)
+    seconds = None if args.model_length else args.seconds
+    # the bar opens at the first prompt, after the classifier's bars
+    return run_and_show("eval paraphrase", args.quiet, lambda progress: eval_paraphrase(
+        args.model, args.prompts, args.tma, args.seed, seconds, progress, data=args.data,
+        show_progress=not args.quiet, candidates=args.candidates, retrieval=not args.no_retrieval,
+        retrieval_prefix=args.retrieval_prefix, retrieved=args.retrieved, retrieval_first=args.retrieval_first,
+        by_parts=not args.no_parts, library=args.library, captured=not args.no_library), format_results, args.json)

@@ -224,6 +224,8 @@ def format_results(res: dict) -> str:
 
 def add_arguments(p) -> None:
     """Options of `python -m shapemove eval parts`."""
+    from .report import add_output_arguments
+
     p.add_argument("--model", type=Path, default=None, help="model folder (default: the embedded default model)")
     p.add_argument("--data", type=Path, default=None,
                    help="built dataset: its real training clips are the judge's references, its test clips check the "
@@ -244,21 +246,15 @@ def add_arguments(p) -> None:
     p.add_argument("--retrieval-first", type=float, default=None, metavar="SIM",
                    help="caption similarity from which only retrieved clips compete (default: the product's)")
     p.add_argument("--no-judge-check", action="store_true", help="skip the judge's accuracy on the real test clips")
-    p.add_argument("--json", type=Path, default=None, help="write the results here")
-    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    add_output_arguments(p)
 
 
 def from_cli(args) -> int:
-    from .report import PercentBar, show_result
+    from .report import checked_seconds, run_and_show
 
-    if args.seconds is not None and not 0.5 <= args.seconds <= 60:
-        raise ShapeMoveError(f"--seconds must be between 0.5 and 60, got {args.seconds}")
-    progress = PercentBar("eval parts", args.quiet)
-    try:
-        res = eval_parts(args.model, args.data, args.sides, args.two_things, args.seed, args.seconds, args.candidates,
-                         retrieval=not args.no_retrieval, judge_check=not args.no_judge_check, progress=progress,
-                         show_progress=not args.quiet, by_parts=not args.no_parts, retrieved=args.retrieved,
-                         retrieval_first=args.retrieval_first)
-    finally:
-        progress.close()
-    return show_result(format_results(res), res, args.json)
+    checked_seconds(args.seconds, 0.5)
+    return run_and_show("eval parts", args.quiet, lambda progress: eval_parts(
+        args.model, args.data, args.sides, args.two_things, args.seed, args.seconds, args.candidates,
+        retrieval=not args.no_retrieval, judge_check=not args.no_judge_check, progress=progress,
+        show_progress=not args.quiet, by_parts=not args.no_parts, retrieved=args.retrieved,
+        retrieval_first=args.retrieval_first), format_results, args.json)

@@ -110,3 +110,44 @@ def show_result(table: str, result: dict, json_path=None) -> int:
 
         print(f"wrote {atomic_write_json(Path(json_path), result, nan_to_null=True)}")
     return 0
+
+
+def run_and_show(desc: str, quiet: bool, run, format_results, json_path=None) -> int:
+    """An evaluation command's run: ``run(progress)`` under a ``PercentBar`` named ``desc``, then
+    ``show_result`` of ``format_results(result)``."""
+    progress = PercentBar(desc, quiet)
+    try:
+        res = run(progress)
+    finally:
+        progress.close()
+    return show_result(format_results(res), res, json_path)
+
+
+def prompt_items(path, default, what: str, max_bytes: int) -> tuple:
+    """(path, items) of a held-out prompt file ({"prompts": [...]} or a bare list), read with a size
+    bound (``io.limits.read_json``); ``default`` when ``path`` is None; items [] when not a list."""
+    from pathlib import Path
+
+    from ..io.limits import read_json
+
+    path = Path(path) if path else Path(default)
+    doc = read_json(path, what, max_bytes)
+    items = doc.get("prompts") if isinstance(doc, dict) else doc
+    return path, items if isinstance(items, list) else []
+
+
+def add_output_arguments(p) -> None:
+    """An evaluation command's ``--json`` (write the results there) and ``--quiet`` (no progress bar)."""
+    from pathlib import Path
+
+    p.add_argument("--json", type=Path, default=None, help="write the results here")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+
+
+def checked_seconds(seconds, lo: float, hi: float = 60.0):
+    """``seconds`` (None: the product's length) when within lo..hi, else a ShapeMoveError naming it."""
+    from ..errors import ShapeMoveError
+
+    if seconds is not None and not lo <= seconds <= hi:
+        raise ShapeMoveError(f"--seconds must be between {lo:g} and {hi:g}, got {seconds}")
+    return seconds

@@ -52,13 +52,11 @@ LEGS, ARMS, ACTION = "legs", "arms", "action"   # which judge reads an action
 
 def load_sequences(path=None) -> list[dict]:
     """The held-out sequences [{text, words}] of a JSON file ({"prompts": [[text, [word, ...]], ...]})."""
-    from ..io.limits import read_json
+    from .report import prompt_items
 
-    path = Path(path) if path else DEFAULT_PROMPTS
-    doc = read_json(path, "sequence prompt list", MAX_PROMPTS_BYTES)
-    items = doc.get("prompts") if isinstance(doc, dict) else doc
+    path, items = prompt_items(path, DEFAULT_PROMPTS, "sequence prompt list", MAX_PROMPTS_BYTES)
     out = []
-    for i, it in enumerate(items if isinstance(items, list) else []):
+    for i, it in enumerate(items):
         if not (isinstance(it, list) and len(it) == 2 and isinstance(it[0], str) and it[0].strip()
                 and isinstance(it[1], list) and it[1] and all(isinstance(w, str) and w.strip() for w in it[1])):
             raise ShapeMoveError(f"{path}: prompt {i} must be [\"text\", [\"a word of each segment\", ...]]")
@@ -346,6 +344,8 @@ def format_results(res: dict) -> str:
 
 def add_arguments(p) -> None:
     """Options of `python -m shapemove eval sequences`."""
+    from .report import add_output_arguments
+
     p.add_argument("--model", type=Path, default=None, help="model folder (default: the embedded default model)")
     p.add_argument("--data", type=Path, default=None,
                    help="built dataset: its real training clips are the judges' references "
@@ -358,19 +358,13 @@ def add_arguments(p) -> None:
     p.add_argument("--candidates", type=int, default=None,
                    help="token samples per segment, the TMA keeps the closest (default: the product's; 1 = none)")
     p.add_argument("--max-prompts", type=int, default=None, metavar="N", help="only the first N prompts (a quick run)")
-    p.add_argument("--json", type=Path, default=None, help="write the results here")
-    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    add_output_arguments(p)
 
 
 def from_cli(args) -> int:
-    from .report import PercentBar, show_result
+    from .report import checked_seconds, run_and_show
 
-    if args.seconds is not None and not 0.8 <= args.seconds <= 60:
-        raise ShapeMoveError(f"--seconds must be between 0.8 and 60, got {args.seconds}")
-    progress = PercentBar("eval sequences", args.quiet)
-    try:
-        res = eval_sequences(args.model, args.data, args.prompts, args.seed, args.seconds, args.candidates,
-                             args.max_prompts, progress=progress, show_progress=not args.quiet)
-    finally:
-        progress.close()
-    return show_result(format_results(res), res, args.json)
+    checked_seconds(args.seconds, 0.8)
+    return run_and_show("eval sequences", args.quiet, lambda progress: eval_sequences(
+        args.model, args.data, args.prompts, args.seed, args.seconds, args.candidates, args.max_prompts,
+        progress=progress, show_progress=not args.quiet), format_results, args.json)

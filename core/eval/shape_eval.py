@@ -148,11 +148,12 @@ def format_results(res: dict) -> str:
 
 
 def add_arguments(p) -> None:
+    from .report import add_output_arguments
+
     p.add_argument("--model", type=Path, default=None, help="model folder (default: the embedded default model)")
     p.add_argument("--bodies", type=int, default=200, help="number of new random bodies (default 200)")
     p.add_argument("--seed", type=int, default=0)
-    p.add_argument("--json", type=Path, default=None, help="write the results here")
-    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    add_output_arguments(p)
 
 
 def from_cli(args) -> int:
