@@ -22,27 +22,11 @@ import numpy as np
 
 from ..constants import FPS
 from ..errors import ShapeMoveError
+from ..motion.root_speed import _joints, mean_speed, root_velocity  # noqa: F401  (the root's speed, one definition)
 from ..motion.skeleton_ops import facing_directions
 
 MIN_HZ, MAX_HZ = 0.3, 4.0   # gait cycles per second searched (a slow walk ~0.5, a sprint ~2)
 PAD = 8192                   # FFT length (zero-padded): 0.0024 Hz resolution at 20 fps
-
-
-def _joints(joints) -> np.ndarray:
-    j = np.asarray(joints, dtype=np.float64)
-    if j.ndim != 3 or j.shape[1] < 22 or j.shape[2] != 3 or len(j) < 2 or not np.isfinite(j).all():
-        raise ShapeMoveError(f"gait measures need finite (frames >= 2, 22, 3) joints, got shape {j.shape}")
-    return j
-
-
-def root_velocity(joints, fps: float = FPS) -> np.ndarray:
-    """(T-1,2) horizontal (x, z) root velocity, m/s."""
-    return np.diff(_joints(joints)[:, 0, [0, 2]], axis=0) * fps
-
-
-def mean_speed(joints, fps: float = FPS) -> float:
-    """Mean horizontal root speed (m/s): path length / duration."""
-    return float(np.linalg.norm(root_velocity(joints, fps), axis=-1).mean())
 
 
 def velocity_correlation(a, b, fps: float = FPS) -> float:

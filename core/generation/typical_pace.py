@@ -4,7 +4,7 @@ that gait go at, on the body asked for.
 
 The T5's samples and the captured takes of a plain gait spread widely in speed (walks from 0.8 to
 1.2 m/s, jogs at 2.1-2.4 m/s against 1.56 captured), and the TMA that chooses among them hardly
-tells a brisk one from a slow one. So after the choice, a motion whose root speed (``eval.gait.mean_speed``) is more than ``TOLERANCE``
+tells a brisk one from a slow one. So after the choice, a motion whose root speed (``motion.root_speed.mean_speed``) is more than ``TOLERANCE``
 above its gait's typical speed is brought down to it (by at most ``MAX_CHANGE``): a walk (no
 flight phase) is played slower, the way the words' "slowly" is done (``slow_steps.py``: the first
 share of its joint track resampled to the whole length); a jog or a run keeps its cadence and its
@@ -94,7 +94,7 @@ def typical_paced(motion, body, words, speeds: dict, ik_refine_iters: int = 10):
     """``motion`` brought down to its plain gait's typical speed on its body (module doc); the
     motion itself when the words ask more than a plain gait, the table lacks the gait, or it is no
     more than ``TOLERANCE`` above typical."""
-    from ..eval.gait import mean_speed
+    from ..motion.root_speed import mean_speed
     from .stride_scale import scaled_strides
     from .track import Track, replanted, resample, track_of
 
