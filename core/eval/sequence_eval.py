@@ -71,22 +71,30 @@ def expected_actions(text: str, words: list[str]) -> list[str | None]:
     stands in ``text`` (its first place no earlier word took: the words are in the order things
     happen, not always the prompt's, "before kicking the ball, he jogs"; a word may be the start of
     a longer one: 'wav' of 'waving'); None when no action covers it."""
-    import re
-
     from ..data.actions import action_spans, split_words
 
     t = split_words(text)
     spans = action_spans(text)
     out, taken = [], set()
     for w in words:
-        m = next((m for m in re.finditer(r"\b" + re.escape(split_words(w)), t) if m.start() not in taken), None)
-        if m is None:
+        w = split_words(w)
+        start = next((i for i in _word_starts(t, w) if i not in taken), None)
+        if start is None:
             out.append(None)
             continue
-        taken.add(m.start())
-        hit = [name for s, e, name in spans if s < m.end() and e > m.start()]
+        taken.add(start)
+        hit = [name for s, e, name in spans if s < start + len(w) and e > start]
         out.append(hit[0] if hit else None)
     return out
+
+
+def _word_starts(text: str, word: str):
+    """Where ``word`` starts a word of ``text`` (a prefix of it: 'wav' of 'waving'), in order."""
+    i = text.find(word)
+    while word and i >= 0:
+        if i == 0 or not text[i - 1].isalnum():
+            yield i
+        i = text.find(word, i + 1)
 
 
 def split_right(segments: list[str], words: list[str]) -> bool:
