@@ -114,7 +114,7 @@ def test_the_manifest_says_what_made_each_file(one_process):
     assert recs[2]["options"]["betas"][:3] == [1.5, -0.5, 0.0]
     for i in (0, 1, 2, 4):
         r = recs[i]
-        assert r["status"] == "done" and r["error"] is None and r["source"]["kind"] in ("generated", "retrieved")
+        assert r["status"] == "done" and r["error"] is None and r["source"]["kind"] == ("captured" if (r["source"]["provenance"] or "").startswith("captured") else "retrieved" if r["source"]["retrieved_clips"] else "generated")
         (out,) = r["outputs"]
         f = one_process / out["file"]
         assert out["sha256"] == sha(f) and out["bytes"] == f.stat().st_size

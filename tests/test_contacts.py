@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 import torch
 
-from shapemove.core.body.plant import ground_shift, plant_targets, source_floor
+from shapemove.core.body.plant import EASE, MIN_EASE, ground_shift, plant_targets, source_floor
 from shapemove.core.body.soles import GroundProbe, sole_offsets
 from shapemove.core.errors import ShapeMoveError
 from shapemove.core.motion.contacts import detect_contacts, runs, to_feature_order
@@ -55,14 +55,17 @@ def test_plant_targets_fix_contact_joints_on_the_soles(openbody):
     assert floor == pytest.approx(source_floor(j, c, off))
     rest_h = j[0, [7, 8], 1] - 0.3
     assert floor == pytest.approx(0.3 + float(np.median(np.r_[rest_h[0] - 0.07, rest_h[1] - 0.07])), abs=1e-6)
-    planted = tgt[2:12, 7]
+    planted = tgt[3:10, 7]   # the run 2..11 once eased onto the plant (plant.EASE a frame at its edges)
     assert np.ptp(planted[:, 0]) < 1e-12 and np.ptp(planted[:, 2]) < 1e-12
     assert planted[0, 0] == pytest.approx(j[2:12, 7, 0].mean())
+    change = np.linalg.norm(np.diff(tgt[:, 7] - j[:, 7], axis=0), axis=1)   # outside the run the change
+    largest = np.linalg.norm(np.diff(j[:, 7], axis=0), axis=1).max()        # moves at the eased rate
+    assert change[np.r_[0:2, 11:T - 1]].max() <= max(EASE * largest, MIN_EASE) + 1e-9
     np.testing.assert_allclose(planted[:, 1], 0.07)
     np.testing.assert_allclose(tgt[:, 8, 1], 0.07)
-    # outside the run the change fades out within FADE frames, the other joints are untouched
-    assert np.allclose(tgt[17:, 7], j[17:, 7] - [0, floor, 0])
-    assert np.abs(tgt[12, 7] - (j[12, 7] - [0, floor, 0])).max() > 0
+    # after the run the change fades out (at the eased rate), the other joints are untouched
+    after = np.linalg.norm((tgt - (j - [0, floor, 0]))[11:, 7], axis=1)
+    assert np.all(np.diff(after) <= 1e-12) and after[-1] < 0.5 * after[0] and after[1] > 0
     np.testing.assert_allclose(tgt[:, 0], j[:, 0] - [0, floor, 0])
 
 
@@ -178,7 +181,9 @@ def test_known_contacts_planted_without_drift_and_body_smoothed(openbody):
     for k, jid in enumerate((7, 8, 10, 11)):
         for s, e in runs(c[:, k]):
             xz = posed[s:e, jid][:, [0, 2]]
-            assert np.linalg.norm(xz - xz.mean(0), axis=1).max() < 1e-3, (jid, s, e)   # < 1 mm drift
+            inner = xz[1:-1] - xz[1:-1].mean(0)   # a run's first and last frames ease on and off the plant
+            assert np.linalg.norm(inner, axis=1).max() < 1e-3, (jid, s, e)   # < 1 mm drift
+            assert np.linalg.norm(xz[[0, -1]] - xz[1:-1].mean(0), axis=1).max() < 0.006, (jid, s, e)
     src = j[:, 10, [0, 2]]
     assert np.linalg.norm(src[2:14] - src[2:14].mean(0), axis=1).max() > 0.015     # the input did slide
     # grounded on the mesh: the lowest vertex of the planted foot touches y = 0
