@@ -30,7 +30,7 @@ $(GLTF_VALIDATOR): | $(VENV)/.installed
 	npm install --no-audit --no-fund --prefix $(VENV)/node gltf-validator@2.0.0-dev.3.10
 
 test: setup
-	$(PY) -m pytest -q
+	$(PY) -m pytest -q --durations=25
 
 test-fast: setup
 	$(PY) -m pytest -q -m "not slow"
