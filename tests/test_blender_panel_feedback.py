@@ -5,45 +5,15 @@ file and handed to the operator's callback, and the panel's real ``draw`` is run
 records what it draws."""
 from __future__ import annotations
 
-from types import SimpleNamespace
-
 import numpy as np
 import pytest
+
+from panel_layout import drawn
 
 from shapemove.core.scene.motion_file import make_motion, save_motion
 
 bpy = pytest.importorskip("bpy", reason="needs the bpy module (pip install bpy==5.0.1)")
 pytestmark = pytest.mark.blender
-
-
-class Layout:
-    """Records labels (text) and nested layouts; accepts the calls a panel makes."""
-
-    def __init__(self, log):
-        self.log = log
-
-    def label(self, text="", icon="NONE", **_):
-        self.log.append(text)
-
-    def _child(self, *_, **__):
-        return Layout(self.log)
-
-    box = column = row = grid_flow = split = _child
-
-    def prop(self, *_, **__):
-        pass
-
-    def operator(self, *_, **__):
-        return SimpleNamespace()
-
-    def progress(self, *_, **__):
-        pass
-
-
-def _draw(panel_cls, context) -> list:
-    log: list = []
-    panel_cls.draw(SimpleNamespace(layout=Layout(log)), context)
-    return log
 
 
 @pytest.fixture()
@@ -74,14 +44,14 @@ def test_generate_panel_shows_physics_and_measurements(addon, openbody, tmp_path
     assert physics["float_cm"] > 3.0  # it does float: the figures are the motion's own
     assert set(measurements) >= {"height_cm", "chest_cm", "waist_cm", "hip_cm"}
 
-    before = _draw(panels.SHAPEMOVE_PT_generate, bpy.context)
+    before = drawn(panels.SHAPEMOVE_PT_generate, bpy.context)
     assert not any(s.startswith(("Penetrate", "Height")) for s in before)  # nothing generated yet
 
     rig = operators.on_generated("Walker", {"result": {"path": str(tmp_path / "m.npz"), "measurements": measurements,
                                                       "physics": physics}})
     assert rig is not None and bpy.context.view_layer.objects.active == rig
     assert dict(rig[operators.PHYSICS_KEY]) == pytest.approx(physics)
-    shown = _draw(panels.SHAPEMOVE_PT_generate, bpy.context)
+    shown = drawn(panels.SHAPEMOVE_PT_generate, bpy.context)
     assert f"Penetrate: {physics['penetrate_cm']:.2f} cm" in shown
     assert f"Float: {physics['float_cm']:.2f} cm" in shown
     assert f"Skate: {physics['skate_pct']:.1f} %" in shown

@@ -6,37 +6,12 @@ worker runs it."""
 from __future__ import annotations
 
 import json
-from types import SimpleNamespace
 
 import pytest
+from panel_layout import drawn
 
 bpy = pytest.importorskip("bpy", reason="needs the bpy module (pip install bpy==5.0.1)")
 pytestmark = pytest.mark.blender
-
-
-class Layout:
-    """Records labels and the properties drawn; accepts the calls a panel makes."""
-
-    def __init__(self, log):
-        self.log = log
-
-    def label(self, text="", icon="NONE", **_):
-        self.log.append(text)
-
-    def _child(self, *_, **__):
-        return Layout(self.log)
-
-    box = column = row = grid_flow = split = _child
-
-    def prop(self, data, name, *_, **__):
-        self.log.append(f"prop:{name}")
-
-    def operator(self, idname, *_, **__):
-        self.log.append(f"op:{idname}")
-        return SimpleNamespace()
-
-    def progress(self, *_, **__):
-        pass
 
 
 @pytest.fixture()
@@ -64,8 +39,7 @@ def test_the_plan_is_shown_edited_and_generated_from(addon, tmp_path, monkeypatc
     assert bpy.ops.shapemove.read_plan() == {"FINISHED"}
     assert [(i.text, i.action, i.distance) for i in s.plan_segments] == [
         ("a man walks 2 metres forward", "walk", 2.0), ("a man waves", "wave", 0.0)]
-    log: list = []
-    panels.SHAPEMOVE_PT_generate.draw(SimpleNamespace(layout=Layout(log)), bpy.context)
+    log = drawn(panels.SHAPEMOVE_PT_generate, bpy.context)
     assert "Segment 2 of 2" in log and log.count("prop:distance") == 2 and "op:shapemove.read_plan" in log
 
     s.plan_segments[0].seconds, s.plan_segments[1].seconds = 1.0, 1.2   # the user's changes
