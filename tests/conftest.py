@@ -34,6 +34,20 @@ def need_module(name: str, reason: str | None = None):
         need_data(reason or f"needs the Python module {name!r} ({exc})")
 
 
+@pytest.fixture()
+def addon():
+    """The extension registered in a factory-fresh scene of the real bpy (skipped without bpy), and
+    unregistered after the test."""
+    bpy = pytest.importorskip("bpy", reason="needs the bpy module (pip install bpy==5.0.1)")
+    import shapemove
+
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    shapemove.register()
+    yield
+    shapemove.unregister()
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+
+
 @pytest.fixture(scope="module")
 def one_thread():
     """Tiny models on a shared 2-core machine: intra-op threads only add contention (up to 10x slower).

@@ -10,12 +10,12 @@ from shapemove.core.generation.model_bundle import part_warnings
 from shapemove.core.scene.motion_file import make_motion, save_motion
 
 bpy = pytest.importorskip("bpy", reason="needs the bpy module (pip install bpy==5.0.1)")
-from test_blender_panel_feedback import _draw, addon  # noqa: E402,F401  (the recording layout, the add-on fixture)
+from panel_layout import drawn  # noqa: E402  (the recording layout; the add-on fixture is conftest's)
 
 pytestmark = pytest.mark.blender
 
 
-def test_panel_shows_what_the_model_lacks(addon, openbody, tmp_path):  # noqa: F811
+def test_panel_shows_what_the_model_lacks(addon, openbody, tmp_path):
     from shapemove.shapemove_addon import operators, panels
 
     T = 12
@@ -24,6 +24,6 @@ def test_panel_shows_what_the_model_lacks(addon, openbody, tmp_path):  # noqa: F
     (w,) = part_warnings(tmp_path / "no_model")  # a folder without tma/tma.pt
     rig = operators.on_generated("Walker", {"result": {"path": str(tmp_path / "m.npz"), "warnings": [w],
                                                       "model_warnings": [w], "nearest_actions": ["walk"]}})
-    shown = _draw(panels.SHAPEMOVE_PT_generate, bpy.context)
+    shown = drawn(panels.SHAPEMOVE_PT_generate, bpy.context)
     assert w in shown and "best-of-N picking is off" in w
     assert not any(s.startswith("Prompt unlike") for s in shown)  # the prompt was fine

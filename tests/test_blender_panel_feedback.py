@@ -16,17 +16,6 @@ bpy = pytest.importorskip("bpy", reason="needs the bpy module (pip install bpy==
 pytestmark = pytest.mark.blender
 
 
-@pytest.fixture()
-def addon():
-    import shapemove
-
-    bpy.ops.wm.read_factory_settings(use_empty=True)
-    shapemove.register()
-    yield
-    shapemove.unregister()
-    bpy.ops.wm.read_factory_settings(use_empty=True)
-
-
 def test_generate_panel_shows_physics_and_measurements(addon, openbody, tmp_path):
     from shapemove.core.worker.jobs_shapemove import _measurements, _physics
     from shapemove.shapemove_addon import operators, panels

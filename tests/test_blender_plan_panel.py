@@ -14,17 +14,6 @@ bpy = pytest.importorskip("bpy", reason="needs the bpy module (pip install bpy==
 pytestmark = pytest.mark.blender
 
 
-@pytest.fixture()
-def addon():
-    import shapemove
-
-    bpy.ops.wm.read_factory_settings(use_empty=True)
-    shapemove.register()
-    yield
-    shapemove.unregister()
-    bpy.ops.wm.read_factory_settings(use_empty=True)
-
-
 def _run_job(params):
     from shapemove.core.worker.jobs_shapemove import generate
 

@@ -12,12 +12,12 @@ import pytest
 from shapemove.core.scene.motion_file import make_motion, save_motion
 
 bpy = pytest.importorskip("bpy", reason="needs the bpy module (pip install bpy==5.0.1)")
-from test_blender_panel_feedback import _draw, addon  # noqa: E402,F401  (the recording layout, the add-on fixture)
+from panel_layout import drawn  # noqa: E402  (the recording layout; the add-on fixture is conftest's)
 
 pytestmark = pytest.mark.blender
 
 
-def test_panel_says_a_take_was_moved_by_its_rotations(addon, openbody, tmp_path, monkeypatch):  # noqa: F811
+def test_panel_says_a_take_was_moved_by_its_rotations(addon, openbody, tmp_path, monkeypatch):
     from shapemove.shapemove_addon import job_submit, operators, panels, redecode
     from shapemove.shapemove_addon.rig_state import TAKE_NOTES_KEY
 
@@ -36,12 +36,12 @@ def test_panel_says_a_take_was_moved_by_its_rotations(addon, openbody, tmp_path,
     kw["on_result"]({"result": {"path": str(tmp_path / "m.npz"), "method": "planted", "notes": [note]}})
     rig = operators.active_rig(bpy.context)
     assert rig is not None and list(rig[TAKE_NOTES_KEY]) == [note]
-    assert note in _draw(panels.SHAPEMOVE_PT_generate, bpy.context)
+    assert note in drawn(panels.SHAPEMOVE_PT_generate, bpy.context)
     assert redecode.wants_redecode(rig)     # a shape change plants it again (the redecode job: retarget.replant)
     # a take the codes carry leaves no note; a motion with neither tokens nor measured contacts is not remade
     kw["on_result"]({"result": {"path": str(tmp_path / "plain.npz"), "method": "savae", "notes": []}})
     rig = operators.active_rig(bpy.context)
-    assert TAKE_NOTES_KEY not in rig and not any("SA-VAE" in s for s in _draw(panels.SHAPEMOVE_PT_generate,
+    assert TAKE_NOTES_KEY not in rig and not any("SA-VAE" in s for s in drawn(panels.SHAPEMOVE_PT_generate,
                                                                                  bpy.context))
     assert not redecode.wants_redecode(rig)
 
@@ -74,7 +74,7 @@ def _motion_file(openbody, tmp_path):
 NOTE = "played as captured from your library (kick.bvh): its codes miss it by 253 mm in its worst second"
 
 
-def test_generate_uses_the_library_when_asked_and_notes_a_captured_take(addon, openbody, tmp_path,  # noqa: F811
+def test_generate_uses_the_library_when_asked_and_notes_a_captured_take(addon, openbody, tmp_path,
                                                                          monkeypatch):
     from shapemove.shapemove_addon import job_submit, operators, panels
     from shapemove.shapemove_addon.rig_state import TAKE_NOTES_KEY
@@ -85,11 +85,11 @@ def test_generate_uses_the_library_when_asked_and_notes_a_captured_take(addon, o
     rig = operators.on_generated("Kicker", {"result": {"path": _motion_file(openbody, tmp_path), "warnings": [],
                                                       "notes": [NOTE]}})
     assert list(rig[TAKE_NOTES_KEY]) == [NOTE]
-    shown = _draw(panels.SHAPEMOVE_PT_generate, bpy.context)
+    shown = drawn(panels.SHAPEMOVE_PT_generate, bpy.context)
     assert NOTE in shown and not any(line.startswith("Prompt unlike") for line in shown)
 
 
-def test_generate_animated_uses_the_library_and_keeps_the_note(addon, openbody, tmp_path, monkeypatch):  # noqa: F811
+def test_generate_animated_uses_the_library_and_keeps_the_note(addon, openbody, tmp_path, monkeypatch):
     """Loop, root motion, path and speed ("Generate Animated") take the Library as Generate does, and
     the rig they build keeps the job's note."""
     from shapemove.shapemove_addon import job_submit, operators, panels
@@ -103,4 +103,4 @@ def test_generate_animated_uses_the_library_and_keeps_the_note(addon, openbody, 
     jobs[-1][2]["on_result"]({"result": {"path": _motion_file(openbody, tmp_path), "warnings": [], "notes": [NOTE]}})
     rig = operators.active_rig(bpy.context)
     assert rig is not None and list(rig[TAKE_NOTES_KEY]) == [NOTE]
-    assert NOTE in _draw(panels.SHAPEMOVE_PT_generate, bpy.context)
+    assert NOTE in drawn(panels.SHAPEMOVE_PT_generate, bpy.context)
