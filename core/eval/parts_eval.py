@@ -42,9 +42,10 @@ SIDES, PARTS = ("left", "right"), ("hand", "foot")
 
 
 def _items(path: Path, what: str) -> list:
-    from ..io.limits import read_json
+    from .report import prompt_items
 
-    return _prompts(read_json(path, what, MAX_PROMPTS_BYTES), path)
+    _, items = prompt_items(path, path, what, MAX_PROMPTS_BYTES)
+    return _prompts({"prompts": items}, path)
 
 
 def _prompts(doc, path: Path) -> list:
