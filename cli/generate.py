@@ -195,7 +195,7 @@ def run(args) -> int:
               + (" (arms mirrored to the named side)" if motion.arms_mirrored else ""))
     elif motion.mirrored:
         print("mirrored: the named side now moves most")
-    if motion.retrieved_clips and not (motion.provenance or "").startswith("captured"):
+    if motion.retrieved_clips and "captured:" not in (motion.provenance or ""):
         print(f"kept a retrieved clip: {', '.join(motion.retrieved_clips)}")
     if motion.loop_advance is not None:
         print(f"loop: the root advances {float(np.linalg.norm(motion.loop_advance[[0, 2]])):.2f} m per cycle")

@@ -22,6 +22,15 @@ def gen():
     return Generator(None)
 
 
+@pytest.fixture
+def codes_only(gen):
+    """A timeline of codes (captured takes off, ``--no-library``): these tests are about its codes;
+    the timeline of finished segments is tests/test_stitched_timeline.py's."""
+    gen.set_captured(False)
+    yield
+    gen.set_captured(True)
+
+
 @pytest.fixture(scope="module")
 def walk(gen):
     from shapemove.core.generation.generate import Request
@@ -102,6 +111,7 @@ def test_in_place_no_drift_feet_alternate(walk):
     assert changes >= 3                                                   # left, right, left, right
 
 
+@pytest.mark.usefixtures("codes_only")
 def test_a_motion_held_in_place_stays_in_place_on_a_new_body_and_a_new_strip(gen, walk, tmp_path):
     """``in_place`` keeps the tokens; its file says it was held in place, so re-decoding for a new
     body (the Shape sliders) and regenerating a timeline's strip hold it again. Before, the
@@ -202,6 +212,7 @@ def test_speed_exact_duration_and_planted(gen, walk):
         time_warp(walk, gen.body, speed=3.0)
 
 
+@pytest.mark.usefixtures("codes_only")
 def test_timeline_boundaries_and_regenerate(gen):
     from shapemove.core.generation.sequence import boundary_report, generate_sequence, regenerate_segment, segment_codes
 
@@ -230,6 +241,7 @@ def test_timeline_boundaries_and_regenerate(gen):
     assert tall.segment_prompts == m.segment_prompts and np.allclose(tall.betas, 0.8)
 
 
+@pytest.mark.usefixtures("codes_only")
 def test_timeline_segments_obey_their_pace_and_travel_words(gen):
     """"jogs in place" steps on the spot and "walks slowly" takes shorter strides inside a timeline
     too (``timeline_words.py``): the same codes as without the edits (the tokens are kept for
@@ -262,6 +274,7 @@ def test_timeline_segments_obey_their_pace_and_travel_words(gen):
     assert worded_joints(plain.joints, [[0, 140]], ["a person walks forward"]) is None
 
 
+@pytest.mark.usefixtures("codes_only")
 def test_a_timeline_segment_that_turns_around_sends_the_next_one_back(gen):
     """"walks forward" -> "turns around" -> "walks forward": the codec does not carry turning, so
     before ``timeline_words.turn_profile`` the last walk went on the way the first went (seed 1:
@@ -303,6 +316,7 @@ def test_a_timeline_segment_that_turns_around_sends_the_next_one_back(gen):
     assert turn_profile(plain.joints, plain.segment_bounds, ["a person walks forward"] * 3) is None
 
 
+@pytest.mark.usefixtures("codes_only")
 def test_a_timeline_segment_that_walks_in_a_circle_goes_round_once(gen):
     """A circle segment's course is bent once round (a whole turn at an even rate, left unless
     the words say clockwise) and the walk after it goes on the way the walk before it went."""
@@ -324,6 +338,7 @@ def test_a_timeline_segment_that_walks_in_a_circle_goes_round_once(gen):
     assert np.linalg.norm(r0[b - 1] - r0[a]) > 0.8 * travel(plain.joints[a:b])[-1]    # straight before
 
 
+@pytest.mark.usefixtures("codes_only")
 def test_a_timeline_segment_that_walks_a_figure_eight_goes_round_both_loops(gen):
     """A figure-eight segment is sampled as its gait walked straight ("a person walks") and turned a
     whole turn one way over its first half and back over its second (``course_walk.course_turn``):
@@ -367,6 +382,7 @@ def test_cli_refuses_bad_animation_input(tmp_path, args, message):
     assert len(lines) == 1 and message in lines[0], res.stderr
 
 
+@pytest.mark.usefixtures("codes_only")
 def test_timeline_segment_of_two_things_is_made_by_part(gen):
     """A "walks and waves" segment: its legs walk on from the timeline, its hand is up while the
     segments around it keep their arms down; the arms' codes are kept, a regenerated neighbour
@@ -422,6 +438,7 @@ def test_timeline_segment_naming_a_side_moves_that_side(gen):
     assert mr > 1.5 * ml and mr == pytest.approx(left, rel=0.35)        # the same wave, by the right hand
 
 
+@pytest.mark.usefixtures("codes_only")
 def test_timeline_segments_are_the_actions_asked(gen):
     """The model's TMA names each segment's own prompt as the closest of the timeline's prompts
     (the action classifier in core/eval needs a built dataset; this judge needs only the model)."""

@@ -50,6 +50,7 @@ def test_a_sit_then_a_wave_has_no_pop_at_the_seam():
     from shapemove.core.generation.track import decoded_track
 
     gen = Generator(None)
+    gen.set_captured(False)   # a timeline of codes (the decoder's own seam)
     m = generate_sequence(gen, [("a person sits down", 3.0), ("a person waves with the right hand", 2.0)], seed=7)
     track, _ = decoded_track([int(t) for t in m.tokens], gen.vae, gen.body, m.betas)
     assert seam_steps(track.joints, [60])[0] > 1.8

@@ -77,6 +77,15 @@ def gen_default():
     return Generator(None)
 
 
+@pytest.fixture
+def codes_only(gen_default):
+    """A timeline of codes (captured takes off, ``--no-library``): these tests read its codes; the
+    timeline of finished segments is tests/test_stitched_timeline.py's."""
+    gen_default.set_captured(False)
+    yield
+    gen_default.set_captured(True)
+
+
 def test_three_steps_and_a_stop(gen_default):
     """The default model: "a man takes three steps forward and stops" (4 s) strikes three times, then
     stands still for the last 1.5 s; a plain walk walks to the end. A taller body stops too. Without
@@ -106,6 +115,7 @@ def test_three_steps_and_a_stop(gen_default):
     assert speeds(taller)[-30:].mean() < 0.08 and taller.joints[:, 0, 1].mean() > m.joints[:, 0, 1].mean()
 
 
+@pytest.mark.usefixtures("codes_only")
 def test_a_timeline_segment_that_stands_still_stands(gen_default):
     """"walks forward" -> "stands still" -> "walks forward": the T5 has no standing caption and its
     middle segment walked on (seed 0: 1.1-1.3 m/s); it is now the model's standing code, so the body
@@ -155,6 +165,7 @@ def test_two_things_at_once_then_a_stop(gen_default):
     assert speeds(taller)[-30:].mean() < 0.08 and taller.arms_tokens is not None
 
 
+@pytest.mark.usefixtures("codes_only")
 def test_a_timeline_segment_that_counts_its_steps_stands_after_them(gen_default):
     """"a man takes three steps forward" 3 s -> "he waves" 2 s: the first segment walks three steps
     (and the closing one) and stands until the wave; without the word edits it walked its 3 s
@@ -216,3 +227,14 @@ def test_a_timeline_distance_is_cut_on_its_own_body_and_a_wave_after_it_stands(g
     (a, b), (c, e) = m.segment_bounds
     assert abs(from_start(m.joints[a:b])[-1] - 3.0) <= 0.15                # within 5 %
     assert from_start(m.joints[c:e]).max() < 0.1                          # standing while it waves
+
+
+def test_a_prompt_that_stands_still_stands(gen_default):
+    """"a person stands still" alone: no caption stands still, and the nearest captured take walked
+    backwards (1.1 m/s); it is the model's standing code for the length asked."""
+    from shapemove.core.generation.generate import Request
+
+    m = gen_default.generate_batch([Request("a person stands still", seconds=2.0, seed=1)])[0]
+    r = m.joints[:, 0, [0, 2]]
+    assert np.linalg.norm(np.diff(r, axis=0), axis=1).mean() * m.fps < 0.05
+    assert m.tokens.tolist() == [gen_default.rest_code] * 10 and m.provenance == "generated"

@@ -57,7 +57,7 @@ def item_motion(spec: dict):
 def motion_facts(motion) -> dict:
     """{"source", "result"} of a motion for its manifest line."""
     provenance = getattr(motion, "provenance", None) or ""
-    kind = "captured" if provenance.startswith("captured") else "retrieved" if motion.retrieved_clips else "generated"
+    kind = "captured" if "captured:" in provenance else "retrieved" if motion.retrieved_clips else "generated"
     source = {"kind": kind, "provenance": getattr(motion, "provenance", None), "retrieved_clips": list(motion.retrieved_clips), "notes": list(motion.notes),
               "warnings": list(motion.warnings), "part_prompts": list(motion.part_prompts or []) or None,
               "mirrored": bool(motion.mirrored)}

@@ -510,7 +510,9 @@ class Generator:
                                         min(DISTANCE_SECONDS, metres / DISTANCE_PACE + 1.0)) if stop else r
             asked = dataclasses.replace(asked, plan=None, words=None)
             by_parts = words is not None and (words.parts is not None or words.side is not None or not edited)
-            motion = generate_by_parts(self, asked, words if edited else None) if by_parts else None
+            standing = words is not None and words.stand_still and self.rest_code is not None
+            motion = self.standing(r) if standing else \
+                generate_by_parts(self, asked, words if edited else None) if by_parts else None
             came_from = motion.provenance if motion is not None else None   # kept through the edits below
             if motion is not None and stop is not None:
                 motion.prompt = r.prompt
@@ -551,9 +553,21 @@ class Generator:
                 progress((i + 1) / len(reqs), r.prompt)
         return out
 
+    def standing(self, r: Request) -> Motion:
+        """"a person stands still", "she waits": no caption stands still, so nothing sampled does;
+        the model's standing code (``stop_words.standing_code``) for the length asked
+        (``STAND_SECONDS`` when none), decoded on the request's body."""
+        n = self._length(r.seconds)[0] if r.seconds is not None else max(1, round(STAND_SECONDS * FPS / self.vae.cfg.downsample))
+        with one_torch_thread():
+            betas, source = self.body_shape(r, self.predicted_betas(r.prompt, r.shape_text).numpy())
+        motion = self.decode_motion([self.rest_code] * n, betas, prompt=r.prompt)
+        motion.shape_source, motion.provenance = source, "generated"
+        return motion
+
     def planned_sequence(self, r: Request, plan) -> Motion:
         """A prompt of segments in order (``plan.segments.Plan``: "walks forward, then sits down") made
-        as a timeline of its segments (``sequence.generate_sequence``), each its share of ``r.seconds``
+        as a timeline of its segments (``sequence.generate_sequence``: where captured takes compete,
+        each segment's own choice among samples and takes), each its share of ``r.seconds``
         (``Plan.lengths``), one body for all."""
         from .sequence import generate_sequence
 

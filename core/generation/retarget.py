@@ -255,7 +255,9 @@ def replant(motion: Motion, body, betas, ik_refine_iters: int = 10) -> Motion:
             "root": np.asarray(motion.transl, np.float32) + rest[0], "rest": rest,
             "contacts": np.asarray(motion.contacts, np.uint8)}
     out = planted_retarget(take, body, betas, ik_refine_iters)
-    out.prompt, out.notes = motion.prompt, list(motion.notes)
+    out.prompt, out.notes, out.provenance = motion.prompt, list(motion.notes), motion.provenance
+    if motion.segment_bounds is not None:   # a timeline joined from finished segments keeps its segments
+        out.segment_bounds, out.segment_prompts = motion.segment_bounds, motion.segment_prompts
     return out
 
 

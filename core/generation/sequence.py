@@ -332,6 +332,17 @@ def generate_sequence(gen, segments, shape_text: str | None = None, betas=None, 
     # state a sample's [BETA] is read from), known before any stop is cut
     body, source = body_for(gen, segs[0].prompt, shape_text, betas,
                             gen.predicted_betas(segs[0].prompt, shape_text).numpy())
+    if by_parts and gen.captured_on and gen.pool is not None and len(gen.pool):   # captured takes compete:
+        from .request import Request                                              # each segment a prompt of
+        from .stitched_timeline import stitched_sequence                          # its own, joined
+
+        base = Request(segs[0].prompt, None, None, None, seed, temperature, top_k, candidates=candidates,
+                       guidance=guidance)
+        motion = stitched_sequence(gen, [(s.prompt, s.seconds) for s in segs], body, base, readings, progress, cancel)
+        motion.shape_source, motion.warnings = source, warnings
+        if progress is not None:
+            progress(1.0, "timeline planted")
+        return motion
     chosen, arms = [], []
     for i, s in enumerate(segs):
         if cancel is not None and cancel():
@@ -378,7 +389,21 @@ def regenerate_segment(gen, motion: Motion, index: int, seed: int, prompt: str |
                        by_parts: bool = True) -> Motion:
     """Segment ``index`` sampled again (new ``seed``, optionally a new ``prompt``/``seconds``),
     continuing from the previous segment; every other segment keeps its codes (and its arms'), the
-    body its betas; a timeline held in place is held in place again."""
+    body its betas; a timeline held in place is held in place again. A timeline joined from finished
+    segments (``stitched_timeline.py``) has that segment made again as a prompt of its own."""
+    from .stitched_timeline import is_stitched, regenerate_stitched
+
+    if is_stitched(motion):
+        from .request import Request
+
+        base = Request(prompt or "", None, None, None, seed, temperature, top_k, candidates=candidates,
+                       guidance=guidance, by_parts=by_parts)
+        out = regenerate_stitched(gen, motion, index, seed, prompt, seconds, base)
+        if motion.held_in_place:
+            from .in_place import in_place
+
+            out = in_place(out)
+        return out
     old_per, old_arms = segment_codes(motion), segment_codes(motion, arms=True)
     per, arms = list(old_per), list(old_arms)
     prompts = list(motion.segment_prompts)

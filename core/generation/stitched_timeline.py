@@ -1,0 +1,163 @@
+"""A timeline of finished motions: each segment chosen as a single prompt is, then joined.
+
+Where captured takes compete (``captured_takes.py``), a segment of a timeline is one more prompt:
+its own pool of T5 samples and captured windows of the action its words ask, one choice by the TMA
+on the finished motions, and every edit a single prompt gets (a stop, a count, a course, a turn,
+a pace, on the spot) made by ``Generator.generate_batch`` on the timeline's one body. A code
+timeline (``sequence.generate_sequence``) cannot hold a captured take: its segments are codes,
+and the codes flatten a kick to standing.
+
+The finished segments are joined on their joints (``stitch``): each next segment is turned about
+the vertical so that it starts facing where the one before ends, and moved so that its root starts
+where that one's ends; the difference left between the last pose and the next first pose (arms,
+legs, the root's height) is carried into the next segment and faded out over ``BLEND`` frames
+(smoothstep), so no frame jumps and each segment is its own motion after the fade. The seams are
+then paced (``seam_pace.paced_seams``) and the whole planted once on the body (``track.plant``).
+The Motion is played by its rotations (no tokens, its contacts kept): another body plants it again
+(``retarget.replant``); Regenerate samples one segment again and joins the rest as they are
+(``regenerate_stitched``).
+
+    motion = stitched_sequence(gen, [("a man walks forward", 3.0), ("he kicks", 2.0)], betas, Request(""))
+"""
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from ..errors import ShapeMoveError
+from ..scene.motion_file import Motion
+from .seam_pace import paced_seams
+from .track import Track, headings, plant, rotate_y
+
+BLEND = 10   # frames (0.5 s) over which the pose difference at a seam fades into the next segment
+
+
+def smoothstep(x: np.ndarray) -> np.ndarray:
+    x = np.clip(x, 0.0, 1.0)
+    return x * x * (3 - 2 * x)
+
+
+def joined(prev: np.ndarray, nxt: np.ndarray, blend: int = BLEND) -> np.ndarray:
+    """(T,22,3) joints of ``nxt`` placed after ``prev`` (module docstring): turned and moved so its
+    root starts where ``prev``'s ends, facing as it ends (``track.headings``), and the remaining pose difference at
+    the seam faded out over ``blend`` frames. The first frame continues ``prev`` by no more than
+    ``nxt``'s own first step."""
+    prev, nxt = np.asarray(prev, np.float64), np.asarray(nxt, np.float64)
+    out = nxt.copy()
+    out[..., [0, 2]] -= nxt[0, 0, [0, 2]]
+    out = rotate_y(out, headings(prev)[-1] - headings(nxt)[0])
+    out[..., [0, 2]] += prev[-1, 0, [0, 2]]
+    first_step = out[1] - out[0] if len(out) > 1 else np.zeros_like(out[0])
+    offset = prev[-1] + first_step - out[0]     # where the next first frame should be, continuing prev
+    fade = 1.0 - smoothstep(np.arange(len(out)) / max(1, min(blend, len(out))))   # 1 at the seam, 0 from blend on
+    return out + fade[:, None, None] * offset[None]
+
+
+def stitch(joints: list[np.ndarray], contacts: list[np.ndarray], blend: int = BLEND) -> tuple[Track, np.ndarray]:
+    """The segments' joints joined in order (``joined``) and their contacts; (Track, (S,2) bounds)."""
+    if not joints or len(joints) != len(contacts):
+        raise ShapeMoveError("a stitched timeline needs each segment's joints and contacts")
+    out, con = [np.asarray(joints[0], np.float64)], [np.asarray(contacts[0], np.uint8)]
+    for j, c in zip(joints[1:], contacts[1:]):
+        out.append(joined(out[-1], j, blend))
+        con.append(np.asarray(c, np.uint8))
+    ends = np.cumsum([len(j) for j in out])
+    bounds = np.stack([np.r_[0, ends[:-1]], ends], axis=1).astype(np.int64)
+    return Track(np.concatenate(out), np.concatenate(con)), bounds
+
+
+def _contacts(m: Motion) -> np.ndarray:
+    if m.contacts is not None and len(m.contacts) == m.num_frames:
+        return np.asarray(m.contacts, np.uint8)
+    from ..motion.contacts import foot_contacts
+
+    return np.asarray(foot_contacts(m.joints), np.uint8)
+
+
+def segment_request(base, text: str, seconds: float, body: np.ndarray, seed: int, words=None):
+    """The ``Request`` of one segment: ``base``'s sampling, its own text and seconds on the
+    timeline's ``body``; ``words``: an edited plan's reading of it (``plan.words.Words``), acted on."""
+    from ..plan.plan import Plan, Segment
+
+    plan = None if words is None else Plan(text, (Segment(text, 1.0, words),), float(seconds))
+    return dataclasses.replace(base, prompt=text, seconds=float(seconds), betas=np.asarray(body, np.float32),
+                               shape_text=None, seed=int(seed), plan=plan, words=None)
+
+
+def planted(gen, joints: list[np.ndarray], contacts: list[np.ndarray], prompts: list[str], betas,
+            prompt: str | None = None) -> Motion:
+    """Segments' joints and contacts on one body ``betas`` joined (``stitch``), paced and planted:
+    the timeline Motion with its segments, played by its rotations."""
+    from ..motion.features import motion_features
+
+    track, bounds = stitch(joints, contacts)
+    paced = paced_seams(track.joints, track.contacts, bounds)
+    if paced is not None:
+        track = Track(*paced)
+    motion = plant(gen.body, np.asarray(betas, np.float32), track, gen.ik_refine_iters,
+                   prompt=prompt or " -> ".join(prompts))
+    motion.features = motion_features(motion)
+    motion.contacts_measured = True     # played by its rotations: another body plants it again (replant)
+    motion.segment_bounds, motion.segment_prompts = bounds, list(prompts)
+    return motion
+
+
+def assembled(gen, motions: list[Motion], prompts: list[str], betas, prompt: str | None = None) -> Motion:
+    """The finished segment ``motions`` (one body ``betas``) as one timeline (``planted``), with
+    their provenances and notes."""
+    motion = planted(gen, [m.joints for m in motions], [_contacts(m) for m in motions], prompts, betas, prompt)
+    motion.provenance = "; ".join(f"segment {i + 1}: {m.provenance or 'generated'}" for i, m in enumerate(motions))
+    motion.retrieved_clips = [c for m in motions for c in m.retrieved_clips]
+    motion.notes = [f"segment {i + 1}: {n}" for i, m in enumerate(motions) for n in m.notes]
+    return motion
+
+
+def stitched_sequence(gen, segments: list[tuple[str, float]], body: np.ndarray, base, readings=None,
+                      progress=None, cancel=None) -> Motion:
+    """The timeline of ``segments`` [(prompt, seconds)] on the betas ``body``, each segment made as a
+    single prompt (module docstring) with ``base``'s sampling (a ``Request``), seeds ``base.seed``,
+    ``base.seed + 1``, ...; ``readings``: an edited plan's reading of each segment."""
+    motions = []
+    for i, (text, sec) in enumerate(segments):
+        if cancel is not None and cancel():
+            raise ShapeMoveError("cancelled")
+        seg = segment_request(base, text, sec, body, base.seed + i, None if readings is None else readings[i])
+        motions.append(gen.generate_batch([seg])[0])
+        if progress is not None:
+            progress((i + 1) / (len(segments) + 1), f"segment {i + 1}/{len(segments)}: {text}")
+    return assembled(gen, motions, [t for t, _ in segments], body)
+
+
+def is_stitched(motion: Motion) -> bool:
+    """A timeline joined from finished segments (no tokens, played by its rotations)."""
+    return motion.segment_bounds is not None and motion.num_tokens == 0 and motion.contacts_measured
+
+
+def regenerate_stitched(gen, motion: Motion, index: int, seed: int, prompt: str | None = None,
+                        seconds: float | None = None, request=None) -> Motion:
+    """Segment ``index`` of a stitched timeline made again (new ``seed``, optionally a new ``prompt``
+    or ``seconds``) as a single prompt on the timeline's body; the other segments keep their frames
+    and are joined again around it."""
+    from ..constants import FPS
+    from .request import Request
+
+    bounds = np.asarray(motion.segment_bounds)
+    prompts = list(motion.segment_prompts)
+    if not 0 <= index < len(bounds):
+        raise ShapeMoveError(f"segment {index + 1} does not exist: this timeline has {len(bounds)}")
+    text = prompt or prompts[index]
+    sec = float(seconds) if seconds is not None else (bounds[index, 1] - bounds[index, 0]) / FPS
+    base = request if request is not None else Request(text)
+    new = gen.generate_batch([segment_request(base, text, sec, motion.betas, seed)])[0]
+    joints = [np.asarray(motion.joints[s:e]) for s, e in bounds]
+    contacts = [_contacts(motion)[s:e] for s, e in bounds]
+    joints[index], contacts[index] = np.asarray(new.joints), _contacts(new)
+    prompts[index] = text
+    out = planted(gen, joints, contacts, prompts, motion.betas, motion.prompt)
+    kinds = (motion.provenance or "").split("; ")
+    kinds = kinds if len(kinds) == len(prompts) else [f"segment {i + 1}: generated" for i in range(len(prompts))]
+    kinds[index] = f"segment {index + 1}: {new.provenance or 'generated'}"
+    out.provenance, out.shape_source = "; ".join(kinds), "given"
+    out.plan = motion.plan if text == motion.segment_prompts[index] else None
+    return out
