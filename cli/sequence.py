@@ -26,6 +26,8 @@ def add_arguments(p):
     p.add_argument("--motion", type=Path, default=None, help="the timeline to change with --regenerate")
     p.add_argument("--no-parts", action="store_true",
                    help="generate segments of two things at once whole, not by body part")
+    p.add_argument("--no-library", action="store_true",
+                   help="no captured take competes: a timeline of the model's codes (docs/animation.md)")
     p.add_argument("--in-place", action="store_true", help="remove the root's horizontal travel")
     p.add_argument("--model", type=Path, default=None)
     p.add_argument("--body-model", default=None)
@@ -63,6 +65,7 @@ def run(args) -> int:
 
     betas = parse_betas(args.betas) if args.betas else None
     gen = loaded_generator(args.model, args.body_model)
+    gen.set_captured(not args.no_library)
     if args.regenerate is not None:
         motion = regenerate_segment(gen, base, args.regenerate - 1, args.seed, args.prompt[0] if args.prompt else None,
                                     args.seconds[0] if args.seconds else None, args.temperature, args.top_k,
@@ -87,7 +90,11 @@ def run(args) -> int:
         print(f"warning: {w}", file=sys.stderr)
     print(f"wrote {args.out}: {motion.num_frames} frames ({motion.num_frames / motion.fps:.1f} s), "
           f"{len(motion.segment_bounds)} segments, IK error {motion.ik_error_cm:.2f} cm")
-    own_arms = segment_codes(motion, arms=True)
-    for (s, e), p, a in zip(motion.segment_bounds, motion.segment_prompts, own_arms):
-        print(f"  frames {int(s):4d}-{int(e) - 1:4d}  {p}{'  (by body part)' if a is not None else ''}")
+    n = len(motion.segment_bounds)
+    own_arms = segment_codes(motion, arms=True) if motion.num_tokens else [None] * n
+    sources = (motion.provenance or "").split("; ")   # "segment K: captured: ..." of a timeline of finished segments
+    sources = [x.split(": ", 1)[1] for x in sources] if len(sources) == n and motion.num_tokens == 0 else [""] * n
+    for (s, e), p, a, src in zip(motion.segment_bounds, motion.segment_prompts, own_arms, sources):
+        print(f"  frames {int(s):4d}-{int(e) - 1:4d}  {p}{'  (by body part)' if a is not None else ''}"
+              f"{f'  [{src}]' if src else ''}")
     return 0

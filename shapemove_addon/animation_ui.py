@@ -25,7 +25,7 @@ from .operators import (JobOperator, ReportingOperator, build_rig_from_file, gen
                         library_param, scene_prompt)
 from .panels import _SettingsPanel, draw_job, draw_optional
 from .redecode import MOTION_FILE_KEY
-from .rig_state import current_betas, rig_of
+from .rig_state import PROVENANCE_KEY, current_betas, rig_of
 
 MAX_CURVE_POINTS = 20_000
 
@@ -111,6 +111,8 @@ def _on_built(name: str, root_motion: str, replace=None, keep_strips=None):
             return None
         rig = rig_of(bpy.context.active_object)
         keep_notes(rig, r)   # a library clip played as captured
+        if rig is not None and r.get("provenance"):   # "segment 2: captured: HDM05 ...; ..." of a timeline
+            rig[PROVENANCE_KEY] = str(r["provenance"])
         if rig is not None and keep_strips:
             retime_strips(rig, keep_strips)
         if rig is not None and replace is not None and replace.name in bpy.data.objects:
@@ -214,7 +216,8 @@ class SHAPEMOVE_OT_sequence(JobOperator, bpy.types.Operator):
         empty = [i + 1 for i, sg in enumerate(segs) if not sg["prompt"]]
         if empty:
             raise ShapeMoveError(f"timeline prompt {empty[0]} is empty")
-        params = {**generation_params(context, "timeline"), "segments": segs}
+        params = {**generation_params(context, "timeline"), "segments": segs,
+                  "captured": bool(context.scene.shapemove.use_captured)}
         job_submit.submit_job("sequence", params, kind=self.job, label="timeline",
                               on_result=_on_built("Timeline", a.root_motion))
         return f"generating a timeline of {len(segs)} prompts..."
@@ -244,7 +247,8 @@ class SHAPEMOVE_OT_regenerate_strip(ReportingOperator, bpy.types.Operator):
         timing = {i: t for i, t in enumerate(strip_timing(rig)) if i != k}
         params = {**generation_params(context, "timeline"), "regenerate": k, "motion": str(source),
                   "seed": int(context.scene.shapemove.seed) + 1000 + k,
-                  "betas": [float(b) for b in current_betas(rig)]}   # the body as the sliders left it
+                  "betas": [float(b) for b in current_betas(rig)],   # the body as the sliders left it
+                  "captured": bool(context.scene.shapemove.use_captured)}
         context.scene.shapemove.seed += 1   # the next press samples another one
         job_submit.submit_job("sequence", params, kind="sequence", label="regenerate strip",
                               on_result=_on_built(rig.name, rig.get("shapemove_root_motion", "PELVIS"), replace=rig,

@@ -155,8 +155,8 @@ def draw_result(layout, rig) -> None:
         box.label(text=w, icon="ERROR")
     for line in parts:
         box.label(text=line, icon="MOD_ARMATURE")
-    if source:
-        box.label(text=source[:1].upper() + source[1:], icon="REC" if source.startswith("captured") else "INFO")
+    for part in source.split("; ") if source else []:   # a timeline: "segment 1: generated; segment 2: captured: ..."
+        box.label(text=part[:1].upper() + part[1:], icon="REC" if "captured:" in part else "INFO")
     for line in notes:
         box.label(text=line, icon="INFO")
     if physics:

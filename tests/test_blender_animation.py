@@ -263,6 +263,10 @@ def test_regenerate_strip_asks_for_the_rigs_body_now(openbody, tmp_path, monkeyp
         (op, params), = jobs
         assert op == "sequence" and params["regenerate"] == 1 and params["motion"].endswith("t.npz")
         assert params["betas"][0] == pytest.approx(1.25) and params["betas"][1:] == [0.0] * 9
+        assert params["captured"] is True              # captured takes compete in the new strip
+        bpy.context.scene.shapemove.use_captured = False   # the panel's Captured takes off: a strip of codes
+        assert "FINISHED" in bpy.ops.shapemove.regenerate_strip()
+        assert jobs[-1][1]["captured"] is False
     finally:
         shapemove.unregister()
         bpy.ops.wm.read_factory_settings(use_empty=True)

@@ -6,7 +6,8 @@
 - ``sequence``: {"segments": [{"prompt", "seconds"}, ...], "shape_text", "betas", "seed", "model",
   "body", "out"} -> a timeline motion; with "regenerate": K (0-based) and "motion" (a timeline
   file) segment K is sampled again with "seed" and the others are kept, for the body "betas" (the
-  rig's now) or else the file's.
+  rig's now) or else the file's; "captured" (default true): captured takes compete in each segment
+  (``stitched_timeline.py``), false: a timeline of codes.
 """
 from __future__ import annotations
 
@@ -21,7 +22,7 @@ from .op_support import JobCancelled, param
 def _facts(out, motion, body) -> dict:
     facts = {**_motion_facts(out, motion), "measurements": _measurements(body, motion.betas),
              "ik_error_cm": float(motion.ik_error_cm or 0.0), "warnings": list(motion.warnings),
-             "notes": list(motion.notes)}
+             "notes": list(motion.notes), "provenance": motion.provenance}
     if motion.loop_advance is not None:
         facts["loop_advance"] = [float(v) for v in motion.loop_advance]
     if motion.segment_bounds is not None:
@@ -80,6 +81,7 @@ def sequence(params, progress, cancel) -> dict:
     by_parts = bool(param(params, op, "by_parts", bool, True))
     progress(0.05, "loading models")
     gen = _generator(param(params, op, "model", str, None), param(params, op, "body", str, None))
+    gen.set_captured(bool(param(params, op, "captured", bool, True)))   # captured takes compete in each segment
     if regen is not None:
         timeline = load_motion(param(params, op, "motion", str))
         betas = _betas(params, op)
