@@ -10,8 +10,10 @@ and the codes flatten a kick to standing.
 The finished segments are joined on their joints (``stitch``): each next segment is turned about
 the vertical so that it starts facing where the one before ends, and moved so that its root starts
 where that one's ends; the difference left between the last pose and the next first pose (arms,
-legs, the root's height) is carried into the next segment and faded out over ``BLEND`` frames
-(smoothstep), so no frame jumps and each segment is its own motion after the fade. The seams are
+legs, the root's height) is carried into the next segment and faded out (smoothstep) over
+``BLEND`` to ``MAX_BLEND`` frames, as long as no joint then moves more than ``FADE_SHARE`` of its
+99th-percentile step a frame for the fade, so no frame jumps and each segment is its own motion
+after the fade. The seams are
 then paced (``seam_pace.paced_seams``) and the whole planted once on the body (``track.plant``).
 The Motion is played by its rotations (no tokens, its contacts kept): another body plants it again
 (``retarget.replant``); Regenerate samples one segment again and joins the rest as they are
@@ -30,7 +32,9 @@ from ..scene.motion_file import Motion
 from .seam_pace import paced_seams
 from .track import Track, headings, plant, rotate_y
 
-BLEND = 10   # frames (0.5 s) over which the pose difference at a seam fades into the next segment
+BLEND = 10       # frames (0.5 s): the shortest fade of the pose difference at a seam into the next segment
+MAX_BLEND = 40   # frames (2 s): the longest
+FADE_SHARE = 1 / 3   # the fade moves a joint at most this share of its 99th-percentile step a frame
 
 
 def smoothstep(x: np.ndarray) -> np.ndarray:
@@ -50,8 +54,20 @@ def joined(prev: np.ndarray, nxt: np.ndarray, blend: int = BLEND) -> np.ndarray:
     out[..., [0, 2]] += prev[-1, 0, [0, 2]]
     first_step = out[1] - out[0] if len(out) > 1 else np.zeros_like(out[0])
     offset = prev[-1] + first_step - out[0]     # where the next first frame should be, continuing prev
-    fade = 1.0 - smoothstep(np.arange(len(out)) / max(1, min(blend, len(out))))   # 1 at the seam, 0 from blend on
+    n = fade_frames(prev, out, offset, blend)
+    fade = 1.0 - smoothstep(np.arange(len(out)) / n)   # 1 at the seam, 0 from n frames on
     return out + fade[:, None, None] * offset[None]
+
+
+def fade_frames(prev: np.ndarray, nxt: np.ndarray, offset: np.ndarray, blend: int = BLEND) -> int:
+    """Frames over which a seam's pose ``offset`` (22,3) fades: at least ``blend``, long enough that
+    the fade (a smoothstep, fastest at 1.5x its mean) moves no joint more than ``FADE_SHARE`` of
+    that joint's 99th-percentile step in the two segments a frame, at most ``MAX_BLEND`` and the
+    next segment's length."""
+    steps = np.linalg.norm(np.diff(np.concatenate([prev, nxt]), axis=0), axis=-1)   # (T-1, 22)
+    p99 = np.maximum(np.percentile(steps, 99, axis=0), 0.005)
+    need = int(np.ceil(1.5 * float((np.linalg.norm(offset, axis=-1) / p99).max()) / FADE_SHARE))
+    return max(1, min(max(blend, need), MAX_BLEND, len(nxt)))
 
 
 def stitch(joints: list[np.ndarray], contacts: list[np.ndarray], blend: int = BLEND) -> tuple[Track, np.ndarray]:
