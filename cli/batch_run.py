@@ -19,7 +19,9 @@ def add_batch_arguments(p) -> None:
                    help="run the items on a Dask distributed cluster (scheduler address, e.g. tcp://host:8786)")
 
 
-def engine_of(args):
+def engine_of(args, preload=None):
+    """The engine ``--jobs`` / ``--dask`` ask for; ``preload``: what workers forked from this process
+    start with (``engines.ProcessPool``)."""
     from ..core.batch.engines import DaskCluster, InProcess, ProcessPool
 
     if args.dask and args.jobs != 1:
@@ -28,7 +30,7 @@ def engine_of(args):
         return DaskCluster(args.dask)
     if args.jobs < 1:
         raise ShapeMoveError(f"--jobs takes a number of worker processes >= 1, got {args.jobs}")
-    return InProcess() if args.jobs == 1 else ProcessPool(args.jobs)
+    return InProcess() if args.jobs == 1 else ProcessPool(args.jobs, preload)
 
 
 def sampling_settings(args) -> dict:
@@ -73,7 +75,14 @@ def run_and_report(kind: str, task, args, items, count: int, settings: dict, whe
                    shard) -> int:
     from ..core.batch.runner import run_batch
 
-    engine = engine_of(args)
+    preload = None
+    if kind == "generate":   # workers forked from a process with the model loaded (no Blender here)
+        from functools import partial
+
+        from ..core.batch.generate_item import warm_generator
+
+        preload = partial(warm_generator, where)
+    engine = engine_of(args, preload)
     try:
         res = run_batch(kind, task, items, count, settings, model, where, args.out, engine, shard)
     except KeyboardInterrupt:

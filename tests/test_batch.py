@@ -141,7 +141,9 @@ def test_a_second_run_redoes_only_what_is_not_done(one_process, prompts):
 KILL_PROMPTS = ["a person walks forward", "someone waves", "a person jumps", "a person squats", "a man runs forward",
                 "a person kicks", "a person sits down", "someone turns around", "a person claps", "a person bows",
                 "a person walks backward", "someone raises both arms", "a person stretches", "someone nods",
-                "a person spins around", "a person crouches"]
+                "a person spins around", "a person crouches", "a man jogs forward", "a woman waves both hands",
+                "a person hops", "a person throws a ball", "someone sidesteps to the left", "a person punches",
+                "a man climbs stairs", "a person lies down"]   # more than five short runs can finish
 
 
 def _valid_records(manifest: Path) -> int:
@@ -172,7 +174,7 @@ def test_kill_9_at_five_random_moments_then_resume(tmp_path):
         deadline = time.time() + 120
         while time.time() < deadline and proc.poll() is None and _valid_records(manifest) <= before:
             time.sleep(0.02)
-        time.sleep(rng.uniform(0.0, 1.0))
+        time.sleep(rng.uniform(0.0, 0.6))
         assert proc.poll() is None, f"kill {kill}: the run ended before it was killed"
         os.killpg(proc.pid, signal.SIGKILL)
         proc.wait()
@@ -335,3 +337,14 @@ def test_a_batch_worker_and_the_extension_worker_share_one_loaded_model(tmp_path
     st = (model / "manifest.json").stat()
     os.utime(model / "manifest.json", ns=(st.st_atime_ns, st.st_mtime_ns + 10**9))
     assert loaded_generator(model) is not gen                           # the folder changed: loaded again
+
+
+def test_workers_fork_from_a_warm_process_only_without_blender(monkeypatch):
+    """``generate --prompts --jobs N`` loads the model once here and forks the workers from it;
+    ``render`` (no preload: bpy) and a process that imported bpy spawn them."""
+    from shapemove.core.batch.engines import start_method
+
+    monkeypatch.delitem(sys.modules, "bpy", raising=False)
+    assert start_method(None) == "spawn" and start_method(print) == "fork"
+    monkeypatch.setitem(sys.modules, "bpy", object())
+    assert start_method(print) == "spawn"

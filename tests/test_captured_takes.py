@@ -8,7 +8,7 @@ import pytest
 
 from shapemove.core.data.motion_library import MotionLibrary
 from shapemove.core.errors import ShapeMoveError
-from shapemove.core.generation.captured_takes import TakePool, busiest_start, hold, mirrored
+from shapemove.core.generation.captured_takes import ACTION_BONUS, TakePool, action_credit, busiest_start, hold, mirrored
 
 pytestmark = pytest.mark.usefixtures("one_thread")
 
@@ -67,6 +67,26 @@ def test_the_pool_offers_takes_of_the_asked_action_and_the_nearest_captions(open
     plain = pool.nearest(text, None, 0)                            # no action named: by caption only
     assert len(plain) == 5 and "walk" not in {actions[i] for i in plain}
     assert pool.take(3)["provenance"] == "captured: take 3 (CC0)"
+
+
+def test_a_take_of_another_action_than_the_words_name_does_not_compete():
+    assert action_credit("kick", "kick") == ACTION_BONUS
+    assert action_credit("jump", "jump forward") == ACTION_BONUS        # a specific form of the asked action
+    assert action_credit("jump forward", "jump") is None                 # not the other way round
+    assert action_credit("sit", "lie down") is None                      # no sit take: a lying-down take is not one
+    assert action_credit(None, "lie down") == 0.0 and action_credit("sit", "") == 0.0   # nothing named, no label
+
+
+def test_sitting_down_is_never_a_lying_down_take():
+    """The default model has no take of sitting; the lying-down take nearest the words won
+    "an old man sits down slowly" and lay flat on the floor. It no longer competes."""
+    from shapemove.core.generation.generate import Generator, Request
+
+    gen = Generator(None)
+    for seed in (0, 1):
+        m = gen.generate_batch([Request("an old man sits down slowly", seconds=4, seed=seed)])[0]
+        assert "lieDown" not in (m.provenance or "") and not (m.provenance or "").startswith("captured")
+        assert m.joints[:, 15, 1].min() > 0.5                            # the head never on the floor
 
 
 @pytest.fixture(scope="module")

@@ -2,10 +2,14 @@
 as they finish (in any order); the caller is the one manifest writer.
 
 - ``InProcess``: one after another in this process (``--jobs 1``).
-- ``ProcessPool(jobs)``: ``jobs`` worker processes (spawned, so each imports torch and loads the
-  model once and keeps it: the task caches it per process), each on cores / jobs torch threads;
+- ``ProcessPool(jobs, preload)``: ``jobs`` worker processes, each on cores / jobs torch threads;
   an item is handed out when a worker frees up (at most two per worker queued); workers write
-  their files into the batch folder.
+  their files into the batch folder. With a ``preload`` (``generate --prompts``: load the model),
+  this process runs it once on one torch thread and the workers are forked from it, so they start
+  with the model loaded (no OpenMP thread pool exists yet to be lost in the fork; tokenizers'
+  threads are turned off); without one (``render``: bpy) or where fork does not exist, they are
+  spawned, and each imports torch and loads the model on its first item and keeps it (the task
+  caches it per process).
 - ``DaskCluster(address)``: items as tasks on a running Dask distributed cluster; a task returns its
   files' bytes (``item_run.run_remote``) and they are written here, so the workers need no shared
   disk, only this package and the model folder (the default model ships inside the package).
@@ -81,17 +85,33 @@ def _init_worker(threads: int, parent: int) -> None:
     threading.Thread(target=_watch_parent, args=(parent,), daemon=True).start()
 
 
+def start_method(preload) -> str:
+    """"fork" for workers that start from this process's ``preload`` (where fork exists and bpy is
+    not loaded here), else "spawn"."""
+    import multiprocessing
+
+    forks = "fork" in multiprocessing.get_all_start_methods() and "bpy" not in sys.modules
+    return "fork" if preload is not None and forks else "spawn"
+
+
 class ProcessPool:
-    def __init__(self, jobs: int):
+    def __init__(self, jobs: int, preload=None):
         if not 1 <= jobs <= 256:
             raise ShapeMoveError(f"--jobs takes 1 to 256 worker processes, got {jobs}")
-        self.jobs = jobs
+        self.jobs, self.preload = jobs, preload
 
     def run(self, task, specs, folder):
         import multiprocessing
 
         threads = threads_per_worker(self.jobs)
-        pool = ProcessPoolExecutor(self.jobs, mp_context=multiprocessing.get_context("spawn"),
+        method = start_method(self.preload)
+        if method == "fork":
+            from ..torch_threads import one_torch_thread
+
+            os.environ["TOKENIZERS_PARALLELISM"] = "false"   # its threads do not survive a fork either
+            with one_torch_thread():
+                self.preload()
+        pool = ProcessPoolExecutor(self.jobs, mp_context=multiprocessing.get_context(method),
                                    initializer=_init_worker, initargs=(threads, os.getpid()))
         specs, running = iter(specs), set()
         try:

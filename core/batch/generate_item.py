@@ -28,6 +28,14 @@ def generator_for(where: dict, retrieval: bool = True, captured: bool = True):
     return gen
 
 
+def warm_generator(where: dict) -> None:
+    """Load the generator for ``where`` and what it reads on first use (the TMA that picks, the
+    captured takes, the standing code), so processes forked from this one start warm
+    (``engines.ProcessPool(preload=...)``)."""
+    gen = generator_for(where)
+    _ = gen.picker, gen.pool, gen.rest_code, gen.typical_speeds
+
+
 def item_motion(spec: dict):
     """(Motion, Generator) of one item (``spec``: options + settings, see manifest.py)."""
     import numpy as np

@@ -19,7 +19,9 @@ in one ``TakePool``. For a prompt:
   (``part_compose.needs_mirror``; ``data/mirror.py``'s rotations);
 - each window's features, on the performer's own body (``ClipProcessor.pose_on``), join the
   samples' decoded features, and the TMA chooses among them all (``rerank.CandidatePicker``), a
-  take of the asked action credited ``ACTION_BONUS``.
+  take of the asked action credited ``ACTION_BONUS``; when the words name an action, a take of
+  another one does not compete (``action_credit``: with no sit take, a lying-down take won "sits
+  down"; blind paraphrases, seed 0: 39.9 -> 42.0 % by the TMA judge, 31.9 -> 33.5 % raw).
 
 A window kept is moved onto the requested body by its own rotations with its feet planted
 (``retarget.planted_retarget``), never through the codes, and says where it came from
@@ -224,6 +226,18 @@ class TakePool:
     def windows(self, text: np.ndarray, action: str | None, seed: int, frames: int, side=None,
                 longest: int | None = None, count: int = TAKES) -> list[Window]:
         return [self.window(i, frames, seed, side, longest) for i in self.nearest(text, action, seed, count)]
+
+
+def action_credit(asked: str | None, action: str) -> float | None:
+    """What the choice credits a take of ``action`` for a prompt asking ``asked``: ``ACTION_BONUS``
+    for the asked action or a specific form of it (``actions.GENERIC_OF``: a jump forward for a
+    jump), nothing when the words name no action or the take has no label, and None for a take of
+    another action, which does not compete (no sit take: a lying-down take is not a sit)."""
+    from ..data.actions import GENERIC_OF
+
+    if not asked or not action:
+        return 0.0
+    return ACTION_BONUS if action == asked or asked in GENERIC_OF.get(action, ()) else None
 
 
 def busiest_start(rotations, frames: int, seed: int) -> int:

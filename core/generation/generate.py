@@ -31,7 +31,7 @@ from ..models.text_encoder import load_text_encoder
 from ..scene.motion_file import Motion
 from ..torch_threads import one_torch_thread
 from .action_clips import ACTION_CLIPS, UNASKED_SECONDS, action_clips
-from .captured_takes import ACTION_BONUS, TakePool, Window, captured_motion, decoded_provenance
+from .captured_takes import TakePool, Window, action_credit, captured_motion, decoded_provenance
 from .course_walk import ACTIONS as COURSE_ACTIONS, course_motion
 from .decode import decode_features, decode_tokens, redecode
 from .library_takes import captured_window, read_take, window_fit
@@ -232,7 +232,9 @@ class Generator:
             g = torch.Generator().manual_seed(int(r.seed))
             lo, hi = self._length(r.seconds)
             found = self._action_clips(r, lo, hi)
-            windows = self._windows(r, lo, hi, side) if captured else []
+            asked = self._asked(r)   # a take of another action than the words ask does not compete
+            windows = [w for w in (self._windows(r, lo, hi, side) if captured else [])
+                       if action_credit(asked, w.action) is not None]
             cands, sources, beta = (self._from_action_clips(r, found) if found    # the user's clips: as captured
                                     else self._sampled(r, lo, hi, g, library=not windows))   # takes, or as codes
             best = 0
@@ -242,8 +244,7 @@ class Generator:
                     fit = self._library_window(src, c) if library_as_captured else None
                     feats.append(decode_features(c, self.vae, beta.numpy()).numpy() if fit is None
                                  else np.asarray(self._library_takes[src]["new_joint_vecs"][fit.lo:fit.hi]))
-                asked = self._asked(r)
-                bonus = [0.0] * len(cands) + [ACTION_BONUS if asked and w.action == asked else 0.0 for w in windows]
+                bonus = [0.0] * len(cands) + [action_credit(asked, w.action) for w in windows]
                 best = self.picker.pick(r.prompt, feats + [w.features for w in windows], bonus, r.words)
             if best >= len(cands):
                 return Choice(None, beta, None, windows[best - len(cands)])
