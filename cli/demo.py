@@ -46,6 +46,8 @@ def run(args) -> int:
     m = measure(gen.body, motion.betas)
     print(f"prompt:      {motion.prompt}")
     print(f"shape text:  {args.shape_text}  (body from: {motion.shape_source or '[BETA] head'})")
+    if motion.provenance:   # "captured: HDM05 bd kickLFront 002 (CC BY-SA 3.0)", "generated", per segment
+        print(f"source:      {motion.provenance}")
     print(f"motion:      {motion.num_frames} frames at {motion.fps:g} fps ({motion.num_frames / motion.fps:.1f} s), "
           f"{motion.num_tokens} tokens, generated in {t1 - t0:.1f} s")
     if motion.part_prompts:

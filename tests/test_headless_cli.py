@@ -39,6 +39,8 @@ def test_demo_writes_blend_preview_and_motion(tiny_bundle, tmp_path):
         assert z["poses"].shape == (40, 24, 3) and z["betas"].shape == (10,)
     for word in ("prompt:", "body:", "height", "scene:", "preview:"):
         assert word in r.stdout
+    source = [ln for ln in r.stdout.splitlines() if ln.startswith("source:")]   # where the motion came from
+    assert len(source) == 1 and ("captured: " in source[0] or "generated" in source[0]), r.stdout
     assert not list(out.glob("*.tmp*"))
 
 
