@@ -316,7 +316,6 @@ def test_a_timeline_segment_that_turns_around_sends_the_next_one_back(gen):
     assert turn_profile(plain.joints, plain.segment_bounds, ["a person walks forward"] * 3) is None
 
 
-@pytest.mark.usefixtures("codes_only")
 def test_a_timeline_segment_that_walks_in_a_circle_goes_round_once(gen):
     """A circle segment's course is bent once round (a whole turn at an even rate, left unless
     the words say clockwise) and the walk after it goes on the way the walk before it went."""
@@ -338,7 +337,6 @@ def test_a_timeline_segment_that_walks_in_a_circle_goes_round_once(gen):
     assert np.linalg.norm(r0[b - 1] - r0[a]) > 0.8 * travel(plain.joints[a:b])[-1]    # straight before
 
 
-@pytest.mark.usefixtures("codes_only")
 def test_a_timeline_segment_that_walks_a_figure_eight_goes_round_both_loops(gen):
     """A figure-eight segment is sampled as its gait walked straight ("a person walks") and turned a
     whole turn one way over its first half and back over its second (``course_walk.course_turn``):

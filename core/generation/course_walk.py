@@ -126,11 +126,14 @@ COURSES = {
 }
 
 
-def course_line(distance: float, course: str, right: bool) -> Polyline:
+def course_line(distance: float, course: str, right: bool, whole: bool = False) -> Polyline:
     """``course`` from the origin, heading +Z, as long as ``distance`` metres need (at least one
-    period and a quarter more): its heading integrated every ``STEP`` m."""
+    period and a quarter more): its heading integrated every ``STEP`` m. ``whole``: a whole number
+    of periods (at least one) fitted to ``distance``, as a timeline's segment walks it, so the next
+    segment goes on the way the course leaves."""
     c = COURSES[course]
     period = c.period_for(distance)
+    period = distance / max(1, round(distance / period)) if whole and distance > 0 else period
     s = np.arange(0.0, max(distance, period) + period / 4 + STEP, STEP)
     yaw = c.yaw(s, period, right)
     mid = (yaw[1:] + yaw[:-1]) / 2
@@ -148,19 +151,21 @@ def course_turn(own: np.ndarray, s: np.ndarray, course: str, right: bool) -> np.
     return c.yaw(s, period, right) - (own[-1] - own[0]) * np.asarray(s, np.float64) / total
 
 
-def on_course(track: Track, course: str | None, right: bool = False, fps: float = FPS) -> Track:
+def on_course(track: Track, course: str | None, right: bool = False, fps: float = FPS, whole: bool = False) -> Track:
     """``track`` walked along ``course`` (the plan's, or the action of the nearest known caption;
-    None: a circle), clockwise when ``right``; unchanged when it does not travel."""
+    None: a circle), clockwise when ``right``; unchanged when it does not travel. ``whole``: whole
+    periods fitted to its travel (``course_line``)."""
     if motion_speed(track.joints, fps) < MIN_SPEED:
         return track
-    return follow_track(track, course_line(float(travel(track.joints)[-1]), course or CIRCLE, right), crop=False)
+    return follow_track(track, course_line(float(travel(track.joints)[-1]), course or CIRCLE, right, whole), crop=False)
 
 
-def course_motion(motion, body, course: str | None, right: bool = False, ik_refine_iters: int = 10):
+def course_motion(motion, body, course: str | None, right: bool = False, ik_refine_iters: int = 10,
+                  whole: bool = False):
     """A generated ``Motion`` walked along ``course`` (as ``on_course``; ``track.replanted``: an edit,
     no tokens kept); the motion itself when it does not travel."""
     from .track import replanted, track_of
 
     tr = track_of(motion)
-    bent = on_course(tr, course, right, motion.fps)
+    bent = on_course(tr, course, right, motion.fps, whole)
     return motion if bent is tr else replanted(motion, body, bent, ik_refine_iters)

@@ -536,7 +536,7 @@ class Generator:
                 motion.retrieved_clips = choice.clips
                 self._say_if_short(motion, choice.kept, r.seconds)
                 if words is not None:  # the codec does not carry turning: a course or a turn the words name, given back
-                    motion = (course_motion(motion, self.body, course, words.course_right, self.ik_refine_iters)
+                    motion = (course_motion(motion, self.body, course, words.course_right, self.ik_refine_iters, r.whole_course)
                               if course is not None else                                          # course_walk.py
                               turn_motion(motion, self.body, turn, self.ik_refine_iters))         # turn_words.py
                     motion = slow_motion(motion, self.body, words, self.ik_refine_iters)      # slow_steps.py

@@ -112,7 +112,8 @@ def generate_by_parts(gen, r, words=None) -> Motion | None:
                          provenance=decoded_provenance(choice.kept))
         m.shape_source = source
         m.retrieved_clips = choice.clips
-        return m if course is None else course_motion(m, gen.body, course, words.course_right, gen.ik_refine_iters)
+        return m if course is None else course_motion(m, gen.body, course, words.course_right, gen.ik_refine_iters,
+                                                      r.whole_course)
     course = plan.legs_action if plan.legs_action in COURSE_ACTIONS else read_words(plan.legs_prompt).course
     gait = read_words(plan.legs_prompt).course_gait if course is not None else None   # walked straight, then bent
     legs_req = dataclasses.replace(r, prompt=gait[0], action=gait[1]) if gait else \
@@ -128,7 +129,8 @@ def generate_by_parts(gen, r, words=None) -> Motion | None:
     tokens = dict(tokens=np.asarray(codes[0], np.int32), arms_tokens=np.asarray(arms_codes[0], np.int32),
                   arms_mirrored=arms_mirrored)
     if course is not None:  # the codec does not carry turning: the words' course is walked (course_walk.py)
-        legs, tokens = on_course(legs, course, read_words(plan.legs_prompt).course_right), {}   # an edit: no tokens kept
+        right = read_words(plan.legs_prompt).course_right
+        legs, tokens = on_course(legs, course, right, whole=r.whole_course), {}   # an edit: no tokens kept
     m = assemble(gen.body, betas, legs, arms, r.prompt, gen.ik_refine_iters, **tokens)
     m.shape_source = source
     m.part_prompts = (plan.legs_prompt, plan.arms_prompt)

@@ -29,3 +29,4 @@ class Request:
     action: str | None = None  # the action the prompt names (the planner's reading): its captured clips compete alone
     plan: object | None = None  # an edited plan (``plan.plan.Plan``, ``generate --plan``): acted on instead of the prompt's reading
     words: object | None = None  # the reading the candidates are chosen by (``plan.words.Words``; None: the prompt's)
+    whole_course: bool = False  # a timeline's segment: a course walks whole periods fitted to its travel (course_walk.py)

@@ -98,7 +98,7 @@ def segment_request(base, text: str, seconds: float, body: np.ndarray, seed: int
 
     plan = None if words is None else Plan(text, (Segment(text, 1.0, words),), float(seconds))
     return dataclasses.replace(base, prompt=text, seconds=float(seconds), betas=np.asarray(body, np.float32),
-                               shape_text=None, seed=int(seed), plan=plan, words=None)
+                               shape_text=None, seed=int(seed), plan=plan, words=None, whole_course=True)
 
 
 def planted(gen, joints: list[np.ndarray], contacts: list[np.ndarray], prompts: list[str], betas,
