@@ -29,6 +29,16 @@ def test_vocabulary():
     ("turns around 180 degrees", ["turn"]),
     ("The person does a 360 clockwise jump", ["spin jump"]),
     ("a purple teapot", []),
+    # everyday words (actions._EVERYDAY), a longer match over a shorter one it overlaps
+    ("a tourist ambles through the park", ["walk"]),
+    ("the thief tiptoes past the guard", ["sneak"]),
+    ("a baby creeps along on all fours", ["crawl"]),
+    ("she hurls a stone into the lake", ["throw"]),
+    ("the old man reclines on the grass", ["lie down"]),
+    ("a woman takes a seat", ["sit"]),
+    ("the class does star jumps", ["jumping jacks"]),
+    ("a knight swings a longsword", ["slash"]),
+    ("a pony trots around the field", ["jog"]),
 ])
 def test_find_actions(text, expected):
     assert find_actions(text) == expected

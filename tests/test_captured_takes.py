@@ -78,8 +78,8 @@ def test_a_take_of_another_action_than_the_words_name_does_not_compete():
 
 
 def test_sitting_down_is_never_a_lying_down_take():
-    """The default model has no take of sitting; the lying-down take nearest the words won
-    "an old man sits down slowly" and lay flat on the floor. It no longer competes."""
+    """The default model has no take of sitting: "an old man sits down slowly" is generated, not
+    played as the lying-down take nearest its words (flat on the floor)."""
     from shapemove.core.generation.generate import Generator, Request
 
     gen = Generator(None)

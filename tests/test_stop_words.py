@@ -230,8 +230,8 @@ def test_a_timeline_distance_is_cut_on_its_own_body_and_a_wave_after_it_stands(g
 
 
 def test_a_prompt_that_stands_still_stands(gen_default):
-    """"a person stands still" alone: no caption stands still, and the nearest captured take walked
-    backwards (1.1 m/s); it is the model's standing code for the length asked."""
+    """"a person stands still" alone: no caption stands still (the nearest captured take walks
+    backwards at 1.1 m/s), so it is the model's standing code for the length asked."""
     from shapemove.core.generation.generate import Request
 
     m = gen_default.generate_batch([Request("a person stands still", seconds=2.0, seed=1)])[0]

@@ -28,8 +28,90 @@ class Action:
     group: str          # locomotion | acrobatics | floor | exercise | gesture | combat | sport | dance
 
 
+# everyday words for the actions, beyond the labels and the caption generator's phrases ("ambles",
+# "tiptoes", "hurls", "on all fours"): what people type; a longer match wins over a shorter one it
+# overlaps ("creeps along on all fours" is a crawl, not a sneak)
+_EVERYDAY = {
+    "walk": (
+        r"\bambl(e|es|ing)\b", r"\bsaunter", r"\btrudg", r"\bwander", r"\bon foot\b",
+        r"\bone foot after the other\b",
+    ),
+    "walk backward": (r"\bin reverse\b", r"\bbacks? away\b", r"\bretreat",),
+    "sidestep": (r"\blike a crab\b", r"\blaterally\b",),
+    "turn": (r"\babout[- ]face\b", r"\bswivel",),
+    "walk in a circle": (
+        r"\bcircular (path|route|track)\b", r"\bround and round\b", r"\bcircles? the room\b", r"\bin a loop\b",
+    ),
+    "walk in a figure eight": (r"\b(eight|infinity)[- ]shaped\b", r"\binfinity (sign|shape|path)\b",),
+    "run": (r"\brac(e|es|ing) (down|ahead|along|across|around|off|away)\b",),
+    "jog": (r"\btrot(s|ting|ted)?\b",),
+    "sprint": (
+        r"\bbolt(s|ed|ing)? (ahead|off|away|forward)\b", r"\b(at )?(top|full) speed\b",
+        r"\bas fast as (possible|\w+ can)\b",
+    ),
+    "march": (r"\bparad(e|es|ing)\b",),
+    "limp": (r"\bhobbl",),
+    "sneak": (r"\btiptoe", r"\bslink", r"\bmov(e|es|ing) silently\b",),
+    "zombie walk": (r"\bshambl", r"\blurch", r"\bundead\b",),
+    "crawl": (
+        r"\bon all fours\b", r"\bcreep\w* (\w+ )?on all fours\b", r"\bon (his |her |their |your )?hands and knees\b",
+    ),
+    "jump": (r"\bsprings? (up|into the air)\b", r"\bvault(s|ed|ing)?\b",),
+    "jump forward": (r"\b(broad|standing long) jumps?\b", r"\bleap\w* as far\b",),
+    "spin jump": (r"\b(jump|leap)\w* (up )?and (twirl|spin|turn|rotat)\w*",),
+    "hop": (r"\bskip\w* (along )?on one (leg|foot)\b", r"\bbounc\w* on (both|two) feet\b",),
+    "jumping jacks": (r"\bstar[- ]?jumps?\b",),
+    "backflip": (r"\bsomersault\w* backwards?\b", r"\bback tuck\b", r"\bflip\w* over backwards?\b",),
+    "sideflip": (r"\bflip\w* over sideways\b", r"\baerial twist to the side\b",),
+    "cartwheel": (r"\bwheel\w* sideways\b",),
+    "roll": (r"\bsomersault\w*\b(?! backwards?)", r"\btumbl",),
+    "get up": (
+        r"\bris(e|es|ing) from the (floor|ground)\b", r"\bonto (his|her|their|your) feet\b", r"\bcome to standing\b",
+        r"\bto a standing position\b",
+    ),
+    "lie down": (r"\breclin", r"\b(lay|lays|lie|lies|lying) flat\b", r"\bstretch\w* out flat\b",),
+    "sit": (
+        r"\btak(e|es|ing) a seat\b", r"\bplops? down\b", r"\blower\w* (yourself|himself|herself|themselves) onto\b",
+    ),
+    "climb": (r"\bscal(e|es|ing) (a|the) (ladder|wall|rope)\b", r"\bladder\b",),
+    "squat": (r"\bknee bends?\b", r"\bcrouch\w* down\b", r"\blower\w* the hips\b", r"\bsink\w* down by bending\b",),
+    "bend over": (r"\bfold\w* forward\b",),
+    "pick up": (
+        r"\blift\w* (a|an|the) \w+ (off|from) (the )?(floor|ground)\b",
+        r"\bcollect\w* (an? |the )?\w+ (lying )?on the (floor|ground)\b",
+    ),
+    "put down": (r"\bset\w* (a|an|the) \w+ down\b",),
+    "reach up": (r"\bextend\w* an arm overhead\b", r"\breach\w* overhead\b",),
+    "stretch": (r"\bflexibility\b", r"\blengthen",),
+    "side twist": (r"\b(torso|trunk) rotations?\b", r"\brotat\w* the (torso|trunk|upper body)\b",),
+    "elbow to knee": (r"\bcross crunch", r"\belbows? (meeting|touching) (the )?opposite knees?\b",),
+    "arm circles": (r"\bwindmill", r"\bcircular swings? of the arms\b",),
+    "balance": (r"\bflamingo\b", r"\bsingle[- ]leg stance\b", r"\bstand\w* on one (foot|leg)\b",),
+    "wave": (
+        r"\bsignals? hello\b", r"\bsay(s)? hi\b", r"\bflaps? a hand\b", r"\bwaggl\w* a hand\b",
+        r"\bgreet\w* (\w+ ){0,3}with a (\w+ )?(hand|arm)\b",
+    ),
+    "wave goodbye": (r"\bfarewell\b", r"\bsee[- ]you[- ]later\b",),
+    "raise hand": (r"\bhold\w* (one|an|both|a) arms? (straight )?up\b", r"\barms? (straight )?up in the air\b",),
+    "bow": (r"\bbend\w* (\w+ )?at the waist\b",),
+    "beckon": (r"\bmotion\w* for (\w+ ){0,3}to come\b", r"\bcome closer\b",),
+    "punch": (r"\bone-two\b", r"\bshadow ?box", r"\buppercut",),
+    "kick": (r"\blash\w* out with (a|the|one|his|her) (foot|leg)\b", r"\bboot(s)? \w+ away\b",),
+    "spin kick": (r"\bwhirl\w* around and kicks?\b",),
+    "slash": (r"\bblade\b", r"\b\w*sword\b", r"\bswing\w* (a |an |the )?\w*sword\b",),
+    "kick ball": (r"\bstrik\w* the ball\b",),
+    "throw": (r"\bhurl", r"\btoss", r"\bpitch\w* (a|the) (base)?ball\b",),
+    "dribble": (r"\bbounc\w* the (basket)?ball\b",),
+    "shoot": (r"\bjump shot\b", r"\bshot at the (hoop|basket)\b",),
+    "dance": (r"\bgroov", r"\bboogie",),
+    "ballet": (r"\bballerina",),
+    "spin": (r"\btwirl", r"\bpivot\w* (a full circle|around)\b",),
+    "pose": (r"\bstrik\w* an? [\w -]{0,30}(pose|stance)\b",),
+}
+
+
 def _a(name, group, phrases, patterns):
-    return Action(name, tuple(phrases), tuple(patterns), group)
+    return Action(name, tuple(phrases), tuple(patterns) + _EVERYDAY.get(name, ()), group)
 
 
 _LIST = [

@@ -20,8 +20,8 @@ in one ``TakePool``. For a prompt:
 - each window's features, on the performer's own body (``ClipProcessor.pose_on``), join the
   samples' decoded features, and the TMA chooses among them all (``rerank.CandidatePicker``), a
   take of the asked action credited ``ACTION_BONUS``; when the words name an action, a take of
-  another one does not compete (``action_credit``: with no sit take, a lying-down take won "sits
-  down"; blind paraphrases, seed 0: 39.9 -> 42.0 % by the TMA judge, 31.9 -> 33.5 % raw).
+  another one does not compete (``action_credit``: with no take of sitting, "sits down" is
+  generated, not played as the nearest lying-down take; docs/design-notes.md).
 
 A window kept is moved onto the requested body by its own rotations with its feet planted
 (``retarget.planted_retarget``), never through the codes, and says where it came from
