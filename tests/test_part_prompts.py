@@ -16,6 +16,8 @@ from shapemove.core.plan.part_prompts import named_side, plan_parts
     # "back and forth" is a course, not two clauses ("walks back" + "forth waving" before)
     ("a person walks back and forth waving", "a person walks back and forth", "a person waving", ("walk", "wave")),
     ("a man jogs to and fro and waves", "a man jogs to and fro", "a person waves", ("jog", "wave")),
+    # a subject the table does not list is kept: no "a person" put before "a coach"
+    ("a coach runs ahead, waving to the team", "a coach runs ahead", "a person waving to the team", ("run", "wave")),
 ])
 def test_two_things_split_into_a_legs_and_an_arms_prompt(text, legs, arms, acts):
     plan = plan_parts(text)

@@ -85,7 +85,9 @@ def _tidy(clause: str) -> str:
 
 
 def _with_subject(clause: str, subject: str = "a person") -> str:
-    return clause if SUBJECT.match(clause) else f"{subject} {clause}"
+    """``clause`` with a subject: its own ("a man", "she", or any noun a verb follows: "a coach runs
+    ahead"), else ``subject``."""
+    return clause if SUBJECT.match(clause) or SUBJECT_VERB.match(clause) else f"{subject} {clause}"
 
 
 def _part_action(clause: str, part: frozenset) -> str | None:
