@@ -20,7 +20,7 @@ def test_expected_actions_are_the_vocabulary_at_each_word():
     assert expected_actions("after waving goodbye she strolls off", ["wav", "stroll"]) == ["wave goodbye", "walk"]
     assert expected_actions("he gets up, then bends over", ["get", "bend"]) == ["get up", "bend over"]
     # no action of the vocabulary covers the word, or the word is not there: not guessed
-    assert expected_actions("a man salutes, then takes a seat", ["salute", "seat"]) == [None, None]
+    assert expected_actions("a man salutes, then nods", ["salute", "nod"]) == [None, None]
     assert expected_actions("a man walks", ["walk", "walk"]) == ["walk", None]
 
 
@@ -114,7 +114,7 @@ def test_eval_sequences_command_on_a_tiny_model(tiny_bundle, tmp_path, capsys): 
 
     model, data = tiny_bundle
     prompts = {"prompts": [["a man jogs forward, then waves", ["jog", "wave"]],
-                           ["after kicking, she walks on, then takes a seat", ["kick", "walk", "seat"]]]}
+                           ["after kicking, she walks on, then salutes", ["kick", "walk", "salute"]]]}
     (tmp_path / "p.json").write_text(json.dumps(prompts))
     assert main(["eval", "sequences", "--model", str(model), "--data", str(data), "--prompts", str(tmp_path / "p.json"),
                  "--seconds", "3", "--candidates", "2", "--json", str(tmp_path / "r.json"), "--quiet"]) == 0
@@ -131,7 +131,7 @@ def test_eval_sequences_command_on_a_tiny_model(tiny_bundle, tmp_path, capsys): 
     assert rows[1]["actions"] == ["kick", "walk", None] and rows[1]["right"][2] is None
     judged = [ok for r in rows for ok in r["right"] if ok is not None]
     assert res["segments"]["judged"] == len(judged) and res["segments"]["right"] == sum(judged)
-    assert res["segments"]["unjudged_by_action"] == {"'seat' (no action)": 1}
+    assert res["segments"]["unjudged_by_action"] == {"'salute' (no action)": 1}
     assert res["split"]["right"] == 2 and "Held-out one-prompt sequences (p.json, 2 prompts)" in out
     told = {a for r in rows for a, ok in zip(r["actions"], r["right"]) if ok is not None}
     reach = res["reachable"]
