@@ -113,3 +113,25 @@ def test_a_stitched_timeline_on_another_body_a_new_strip_and_on_disk(gen, timeli
     back = load_motion(save_motion(tmp_path / "t.npz", timeline))
     assert is_stitched(back) and back.provenance == timeline.provenance
     assert back.segment_prompts == timeline.segment_prompts
+
+
+def test_sequence_no_library_gives_the_timeline_of_codes(tmp_path, capsys):
+    """`sequence` names each segment's source; `--no-library` makes the timeline of codes."""
+    from shapemove.cli import main
+    from shapemove.core.scene.motion_file import load_motion
+
+    argv = ["sequence", "--prompt", "a person walks forward", "--seconds", "1.2", "--prompt", "a person kicks",
+            "--seconds", "1.2", "--candidates", "1"]
+    assert main([*argv, "--out", str(tmp_path / "s.npz")]) == 0
+    out = capsys.readouterr().out
+    stitched = load_motion(tmp_path / "s.npz")
+    assert stitched.num_tokens == 0 and stitched.provenance.count("segment ") == 2
+    assert "[captured: " in out or "[generated" in out
+    try:
+        assert main([*argv, "--no-library", "--out", str(tmp_path / "c.npz")]) == 0
+    finally:   # the process's one loaded generator, as the other commands leave it
+        from shapemove.core.generation.loaded_generator import loaded_generator
+
+        loaded_generator(None, None).set_captured(True)
+    codes = load_motion(tmp_path / "c.npz")
+    assert codes.num_tokens == 12 and codes.segment_bounds.tolist() == [[0, 24], [24, 48]]
