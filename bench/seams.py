@@ -2,8 +2,8 @@
 joint step (within ``seam_pace.SEAM`` frames of it) over that joint's 99th percentile step inside
 the segments, for the played motion (paced seams, planted) of the timeline of finished segments
 (captured takes on, ``stitched_timeline.py``) and of the timeline of codes (off), and for the
-latter the decoded track of the same codes (no pacing, no planting). Goal: every boundary of the played motion <= 1.5. Deterministic (seed 0
-for the first timeline, +1 for each next)."""
+latter the decoded track of the same codes (no pacing, no planting). Goal: every boundary of the
+played motion <= 1.5. Deterministic (seed 0 for the first timeline, +1 for each next)."""
 from __future__ import annotations
 
 import numpy as np
@@ -59,7 +59,8 @@ def run(quick: bool = False) -> dict:
             played += r["ratios"]
             decoded += raw
             rows.append({"prompts": [p for p, _ in segs], "seed": i, "played": r["ratios"], "decoded": raw})
-            print(f"[{kind}] {' -> '.join(p for p, _ in segs)} (seed {i}): played {', '.join(f'{x:.2f}' for x in r['ratios'])}"
+            print(f"[{kind}] {' -> '.join(p for p, _ in segs)} (seed {i}): played "
+                  f"{', '.join(f'{x:.2f}' for x in r['ratios'])}"
                   + (f"; decoded {', '.join(f'{x:.2f}' for x in raw)}" if raw else "") + " x p99 step", flush=True)
         worst = float(max(played))
         print(f"[{kind}] {len(played)} boundaries of {len(rows)} timelines: played worst {worst:.2f}, median "

@@ -62,6 +62,7 @@ def run(args) -> int:
     from ..core.generation.loaded_generator import loaded_generator
     from ..core.generation.in_place import in_place
     from ..core.generation.sequence import generate_sequence, regenerate_segment, segment_codes
+    from ..core.generation.stitched_timeline import segment_sources
 
     betas = parse_betas(args.betas) if args.betas else None
     gen = loaded_generator(args.model, args.body_model)
@@ -92,8 +93,7 @@ def run(args) -> int:
           f"{len(motion.segment_bounds)} segments, IK error {motion.ik_error_cm:.2f} cm")
     n = len(motion.segment_bounds)
     own_arms = segment_codes(motion, arms=True) if motion.num_tokens else [None] * n
-    sources = (motion.provenance or "").split("; ")   # "segment K: captured: ..." of a timeline of finished segments
-    sources = [x.split(": ", 1)[1] for x in sources] if len(sources) == n and motion.num_tokens == 0 else [""] * n
+    sources = segment_sources(motion) or [""] * n   # a timeline of finished segments: each one's source
     for (s, e), p, a, src in zip(motion.segment_bounds, motion.segment_prompts, own_arms, sources):
         print(f"  frames {int(s):4d}-{int(e) - 1:4d}  {p}{'  (by body part)' if a is not None else ''}"
               f"{f'  [{src}]' if src else ''}")

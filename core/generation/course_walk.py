@@ -126,14 +126,18 @@ COURSES = {
 }
 
 
+def whole_period(course: str, distance: float) -> float:
+    """The period (m) of ``course`` fitted to ``distance`` a whole number of times (at least once)."""
+    return distance / max(1, round(distance / COURSES[course].period_for(distance)))
+
+
 def course_line(distance: float, course: str, right: bool, whole: bool = False) -> Polyline:
     """``course`` from the origin, heading +Z, as long as ``distance`` metres need (at least one
     period and a quarter more): its heading integrated every ``STEP`` m. ``whole``: a whole number
     of periods (at least one) fitted to ``distance``, as a timeline's segment walks it, so the next
     segment goes on the way the course leaves."""
     c = COURSES[course]
-    period = c.period_for(distance)
-    period = distance / max(1, round(distance / period)) if whole and distance > 0 else period
+    period = whole_period(course, distance) if whole and distance > 0 else c.period_for(distance)
     s = np.arange(0.0, max(distance, period) + period / 4 + STEP, STEP)
     yaw = c.yaw(s, period, right)
     mid = (yaw[1:] + yaw[:-1]) / 2
@@ -147,7 +151,7 @@ def course_turn(own: np.ndarray, s: np.ndarray, course: str, right: bool) -> np.
     (at least one), what it turns by itself taken out evenly along its travel."""
     c = COURSES[course]
     total = max(float(s[-1]), 1e-6)
-    period = total / max(1, round(total / c.period_for(total)))
+    period = whole_period(course, total)
     return c.yaw(s, period, right) - (own[-1] - own[0]) * np.asarray(s, np.float64) / total
 
 

@@ -36,7 +36,7 @@ from .prompts import check_prompt
 from .sampling_params import DEFAULT_CANDIDATES, check_candidates, check_sampling
 from .token_sampling import body_for, sample_codes
 from .loop_cut import EDGE, MIN_PERIOD, Cut, _local, best_cut  # noqa: F401  (where a motion loops)
-from .track import Track, decoded_track, headings, plant, rotate_y, track_of, yaw_matrix
+from .track import Track, decoded_track, headings, plant, rotate_y, smoothstep, track_of, yaw_matrix
 
 BLEND = 6              # frames over which the seam's last offset is blended in
 PLANTED_TRIES = 3      # the best cuts planted until one's seam is good (``seam_report``)
@@ -44,11 +44,6 @@ GOOD_SEAM = 1.5        # worst joint's wrap jump over its mean step that ends th
 LOOP_MIN_SECONDS = 4.0  # candidates are at least this long, so a cycle has room
 PART_SECONDS = 6.0     # a by-part motion's length when the loop's length is not asked for
 PART_TRIES = 3         # by-part motions (seeds seed, seed + 2, ...) whose cycles compete
-
-
-def _smoothstep(x):
-    x = np.clip(x, 0.0, 1.0)
-    return x * x * (3 - 2 * x)
 
 
 def make_cycle(track: Track, cut: Cut, blend: int = BLEND) -> tuple[Track, np.ndarray]:
@@ -63,7 +58,7 @@ def make_cycle(track: Track, cut: Cut, blend: int = BLEND) -> tuple[Track, np.nd
     advance = np.array([J[P, 0, 0] - J[0, 0, 0], 0.0, J[P, 0, 2] - J[0, 0, 2]])
     residual = J[0] + advance - J[P]                        # (22,3)
     n = max(1, min(int(blend), P - 1))
-    w = _smoothstep((np.arange(P + 1) - (P - n)) / n)
+    w = smoothstep((np.arange(P + 1) - (P - n)) / n)
     J += w[:, None, None] * residual[None]
     return Track(J[:P], track.contacts[a:b]), advance
 

@@ -42,7 +42,7 @@ from .seam_pace import paced_seams, seam_steps
 from ..plan.words import read_words
 from .stop_words import distance_cut, distance_keeps, from_start, standing_after, stop_cut
 from .token_sampling import body_for, sample_codes
-from .track import Track, decoded_track, plant, rotate_y
+from .track import Track, decoded_track, plant, rotate_y, smoothstep
 
 PREFIX_CODES = 4          # codes (0.8 s at 4 frames a code) a segment continues from
 SPLICE_BLEND = 6          # frames each side of a regenerated segment's seams that fade between old and new
@@ -300,8 +300,7 @@ def splice(old: Track, new: Track, start: int, old_end: int, new_end: int, blend
     k = np.arange(T, dtype=np.float64)
 
     def rise(centre):
-        x = np.clip((k - (centre - blend)) / (2 * blend), 0.0, 1.0)
-        return x * x * (3 - 2 * x)
+        return smoothstep((k - (centre - blend)) / (2 * blend))
 
     w = np.minimum(rise(start) if start > 0 else 1.0, 1.0 - rise(new_end) if new_end < T else 1.0)
     joints = w[:, None, None] * nj + (1 - w[:, None, None]) * other

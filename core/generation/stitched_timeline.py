@@ -30,16 +30,11 @@ import numpy as np
 from ..errors import ShapeMoveError
 from ..scene.motion_file import Motion
 from .seam_pace import paced_seams
-from .track import Track, headings, plant, rotate_y
+from .track import Track, headings, plant, rotate_y, smoothstep
 
 BLEND = 10       # frames (0.5 s): the shortest fade of the pose difference at a seam into the next segment
 MAX_BLEND = 40   # frames (2 s): the longest
 FADE_SHARE = 1 / 3   # the fade moves a joint at most this share of its 99th-percentile step a frame
-
-
-def smoothstep(x: np.ndarray) -> np.ndarray:
-    x = np.clip(x, 0.0, 1.0)
-    return x * x * (3 - 2 * x)
 
 
 def joined(prev: np.ndarray, nxt: np.ndarray, blend: int = BLEND) -> np.ndarray:
@@ -119,11 +114,27 @@ def planted(gen, joints: list[np.ndarray], contacts: list[np.ndarray], prompts: 
     return motion
 
 
+def segment_provenance(sources: list[str | None]) -> str:
+    """A timeline's provenance from each segment's ("segment 1: generated; segment 2: captured: ...")."""
+    return "; ".join(f"segment {i + 1}: {p or 'generated'}" for i, p in enumerate(sources))
+
+
+def segment_sources(motion: Motion) -> list[str] | None:
+    """Each segment's provenance of a stitched timeline (``segment_provenance`` read back), None when
+    the motion's provenance is not one per segment."""
+    parts = (motion.provenance or "").split("; ")
+    if motion.segment_bounds is None or len(parts) != len(motion.segment_bounds):
+        return None
+    if not all(p.startswith(f"segment {i + 1}: ") for i, p in enumerate(parts)):
+        return None
+    return [p.split(": ", 1)[1] for p in parts]
+
+
 def assembled(gen, motions: list[Motion], prompts: list[str], betas, prompt: str | None = None) -> Motion:
     """The finished segment ``motions`` (one body ``betas``) as one timeline (``planted``), with
     their provenances and notes."""
     motion = planted(gen, [m.joints for m in motions], [_contacts(m) for m in motions], prompts, betas, prompt)
-    motion.provenance = "; ".join(f"segment {i + 1}: {m.provenance or 'generated'}" for i, m in enumerate(motions))
+    motion.provenance = segment_provenance([m.provenance for m in motions])
     motion.retrieved_clips = [c for m in motions for c in m.retrieved_clips]
     motion.notes = [f"segment {i + 1}: {n}" for i, m in enumerate(motions) for n in m.notes]
     return motion
@@ -167,13 +178,13 @@ def regenerate_stitched(gen, motion: Motion, index: int, seed: int, prompt: str 
     base = request if request is not None else Request(text)
     new = gen.generate_batch([segment_request(base, text, sec, motion.betas, seed)])[0]
     joints = [np.asarray(motion.joints[s:e]) for s, e in bounds]
-    contacts = [_contacts(motion)[s:e] for s, e in bounds]
+    whole = _contacts(motion)
+    contacts = [whole[s:e] for s, e in bounds]
     joints[index], contacts[index] = np.asarray(new.joints), _contacts(new)
     prompts[index] = text
     out = planted(gen, joints, contacts, prompts, motion.betas, motion.prompt)
-    kinds = (motion.provenance or "").split("; ")
-    kinds = kinds if len(kinds) == len(prompts) else [f"segment {i + 1}: generated" for i in range(len(prompts))]
-    kinds[index] = f"segment {index + 1}: {new.provenance or 'generated'}"
-    out.provenance, out.shape_source = "; ".join(kinds), "given"
+    sources = segment_sources(motion) or [None] * len(prompts)
+    sources[index] = new.provenance
+    out.provenance, out.shape_source = segment_provenance(sources), "given"
     out.plan = motion.plan if text == motion.segment_prompts[index] else None
     return out

@@ -178,6 +178,12 @@ def yaw_matrix(angle: float) -> np.ndarray:
     return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
 
 
+def smoothstep(x) -> np.ndarray:
+    """0 -> 1 over x in [0, 1] with zero slope at both ends (3x^2 - 2x^3), 0 before, 1 after."""
+    x = np.clip(x, 0.0, 1.0)
+    return x * x * (3 - 2 * x)
+
+
 def rotate_y(points, angle) -> np.ndarray:
     """Rotate (...,3) points about +Y by ``angle`` (per leading frame when an array)."""
     a = np.asarray(angle, np.float64)
