@@ -70,6 +70,25 @@ def test_the_distance_cut_is_the_code_that_gets_there():
     assert distance_cut(joints, 3.9, 20, 4) == 20 and distance_cut(joints, 5.0, 20, 4) is None
 
 
+def test_the_samples_that_reach_the_distance_are_chosen_among():
+    """Of candidates walking 1.0, 1.5 and 2.0 m/s for 2 s (features: metres a frame at 20 fps),
+    3 m asks the two that get there; 5 m, which none reaches, the longest; a candidate already set
+    aside stays aside."""
+    from shapemove.core.generation.stop_words import reaching
+
+    def walk(speed):
+        f = np.zeros((40, 263))
+        f[:, 2] = speed / 20.0
+        return f
+
+    feats = [walk(1.0), walk(1.5), walk(2.0)]
+    every = np.ones(3, bool)
+    assert reaching(feats, 3.0, every).tolist() == [False, True, True]
+    assert reaching(feats, 5.0, every).tolist() == [False, False, True]
+    assert reaching(feats, 3.0, np.array([True, True, False])).tolist() == [False, True, False]
+    assert reaching(feats, 5.0, np.array([True, False, False])).tolist() == [True, False, False]
+
+
 @pytest.fixture(scope="module")
 def gen_default():
     from shapemove.core.generation.generate import Generator
@@ -227,6 +246,25 @@ def test_a_timeline_distance_is_cut_on_its_own_body_and_a_wave_after_it_stands(g
     (a, b), (c, e) = m.segment_bounds
     assert abs(from_start(m.joints[a:b])[-1] - 3.0) <= 0.15                # within 5 %
     assert from_start(m.joints[c:e]).max() < 0.1                          # standing while it waves
+
+
+def test_a_short_body_walks_the_distance_asked(gen_default):
+    """A 5 ft 1 woman's "a man walks 3 metres forward" (seed 0) stopped 2.58 m out, and a 4 ft 6
+    child's 4 s timeline segment 2.59 m: a slow sample was chosen, read on the T5's own body. The
+    samples that get there on the body asked compete; a length no sample can do says so."""
+    from shapemove.core.generation.generate import Request
+    from shapemove.core.generation.sequence import generate_sequence
+    from shapemove.core.generation.stop_words import from_start
+
+    gen = gen_default
+    m = gen.generate_batch([Request("a man walks 3 metres forward", shape_text="a 5 ft 1 woman", seed=0)])[0]
+    assert abs(from_start(m.joints)[-1] - 3.0) <= 0.15
+    t = generate_sequence(gen, [("a man walks 3 metres forward", 4.0), ("he waves", 2.0)], shape_text="a 4 ft 6 child", seed=0)
+    (a, b), _ = t.segment_bounds
+    assert abs(from_start(t.joints[a:b])[-1] - 3.0) <= 0.15
+    short = gen.generate_batch([Request("a man walks 3 metres forward", shape_text="a 4 ft 6 child", seed=0, seconds=4.0)])[0]
+    went = from_start(short.joints)[-1]
+    assert went >= 2.88 or any("of the 3.0 m asked" in n for n in short.notes)
 
 
 def test_a_prompt_that_stands_still_stands(gen_default):

@@ -46,13 +46,13 @@ from ..plan.reader import without_numbers
 from ..plan.segments import MIN_SEGMENT_SECONDS
 from ..plan.words import read_words
 from .retrieved_candidates import library_codes, retrieved_codes
-from .stop_words import (DISTANCE_PACE, DISTANCE_SECONDS, STAND_SECONDS, distance_cut, distance_keeps, from_start,
-                         standing_after, standing_code, stop_cut, shortened_to)
+from .stop_words import (DISTANCE_PACE, DISTANCE_SECONDS, OVERSHOOT, STAND_SECONDS, distance_cut, distance_keeps,
+                         from_start, standing_after, standing_code, stop_cut, shortened_to)
 from .sampling_params import (DEFAULT_GUIDANCE, check_candidates, check_guidance, check_retrieval_first,
                               check_retrieval_prefix, check_retrieved, check_sampling)
 from .request import Request
 from .slow_steps import slow_motion
-from .typical_pace import load_typical_speeds, typical_paced
+from .typical_pace import leg_ratio, load_typical_speeds, slow_take, typical_paced
 from .turn_words import turn_motion
 
 
@@ -218,14 +218,16 @@ class Generator:
         return Chosen([c.codes for c in chosen], torch.stack([c.betas for c in chosen]), [c.kept for c in chosen])
 
     @torch.no_grad()
-    def choose(self, r: Request, side=None, captured: bool = True) -> Choice:
+    def choose(self, r: Request, side=None, captured: bool = True, reach: float | None = None) -> Choice:
         """One request's choice among the T5's samples (and memory clips, as ``tokens_for``) and
         the captured takes of the asked action and nearest captions (``captured_takes.py``), by the
         TMA on the finished motions; ``side``: a named side, the takes mirrored to it. ``captured``
-        False: the samples alone (an edit that needs the codes follows: a stop, a distance)."""
-        return self._choose(r, True, self.captured_on and captured, side)
+        False: the samples alone (an edit that needs the codes follows: a stop, a distance); ``reach``:
+        the distance asked (m), which the samples that get that far compete for."""
+        return self._choose(r, True, self.captured_on and captured, side, reach)
 
-    def _choose(self, r: Request, library_as_captured: bool, captured: bool = False, side=None) -> Choice:
+    def _choose(self, r: Request, library_as_captured: bool, captured: bool = False, side=None,
+                reach: float | None = None) -> Choice:
         if self.t5 is None:
             raise ShapeMoveError(f"{self.model_dir} has no t5/ model: text-to-motion needs one (train t5)")
         with one_torch_thread():
@@ -233,11 +235,15 @@ class Generator:
             lo, hi = self._length(r.seconds)
             found = self._action_clips(r, lo, hi)
             asked = self._asked(r)   # a take of another action than the words ask does not compete
-            windows = [w for w in (self._windows(r, lo, hi, side) if captured else [])
-                       if action_credit(asked, w.action) is not None]
+            words = r.words if r.words is not None else read_words(r.prompt)
+            windows = [w for w in (self._windows(r, lo, hi, side) if captured else [])   # of the asked action,
+                       if action_credit(asked, w.action) is not None                    # at a plain gait's pace
+                       and not slow_take(w, words, self.typical_speeds, self.body)]
             cands, sources, beta = (self._from_action_clips(r, found) if found    # the user's clips: as captured
                                     else self._sampled(r, lo, hi, g, library=not windows))   # takes, or as codes
             best = 0
+            if reach is not None:   # a distance on the body asked; the samples are decoded on the T5's
+                reach *= leg_ratio(self.body, self.body_shape(r, beta.numpy())[0], beta.numpy())   # body, strides scale with the leg
             if len(cands) + len(windows) > 1 and self.picker is not None:
                 feats = []
                 for c, src in zip(cands, sources):
@@ -245,7 +251,7 @@ class Generator:
                     feats.append(decode_features(c, self.vae, beta.numpy()).numpy() if fit is None
                                  else np.asarray(self._library_takes[src]["new_joint_vecs"][fit.lo:fit.hi]))
                 bonus = [0.0] * len(cands) + [action_credit(asked, w.action) for w in windows]
-                best = self.picker.pick(r.prompt, feats + [w.features for w in windows], bonus, r.words)
+                best = self.picker.pick(r.prompt, feats + [w.features for w in windows], bonus, r.words, reach)
             if best >= len(cands):
                 return Choice(None, beta, None, windows[best - len(cands)])
             return Choice(cands[best], beta, sources[best], None)
@@ -526,7 +532,7 @@ class Generator:
                 # in the codes (stop_words.py), a course is a plain gait bent and a turn is given back to
                 # the decoded motion, so those are asked of the samples alone
                 turn = words.turn if words is not None else None   # turn_words.py: given back after
-                choice = self.choose(sampled, captured=stop is None and course is None and turn is None)
+                choice = self.choose(sampled, captured=stop is None and course is None and turn is None, reach=metres)
                 betas, source = self.body_shape(r, choice.betas.numpy())
                 motion = self.chosen_motion(choice, betas, r.prompt)
                 came_from = motion.provenance
@@ -635,6 +641,10 @@ class Generator:
             best.part_prompts = motion.part_prompts
             if metres is not None:   # past the mark by more than the cut's grain: shorter strides
                 best = shortened_to(best, self.body, metres, self.ik_refine_iters)
+        gone = float(from_start(best.joints)[-1]) if metres is not None else None
+        if keep is not None and gone is not None and gone < metres * (1 - OVERSHOOT):   # short, within the slack
+            best.notes.append(f"went {gone:.1f} m of the {metres:.1f} m asked in {best.num_frames / best.fps:.1f} s: "
+                              "ask for more seconds")
         return best
 
     def _say_if_short(self, motion: Motion, clip: str | None, seconds: float | None) -> None:

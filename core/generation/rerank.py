@@ -11,7 +11,7 @@ Travel and pace words come first: a candidate whose root travel goes against "fo
 "backwards", "in place" or "steps to the left" is set aside before the TMA chooses
 (``travel_words``), for "walks quickly" or "a brisk walk" only the fastest candidates compete
 (``pace_words``), and for "jumps twice" or "three squats" only those that leave the floor or go
-down the number of times nearest the asked one (``count_words``), since the TMA reads what the
+down the number of times nearest the asked one (``count_words``), and for "walks 3 metres" those whose path gets that far (``stop_words``), since the TMA reads what the
 body does, not which way, how fast or how many times.
 
 Bias to keep in mind: R-precision and the paraphrase classifier also read TMA embeddings, so
@@ -25,6 +25,7 @@ import numpy as np
 from ..plan.words import read_words
 from .count_words import counter, nearest_count
 from .pace_words import fastest, gait_speed
+from .stop_words import reaching
 from .travel_words import allowed
 
 
@@ -40,13 +41,16 @@ class CandidatePicker:
         text = embed_texts(self.model, self.tok, [prompt])[0]
         return embed_motions(self.model, feats, self.mean, self.std) @ text
 
-    def pick(self, prompt: str, feats: list, bonus=None, words=None) -> int:
+    def pick(self, prompt: str, feats: list, bonus=None, words=None, reach: float | None = None) -> int:
         """Index of the candidate closest to ``prompt`` among those that obey the travel, pace and
         count of its plan (``words``: a ``plan.words.Words``, else the prompt's reading; the first on
         a tie); ``bonus`` (N,): added to the similarities (a captured take of the asked action,
-        ``captured_takes.ACTION_BONUS``)."""
+        ``captured_takes.ACTION_BONUS``); ``reach``: a distance (m) asked of a gait cut where it gets
+        there (``stop_words.reaching``: those whose path is that long, when one is)."""
         words = read_words(prompt) if words is None else words
         keep = allowed(words.travel, feats)
+        if reach is not None:
+            keep = reaching(feats, reach, keep)
         if words.pace == "fast":
             keep = fastest(np.array([gait_speed(f) for f in feats]), keep)
         if words.count is not None:

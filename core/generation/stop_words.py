@@ -21,7 +21,10 @@ A timeline's segment that only asks to stand still ("stands still", "waits", "pa
   m, feet, ft, yards): the cut is the code where the body is that far from where it started in a
   straight line (``distance_cut``; of the codes from two before it to the next, ``distance_keeps``,
   the one whose motion, decoded again on its body, stands nearest the distance). A body's height ("six feet tall", "a six foot man") is no distance.
-  With no length asked, the motion is made long enough for a slow walk to get there.
+  With no length asked, the motion is made long enough for a slow walk to get there. Of the
+  samples, those whose path reaches the distance in the length (``reaching``; on the body asked:
+  the distance scaled by its leg against the samples' body's) are the ones the TMA chooses among
+  (the longest when none does): a slow sample chosen left a 5 ft 1 woman 0.42 m short.
 - The standing code (``standing_code``): of the codes the memory's real clips hold for at least
   ``REST_RUN`` codes in a row, the one whose repetition decodes with the least joint speed and
   root travel, wrists below the shoulders (arms down); found once per model.
@@ -103,6 +106,16 @@ def distance_cut(joints, metres: float, n: int, down: int) -> int | None:
     ``joints``; None when it never gets that far."""
     far = np.flatnonzero(from_start(joints) >= metres - REACH_SLACK)
     return None if not len(far) else min(n, int(far[0]) // down + 1)
+
+
+def reaching(feats: list, metres: float, among: np.ndarray) -> np.ndarray:
+    """(N,) bool: of the candidates ``among`` (bool), those whose root path over their (T,263)
+    features (metres a frame, ``features.py``) is at least ``metres``; where none is, the one (or
+    those) of the longest path."""
+    path = np.array([float(np.hypot(np.asarray(f)[:, 1], np.asarray(f)[:, 2]).sum()) for f in feats])
+    if not among.any():
+        return among
+    return among & (path >= min(metres, path[among].max()))
 
 
 def distance_keeps(keep: int, n: int) -> list[int]:
