@@ -102,3 +102,59 @@ def test_a_time_budget_fits_the_step_count():
     assert fitted_steps(200, 60.0, 0.01, 5.0, t) == 22_700
     assert fitted_steps(200, 400.0, 0.01, 5.0, t) == 201          # over budget: stop at once
     assert fitted_steps(200, 1.0, 1e-6, 5.0, t) == 100_000        # never past the config's ceiling
+
+
+def test_a_clip_shorter_than_the_window_is_trained_whole_and_its_padding_counts_in_no_loss(tmp_path):
+    """Kicks, squats and reaches up are 26-60 frame takes: with a 64-frame window they were left
+    out of the codec's training (38 % of the training split). With ``min_frames`` a shorter clip is
+    served whole from its first frame, zeros after, ``valid`` marking its frames, the same on the
+    CPU and resident paths; and every loss of a padded item equals the loss of the clip alone."""
+    from shapemove.core.models.savae import LossWeights
+    from shapemove.core.models.vae_losses import vae_losses
+    from shapemove.core.train.motion_dataset import MotionClips
+    from shapemove.core.train.resident_batches import ResidentBatches
+
+    rng = np.random.default_rng(3)
+    for sub in ("norm_joint_vecs", "new_joint_vecs", "betas", "contacts"):
+        (tmp_path / sub).mkdir()
+    for i, (cid, n) in enumerate({"kick": 26, "walk": 80, "tiny": 8}.items()):
+        x = rng.normal(size=(n, 263)).astype(np.float32) * 0.1
+        x[:, 0] = i + 1
+        np.save(tmp_path / "norm_joint_vecs" / f"{cid}.npy", x)
+        np.save(tmp_path / "new_joint_vecs" / f"{cid}.npy", x * 2)
+        np.save(tmp_path / "betas" / f"{cid}.npy", np.zeros(10, np.float32))
+        np.save(tmp_path / "contacts" / f"{cid}.npy", (rng.random((n + 1, 4)) > 0.5).astype(np.uint8))   # as built:
+        # a row a frame, the features one fewer
+    np.save(tmp_path / "Mean.npy", np.zeros(263, np.float32))
+    np.save(tmp_path / "Std.npy", np.ones(263, np.float32))
+    (tmp_path / "train.txt").write_text("kick\nwalk\ntiny\n")
+
+    assert MotionClips(tmp_path, "train", window=32).ids == ["walk"]                # no min_frames: as before
+    ds = MotionClips(tmp_path, "train", window=32, min_frames=16)
+    assert ds.ids == ["kick", "walk"] and ds.skipped == ["tiny"]
+    item = ds[(0, 0)]
+    assert torch.equal(item["valid"], (torch.arange(32) < 26).float())
+    assert torch.all(item["x"][:26, 0] == 1) and torch.all(item["x"][26:] == 0) and torch.all(item["contacts"][26:] == 0)
+    assert ds[(1, 0)]["valid"].sum() == 32
+    rb = next(iter(ResidentBatches(ds, batch=64, seed=0, weights=[1.0, 0.0])))    # the kick alone
+    assert torch.equal(rb["x"][0], item["x"]) and torch.equal(rb["valid"][0], item["valid"])
+    assert torch.equal(rb["contacts"][0], item["contacts"])
+    walk = np.load(tmp_path / "contacts" / "walk.npy")[:, [0, 2, 1, 3]]
+    rw = next(iter(ResidentBatches(ds, batch=64, seed=0, weights=[0.0, 1.0])))     # the walk's contacts are
+    start = int(np.flatnonzero((np.load(tmp_path / "norm_joint_vecs" / "walk.npy") == rw["x"][0, 0].numpy()).all(1))[0])
+    assert np.array_equal(rw["contacts"][0].numpy(), walk[start:start + 32])        # its own, after the kick's
+
+    weights = LossWeights(recon_mse=0.5, floating=0.1, slide=0.5, root=1.0, bone=1.0)
+    pred = item["y"] + torch.as_tensor(rng.normal(size=(32, 263)).astype(np.float32)) * 0.05
+    mean, std = torch.zeros(263), torch.ones(263)
+    padded = vae_losses(pred[None], item["y"][None], mean, std, weights, contacts=item["contacts"][None],
+                        valid=item["valid"][None], target_bones=torch.full((1, 21), 0.3))
+    alone = vae_losses(pred[None, :26], item["y"][None, :26], mean, std, weights, contacts=item["contacts"][None, :26],
+                       target_bones=torch.full((1, 21), 0.3))
+    for name in alone:
+        assert torch.allclose(padded[name], alone[name], rtol=1e-4, atol=1e-6), name
+    garbage = pred.clone()
+    garbage[26:] = 50.0                                                             # what the padding decodes to
+    again = vae_losses(garbage[None], item["y"][None], mean, std, weights, contacts=item["contacts"][None],
+                       valid=item["valid"][None], target_bones=torch.full((1, 21), 0.3))
+    assert torch.allclose(again["total"], padded["total"], rtol=1e-4)

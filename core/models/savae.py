@@ -72,6 +72,7 @@ class TrainSettings:
     freeze: tuple = ()           # parts left as they are: "encoder", "quantizer", "shape_embedding", "decoder"
     action_balance: float = 0.0  # clip sampling weight 1 / (clips of its main action) ** this (1 = actions equally)
     active_windows: float = 0.0  # crop starts: 0 uniform; 1 in proportion to how much the pose moves in the crop
+    min_frames: int = 0          # shortest clip trained on (0: ``window``); a shorter one than the window padded, masked
     resident: bool = False       # every training clip held in the device's memory, batches cut there (a GPU run)
 
 
@@ -185,6 +186,8 @@ class SAVAEConfig:
                                  f"({math.prod(self.levels)} codes), so a token holds both (motion_codes.py)")
         if not 0 <= self.train.action_balance <= 1:
             raise ShapeMoveError(f"train.action_balance must be in [0, 1], got {self.train.action_balance!r}")
+        if not 0 <= self.train.min_frames <= self.train.window:
+            raise ShapeMoveError(f"train.min_frames must be in [0, train.window], got {self.train.min_frames!r}")
         if not 0 <= self.train.active_windows <= 1:
             raise ShapeMoveError(f"train.active_windows must be in [0, 1], got {self.train.active_windows!r}")
         if self.decoder_width < 0:

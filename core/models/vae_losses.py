@@ -35,9 +35,24 @@ def bone_lengths(joints: torch.Tensor) -> torch.Tensor:
     return (joints[..., _CHILD, :] - joints[..., _PARENT, :]).norm(dim=-1)
 
 
-def velocity_loss(pred: torch.Tensor, target: torch.Tensor) -> torch.Tensor:
-    """Smooth L1 between the frame-to-frame differences of (B, T, D) sequences."""
-    return F.smooth_l1_loss(pred[:, 1:] - pred[:, :-1], target[:, 1:] - target[:, :-1])
+def masked_mean(x: torch.Tensor, valid: torch.Tensor | None) -> torch.Tensor:
+    """Mean of ``x`` (B, T, ...) over the frames where ``valid`` (B, T) is 1 (None: all of them)."""
+    if valid is None:
+        return x.mean()
+    w = valid.to(x).reshape(valid.shape + (1,) * (x.dim() - 2)).expand_as(x)
+    return (x * w).sum() / w.sum().clamp(min=1)
+
+
+def pairs(valid: torch.Tensor | None) -> torch.Tensor | None:
+    """(B, T) frames -> (B, T-1) steps from one valid frame to a valid next one."""
+    return None if valid is None else valid[:, 1:] * valid[:, :-1]
+
+
+def velocity_loss(pred: torch.Tensor, target: torch.Tensor, valid: torch.Tensor | None = None) -> torch.Tensor:
+    """Smooth L1 between the frame-to-frame differences of (B, T, D) sequences (steps between
+    ``valid`` frames)."""
+    return masked_mean(F.smooth_l1_loss(pred[:, 1:] - pred[:, :-1], target[:, 1:] - target[:, :-1], reduction="none"),
+                       pairs(valid))
 
 
 def sole_heights(joints: torch.Tensor, sole_offsets: torch.Tensor | None) -> torch.Tensor:
@@ -49,14 +64,15 @@ def sole_heights(joints: torch.Tensor, sole_offsets: torch.Tensor | None) -> tor
     return h - sole_offsets[:, SOLE_TO_CONTACT][:, None, :].to(h)
 
 
-def penetration_loss(joints: torch.Tensor, sole_offsets: torch.Tensor | None = None) -> torch.Tensor:
+def penetration_loss(joints: torch.Tensor, sole_offsets: torch.Tensor | None = None,
+                     valid: torch.Tensor | None = None) -> torch.Tensor:
     """Mean depth (m) below the ground y = 0 over all joints and frames; with ``sole_offsets`` the
     ankles and feet count with their soles (their joints may not go below their sole offset)."""
     depth = F.relu(-joints[..., 1])
     if sole_offsets is not None:
         depth = depth.clone()
         depth[..., CONTACT_JOINTS] = F.relu(-sole_heights(joints, sole_offsets))
-    return depth.mean()
+    return masked_mean(depth, valid)
 
 
 def floating_loss(joints: torch.Tensor, target_joints: torch.Tensor, contacts: torch.Tensor,
@@ -74,13 +90,15 @@ def floating_loss(joints: torch.Tensor, target_joints: torch.Tensor, contacts: t
     return (F.relu(low - ref) * mask).sum() / mask.sum().clamp(min=1)
 
 
-def foot_slide_loss(joints: torch.Tensor, contacts: torch.Tensor) -> torch.Tensor:
+def foot_slide_loss(joints: torch.Tensor, contacts: torch.Tensor, valid: torch.Tensor | None = None) -> torch.Tensor:
     """Horizontal (XZ) displacement (m/frame) of the ankle/foot joints from frame t to t+1 while the
     target says that joint is in contact at t; averaged over the contact events. (The sole of a
     planted joint moves as the joint does: no offset needed.)"""
     feet = joints[..., CONTACT_JOINTS, :]                         # (B,T,4,3)
     step = (feet[:, 1:, :, [0, 2]] - feet[:, :-1, :, [0, 2]]).norm(dim=-1)
     mask = (contacts[:, :-1] > 0.5).float()
+    if valid is not None:   # no step into a padded frame
+        mask = mask * pairs(valid)[..., None].to(mask)
     return (step * mask).sum() / mask.sum().clamp(min=1)
 
 
@@ -122,25 +140,25 @@ def dynamic_stability_loss(joints: torch.Tensor, contacts: torch.Tensor, margin:
 
 
 def root_travel_loss(joints: torch.Tensor, target_joints: torch.Tensor, pred: torch.Tensor,
-                     target: torch.Tensor) -> torch.Tensor:
+                     target: torch.Tensor, valid: torch.Tensor | None = None) -> torch.Tensor:
     """How well the root's travel is carried: the mean horizontal distance (m) between the predicted
     and the target root trajectories over the window (both start at the origin, so a shrunk speed
     accumulates), plus smooth L1 on the normalized root channels (rotation velocity, XZ velocity,
     height). The root channels are 4 of 263 features: under the plain reconstruction term their
     errors are diluted ~65x and the decoder learns to under-shoot speed (HumanML3D's code up-weights
     them for the same reason)."""
-    track = (joints[..., 0, :][..., [0, 2]] - target_joints[..., 0, :][..., [0, 2]]).norm(dim=-1).mean()
-    return track + F.smooth_l1_loss(pred[..., :4], target[..., :4])
+    track = masked_mean((joints[..., 0, :][..., [0, 2]] - target_joints[..., 0, :][..., [0, 2]]).norm(dim=-1), valid)
+    return track + masked_mean(F.smooth_l1_loss(pred[..., :4], target[..., :4], reduction="none"), valid)
 
 
-def bone_length_loss(joints: torch.Tensor, target_bones: torch.Tensor) -> torch.Tensor:
+def bone_length_loss(joints: torch.Tensor, target_bones: torch.Tensor, valid: torch.Tensor | None = None) -> torch.Tensor:
     """Mean |bone length - target rest length| (m). joints (B,T,22,3), target_bones (B,21)."""
-    return (bone_lengths(joints) - target_bones[:, None, :]).abs().mean()
+    return masked_mean((bone_lengths(joints) - target_bones[:, None, :]).abs(), valid)
 
 
 def vae_losses(pred: torch.Tensor, target: torch.Tensor, mean: torch.Tensor, std: torch.Tensor, weights,
                target_bones: torch.Tensor | None = None, sole_offsets: torch.Tensor | None = None,
-               contacts: torch.Tensor | None = None) -> dict:
+               contacts: torch.Tensor | None = None, valid: torch.Tensor | None = None) -> dict:
     """All SA-VAE losses for normalized prediction/target features (B, T, 263).
 
     ``weights`` is a ``LossWeights``; ``target_bones`` (B, 21) are the rest bone lengths of the
@@ -148,11 +166,14 @@ def vae_losses(pred: torch.Tensor, target: torch.Tensor, mean: torch.Tensor, std
     lengths of the target motion. ``sole_offsets`` (B, 4): the target body's sole offsets of joints
     7, 8, 10, 11 (``body.soles.sole_offsets``): the ground losses then act on the soles.
     ``contacts`` (B, T, 4) in ``CONTACT_JOINTS`` order (the dataset's stored contacts); None = the
-    target's contact channels. Returns a dict of scalar tensors with the weighted sum in 'total'.
+    target's contact channels. ``valid`` (B, T): 1 on a clip's frames, 0 on a short clip's padding
+    (``MotionClips``), which no term counts; None: every frame. Returns a dict of scalar tensors
+    with the weighted sum in 'total'.
     """
-    out = {"recon": F.smooth_l1_loss(pred, target), "vel": velocity_loss(pred, target)}
+    out = {"recon": masked_mean(F.smooth_l1_loss(pred, target, reduction="none"), valid),
+           "vel": velocity_loss(pred, target, valid)}
     if getattr(weights, "recon_mse", 0.0):
-        out["recon_mse"] = F.mse_loss(pred, target)
+        out["recon_mse"] = masked_mean(F.mse_loss(pred, target, reduction="none"), valid)
     stability = getattr(weights, "dyn_stability", 0.0)
     physical = stability or any(getattr(weights, k, 0.0) for k in ("bone", "floating", "slide", "penetrate", "root"))
     if physical:
@@ -165,12 +186,14 @@ def vae_losses(pred: torch.Tensor, target: torch.Tensor, mean: torch.Tensor, std
         if contacts is None:
             contacts = target_f[..., CONTACT_SLICE]
         contacts = contacts.to(joints)
-        out["bone"] = bone_length_loss(joints, target_bones)
+        if valid is not None:   # no contact on padding: the ground terms count the clip's frames alone
+            contacts = contacts * valid.to(joints)[..., None]
+        out["bone"] = bone_length_loss(joints, target_bones, valid)
         out["floating"] = floating_loss(joints, target_joints, contacts, sole_offsets)
-        out["slide"] = foot_slide_loss(joints, contacts)
-        out["penetrate"] = penetration_loss(joints, sole_offsets)
+        out["slide"] = foot_slide_loss(joints, contacts, valid)
+        out["penetrate"] = penetration_loss(joints, sole_offsets, valid)
         if getattr(weights, "root", 0.0):
-            out["root"] = root_travel_loss(joints, target_joints, pred, target)
+            out["root"] = root_travel_loss(joints, target_joints, pred, target, valid)
         if stability:
             out["dyn_stability"] = dynamic_stability_loss(joints, contacts)
     out["total"] = sum(getattr(weights, k) * v for k, v in out.items())

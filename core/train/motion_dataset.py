@@ -48,17 +48,24 @@ def read_split(root, split: str) -> list[str]:
 class MotionClips(Dataset):
     """Item ``(index, epoch)`` (or ``index``, epoch 0) -> dict of float32 tensors:
     x (window, D) normalized canonical features, y (window, D) normalized shape-aware features
-    (same frames), betas (10,). Clips shorter than ``window`` are left out (``self.skipped``).
+    (same frames), betas (10,). Clips shorter than ``min_frames`` (0: ``window``) are left out
+    (``self.skipped``); with ``min_frames`` under ``window`` a shorter clip is served whole from its
+    first frame, zeros after its end (the mean pose: what a convolution reads past the end of a
+    clip encoded alone), and every item carries ``valid`` (window,): 1 on the clip's frames, 0 on
+    the padding, which no loss counts (``vae_losses``). Left out, the short clips were 38 % of the
+    training split: every squat, 16 of 18 kicks, 14 of 16 reaches up, every jog.
     ``active_windows`` > 0 draws crop starts where the pose moves (``crop_starts.start_weights``).
     ``stats``: (mean, std) to normalize with instead of the folder's Mean/Std (a model fine-tuned
     from a checkpoint keeps the normalization it was trained with)."""
 
     def __init__(self, root, split: str = "train", window: int = 64, seed: int = 0, stats=None,
-                 active_windows: float = 0.0):
+                 active_windows: float = 0.0, min_frames: int = 0):
         self.root = Path(root)
         if not self.root.is_dir():
             raise ShapeMoveError(f"dataset folder not found: {self.root}")
         self.window, self.seed = window, seed
+        self.min_frames = min(window, min_frames) if min_frames > 0 else window
+        self.padded = self.min_frames < window     # items carry ``valid``
         self.has_contacts = (self.root / "contacts").is_dir()
         self.mean, self.std = load_stats(self.root)
         if stats is not None:
@@ -76,12 +83,14 @@ class MotionClips(Dataset):
                 raise ShapeMoveError(f"{self.root}: clip '{cid}' of {split}.txt has no features ({exc.filename})") from exc
             if x.shape != y.shape or x.ndim != 2 or x.shape[1] != self.mean.shape[0]:
                 raise ShapeMoveError(f"{self.root}: clip '{cid}': feature shapes {x.shape} / {y.shape} do not match Mean ({self.mean.shape[0]})")
-            if x.shape[0] < window:
+            if x.shape[0] < self.min_frames:
                 self.skipped.append(cid)
                 continue
             self.ids.append(cid)
             self.lengths.append(int(x.shape[0]))
-            self.start_cdf.append(np.cumsum(start_weights(x, window, active_windows)) if active_windows > 0 else None)
+            whole = x.shape[0] <= window     # served whole: one start
+            self.start_cdf.append(np.cumsum(start_weights(x, window, active_windows))
+                                  if active_windows > 0 and not whole else None)
 
     def __len__(self) -> int:
         return len(self.ids)
@@ -96,19 +105,30 @@ class MotionClips(Dataset):
         rng = np.random.default_rng([self.seed, epoch, index])
         cdf = self.start_cdf[index]
         if cdf is None:
-            start = int(rng.integers(0, self.lengths[index] - self.window + 1))
+            start = int(rng.integers(0, max(1, self.lengths[index] - self.window + 1)))
         else:
             start = min(int(np.searchsorted(cdf, rng.random() * cdf[-1], side="right")), len(cdf) - 1)
-        x = (self._load("norm_joint_vecs", cid, start) - self.mean) / self.std
-        y = (self._load("new_joint_vecs", cid, start) - self.mean) / self.std
+        n = min(self.window, self.lengths[index])    # the clip's frames in the window; zeros after
+        x = self._padded((self._load("norm_joint_vecs", cid, start) - self.mean) / self.std)
+        y = self._padded((self._load("new_joint_vecs", cid, start) - self.mean) / self.std)
         betas = self._load("betas", cid).reshape(-1)
         item = {"x": torch.from_numpy(x), "y": torch.from_numpy(y), "betas": torch.from_numpy(betas)}
         if self.has_contacts:
-            c = self._load("contacts", cid, start)
-            if c.shape != (self.window, 4):
+            c = self._load("contacts", cid, start)[:n]   # a row a frame; the features lack the last frame
+            if c.shape != (n, 4):
                 raise ShapeMoveError(f"{self.root}: clip '{cid}': contacts/{cid}.npy must be (frames, 4), got {c.shape}")
-            item["contacts"] = torch.from_numpy(c[:, CONTACT_ORDER])
+            item["contacts"] = torch.from_numpy(self._padded(c[:, CONTACT_ORDER]))
+        if self.padded:
+            item["valid"] = torch.from_numpy((np.arange(self.window) < n).astype(np.float32))
         return item
+
+    def _padded(self, a: np.ndarray) -> np.ndarray:
+        """(n, C) rows -> (window, C): zeros after the clip's end."""
+        if len(a) == self.window:
+            return np.ascontiguousarray(a, dtype=np.float32)
+        out = np.zeros((self.window, a.shape[1]), np.float32)
+        out[:len(a)] = a
+        return out
 
 
 class BatchStream:
@@ -124,7 +144,7 @@ class BatchStream:
     def __init__(self, dataset: MotionClips, batch: int, rank: int = 0, world_size: int = 1, seed: int = 0,
                  start_step: int = 0, weights=None):
         if len(dataset) == 0:
-            raise ShapeMoveError(f"{dataset.root}: no clips of at least {dataset.window} frames in this split")
+            raise ShapeMoveError(f"{dataset.root}: no clips of at least {dataset.min_frames} frames in this split")
         self.batch, self.start_step = batch, start_step
         self.rank, self.world_size, self.seed = rank, world_size, seed
         self.p, self.sampler = None, None

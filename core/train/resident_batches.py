@@ -32,10 +32,15 @@ class ResidentBatches:
             xs.append((dataset._load("norm_joint_vecs", cid) - dataset.mean) / dataset.std)
             ys.append((dataset._load("new_joint_vecs", cid) - dataset.mean) / dataset.std)
             if dataset.has_contacts:
-                cs.append(dataset._load("contacts", cid)[:, CONTACT_ORDER])
+                cs.append(dataset._load("contacts", cid)[:len(xs[-1]), CONTACT_ORDER])   # a row a feature row:
+                # the contacts hold one more frame than the features (a clip's last), which would
+                # shift every later clip's contacts by a frame more
         lengths = np.array([len(a) for a in xs])
         self.offsets = torch.as_tensor(np.concatenate([[0], np.cumsum(lengths)[:-1]]), dtype=torch.long)
-        self.starts = torch.as_tensor(lengths - self.window + 1, dtype=torch.long)   # possible starts per clip
+        # possible starts per clip; a clip shorter than the window (``MotionClips.min_frames``) has one
+        self.starts = torch.as_tensor(np.maximum(lengths - self.window + 1, 1), dtype=torch.long)
+        self.lengths = torch.as_tensor(lengths, dtype=torch.long)
+        self.padded = dataset.padded
         self.x = torch.from_numpy(np.concatenate(xs)).to(self.device)
         self.y = torch.from_numpy(np.concatenate(ys)).to(self.device)
         self.contacts = torch.from_numpy(np.concatenate(cs)).to(self.device) if cs else None
@@ -75,10 +80,16 @@ class ResidentBatches:
         step = self.start_step
         while True:
             clips, start = self.draw(step)
-            rows = ((self.offsets[clips] + start)[:, None] + self.frames).to(self.device)
+            rows = ((self.offsets[clips] + start)[:, None] + self.frames).clamp(max=len(self.x) - 1).to(self.device)
             b = {"x": self.x[rows], "y": self.y[rows], "betas": self.betas[clips.to(self.device)]}
             if self.contacts is not None:
                 b["contacts"] = self.contacts[rows]
+            if self.padded:   # past a short clip's end: zeros, not the next clip's frames (``MotionClips``)
+                valid = (self.frames[None] < self.lengths[clips][:, None]).to(self.device)
+                for k in ("x", "y", "contacts"):
+                    if k in b:
+                        b[k] = b[k] * valid[..., None].to(b[k])
+                b["valid"] = valid.float()
             if self.body is not None:
                 c = clips.to(self.device)
                 b["bones"], b["soles"] = self.body[0][c], self.body[1][c]

@@ -76,10 +76,12 @@ def body_soles(body, betas: torch.Tensor) -> torch.Tensor:
 
 def batch_losses(model_out: dict, b: dict, model, cfg, body) -> dict:
     """``vae_losses`` of one batch: target bones and sole offsets of the batch's bodies (the batch's
-    own when it carries them, ``ResidentBatches``), the dataset's stored contacts when it has them."""
+    own when it carries them, ``ResidentBatches``), the dataset's stored contacts when it has them,
+    its clips' frames alone (``valid``) when short clips are padded (``MotionClips``)."""
     bones = b["bones"] if "bones" in b else target_bones(body, b["betas"])
     soles = b["soles"] if "soles" in b else body_soles(body, b["betas"])
-    return vae_losses(model_out["recon"], b["y"], model.mean, model.std, cfg.loss, bones, soles, b.get("contacts"))
+    return vae_losses(model_out["recon"], b["y"], model.mean, model.std, cfg.loss, bones, soles, b.get("contacts"),
+                      b.get("valid"))
 
 
 def start_from(cfg: SAVAEConfig, body_name: str) -> SAVAE:
@@ -174,8 +176,9 @@ def _train(data, out, cfg, t, resume, body, dist, progress, cancel, verbose, min
     source = start_from(cfg, body_name) if t.init_from else None
     # -- data (normalized as the starting model was, when there is one) ----------------------
     stats = (source.mean.numpy(), source.std.numpy()) if source is not None else None
-    train_set = MotionClips(data, "train", t.window, seed=t.seed, stats=stats, active_windows=t.active_windows)
-    val_set = MotionClips(data, "val", t.window, seed=t.seed + 1, stats=stats)
+    train_set = MotionClips(data, "train", t.window, seed=t.seed, stats=stats, active_windows=t.active_windows,
+                            min_frames=t.min_frames)
+    val_set = MotionClips(data, "val", t.window, seed=t.seed + 1, stats=stats, min_frames=t.min_frames)
     mean, std = train_set.mean, train_set.std
     # -- model, optimizer, schedule ----------------------------------------------------------
     torch.manual_seed(t.seed)  # same initial weights on every rank
