@@ -240,8 +240,8 @@ class Generator:
             cands, sources, beta = (self._from_action_clips(r, found) if found    # the user's clips: as captured
                                     else self._sampled(r, lo, hi, g, library=not windows))   # takes, or as codes
             best = 0
-            if reach is not None:   # a distance on the body asked; the samples are decoded on the T5's
-                reach *= leg_ratio(self.body, self.body_shape(r, beta.numpy())[0], beta.numpy())   # body, strides scale with the leg
+            if reach is not None:   # the distance on the T5's body, which the samples are decoded on
+                reach *= leg_ratio(self.body, self.body_shape(r, beta.numpy())[0], beta.numpy())   # (strides scale with the leg)
             if len(cands) + len(windows) > 1 and self.picker is not None:
                 feats = []
                 for c, src in zip(cands, sources):
