@@ -66,6 +66,8 @@ class Choice(NamedTuple):
     betas: torch.Tensor           # (10,) the [BETA] head's body
     kept: str | None              # the memory clip whose codes were kept, None for a T5 sample
     window: Window | None         # the captured take kept (captured_takes.py)
+    body: np.ndarray              # (10,) the body the motion is made for (``Generator.body_shape``)
+    body_source: str              # where that body came from ("[BETA] head", "measurements", ...)
 
     @property
     def clips(self) -> list[str]:
@@ -218,16 +220,19 @@ class Generator:
         return Chosen([c.codes for c in chosen], torch.stack([c.betas for c in chosen]), [c.kept for c in chosen])
 
     @torch.no_grad()
-    def choose(self, r: Request, side=None, captured: bool = True, reach: float | None = None) -> Choice:
+    def choose(self, r: Request, side=None, captured: bool = True, reach: float | None = None,
+               body_of: Request | None = None) -> Choice:
         """One request's choice among the T5's samples (and memory clips, as ``tokens_for``) and
         the captured takes of the asked action and nearest captions (``captured_takes.py``), by the
         TMA on the finished motions; ``side``: a named side, the takes mirrored to it. ``captured``
         False: the samples alone (an edit that needs the codes follows: a stop, a distance); ``reach``:
-        the distance asked (m), which the samples that get that far compete for."""
-        return self._choose(r, True, self.captured_on and captured, side, reach)
+        the distance asked (m), which the samples that get that far compete for; ``body_of``: the
+        request whose words give the body (``body_shape``) when ``r`` is a rewording of it (a
+        course's plain gait)."""
+        return self._choose(r, True, self.captured_on and captured, side, reach, body_of)
 
     def _choose(self, r: Request, library_as_captured: bool, captured: bool = False, side=None,
-                reach: float | None = None) -> Choice:
+                reach: float | None = None, body_of: Request | None = None) -> Choice:
         if self.t5 is None:
             raise ShapeMoveError(f"{self.model_dir} has no t5/ model: text-to-motion needs one (train t5)")
         with one_torch_thread():
@@ -240,8 +245,9 @@ class Generator:
             cands, sources, beta = (self._from_action_clips(r, found) if found    # the user's clips: as captured
                                     else self._sampled(r, lo, hi, g, library=not windows))   # takes, or as codes
             best = 0
+            body, body_source = self.body_shape(body_of or r, beta.numpy())
             if reach is not None:   # the distance on the T5's body, which the samples are decoded on
-                reach *= leg_ratio(self.body, self.body_shape(r, beta.numpy())[0], beta.numpy())   # (strides scale with the leg)
+                reach *= leg_ratio(self.body, body, beta.numpy())   # (strides scale with the leg)
             if len(cands) + len(windows) > 1 and self.picker is not None:
                 feats = []
                 for c, src in zip(cands, sources):
@@ -251,8 +257,8 @@ class Generator:
                 bonus = [0.0] * len(cands) + [action_credit(asked, w.action) for w in windows]
                 best = self.picker.pick(r.prompt, feats + [w.features for w in windows], bonus, r.words, reach)
             if best >= len(cands):
-                return Choice(None, beta, None, windows[best - len(cands)])
-            return Choice(cands[best], beta, sources[best], None)
+                return Choice(None, beta, None, windows[best - len(cands)], body, body_source)
+            return Choice(cands[best], beta, sources[best], None, body, body_source)
 
     @staticmethod
     def _asked(r: Request) -> str | None:
@@ -530,8 +536,9 @@ class Generator:
                 # in the codes (stop_words.py), a course is a plain gait bent and a turn is given back to
                 # the decoded motion, so those are asked of the samples alone
                 turn = words.turn if words is not None else None   # turn_words.py: given back after
-                choice = self.choose(sampled, captured=stop is None and course is None and turn is None, reach=metres)
-                betas, source = self.body_shape(r, choice.betas.numpy())
+                choice = self.choose(sampled, captured=stop is None and course is None and turn is None, reach=metres,
+                                     body_of=r)
+                betas, source = choice.body, choice.body_source
                 motion = self.chosen_motion(choice, betas, r.prompt)
                 came_from = motion.provenance
                 if stop is not None:   # stop_words.py: cut, then stand

@@ -27,10 +27,16 @@ from ..constants import FPS
 FAST_SHARE = 1 / 3  # the fastest third of the candidates compete for a fast pace
 SLOW_SPEED = 0.8    # a stepping gait asked slowly is played at this speed
 
+def path_length(features: np.ndarray) -> float:
+    """Metres the root travels along its path over a (T, 263) feature clip (its horizontal
+    velocities, metres a frame, ``features.py``, summed)."""
+    f = np.asarray(features, dtype=np.float64)
+    return float(np.hypot(f[:, 1], f[:, 2]).sum())
+
+
 def gait_speed(features: np.ndarray) -> float:
     """Mean horizontal root speed (m/s) along the path of a (T, 263) feature clip."""
-    f = np.asarray(features, dtype=np.float64)
-    return float(np.hypot(f[:, 1], f[:, 2]).mean() * FPS)
+    return path_length(features) / max(len(features), 1) * FPS
 
 
 def fastest(speeds: np.ndarray, among: np.ndarray) -> np.ndarray:

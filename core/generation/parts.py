@@ -103,9 +103,9 @@ def generate_by_parts(gen, r, words=None) -> Motion | None:
         words = read_words(r.prompt)
         course = words.course                    # "paces back and forth, waving his right hand": its gait
         sampled = dataclasses.replace(r, prompt=words.straight_text) if course else r   # sampled straight
-        choice = gen.choose(sampled, side)   # captured takes, mirrored to the side, compete with the samples
-        betas, source = gen.body_shape(r, choice.betas.numpy())   # (planting, the foot roll above all, changes
-        m = gen.chosen_motion(choice, betas, r.prompt)            # how far a foot travels)
+        choice = gen.choose(sampled, side, body_of=r)   # captured takes, mirrored to the side, compete with the samples
+        betas, source = choice.body, choice.body_source   # (planting, the foot roll above all, changes
+        m = gen.chosen_motion(choice, betas, r.prompt)    # how far a foot travels)
         if choice.window is None and needs_mirror(m.joints, *side):
             m = assemble(gen.body, betas, _track(choice.codes, gen.vae, gen.body, betas, True), None, r.prompt,
                          gen.ik_refine_iters, tokens=np.asarray(choice.codes, np.int32), mirrored=True,

@@ -11,8 +11,9 @@ Travel and pace words come first: a candidate whose root travel goes against "fo
 "backwards", "in place" or "steps to the left" is set aside before the TMA chooses
 (``travel_words``), for "walks quickly" or "a brisk walk" only the fastest candidates compete
 (``pace_words``), and for "jumps twice" or "three squats" only those that leave the floor or go
-down the number of times nearest the asked one (``count_words``), and for "walks 3 metres" those whose path gets that far (``stop_words``), since the TMA reads what the
-body does, not which way, how fast or how many times.
+down the number of times nearest the asked one (``count_words``), and for "walks 3 metres" those
+whose path gets that far (``stop_words``), since the TMA reads what the body does, not which way,
+how fast, how far or how many times.
 
 Bias to keep in mind: R-precision and the paraphrase classifier also read TMA embeddings, so
 ``eval generate`` scores the generator with one candidate, and ``eval paraphrase`` also reports a

@@ -40,6 +40,7 @@ import numpy as np
 import torch
 
 from ..motion.contacts import runs
+from .pace_words import path_length
 
 REACH_SLACK = 0.1          # m: a gait this close to the distance has got there
 DISTANCE_PACE = 0.7        # m/s: with no length asked, a distance is given time for this slow a walk ...
@@ -112,7 +113,7 @@ def reaching(feats: list, metres: float, among: np.ndarray) -> np.ndarray:
     """(N,) bool: of the candidates ``among`` (bool), those whose root path over their (T,263)
     features (metres a frame, ``features.py``) is at least ``metres``; where none is, the one (or
     those) of the longest path."""
-    path = np.array([float(np.hypot(np.asarray(f)[:, 1], np.asarray(f)[:, 2]).sum()) for f in feats])
+    path = np.array([path_length(f) for f in feats])
     if not among.any():
         return among
     return among & (path >= min(metres, path[among].max()))
