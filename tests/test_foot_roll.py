@@ -115,3 +115,36 @@ def test_a_stance_within_reach_stays_flat(body):
     j, c, _ = _stance(body, b, end=0.05)
     p = plant_motion(body, b, j, c, gate=False, max_flight=None)
     np.testing.assert_array_equal(p.contacts, c)
+
+
+@pytest.mark.parametrize("pitch_deg, roll_deg", [(40.0, 20.0), (25.0, 25.0), (10.0, 35.0)])
+def test_rolled_toes_lie_flat_whatever_the_foot_pitch(body, pitch_deg, roll_deg):
+    """The leg pass lays a rolled foot's toes flat on the floor, turned to the foot's heading, even
+    where the foot is pitched more (or less) than the roll: undoing the roll's angle alone left the
+    difference in the toes (a 19-degree excess put them 3 cm under the floor)."""
+    from shapemove.core.body.plant import LEGS, pin_feet
+    from shapemove.core.geometry.fk import forward_kinematics
+    from shapemove.core.geometry.rotations import axis_angle_to_matrix
+
+    with torch.no_grad():
+        rest = body.rest_joints(torch.zeros(1, 10))[0].numpy().astype(np.float64)
+    T = 3
+    rot = np.repeat(np.eye(3)[None, None], T, 0).repeat(len(body.parents), 1)
+    yaw = axis_angle_to_matrix(np.array([0.0, np.deg2rad(30.0), 0.0]))
+    rot[:, 0] = yaw                                                    # the body faces 30 degrees round
+    rot[:, 7] = axis_angle_to_matrix(np.array([np.deg2rad(-pitch_deg), 0.0, 0.0]))   # left foot: heel up
+    transl = np.zeros((T, 3))
+    pos, _ = forward_kinematics(rot, rest, body.parents)
+    targets = pos[:, :22].copy()                                       # every joint where it is
+    weights = np.zeros((T, 4))
+    weights[:, 2] = 1.0                                                # the left ball planted
+    toe = np.zeros((T, 2, 3))
+    toe[:, 0] = [np.deg2rad(roll_deg), 0.0, 0.0]                       # the roll's own pitch differs
+    out = pin_feet(rot, transl, rest, body.parents, targets, weights, toe=toe)
+    _, G = forward_kinematics(out, rest, body.parents)
+    g = G[:, LEGS[0][3]]
+    assert np.allclose(g[:, :, 1], [0.0, 1.0, 0.0], atol=1e-9)         # toes flat: their up is the world's
+    heading = np.arctan2(g[:, 0, 2], g[:, 2, 2])
+    assert np.allclose(heading, np.deg2rad(30.0), atol=1e-9)           # the foot's heading kept
+    right = G[:, LEGS[1][3]]                                           # the other foot: no roll, unchanged
+    assert np.allclose(right, forward_kinematics(rot, rest, body.parents)[1][:, LEGS[1][3]])

@@ -55,3 +55,34 @@ def test_a_plain_jog_goes_at_the_captured_pace(prompt, gait):
     fast = gen.generate_batch([Request("a person jogs quickly", seed=0)])[0]
     assert mean_speed(fast.joints) > 1.2 * gen.typical_speeds[gait]    # a pace asked is kept
 
+
+def test_a_slow_captured_take_does_not_compete_for_a_plain_gait():
+    """The data's strolls won "a man walks" as readily as plain walks (median 0.93x the typical
+    pace): a take under 0.95x its typical speed, on its performer's leg, is left out; a pace the
+    words ask lets it compete."""
+    from shapemove.core.body.load import load_body_model
+    from shapemove.core.constants import FPS
+    from shapemove.core.generation.captured_takes import Window
+    from shapemove.core.generation.typical_pace import SLOW_TAKE, slow_take
+    from shapemove.core.plan.words import read_words
+
+    body = load_body_model(None)
+    rest = body.rest_joints(__import__("torch").zeros(1, body.num_betas))[0, :24].numpy()
+    tall = rest * 1.2                                   # a performer whose leg is 1.2x the average's
+
+    def take(speed, performer, held=0):
+        feats = np.zeros((59, 263), np.float32)
+        feats[:, 1] = speed / FPS                       # metres a frame, sideways in the root frame
+        feats[59 - held:, 1] = 0.0                      # held on its last pose: not walking
+        return Window(rotations=np.zeros((60, 24, 3, 3)), root=np.zeros((60, 3)), contacts=np.zeros((60, 4)),
+                      rest=performer, features=feats, action="walk", clip_id="x", provenance="captured", held=held)
+
+    speeds = {"walk": 1.2}
+    plain = read_words("a man walks")
+    assert slow_take(take(1.0, rest), plain, speeds, body)                       # 0.83x
+    assert not slow_take(take(1.2 * SLOW_TAKE + 0.01, rest), plain, speeds, body)
+    assert slow_take(take(1.2, tall), plain, speeds, body)                      # 1.2 m/s on a 1.2x leg: 0.83x
+    assert not slow_take(take(1.2, rest, held=20), plain, speeds, body)         # the held frames do not count
+    assert not slow_take(take(1.0, rest), read_words("a man walks slowly"), speeds, body)
+    assert not slow_take(take(1.0, rest), read_words("a man waves"), speeds, body)
+    assert not slow_take(take(1.0, rest), plain, {}, body)

@@ -229,8 +229,9 @@ def pin_feet(rotations, transl, rest, parents, targets, weights, soft_reach: flo
     leg moves that fraction of its miss (1 in contact: exactly on target where the leg reaches).
     rotations (T,24,3,3) local, transl (T,3), rest (24,3), targets (T,22,3) ->
     new local rotations (T,24,3,3); frames without weight are unchanged. ``toe`` (T,2,3) world
-    rotation vectors (left, right leg) that the toes undo where the foot rolls over its ball
-    (``foot_roll.roll_feet``): the ball joint's rotation turns back so the toes stay on the floor."""
+    rotation vectors (left, right leg), non-zero where the foot rolls over its ball
+    (``foot_roll.roll_feet``): there the ball joint's rotation lays the toes flat on the floor
+    (``flat_toes``)."""
     import torch
 
     from ..geometry.torch_ops import forward_kinematics
@@ -299,13 +300,22 @@ def pin_feet(rotations, transl, rest, parents, targets, weights, soft_reach: flo
         if toe is not None:
             leg = 0 if kh == 0 else 1
             r = np.flatnonzero(np.abs(np.asarray(toe)[t, leg]).sum(-1) > 0)
-            if len(r):
-                from ..geometry.rotations import axis_angle_to_matrix
-
-                back = axis_angle_to_matrix(-np.asarray(toe, np.float64)[t[r], leg])   # undo the roll
-                ga = g_ankle[r]
-                rot[t[r], foot] = ga.transpose(0, 2, 1) @ back @ ga @ rot[t[r], foot]
+            if len(r):   # the toes lie flat as in the rest pose, turned to their heading: undoing the
+                # roll's pitch alone left the pitch the pose already had, toes 3 cm under the floor
+                rot[t[r], foot] = g_ankle[r].transpose(0, 2, 1) @ flat_toes(g_ankle[r] @ rot[t[r], foot])
     return rot
+
+
+def flat_toes(g_toe) -> np.ndarray:
+    """(N,3,3) world rotations of a toe segment -> the rest pose's orientation (toes flat on the
+    floor) turned about the vertical to the same heading (the direction its forward axis, +z,
+    points along the floor)."""
+    fwd = np.asarray(g_toe, np.float64)[:, :, 2]
+    yaw = np.arctan2(fwd[:, 0], fwd[:, 2])
+    c, s = np.cos(yaw), np.sin(yaw)
+    out = np.zeros((len(yaw), 3, 3))
+    out[:, 0, 0], out[:, 0, 2], out[:, 1, 1], out[:, 2, 0], out[:, 2, 2] = c, s, 1.0, -s, c
+    return out
 
 
 MAX_FLIGHT = 10   # frames (0.5 s at 20 fps, a 30 cm jump): longer flights are missed steps, unless they jump

@@ -52,7 +52,7 @@ from .sampling_params import (DEFAULT_GUIDANCE, check_candidates, check_guidance
                               check_retrieval_prefix, check_retrieved, check_sampling)
 from .request import Request
 from .slow_steps import slow_motion
-from .typical_pace import leg_ratio, load_typical_speeds, typical_paced
+from .typical_pace import leg_ratio, load_typical_speeds, slow_take, typical_paced
 from .turn_words import turn_motion
 
 
@@ -240,8 +240,10 @@ class Generator:
             lo, hi = self._length(r.seconds)
             found = self._action_clips(r, lo, hi)
             asked = self._asked(r)   # a take of another action than the words ask does not compete
-            windows = [w for w in (self._windows(r, lo, hi, side) if captured else [])
-                       if action_credit(asked, w.action) is not None]
+            words = r.words if r.words is not None else read_words(r.prompt)
+            windows = [w for w in (self._windows(r, lo, hi, side) if captured else [])   # of the asked action,
+                       if action_credit(asked, w.action) is not None                    # at a plain gait's pace
+                       and not slow_take(w, words, self.typical_speeds, self.body)]
             cands, sources, beta = (self._from_action_clips(r, found) if found    # the user's clips: as captured
                                     else self._sampled(r, lo, hi, g, library=not windows))   # takes, or as codes
             best = 0

@@ -12,6 +12,9 @@ flights and takes shorter strides (``stride_scale.scaled_strides``). A motion sl
 is kept as it is: playing a walk faster, walking on in its own stride where its frames ran out,
 changed the walks that path following and speed edits are made from past their bars (an s-curve
 followed 0.75 m off, a walk at 2x sliding 0.77 mm a frame), so a slow chosen walk stays slow.
+Instead a captured take slower than ``SLOW_TAKE`` of the typical speed (on its performer's body)
+does not compete for a plain gait (``slow_take``): the data's walks include strolls, which the TMA
+chose for "a man walks" as readily as plain walks (median 0.93x typical with them, 0.97x without).
 The feet are planted again (``track.replanted``). Nothing is retimed when the words ask a pace ("quickly"),
 a distance, a number of steps, a stop, a course, a turn, a direction other than forward, a count,
 two things at once or a side (``plan.words.Words``); the user's ``--speed`` applies after.
@@ -31,6 +34,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..constants import FPS
 from ..errors import ShapeMoveError
 
 FORMAT = "shapemove-typical-pace/1"
@@ -41,6 +45,7 @@ FLIGHT = ("jog", "run")     # keep their cadence; shorter strides instead
 TOLERANCE = 0.03            # a motion within this share of its typical speed is left as it is
 MAX_CHANGE = 1.5            # the most a motion's speed is changed by (either way)
 MOVING = 0.2                # m/s: a motion slower than this is not a gait going anywhere: left as it is
+SLOW_TAKE = 0.95            # a captured take under this share of its typical speed does not compete
 
 
 def load_typical_speeds(model_dir) -> dict[str, float]:
@@ -135,3 +140,15 @@ def typical_paced(motion, body, words, speeds: dict, ik_refine_iters: int = 10):
             hi = mid
     return replanted(motion, body, resample(Track(track.joints[:hi], track.contacts[:hi]), n), ik_refine_iters)
 
+
+def slow_take(window, words, speeds: dict, body) -> bool:
+    """Whether the captured take ``window`` (``captured_takes.Window``) goes slower than
+    ``SLOW_TAKE`` of its plain gait's typical speed on the performer's body (module doc); False when
+    the words ask more than a plain gait or the table lacks it."""
+    gait = plain_gait(words)
+    if gait is None or gait not in speeds:
+        return False
+    moving = np.asarray(window.features)[: max(1, len(window.features) - window.held), 1:3]
+    speed = float(np.linalg.norm(moving, axis=1).mean()) * FPS     # root_lin_vel is metres a frame
+    want = speeds[gait] * leg_length(window.rest) / leg_length(rest_of(body, None))
+    return speed < SLOW_TAKE * want
