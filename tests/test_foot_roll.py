@@ -148,3 +148,36 @@ def test_rolled_toes_lie_flat_whatever_the_foot_pitch(body, pitch_deg, roll_deg)
     assert np.allclose(heading, np.deg2rad(30.0), atol=1e-9)           # the foot's heading kept
     right = G[:, LEGS[1][3]]                                           # the other foot: no roll, unchanged
     assert np.allclose(right, forward_kinematics(rot, rest, body.parents)[1][:, LEGS[1][3]])
+
+
+@pytest.mark.parametrize("roll_deg", [-12.0, 8.0])
+def test_a_flat_planted_foot_rolled_onto_its_edge_lies_flat(body, roll_deg):
+    """Heel and ball planted: the leg pass lays the sole flat (no roll about the foot's length),
+    aimed from the heel's target to the ball's, so the ground shift has no edge to lift the body
+    by (a captured squat's foot rolled 1 cm onto its edge settled a frame later: 7.6 mm in a frame
+    against 5.0 mm in the take)."""
+    from shapemove.core.body.plant import LEGS, pin_feet
+    from shapemove.core.geometry.fk import forward_kinematics
+    from shapemove.core.geometry.rotations import axis_angle_to_matrix
+
+    with torch.no_grad():
+        rest = body.rest_joints(torch.zeros(1, 10))[0].numpy().astype(np.float64)
+    T = 2
+    rot = np.repeat(np.eye(3)[None, None], T, 0).repeat(len(body.parents), 1)
+    rot[:, 0] = axis_angle_to_matrix(np.array([0.0, np.deg2rad(-20.0), 0.0]))
+    foot_dir = rest[10] - rest[7]
+    rot[:, 7] = axis_angle_to_matrix(np.deg2rad(roll_deg) * foot_dir / np.linalg.norm(foot_dir))   # onto an edge
+    pos, G0 = forward_kinematics(rot, rest, body.parents)
+    targets = pos[:, :22].copy()
+    weights = np.zeros((T, 4))
+    weights[:, [0, 2]] = 1.0                                           # left heel and ball planted
+    out = pin_feet(rot, np.zeros((T, 3)), rest, body.parents, targets, weights)
+    p2, G = forward_kinematics(out, rest, body.parents)
+    d = p2[:, 10] - p2[:, 7]                                           # the foot's direction, heel to ball
+    across = np.cross([0.0, 1.0, 0.0], d)
+    across /= np.linalg.norm(across, axis=-1, keepdims=True)
+    up = G[:, 7][:, :, 1]                                              # the sole's normal
+    assert np.abs((up * across).sum(-1)).max() < 1e-9                  # not rolled onto an edge
+    assert np.abs((G0[:, 7][:, :, 1] * across).sum(-1)).min() > 0.1    # (as the source was)
+    assert np.linalg.norm(p2[:, 10] - targets[:, 10], axis=-1).max() < 2e-3   # the ball on its target
+    assert np.abs(G[:, 8] - G0[:, 8]).max() < 1e-9                      # the other foot untouched

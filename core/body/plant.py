@@ -224,8 +224,10 @@ def pin_feet(rotations, transl, rest, parents, targets, weights, soft_reach: flo
              toe=None) -> np.ndarray:
     """The contact-aware IK pass: after the whole-body IK, each leg's hip and knee are turned
     (two-bone IK in the knee's own bending plane) so that a planted heel (ankle joint) lands on its
-    target, and the ankle turned so that a planted ball joint does too; where the ball is planted
-    more firmly than the heel (toe-off) the foot moves without turning so that the ball lands. ``weights`` (T,4) from ``contact_weights``: the
+    target, and the ankle turned so that a planted ball joint does too, its sole flat (no roll onto
+    an edge: ``aimed_flat``, by the weaker of the two weights); where the ball is planted more
+    firmly than the heel (toe-off) the foot moves without turning so that the ball lands.
+    ``weights`` (T,4) from ``contact_weights``: the
     leg moves that fraction of its miss (1 in contact: exactly on target where the leg reaches).
     rotations (T,24,3,3) local, transl (T,3), rest (24,3), targets (T,22,3) ->
     new local rotations (T,24,3,3); frames without weight are unchanged. ``toe`` (T,2,3) world
@@ -293,6 +295,9 @@ def pin_feet(rotations, transl, rest, parents, targets, weights, soft_reach: flo
             b_want = b[both] + wt[both] * (tgt[t[both], foot] - b[both])
             g_ankle = g_ankle.copy()
             g_ankle[both] = _turn(b[both] - a[both], b_want - a2[both]) @ G[t[both], ankle]
+            flat = aimed_flat(rest[foot] - rest[ankle], b_want - a2[both])   # the sole on the floor: a
+            g_ankle[both] = _slerp(g_ankle[both], flat, np.minimum(wh[both], wt[both])[:, 0])   # foot rolled
+            # onto its edge in the source lifted the body by its edge's depth, settling a frame later
         parent = G[t, parents[hip]]
         rot[t, hip] = parent.transpose(0, 2, 1) @ g_hip
         rot[t, knee] = g_hip.transpose(0, 2, 1) @ g_knee
@@ -304,6 +309,27 @@ def pin_feet(rotations, transl, rest, parents, targets, weights, soft_reach: flo
                 # roll's pitch alone left the pitch the pose already had, toes 3 cm under the floor
                 rot[t[r], foot] = g_ankle[r].transpose(0, 2, 1) @ flat_toes(g_ankle[r] @ rot[t[r], foot])
     return rot
+
+
+def aimed_flat(rest_dir, want) -> np.ndarray:
+    """(N,3,3) world rotations of a foot without roll (its rest orientation turned about the vertical,
+    then pitched about the horizontal across it) that take the rest ankle-to-ball direction
+    ``rest_dir`` (3,) to the directions ``want`` (N,3)."""
+    want = np.asarray(want, np.float64)
+    r = np.asarray(rest_dir, np.float64)
+    yaw = np.arctan2(want[:, 0], want[:, 2]) - np.arctan2(r[0], r[2])
+    c, s = np.cos(yaw), np.sin(yaw)
+    Y = np.zeros((len(yaw), 3, 3))
+    Y[:, 0, 0], Y[:, 0, 2], Y[:, 1, 1], Y[:, 2, 0], Y[:, 2, 2] = c, s, 1.0, -s, c
+    return _turn(Y @ r, want) @ Y
+
+
+def _slerp(a, b, w) -> np.ndarray:
+    """(N,3,3) rotations from ``a`` toward ``b`` by the fractions ``w`` (N,)."""
+    from ..geometry.rotations import axis_angle_to_matrix, matrix_to_axis_angle
+
+    d = matrix_to_axis_angle(np.asarray(a).transpose(0, 2, 1) @ np.asarray(b))
+    return np.asarray(a) @ axis_angle_to_matrix(d * np.asarray(w, np.float64)[:, None])
 
 
 def flat_toes(g_toe) -> np.ndarray:
