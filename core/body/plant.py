@@ -315,33 +315,29 @@ def aimed_flat(rest_dir, want) -> np.ndarray:
     """(N,3,3) world rotations of a foot without roll (its rest orientation turned about the vertical,
     then pitched about the horizontal across it) that take the rest ankle-to-ball direction
     ``rest_dir`` (3,) to the directions ``want`` (N,3)."""
+    from ..geometry.rotations import yaw_matrix
+
     want = np.asarray(want, np.float64)
     r = np.asarray(rest_dir, np.float64)
-    yaw = np.arctan2(want[:, 0], want[:, 2]) - np.arctan2(r[0], r[2])
-    c, s = np.cos(yaw), np.sin(yaw)
-    Y = np.zeros((len(yaw), 3, 3))
-    Y[:, 0, 0], Y[:, 0, 2], Y[:, 1, 1], Y[:, 2, 0], Y[:, 2, 2] = c, s, 1.0, -s, c
+    Y = yaw_matrix(np.arctan2(want[:, 0], want[:, 2]) - np.arctan2(r[0], r[2]))
     return _turn(Y @ r, want) @ Y
 
 
 def _slerp(a, b, w) -> np.ndarray:
-    """(N,3,3) rotations from ``a`` toward ``b`` by the fractions ``w`` (N,)."""
-    from ..geometry.rotations import axis_angle_to_matrix, matrix_to_axis_angle
+    """(N,3,3) rotations from ``a`` toward ``b`` by the fractions ``w`` (N,) (``rotations.slerp``)."""
+    from ..geometry.rotations import matrix_to_quaternion, quaternion_to_matrix, slerp
 
-    d = matrix_to_axis_angle(np.asarray(a).transpose(0, 2, 1) @ np.asarray(b))
-    return np.asarray(a) @ axis_angle_to_matrix(d * np.asarray(w, np.float64)[:, None])
+    return quaternion_to_matrix(slerp(matrix_to_quaternion(a), matrix_to_quaternion(b), w))
 
 
 def flat_toes(g_toe) -> np.ndarray:
     """(N,3,3) world rotations of a toe segment -> the rest pose's orientation (toes flat on the
     floor) turned about the vertical to the same heading (the direction its forward axis, +z,
     points along the floor)."""
+    from ..geometry.rotations import yaw_matrix
+
     fwd = np.asarray(g_toe, np.float64)[:, :, 2]
-    yaw = np.arctan2(fwd[:, 0], fwd[:, 2])
-    c, s = np.cos(yaw), np.sin(yaw)
-    out = np.zeros((len(yaw), 3, 3))
-    out[:, 0, 0], out[:, 0, 2], out[:, 1, 1], out[:, 2, 0], out[:, 2, 2] = c, s, 1.0, -s, c
-    return out
+    return yaw_matrix(np.arctan2(fwd[:, 0], fwd[:, 2]))
 
 
 MAX_FLIGHT = 10   # frames (0.5 s at 20 fps, a 30 cm jump): longer flights are missed steps, unless they jump

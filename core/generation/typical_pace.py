@@ -34,8 +34,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..constants import FPS
 from ..errors import ShapeMoveError
+from .pace_words import gait_speed
 
 FORMAT = "shapemove-typical-pace/1"
 TABLE = "typical_pace.json"
@@ -148,7 +148,6 @@ def slow_take(window, words, speeds: dict, body) -> bool:
     gait = plain_gait(words)
     if gait is None or gait not in speeds:
         return False
-    moving = np.asarray(window.features)[: max(1, len(window.features) - window.held), 1:3]
-    speed = float(np.linalg.norm(moving, axis=1).mean()) * FPS     # root_lin_vel is metres a frame
+    speed = gait_speed(np.asarray(window.features)[: max(1, len(window.features) - window.held)])
     want = speeds[gait] * leg_length(window.rest) / leg_length(rest_of(body, None))
     return speed < SLOW_TAKE * want
