@@ -92,14 +92,16 @@ def test_a_stance_that_outruns_a_flat_foot_rolls_over_the_ball(body, longer):
     # the heel rises in late stance and moves forward, about the ball: the foot keeps its length
     assert heel[-1, 1] - heel[0, 1] > 0.03 and heel[-1, 2] > heel[0, 2] + 0.005
     assert np.allclose(np.linalg.norm(heel - ball, axis=1), np.linalg.norm(rj[10] - rj[7]), atol=1e-6)
-    pitch = np.arctan2(heel[:, 1] - ball[:, 1], np.linalg.norm((ball - heel)[:, [0, 2]], axis=1))
-    assert np.all(np.diff(pitch[len(pitch) // 2:]) > -1e-3)          # it never comes back down within the stance
+    rise = heel[len(heel) // 2:, 1]
+    assert np.all(np.diff(rise) > -1e-3)       # it never comes back down within the stance (by a millimetre:
+    # the knee eased at the roll's start lags it by a fraction of a degree)
     # the heel's contact: kept early (flat), released where it rose; a heel in contact is still
     hc = p.contacts[:, 0].astype(bool)
     assert hc[:4].all() and not hc[-4:].any() and p.contacts[:, 2].all()
     assert (heel[hc, 1] - heel[0, 1]).max() <= LIFT_TOL + 1e-3
     released = ~hc & c[:, 0].astype(bool)
-    assert (heel[released, 1] - heel[0, 1]).min() > 0.0
+    up = heel[released, 1] - heel[0, 1]          # released where its rolled target leaves the floor; the
+    assert up.min() > -1e-3 and np.all(np.diff(up) > 0)   # eased knee lets it follow within a millimetre
     mm, _ = stance_slide(pos, p.contacts)
     assert mm.value < 0.5
     # feet on the floor: no point below it by more than 1 cm, the stance foot's sole on it
@@ -181,3 +183,25 @@ def test_a_flat_planted_foot_rolled_onto_its_edge_lies_flat(body, roll_deg):
     assert np.abs((G0[:, 7][:, :, 1] * across).sum(-1)).min() > 0.1    # (as the source was)
     assert np.linalg.norm(p2[:, 10] - targets[:, 10], axis=-1).max() < 2e-3   # the ball on its target
     assert np.abs(G[:, 8] - G0[:, 8]).max() < 1e-9                      # the other foot untouched
+
+
+@pytest.mark.parametrize("start", [0.15, 0.25])
+def test_a_heel_rolling_up_at_once_does_not_snap_the_knee(body, start):
+    """A stance that starts with the hip already past the ball (a take cut mid-stride, a jump's
+    take-off): the heel rolls up from the first frames. The knee moves no more than 1.5x as far in a
+    frame as the source's knee (2.5x when the whole leg followed the rolled heel at once: a
+    captured jump's knee leapt 0.135 m against the take's 0.071), while the ball stays pinned."""
+    from shapemove.core.body.plant import plant_motion
+    from shapemove.core.geometry.fk import forward_kinematics
+
+    b = np.zeros(10, np.float32)
+    j, c, rest = _stance(body, b, T=14, start=start, end=start + 0.30)
+    p = plant_motion(body, b, j, c, gate=False, max_flight=None)
+    with torch.no_grad():
+        rj = body.rest_joints(torch.as_tensor(b)[None])[0].numpy()
+    pos = forward_kinematics(np.asarray(p.rotations, np.float64), rj, body.parents)[0][:, :22] + p.transl[:, None]
+    knee = np.linalg.norm(np.diff(pos[:, 4], axis=0), axis=1).max()
+    source = np.linalg.norm(np.diff(j[:, 4], axis=0), axis=1).max()
+    assert knee <= 1.5 * source, (knee, source)
+    assert np.linalg.norm(pos[:, 10, [0, 2]] - pos[0, 10, [0, 2]], axis=1).max() < 3e-3
+    assert pos[-1, 7, 1] - pos[0, 7, 1] > 0.01 or pos[0, 7, 1] - rest[7, 1] > 0.01   # the heel is up

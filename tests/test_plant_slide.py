@@ -91,3 +91,36 @@ def test_a_turned_foot_reads_its_own_pitch():
     np.testing.assert_allclose(pitch_of(ankle, ball, e1), [0.0, 0.0], atol=1e-9)
     up = 0.15 * np.array([0.0, np.sin(0.3 + np.arcsin(e1[1])), -np.cos(0.3 + np.arcsin(e1[1]))])
     assert pitch_of(up[None], ball[:1], e1)[0] == pytest.approx(0.3)
+
+
+def test_a_foot_gliding_at_walking_pace_is_not_pinned():
+    """A decoder's contact channel on while its heel glides 0.8 m/s ("a man walks backwards in a
+    circle", seed 0: 0.7 m/s in its contact runs): not pinned (pinned, the knee leapt 2.5x its
+    decoded step where the pin let go). A heel at rest, then slowing from rest to 0.5 m/s (under the
+    detector's 0.7 m/s to stay), stays in contact."""
+    from shapemove.core.body.plant import gate_contacts
+    from shapemove.core.constants import FPS
+
+    J, c = _slide(T=40, s=5, e=30, per_frame=0.8 / FPS)
+    c[:, 0] = 1
+    g = gate_contacts(J, c, np.zeros(4))
+    assert g[:4, 0].all()          # still before the glide
+    assert not g[7:30, 0].any()    # gliding: released
+    assert g[:, 1].all()           # the still heel is untouched
+    J2, c2 = _slide(T=40, s=20, e=40, per_frame=0.5 / FPS)
+    c2[:, 0] = 1
+    assert gate_contacts(J2, c2, np.zeros(4))[:, 0].all()   # entered at rest, held under the stay speed
+
+
+def test_a_piecewise_plant_never_outruns_the_joint():
+    """A heel the decoder slides along its run at a changing pace ("a person does five squats
+    slowly": 0.3 m/s during a squat) is planted piece by piece, and the plant moves no faster in a
+    frame than the joint itself does anywhere in the run (the pieces' 4-frame steps moved it 0.035 m
+    in a frame against the decoded 0.021)."""
+    from shapemove.core.body.plant import anchor_track
+
+    pace = 0.008 + 0.004 * np.sin(np.linspace(0, np.pi, 40)) ** 2      # m a frame, 0.008 to 0.012
+    xz = np.stack([np.zeros(40), -np.cumsum(pace)], axis=1)
+    a = anchor_track(xz)
+    assert np.linalg.norm(np.diff(a, axis=0), axis=1).max() <= pace.max() + 1e-9
+    assert np.abs(a - xz).max() < 0.1                                   # and stays near the foot

@@ -64,7 +64,8 @@ def anchor_track(xz, slide: float = SLIDE, piece_len: float = PIECE, fade: int =
     ``xz``: one point, the run's mean, unless the joint slides further than ``slide`` from its first
     frame; then the run cut into pieces along which the joint stays within ``piece_len`` of the
     piece's first frame, each piece planted at its mean, the steps between pieces spread over
-    ``fade`` frames (a moving mean)."""
+    ``fade`` frames (a moving mean) and then eased to the joint's own largest step in the run (the
+    plant never moves faster than the foot it holds)."""
     xz = np.asarray(xz, np.float64)
     n = len(xz)
     piece = np.zeros(n, int)
@@ -81,7 +82,8 @@ def anchor_track(xz, slide: float = SLIDE, piece_len: float = PIECE, fade: int =
     track = means[piece]
     pad = np.pad(track, ((fade // 2, fade - 1 - fade // 2), (0, 0)), mode="edge")
     kernel = np.ones(fade) / fade
-    return np.stack([np.convolve(pad[:, c], kernel, mode="valid") for c in range(2)], axis=1)
+    track = np.stack([np.convolve(pad[:, c], kernel, mode="valid") for c in range(2)], axis=1)
+    return eased(track, float(np.linalg.norm(np.diff(xz, axis=0), axis=1).max()))
 
 
 def eased(change, rate: float, free=None, fixed=None) -> np.ndarray:
@@ -233,7 +235,9 @@ def pin_feet(rotations, transl, rest, parents, targets, weights, soft_reach: flo
     new local rotations (T,24,3,3); frames without weight are unchanged. ``toe`` (T,2,3) world
     rotation vectors (left, right leg), non-zero where the foot rolls over its ball
     (``foot_roll.roll_feet``): there the ball joint's rotation lays the toes flat on the floor
-    (``flat_toes``)."""
+    (``flat_toes``). The knee's move is eased like the ankle's (no faster a frame than ``EASE`` of
+    the knee target's largest step) where a plant is not held exactly: in the fades, beyond the soft
+    reach, and while the heel rolls up; the ankle is then aimed at its goal from the eased knee."""
     import torch
 
     from ..geometry.torch_ops import forward_kinematics
@@ -286,6 +290,19 @@ def pin_feet(rotations, transl, rest, parents, targets, weights, soft_reach: flo
         side /= np.linalg.norm(side, axis=-1, keepdims=True).clip(1e-12)
         cos = ((l1 ** 2 + dc ** 2 - l2 ** 2) / (2 * l1 * dc)).clip(-1, 1)
         k2 = h + l1 * (cos * vh + np.sqrt(1 - cos ** 2) * side)
+        # the knee's move eased as the ankle's is: near full stretch it is several times the ankle's
+        # (a captured toe-off's leg straightened to its planted ball snapped back bent, 0.27 m in a frame)
+        bend = np.zeros((len(rot), 3))
+        bend[t] = k2 - k
+        knee_rate = EASE * float(np.linalg.norm(np.diff(tgt[:, knee], axis=0), axis=1).max()) if len(rot) > 1 else 0.0
+        led = (w[:, kh] >= w[:, kt]) & (w[:, kh] > 0)          # heel-led frames, the foot aimed at its
+        exact = np.maximum(w[:, kh], w[:, kt]) >= 1.0          # ball below: exact unless the heel is
+        exact[t] &= ~led[t] | (d[:, 0] <= soft)                # missed anyway (beyond the soft reach) or
+        if toe is not None:                                    # rolls up (a ball leading is held exactly)
+            exact &= ~(led & np.abs(np.asarray(toe)[:, 0 if kh == 0 else 1]).any(-1))
+        bend = eased(bend, max(knee_rate, MIN_EASE), fixed=exact)[t]
+        k2 = h + l1 * _unit(k + bend - h)
+        a2 = k2 + l2 * _unit(a2 - k2)                          # the ankle aimed at its goal from there
         R1 = _turn(k - h, k2 - h)
         R2 = _turn(np.einsum("nij,nj->ni", R1, a - k), a2 - k2)
         g_hip, g_knee = R1 @ G[t, hip], R2 @ R1 @ G[t, knee]
@@ -309,6 +326,10 @@ def pin_feet(rotations, transl, rest, parents, targets, weights, soft_reach: flo
                 # roll's pitch alone left the pitch the pose already had, toes 3 cm under the floor
                 rot[t[r], foot] = g_ankle[r].transpose(0, 2, 1) @ flat_toes(g_ankle[r] @ rot[t[r], foot])
     return rot
+
+
+def _unit(v) -> np.ndarray:
+    return v / np.linalg.norm(v, axis=-1, keepdims=True).clip(1e-12)
 
 
 def aimed_flat(rest_dir, want) -> np.ndarray:
@@ -415,14 +436,16 @@ class Planted:
 
 def gate_contacts(joints, contacts, sole_offsets, max_height: float = GATE_HEIGHT) -> np.ndarray:
     """Predicted contacts (e.g. a decoder's contact channels) kept only where the joint's sole is
-    within ``max_height`` of the floor that the contacts imply (``source_floor``); runs shorter
-    than 2 frames dropped. (T,22,3), (T,4) -> (T,4) uint8."""
-    from ..motion.contacts import MIN_RUN
+    within ``max_height`` of the floor that the contacts imply (``source_floor``) and where the joint
+    moves as slowly as a resting foot (``contacts.slow_enough``: a decoded foot that glides at walking
+    pace while its channel says contact is not pinned, or its leg leaps where the pin lets go); runs
+    shorter than 2 frames dropped. (T,22,3), (T,4) -> (T,4) uint8."""
+    from ..motion.contacts import MIN_RUN, slow_enough
 
     c = np.asarray(contacts).astype(bool)
     j = np.asarray(joints, dtype=np.float64)
     h = j[:, CONTACT_IDS, 1] - np.asarray(sole_offsets)[None] - source_floor(j, c, sole_offsets)
-    c &= h < max_height
+    c &= (h < max_height) & slow_enough(j, FPS)
     for k in range(4):
         for s, e in runs(c[:, k]):
             if e - s < MIN_RUN:

@@ -80,6 +80,17 @@ def _drop_short(c: np.ndarray, min_run: int) -> np.ndarray:
     return out
 
 
+def slow_enough(joints, fps: float = FPS) -> np.ndarray:
+    """(T,>=22,3) joints -> (T,4) bool: where each contact joint moves along the floor as slowly as a
+    joint resting on it, by the detector's speed thresholds (below ``ENTER_SPEED`` to enter,
+    ``EXIT_SPEED`` to stay) on its horizontal speed (a heel rising at toe-off is left to the height
+    rules: it rolls over its ball)."""
+    flat = np.array(joints, dtype=np.float64)
+    flat[..., 1] = 0.0
+    v = joint_speeds(flat, fps)
+    return _hysteresis(v < ENTER_SPEED, v < EXIT_SPEED)
+
+
 def detect_contacts(joints, fps: float = FPS) -> np.ndarray:
     """(T,>=22,3) joints (metres, Y up) -> (T,4) uint8 contacts of joints 7, 8, 10, 11."""
     j = np.asarray(joints, dtype=np.float64)
