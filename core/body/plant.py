@@ -236,8 +236,9 @@ def pin_feet(rotations, transl, rest, parents, targets, weights, soft_reach: flo
     rotation vectors (left, right leg), non-zero where the foot rolls over its ball
     (``foot_roll.roll_feet``): there the ball joint's rotation lays the toes flat on the floor
     (``flat_toes``). The knee's move is eased like the ankle's (no faster a frame than ``EASE`` of
-    the knee target's largest step) where a plant is not held exactly: in the fades, beyond the soft
-    reach, and while the heel rolls up; the ankle is then aimed at its goal from the eased knee."""
+    the knee target's largest step) where a plant is not held exactly: in the fades, and in the
+    heel-led frames where the heel is beyond the soft reach or rolling up (a ball leading is held
+    exactly); the ankle is then aimed at its goal from the eased knee."""
     import torch
 
     from ..geometry.torch_ops import forward_kinematics
