@@ -39,6 +39,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..constants import FPS
+from ..geometry.rotations import rotation_between
 from ..motion.contacts import CONTACT_IDS, runs
 
 FADE = 4          # frames over which a planted target blends back into the mocap target
@@ -189,18 +190,6 @@ def plant_targets(joints, contacts, sole_offsets, fade: int = FADE, fade_down: b
     return tgt, floor
 
 
-def _turn(u: np.ndarray, v: np.ndarray) -> np.ndarray:
-    """(N,3), (N,3) -> (N,3,3) the smallest rotation taking the direction of u to that of v."""
-    u = u / np.linalg.norm(u, axis=-1, keepdims=True).clip(1e-12)
-    v = v / np.linalg.norm(v, axis=-1, keepdims=True).clip(1e-12)
-    axis = np.cross(u, v)
-    s, c = np.linalg.norm(axis, axis=-1), np.clip((u * v).sum(-1), -1.0, 1.0)
-    k = axis / s[:, None].clip(1e-12)
-    K = np.zeros((len(u), 3, 3))
-    K[:, 0, 1], K[:, 0, 2], K[:, 1, 0], K[:, 1, 2], K[:, 2, 0], K[:, 2, 1] = -k[:, 2], k[:, 1], k[:, 2], -k[:, 0], -k[:, 1], k[:, 0]
-    return np.eye(3)[None] + s[:, None, None] * K + (1 - c)[:, None, None] * (K @ K)
-
-
 SOFT_REACH = 0.99  # of the leg's length: beyond it ``pin_feet`` approaches full stretch asymptotically
 # (0.97 until 2026-11-27: planted feet slid a third more, 0.34 against 0.21 mm per frame on validation
 # takes retargeted, with no fewer knee jerks: docs/codec.md#planted-legs-reach-further-soft-reach-099)
@@ -304,15 +293,15 @@ def pin_feet(rotations, transl, rest, parents, targets, weights, soft_reach: flo
         bend = eased(bend, max(knee_rate, MIN_EASE), fixed=exact)[t]
         k2 = h + l1 * _unit(k + bend - h)
         a2 = k2 + l2 * _unit(a2 - k2)                          # the ankle aimed at its goal from there
-        R1 = _turn(k - h, k2 - h)
-        R2 = _turn(np.einsum("nij,nj->ni", R1, a - k), a2 - k2)
+        R1 = rotation_between(k - h, k2 - h)
+        R2 = rotation_between(np.einsum("nij,nj->ni", R1, a - k), a2 - k2)
         g_hip, g_knee = R1 @ G[t, hip], R2 @ R1 @ G[t, knee]
         g_ankle = G[t, ankle]                                   # the foot keeps its world orientation...
         both = (heel & (wt > 0))[:, 0]
         if both.any():                                          # ...unless heel and ball are planted
             b_want = b[both] + wt[both] * (tgt[t[both], foot] - b[both])
             g_ankle = g_ankle.copy()
-            g_ankle[both] = _turn(b[both] - a[both], b_want - a2[both]) @ G[t[both], ankle]
+            g_ankle[both] = rotation_between(b[both] - a[both], b_want - a2[both]) @ G[t[both], ankle]
             flat = aimed_flat(rest[foot] - rest[ankle], b_want - a2[both])   # the sole on the floor: a
             g_ankle[both] = _slerp(g_ankle[both], flat, np.minimum(wh[both], wt[both])[:, 0])   # foot rolled
             # onto its edge in the source lifted the body by its edge's depth, settling a frame later
@@ -342,7 +331,7 @@ def aimed_flat(rest_dir, want) -> np.ndarray:
     want = np.asarray(want, np.float64)
     r = np.asarray(rest_dir, np.float64)
     Y = yaw_matrix(np.arctan2(want[:, 0], want[:, 2]) - np.arctan2(r[0], r[2]))
-    return _turn(Y @ r, want) @ Y
+    return rotation_between(Y @ r, want) @ Y
 
 
 def _slerp(a, b, w) -> np.ndarray:
