@@ -84,7 +84,13 @@ def anchor_track(xz, slide: float = SLIDE, piece_len: float = PIECE, fade: int =
     pad = np.pad(track, ((fade // 2, fade - 1 - fade // 2), (0, 0)), mode="edge")
     kernel = np.ones(fade) / fade
     track = np.stack([np.convolve(pad[:, c], kernel, mode="valid") for c in range(2)], axis=1)
-    return eased(track, float(np.linalg.norm(np.diff(xz, axis=0), axis=1).max()))
+    return eased(track, largest_step(xz))
+
+
+def largest_step(track) -> float:
+    """The longest move of a (T,D) track between two frames (0 for one frame)."""
+    x = np.asarray(track, np.float64)
+    return float(np.linalg.norm(np.diff(x, axis=0), axis=1).max()) if len(x) > 1 else 0.0
 
 
 def eased(change, rate: float, free=None, fixed=None) -> np.ndarray:
@@ -179,7 +185,7 @@ def plant_targets(joints, contacts, sole_offsets, fade: int = FADE, fade_down: b
                 w = np.array([x for x, _ in near])
                 corr[t] = w.max() * (w[:, None] * np.array([x for _, x in near])).sum(0) / w.sum()
         if planted.any() and T > 1:   # no planting change faster than the joint's own decoded steps allow
-            rate = max(EASE * float(np.linalg.norm(np.diff(tgt[:, j], axis=0), axis=1).max()), MIN_EASE) / np.sqrt(2)
+            rate = max(EASE * largest_step(tgt[:, j]), MIN_EASE) / np.sqrt(2)
             held = planted[1:] & planted[:-1] & (run_of[1:] == run_of[:-1])   # steps within one run
             free_xz = np.where(held, np.linalg.norm(np.diff(corr[:, [0, 2]], axis=0), axis=1), 0.0)
             free_y = np.where(held, np.abs(np.diff(corr[:, 1])), 0.0)
@@ -244,6 +250,8 @@ def pin_feet(rotations, transl, rest, parents, targets, weights, soft_reach: flo
         t = np.flatnonzero((w[:, kh] > 0) | (w[:, kt] > 0))
         if not len(t):
             continue
+        held = np.maximum(w[:, kh], w[:, kt]) >= 1.0            # planted frames
+        led = (w[:, kh] >= w[:, kt]) & (w[:, kh] > 0)           # heel-led (else the ball leads: toe-off)
         wh, wt = w[t, kh, None], w[t, kt, None]
         a = pos[t, ankle]
         lead = np.clip(1.0 - np.maximum(wt - wh, 0.0), 0.0, 1.0)   # the heel's share, moving from heel-led
@@ -252,14 +260,13 @@ def pin_feet(rotations, transl, rest, parents, targets, weights, soft_reach: flo
         # the two targets' disagreement in one frame)
         move = np.zeros((len(rot), 3))
         move[t] = want - a
-        rate = LEG_EASE * float(np.linalg.norm(np.diff(tgt[:, ankle], axis=0), axis=1).max()) if len(rot) > 1 else 0.0
-        move = eased(move, max(rate, MIN_EASE), fixed=np.maximum(w[:, kh], w[:, kt]) >= 1.0)   # planted: exact
+        move = eased(move, max(LEG_EASE * largest_step(tgt[:, ankle]), MIN_EASE), fixed=held)   # planted: exact
         # elsewhere it changes no faster than the targets' own steps allow (a rolled heel let go at
         # once when its ball left moved the ankle and knee 0.12 m in a frame)
         t = np.flatnonzero((np.linalg.norm(move, axis=1) > 1e-9) | (w[:, kh] > 0) | (w[:, kt] > 0))
         h, k, a, b = pos[t, hip], pos[t, knee], pos[t, ankle], pos[t, foot]
         wh, wt = w[t, kh, None], w[t, kt, None]
-        heel = (wh >= wt) & (wh > 0)                            # heel-led (else the ball leads: toe-off)
+        heel = led[t, None]
         want = a + move[t]
         l1, l2 = np.linalg.norm(rest[knee] - rest[hip]), np.linalg.norm(rest[ankle] - rest[knee])
         v = want - h
@@ -284,13 +291,11 @@ def pin_feet(rotations, transl, rest, parents, targets, weights, soft_reach: flo
         # (a captured toe-off's leg straightened to its planted ball snapped back bent, 0.27 m in a frame)
         bend = np.zeros((len(rot), 3))
         bend[t] = k2 - k
-        knee_rate = EASE * float(np.linalg.norm(np.diff(tgt[:, knee], axis=0), axis=1).max()) if len(rot) > 1 else 0.0
-        led = (w[:, kh] >= w[:, kt]) & (w[:, kh] > 0)          # heel-led frames, the foot aimed at its
-        exact = np.maximum(w[:, kh], w[:, kt]) >= 1.0          # ball below: exact unless the heel is
-        exact[t] &= ~led[t] | (d[:, 0] <= soft)                # missed anyway (beyond the soft reach) or
-        if toe is not None:                                    # rolls up (a ball leading is held exactly)
-            exact &= ~(led & np.abs(np.asarray(toe)[:, 0 if kh == 0 else 1]).any(-1))
-        bend = eased(bend, max(knee_rate, MIN_EASE), fixed=exact)[t]
+        exact = held.copy()                                    # planted and exact, unless heel-led (the
+        exact[t] &= ~led[t] | (d[:, 0] <= soft)                # foot aimed at its ball below) with the heel
+        if toe is not None:                                    # missed anyway (beyond the soft reach) or
+            exact &= ~(led & np.abs(np.asarray(toe)[:, 0 if kh == 0 else 1]).any(-1))   # rolling up
+        bend = eased(bend, max(EASE * largest_step(tgt[:, knee]), MIN_EASE), fixed=exact)[t]
         k2 = h + l1 * _unit(k + bend - h)
         a2 = k2 + l2 * _unit(a2 - k2)                          # the ankle aimed at its goal from there
         R1 = rotation_between(k - h, k2 - h)
@@ -488,7 +493,7 @@ def plant_motion(body, betas, joints, contacts, refine_iters: int = 10, gate: bo
         shift = np.maximum(np.minimum(gaussian_smooth(shift, smooth), shift), -low)
     if len(j) > 1:   # where the foot that grounds the body changes (a heel landing after its toe) the
         # body is let down over frames, never under the floor (at once, it dropped 4 cm in a frame)
-        shift = lifted(shift, max(EASE * float(np.linalg.norm(np.diff(j[:, 0], axis=0), axis=1).max()), MIN_EASE))
+        shift = lifted(shift, max(EASE * largest_step(j[:, 0]), MIN_EASE))
     transl[:, 1] += shift
     posed = _posed(ik, rest, body.parents)   # error against the input joints (floor removed)
     posed[..., 1] += shift[:, None]
