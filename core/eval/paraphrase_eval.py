@@ -85,19 +85,28 @@ def action_embeddings(tma, actions: list[str]) -> np.ndarray:
     return np.stack(out).astype(np.float32)
 
 
-def _tally(rows: list[dict], key: str) -> dict:
+def _tally(rows: list[dict], key: str, pairs: set | None = None) -> dict:
+    """Strict, lenient (an 'also' action counts) and, with ``pairs``, merged (a pair the judge does not
+    tell apart in real performances counts, ``indistinct_actions.py``) accuracy, overall and per action."""
+    from .indistinct_actions import merged_right
+
     per: dict = {}
     for r in rows:
-        p = per.setdefault(r["action"], {"n": 0, "strict": 0, "lenient": 0})
+        p = per.setdefault(r["action"], {"n": 0, "strict": 0, "lenient": 0, "merged": 0})
         p["n"] += 1
         p["strict"] += r[key] == r["action"]
         p["lenient"] += r[key] == r["action"] or r[key] in r["also"]
+        p["merged"] += merged_right(r["action"], r[key], pairs or set())
     n = sum(p["n"] for p in per.values())
-    return {"accuracy": sum(p["strict"] for p in per.values()) / max(1, n),
-            "accuracy_lenient": sum(p["lenient"] for p in per.values()) / max(1, n),
-            "per_action": {a: {"n": p["n"], "accuracy": p["strict"] / p["n"], "accuracy_lenient": p["lenient"] / p["n"]}
-                           for a, p in sorted(per.items())},
-            "prompts": n}
+    out = {"accuracy": sum(p["strict"] for p in per.values()) / max(1, n),
+           "accuracy_lenient": sum(p["lenient"] for p in per.values()) / max(1, n),
+           "per_action": {a: {"n": p["n"], "accuracy": p["strict"] / p["n"], "accuracy_lenient": p["lenient"] / p["n"],
+                              **({"accuracy_merged": p["merged"] / p["n"]} if pairs is not None else {})}
+                          for a, p in sorted(per.items())},
+           "prompts": n}
+    if pairs is not None:
+        out["accuracy_merged"] = sum(p["merged"] for p in per.values()) / max(1, n)
+    return out
 
 
 def eval_paraphrase(model_dir=None, prompts=None, tma=None, seed: int | list[int] = 0, seconds: float | None = 4.0,
@@ -189,14 +198,17 @@ def eval_paraphrase(model_dir=None, prompts=None, tma=None, seed: int | list[int
     clfs = {"motion": classifier, "motion_features": feature_classifier}
     per_action = {k: c.reachable() for k, c in clfs.items() if c is not None}   # one leave-one-take-out pass each
     reach = {k: _reachable(per, rows) for k, per in per_action.items()}
-    return {"motion": _tally(rows, "motion_pred"), "text": _tally(rows, "text_pred"),
+    merged = _indistinct(clfs, data, seconds)
+    pairs = {k: set(map(frozenset, v)) for k, v in merged["pairs"].items()}
+    return {"motion": _tally(rows, "motion_pred", pairs.get("motion")), "text": _tally(rows, "text_pred"),
             "motion_vs_text_prototypes": _tally(rows, "motion_proto_pred"),
-            **({"motion_features": _tally(rows, "motion_features_pred")} if feature_classifier is not None else {}),
-            "reachable": reach,
+            **({"motion_features": _tally(rows, "motion_features_pred", pairs.get("motion_features"))}
+               if feature_classifier is not None else {}),
+            "reachable": reach, "indistinct": merged,
             **({"nearest_caption": _tally(rows, "nearest_caption_pred")} if nearest else {}),
             "frequent": {"min_clips": frequent, "actions": sorted({r["action"] for r in often}),
-                         "motion": _tally(often, "motion_pred"),
-                         **({"motion_features": _tally(often, "motion_features_pred")}
+                         "motion": _tally(often, "motion_pred", pairs.get("motion")),
+                         **({"motion_features": _tally(often, "motion_features_pred", pairs.get("motion_features"))}
                             if feature_classifier is not None else {}),
                          "reachable": {k: _reachable(per, often) for k, per in per_action.items()},
                          **({"nearest_caption": _tally(often, "nearest_caption_pred")} if nearest else {})},
@@ -215,6 +227,23 @@ def eval_paraphrase(model_dir=None, prompts=None, tma=None, seed: int | list[int
             "unknown_prompts": len(items) - len(known), "warned": sum(r["warned"] for r in rows),
             "prompts_file": str(Path(prompts) if prompts else DEFAULT_PROMPTS),
             "actions": actions, "rows": rows}
+
+
+def _indistinct(clfs: dict, data, seconds: float | None) -> dict:
+    """Per judge, the pairs of actions whose real windows of the played length it does not tell apart,
+    their windows' confusion and the takes per action (``indistinct_actions.py``)."""
+    from ..constants import FPS
+    from .indistinct_actions import indistinct_pairs, take_counts, window_confusion
+
+    frames = int(round((seconds or 4.0) * FPS))   # the model's own length: the evaluation's 4 s
+    out: dict = {"frames": frames, "pairs": {}, "confusion": {}, "takes": {}}
+    for k, c in clfs.items():
+        if c is None or data is None:
+            continue
+        conf, takes = window_confusion(c, data, frames), take_counts(c)
+        out["pairs"][k] = sorted(sorted(p) for p in indistinct_pairs(conf, takes))
+        out["confusion"][k], out["takes"][k] = conf, takes
+    return out
 
 
 def nearest_caption_baseline(classifier, data, rows: list[dict], gen) -> bool:
@@ -284,6 +313,7 @@ def format_results(res: dict) -> str:
     if res.get("motion_features"):
         lines.append(f"without the TMA (5-NN on pooled raw features): motion {_pct(res['motion_features']['accuracy'])} "
                      f"({_pct(res['motion_features']['accuracy_lenient'])} lenient)")
+    lines += _merged_lines(res)
     reach = res.get("reachable") or {}
     if reach:
         lines.append("reachable (a perfect generator, each prompt's action judged by leave-one-take-out on the "
@@ -317,6 +347,28 @@ def format_results(res: dict) -> str:
                      f"{ceil['split']} clips' action {_pct(ceil['accuracy'])} of the time "
                      f"({_pct(ceil['accuracy_lenient'])} lenient: any of the clip's actions; {ceil['clips']} clips)")
     return "\n".join(lines)
+
+
+def _merged_lines(res: dict, min_takes: int = 3, bar: float = 0.6) -> list[str]:
+    """The merged figures of each judge (pairs it does not tell apart in real windows counted right)
+    and the actions with at least ``min_takes`` takes under ``bar`` by either judge."""
+    ind = res.get("indistinct") or {}
+    fr = res.get("frequent") or {}
+    lines = []
+    for k, name in (("motion", "TMA judge"), ("motion_features", "raw-feature judge")):
+        t = res.get(k) or {}
+        if "accuracy_merged" not in t:
+            continue
+        pairs = ind.get("pairs", {}).get(k) or []
+        often = (fr.get(k) or {}).get("accuracy_merged")
+        lines.append(f"merged, {name} (real {ind.get('frames', 80)}-frame windows not told apart: "
+                     f"{'; '.join(' / '.join(p) for p in pairs) or 'none'}): {_pct(t['accuracy_merged'])}"
+                     + (f", actions with >= {fr.get('min_clips')} clips {_pct(often)}" if often is not None else ""))
+        takes = ind.get("takes", {}).get(k) or {}
+        low = [f"{a} {_pct(p['accuracy_merged'], 0)}" for a, p in t["per_action"].items()
+               if takes.get(a, 0) >= min_takes and p["accuracy_merged"] < bar]
+        lines.append(f"  actions with >= {min_takes} takes under {_pct(bar, 0)} ({name}, merged): {', '.join(low) or 'none'}")
+    return lines
 
 
 def add_arguments(p) -> None:
