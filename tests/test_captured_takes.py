@@ -164,3 +164,35 @@ def test_the_users_library_kick_rises_as_captured(mocap_root, tmp_path, capsys):
     assert main(["generate", "--prompt", KICK, "--library", str(lib), "--no-library", "--seconds", "4",
                  "--out", str(out2)]) == 0
     assert load_motion(out2).provenance.startswith("generated")
+
+
+def test_two_things_at_once_puts_captured_parts_together(openbody):
+    """Each part of a two-things prompt is its own choice among samples and captured takes: the legs
+    of a walk take, the arms of a raised-hands take, planted as one motion that another body plants
+    again by its rotations."""
+    from shapemove.core.generation.generate import Generator, Request
+
+    gen = Generator(None, body=openbody)
+    r = Request("a man walks forward while raising both hands", seconds=4, seed=3)
+    m = gen.generate_batch([r])[0]
+    assert m.provenance.startswith("legs: captured: ") and "; arms: captured: " in m.provenance
+    assert m.tokens is None and m.planted_take and m.num_frames == 80
+    assert m.part_prompts == ("a man walks forward", "a person raising both hands")
+    j = m.joints
+    travel = float(np.linalg.norm(j[-1, 0, [0, 2]] - j[0, 0, [0, 2]]))
+    assert travel > 2.0                                          # a walk's 4 s, not a gesture on the spot
+    alone = gen.generate_batch([Request("a person raising both hands", seconds=4, seed=4)])[0]   # the arms' request
+    assert m.provenance.endswith("; arms: " + alone.provenance)
+
+    def hands(x):   # each wrist's height over the head: the take raises both and lowers them again
+        return np.concatenate([x.joints[:, w, 1] - x.joints[:, 15, 1] for w in (20, 21)])
+
+    assert hands(m).max() > 0.05 and hands(m).min() < -0.5
+    assert np.corrcoef(hands(m), hands(alone))[0, 1] > 0.95       # the arms move as the take's, on a walker
+    other = gen.redecode(m, np.array([2.0, 1.5, 0, 0, 0, 0, 0, 0, 0, 0], np.float32))
+    assert other.num_frames == 80 and other.provenance == m.provenance
+    assert np.corrcoef(hands(other), hands(alone))[0, 1] > 0.95
+    assert float(np.linalg.norm(other.joints[-1, 0, [0, 2]] - other.joints[0, 0, [0, 2]])) > 2.0
+    gen.set_captured(False)   # generation only: both parts from codes, kept for re-decoding
+    off = gen.generate_batch([r])[0]
+    assert off.tokens is not None and off.arms_tokens is not None and off.provenance == "generated"

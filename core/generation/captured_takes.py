@@ -49,7 +49,7 @@ from .take_loop import looped_take
 TAKES = 5              # captured windows offered per prompt
 POOL = 2               # drawn by the seed from the POOL x TAKES nearest
 NEAREST = 2            # of them, at most this many by caption alone when the words name an action
-ACTION_BONUS = 0.1     # TMA cosine credited to a take of the asked action
+ACTION_BONUS = 0.3     # TMA cosine credited to a take of the asked action (tuning paraphrases, docs/library.md)
 UNASKED_SECONDS = 4.0  # the least a take plays when the length is the model's
 BUSIEST = 2            # a long take's busiest windows, one drawn by the seed
 KEPT = 16              # takes kept read at once (rotations as matrices)

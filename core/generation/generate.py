@@ -221,15 +221,16 @@ class Generator:
 
     @torch.no_grad()
     def choose(self, r: Request, side=None, captured: bool = True, reach: float | None = None,
-               body_of: Request | None = None) -> Choice:
+               body_of: Request | None = None, library_as_captured: bool = True) -> Choice:
         """One request's choice among the T5's samples (and memory clips, as ``tokens_for``) and
         the captured takes of the asked action and nearest captions (``captured_takes.py``), by the
         TMA on the finished motions; ``side``: a named side, the takes mirrored to it. ``captured``
         False: the samples alone (an edit that needs the codes follows: a stop, a distance); ``reach``:
         the distance asked (m), which the samples that get that far compete for; ``body_of``: the
         request whose words give the body (``body_shape``) when ``r`` is a rewording of it (a
-        course's plain gait)."""
-        return self._choose(r, True, self.captured_on and captured, side, reach, body_of)
+        course's plain gait); ``library_as_captured`` False: a user's library clip competes by its
+        codes only (a part put together from joint tracks decodes them)."""
+        return self._choose(r, library_as_captured, self.captured_on and captured, side, reach, body_of)
 
     def _choose(self, r: Request, library_as_captured: bool, captured: bool = False, side=None,
                 reach: float | None = None, body_of: Request | None = None) -> Choice:

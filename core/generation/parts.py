@@ -3,17 +3,21 @@
     motion = generate_by_parts(gen, request)     # None: the prompt asks nothing of the parts
     motion = redecode_parts(motion, vae, body, betas)
 
-The plan reads the prompt (``plan/part_prompts.plan_parts``, ``plan/words.py``). Two things at once ("jogs along, waving"): the legs
-prompt is generated first; the arms prompt is then generated for exactly as many tokens, so both
-tracks have one length. Each track is the SA-VAE's decoding of its tokens for the body; the arms
-track is mirrored when it names a side that is not the one that moves most, then its arms are put
-on the legs track's chest (``part_compose.compose_arms``) and the whole is planted on the legs
-track's foot contacts (``decode.motion_from_joints``). A single action naming a side ("kick with
+The plan reads the prompt (``plan/part_prompts.plan_parts``, ``plan/words.py``). Two things at once
+("jogs along, waving"): each part is its own choice among the T5's samples and the captured takes
+of its action (``Generator.choose``; the legs first, the arms then for as long as the legs last).
+Each becomes a joint track on the body (``part_of``): a captured take moved by its own rotations,
+or the SA-VAE's decoding of the codes, mirrored when the arms name a side that is not the one that
+moves most (a take is mirrored when offered). The arms are put on the legs track's chest
+(``part_compose.compose_arms``) and the whole is planted on the legs track's foot contacts
+(``decode.motion_from_joints``; a captured legs take's measured contacts as they are). A motion
+with a captured part keeps no tokens and says where each part came from ("legs: captured: ...;
+arms: generated"); another body plants it again by its rotations (``retarget.replant``). A single action naming a side ("kick with
 the left foot") is generated as usual and mirrored when the other side moves most in the planted
 motion (planting, the foot roll above all, changes how far a foot travels).
 
-The Motion keeps what re-decoding needs: ``tokens`` (the legs, or the whole motion), ``arms_tokens``
-and the two mirror flags; ``features`` are those of the planted motion, computed as the dataset builder computes a clip's
+A motion of two sets of codes keeps what re-decoding needs: ``tokens`` (the legs, or the whole
+motion), ``arms_tokens`` and the two mirror flags; ``features`` are those of the planted motion, computed as the dataset builder computes a clip's
 (``motion.features.posed_features``: the posed joints, their IK rotations, the planted contacts),
 so every later reader of the features (the part judge, the TMA) sees what the rig plays.
 """
@@ -54,12 +58,46 @@ def _side_fixed(codes, vae, body, betas, side: tuple[str, str] | None) -> tuple[
 
 
 def assemble(body, betas, legs: Track, arms: Track | None, prompt: str | None, ik_refine_iters: int,
-             **extra) -> Motion:
-    """The planted Motion of a legs track (and the arms of an arms track, when given)."""
+             known_contacts: bool = False, **extra) -> Motion:
+    """The planted Motion of a legs track (and the arms of an arms track, when given);
+    ``known_contacts``: the legs are a captured take's, their contacts measured (planted as they are,
+    no smoothing)."""
     joints = compose_arms(legs.joints, arms.joints) if arms is not None else legs.joints
-    m = motion_from_joints(body, betas, joints, legs.contacts, ik_refine_iters, prompt=prompt, **extra)
+    m = motion_from_joints(body, betas, joints, legs.contacts, ik_refine_iters, prompt=prompt,
+                           known_contacts=known_contacts, **({"smooth": 0.0} if known_contacts else {}), **extra)
     m.features = motion_features(m)  # as the builder's clips
     return m
+
+
+@dataclasses.dataclass
+class Part:
+    """One part's chosen motion as a joint track on the body, and what the Motion keeps of it."""
+    track: Track
+    codes: list[int] | None   # None: a captured take, played by its own rotations
+    mirrored: bool
+    provenance: str
+
+
+def part_of(gen, choice, betas, side: tuple[str, str] | None = None) -> Part:
+    """The joint track of one part's ``Generator.choose`` on the body ``betas``: a captured take's
+    window moved by its own rotations (``captured_takes.captured_motion``: its posed joints and
+    measured contacts; already mirrored to ``side``), or the codes decoded, mirrored when ``side``
+    names the side that moves less."""
+    if choice.window is not None:
+        m = gen.chosen_motion(choice, betas)
+        return Part(Track(m.network_joints, m.contacts), None, bool(choice.window.mirrored), m.provenance)
+    track, flipped = _side_fixed(choice.codes, gen.vae, gen.body, betas, side) if side is not None else \
+        (_track(choice.codes, gen.vae, gen.body, betas, False), False)
+    return Part(track, [int(c) for c in choice.codes], flipped, decoded_provenance(choice.kept))
+
+
+def fitted(track: Track, frames: int) -> Track:
+    """``track`` cut to ``frames`` frames, or its last frame held to that length."""
+    extra = frames - len(track)
+    if extra <= 0:
+        return Track(track.joints[:frames], track.contacts[:frames])
+    return Track(np.concatenate([track.joints, np.repeat(track.joints[-1:], extra, 0)]),
+                 np.concatenate([track.contacts, np.repeat(track.contacts[-1:], extra, 0)]))
 
 
 CLAUSE_NEAR = 0.5   # MiniLM cosine from which a clause takes the action of its nearest training caption
@@ -118,23 +156,29 @@ def generate_by_parts(gen, r, words=None) -> Motion | None:
     gait = read_words(plan.legs_prompt).course_gait if course is not None else None   # walked straight, then bent
     legs_req = dataclasses.replace(r, prompt=gait[0], action=gait[1]) if gait else \
         dataclasses.replace(r, prompt=plan.legs_prompt, action=plan.legs_action)
-    codes, pred, kept = gen.tokens_for([legs_req])
-    seconds = len(codes[0]) * gen.vae.cfg.downsample / FPS
-    arms_req = dataclasses.replace(r, prompt=plan.arms_prompt, seconds=seconds, seed=r.seed + 1, action=plan.arms_action)
-    arms_codes, _, arms_kept = gen.tokens_for([arms_req])
-    retrieved = [c for c in kept + arms_kept if c]
-    betas, source = gen.body_shape(r, pred[0].numpy())
-    legs = _track(codes[0], gen.vae, gen.body, betas, False)
-    arms, arms_mirrored = _side_fixed(arms_codes[0], gen.vae, gen.body, betas, plan.arms_side)
-    tokens = dict(tokens=np.asarray(codes[0], np.int32), arms_tokens=np.asarray(arms_codes[0], np.int32),
-                  arms_mirrored=arms_mirrored)
+    # each part its own choice among samples and captured takes (a course's gait: the samples, as one prompt's)
+    legs_choice = gen.choose(legs_req, captured=course is None, body_of=r, library_as_captured=False)
+    betas, source = legs_choice.body, legs_choice.body_source
+    legs = part_of(gen, legs_choice, betas)
+    arms_req = dataclasses.replace(r, prompt=plan.arms_prompt, seconds=len(legs.track) / FPS, seed=r.seed + 1,
+                                   action=plan.arms_action)
+    arms_choice = gen.choose(arms_req, plan.arms_side, body_of=r, library_as_captured=False)
+    arms = part_of(gen, arms_choice, betas, plan.arms_side)
+    legs_track, arms_track = legs.track, fitted(arms.track, len(legs.track))
+    played = legs.codes is None or arms.codes is None   # a take in it: played by rotations, no tokens
+    tokens = {} if played else dict(tokens=np.asarray(legs.codes, np.int32),
+                                    arms_tokens=np.asarray(arms.codes, np.int32), arms_mirrored=arms.mirrored)
     if course is not None:  # the codec does not carry turning: the words' course is walked (course_walk.py)
         right = read_words(plan.legs_prompt).course_right
-        legs, tokens = on_course(legs, course, right, whole=r.whole_course), {}   # an edit: no tokens kept
-    m = assemble(gen.body, betas, legs, arms, r.prompt, gen.ik_refine_iters, **tokens)
+        legs_track, tokens = on_course(legs_track, course, right, whole=r.whole_course), {}   # an edit: no tokens kept
+    m = assemble(gen.body, betas, legs_track, arms_track, r.prompt, gen.ik_refine_iters,
+                 known_contacts=legs.codes is None, **tokens)
+    if played:   # another body plants it again by its rotations (retarget.replant), as a take
+        m.contacts_measured = True
+        m.provenance = f"legs: {legs.provenance}; arms: {arms.provenance}"
     m.shape_source = source
     m.part_prompts = (plan.legs_prompt, plan.arms_prompt)
-    m.retrieved_clips = retrieved
+    m.retrieved_clips = legs_choice.clips + arms_choice.clips
     return m
 
 
