@@ -4,7 +4,7 @@ from __future__ import annotations
 import numpy as np
 import torch
 
-from shapemove.core.generation.take_loop import looped_take
+from shapemove.core.generation.take_loop import looped_repetition, looped_take
 
 
 def _take(openbody, arms, forward=0.05):
@@ -42,3 +42,25 @@ def test_a_repeating_take_loops_and_a_single_gesture_is_held(openbody):
     assert looped_take(*_take(openbody, kick, 0.0), 300) is None          # one gesture: held, not repeated
     rise = np.linspace(0.0, 0.8, 80)
     assert looped_take(*_take(openbody, rise, 0.0), 300) is None          # never comes back: held
+
+
+def test_one_repetition_of_a_repeated_action_plays_on(openbody):
+    """One arm circle (arms up and back down once, standing before and after, swaying 1 mm a
+    frame): not a repeat ``looped_take`` finds, but ``looped_repetition`` plays its busy stretch
+    again, on the spot; a movement that ends elsewhere than it began is held."""
+    circle = np.concatenate([np.zeros(10), 0.6 * np.sin(np.pi * np.arange(30) / 30), np.zeros(10)])
+    rot, root, con, J = _take(openbody, circle, forward=0.001)
+    assert looped_take(rot, root, con, J, 120) is None
+    out = looped_repetition(rot, root, con, J, 120)
+    assert out is not None
+    r, rt, c, first = out
+    assert len(r) == len(rt) == len(c) == 120
+    order = r[:, 0, 0, 0].astype(int)
+    a = int(order[first])
+    assert np.array_equal(order[:first], np.arange(first)) and 8 <= a <= 11 and 39 <= first <= 42
+    assert np.array_equal(order[first:first + (first - a)], np.arange(a, first))   # the circle again
+    assert np.array_equal(rt[first], root[a])                                     # in place: no sway added up
+    assert np.ptp(rt[:, 2]) < 0.06
+    assert looped_repetition(rot, root, con, J, len(rot)) is None                 # long enough: nothing to do
+    rise = np.concatenate([np.zeros(10), np.linspace(0.0, 0.8, 30), np.full(10, 0.8)])
+    assert looped_repetition(*_take(openbody, rise, 0.0), 120) is None            # ends up high: held

@@ -227,6 +227,11 @@ GENERIC_OF = {"walk in a figure eight": ("walk",), "walk in a circle": ("walk",)
               "ballet": ("dance",), "wave goodbye": ("wave",), "cartwheel": ("turn",), "slash": ("swing",)}
 
 
+# actions done over and over by their nature: a take of one repetition plays on as a loop of it
+# (``generation.take_loop.looped_repetition``); a kick or a throw done once is held instead
+REPEATED = frozenset({"arm circles", "jumping jacks", "dribble", "elbow to knee", "side twist"})
+
+
 def specific(acts: list[str]) -> list[str]:
     """Drop the generic actions of the specific ones also present (["walk", "limp"] -> ["limp"])."""
     drop = {g for a in acts for g in GENERIC_OF.get(a, ())}

@@ -44,7 +44,8 @@ import numpy as np
 from ..constants import FPS
 from ..errors import ShapeMoveError
 from ..scene.motion_file import Motion
-from .take_loop import looped_take
+from ..data.actions import REPEATED
+from .take_loop import looped_repetition, looped_take
 
 TAKES = 5              # captured windows offered per prompt
 POOL = 2               # drawn by the seed from the POOL x TAKES nearest
@@ -209,7 +210,10 @@ class TakePool:
         rot, root, con = (np.asarray(t[k][lo:lo + want]) for k in ("rotations", "root", "contacts"))
         held = looped = 0
         if len(rot) < want:   # a take that repeats plays on as a loop, another is held on its last pose
-            again = looped_take(rot, root, con, self.proc.pose_on(rot, root, t["betas"], 1.0, con), want)
+            posed = self.proc.pose_on(rot, root, t["betas"], 1.0, con)
+            again = looped_take(rot, root, con, posed, want)
+            if again is None and self.actions[i] in REPEATED:   # one arm circle: circled again
+                again = looped_repetition(rot, root, con, posed, want)
             if again is not None:
                 rot, root, con, first = again
                 looped = want - first

@@ -18,6 +18,10 @@ that say the take repeats rather than merely starts and ends alike:
 The take plays from its first frame to b - 1, then a..b - 1 again and again, each repeat moved by
 the cycle's advance on the floor; the contacts repeat with the frames, so planting the whole
 window (``retarget.planted_retarget``) plants the repeats as the take's own steps.
+
+A take of one repetition of an action done over and over by its nature (``actions.REPEATED``: a
+single arm circle of 1.2 s) has no second cycle to find; ``looped_repetition`` plays its busy
+stretch again when the stretch ends where it began (the same seam and heading conditions).
 """
 from __future__ import annotations
 
@@ -42,15 +46,13 @@ def looped_take(rotations, root, contacts, joints, frames: int):
     from .loop_cut import best_cut
     from .track import headings
 
-    n = len(rotations)
-    if n >= frames:
+    if len(rotations) >= frames:
         return None
     J = np.asarray(joints, np.float64)
-    steps = np.linalg.norm(np.diff(J, axis=0), axis=-1).max(-1)            # (T-1,) largest joint step
-    moving = np.flatnonzero(steps >= STILL * np.percentile(steps, 90))
-    if len(moving) < 2:
+    busy = _busy(J)
+    if busy is None:
         return None
-    s, e = int(moving[0]), int(moving[-1]) + 2                              # the busy stretch s..e-1
+    steps, s, e = busy
     try:
         cut = best_cut(J[s:e], FPS, (SHORTEST_CYCLE, MOST_OF_TAKE * (e - s) / FPS))
     except ShapeMoveError:   # too short for two cycles of the shortest length
@@ -58,11 +60,47 @@ def looped_take(rotations, root, contacts, joints, frames: int):
     a, b = cut.start + s, cut.end + s
     if steps[a:b].mean() < BUSY * steps[s:e - 1].mean() or not _repeated(J, a, b):
         return None
-    h = headings(J)
-    if abs(np.degrees(np.angle(np.exp(1j * (h[b] - h[a]))))) > MOST_TURN:
+    return _played_on(rotations, root, contacts, J, steps, headings(J), a, b, b, frames)
+
+
+def looped_repetition(rotations, root, contacts, joints, frames: int):
+    """As ``looped_take`` for a take of one repetition (``actions.REPEATED``): its busy stretch a..b-1
+    (the standing start and end left out) is the cycle, played again while its last frame steps into
+    its first no farther than the take's own steps; None when it does not, or the take is long
+    enough."""
+    from .track import headings
+
+    if len(rotations) >= frames:
+        return None
+    J = np.asarray(joints, np.float64)
+    busy = _busy(J)
+    if busy is None or busy[2] - busy[1] < SHORTEST_CYCLE * FPS:
+        return None
+    steps, a, b = busy
+    return _played_on(rotations, root, contacts, J, steps, headings(J), a, b, b - 1, frames, travel=False)
+
+
+def _busy(J):
+    """(largest joint step of each frame (T-1,), s, e) of the take's busy stretch s..e-1: its
+    standing start and end left out (frames whose largest step is under ``STILL`` of the 90th
+    percentile); None when nothing moves."""
+    steps = np.linalg.norm(np.diff(J, axis=0), axis=-1).max(-1)
+    moving = np.flatnonzero(steps >= STILL * np.percentile(steps, 90))
+    if len(moving) < 2:
+        return None
+    return steps, int(moving[0]), int(moving[-1]) + 2
+
+
+def _played_on(rotations, root, contacts, J, steps, h, a: int, b: int, on: int, frames: int, travel: bool = True):
+    """Frames 0..b-1, then a..b-1 over and over to ``frames``, each repeat moved by the cycle's
+    advance (frame ``on``'s root and heading against frame a's: b where the take goes on past the
+    cycle, else its last frame; none without ``travel``: a repetition on the spot, whose sway must
+    not add up); None when the cycle turns more than ``MOST_TURN`` or its seam steps farther than
+    ``SEAM_STEP`` x the take's 99th-percentile step."""
+    if abs(np.degrees(np.angle(np.exp(1j * (h[on] - h[a]))))) > MOST_TURN:
         return None
     root = np.asarray(root, np.float32)
-    advance = (root[b] - root[a]) * np.array([1.0, 0.0, 1.0], np.float32)
+    advance = (root[on] - root[a]) * np.array([1.0, 0.0, 1.0], np.float32) * float(travel)
     seam = np.linalg.norm(J[a] + advance - J[b - 1], axis=-1).max()
     if seam > SEAM_STEP * np.percentile(steps, 99):
         return None
