@@ -224,7 +224,8 @@ def action(name: str) -> Action:
 GENERIC_OF = {"walk in a figure eight": ("walk",), "walk in a circle": ("walk",), "zombie walk": ("walk",),
               "limp": ("walk",), "sneak": ("walk",), "walk backward": ("walk",), "jump forward": ("jump",),
               "spin jump": ("jump", "spin"), "kick ball": ("kick",), "spin kick": ("kick", "spin"),
-              "ballet": ("dance",), "wave goodbye": ("wave",), "cartwheel": ("turn",), "slash": ("swing",)}
+              "ballet": ("dance",), "wave goodbye": ("wave",), "cartwheel": ("turn",), "slash": ("swing",),
+              "hop": ("jump",)}
 
 
 # actions done over and over by their nature: a take of one repetition plays on as a loop of it

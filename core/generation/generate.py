@@ -192,7 +192,7 @@ class Generator:
         if pool is None or not len(pool):
             return []
         down = self.vae.cfg.downsample
-        action = self._asked(r)
+        action = self._taken(self._asked(r))
         text = self._embed_texts([r.prompt])[0]
         if r.seconds is None:   # the model's length: a take plays whole, at least UNASKED_SECONDS
             return pool.windows(text, action, r.seed, self._length(UNASKED_SECONDS)[0] * down, side, hi * down)
@@ -240,7 +240,7 @@ class Generator:
             g = torch.Generator().manual_seed(int(r.seed))
             lo, hi = self._length(r.seconds)
             found = self._action_clips(r, lo, hi)
-            asked = self._asked(r)   # a take of another action than the words ask does not compete
+            asked = self._taken(self._asked(r))   # a take of another action than the words ask does not compete
             words = r.words if r.words is not None else read_words(r.prompt)
             windows = [w for w in (self._windows(r, lo, hi, side) if captured else [])   # of the asked action,
                        if action_credit(asked, w.action) is not None                    # at a plain gait's pace
@@ -271,6 +271,17 @@ class Generator:
 
         actions = (r.words if r.words is not None else read_words(r.prompt)).actions
         return r.action or (specific(list(actions)) or [None])[0]
+
+    def _taken(self, action: str | None) -> str | None:
+        """The action whose captured takes compete for ``action``: itself, or, when no take is of it,
+        the more general action it is a form of that has takes (``actions.GENERIC_OF``: a hop is a
+        jump, ballet a dance)."""
+        from ..data.actions import GENERIC_OF
+
+        pool = self.pool if self.captured_on else None
+        if action is None or pool is None or action in pool.actions:
+            return action
+        return next((g for g in GENERIC_OF.get(action, ()) if g in pool.actions), action)
 
     def _sampled(self, r: Request, lo: int, hi: int, g: torch.Generator, library: bool = True):
         """(candidate codes, their memory clip or None, betas): best-of-N's T5 samples (some seeded
