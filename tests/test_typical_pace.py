@@ -86,3 +86,32 @@ def test_a_slow_captured_take_does_not_compete_for_a_plain_gait():
     assert not slow_take(take(1.0, rest), read_words("a man walks slowly"), speeds, body)
     assert not slow_take(take(1.0, rest), read_words("a man waves"), speeds, body)
     assert not slow_take(take(1.0, rest), plain, {}, body)
+
+
+def test_a_take_that_stops_or_circles_is_no_plain_gait():
+    """For "a person jogs", a take that stops (1.9 s of jogging held on its last pose for the rest
+    of 4 s) or runs around a circle does not compete; one that goes straight does, and a course
+    asked for lets a circling take compete."""
+    from shapemove.core.generation.captured_takes import Window
+    from shapemove.core.generation.typical_pace import unplain_take
+    from shapemove.core.plan.words import read_words
+
+    def take(root, held=0):
+        n = len(root)
+        return Window(rotations=np.zeros((n, 24, 3, 3)), root=np.asarray(root, np.float32), contacts=np.zeros((n, 4)),
+                      rest=np.zeros((24, 3)), features=np.zeros((n - 1, 263)), action="jog", clip_id="x",
+                      provenance="captured", held=held)
+
+    t = np.arange(80) / 20.0
+    line = np.stack([0.1 * np.sin(6 * t), np.full(80, 0.9), 1.5 * t], 1)           # swaying, straight on
+    a = 1.5 * t / 2.0                                                               # 1.5 m/s on a 2 m circle
+    circle = np.stack([2.0 * (1 - np.cos(a)), np.full(80, 0.9), 2.0 * np.sin(a)], 1)
+    stops = line.copy()
+    stops[38:] = stops[37]
+    plain = read_words("a person jogs")
+    assert not unplain_take(take(line), plain)
+    assert unplain_take(take(circle), plain)                                        # 172 degrees of a circle
+    assert unplain_take(take(stops, held=42), plain)                                # 2.1 of 4 s standing
+    assert not unplain_take(take(stops[:42], held=4), plain)                        # the last 0.2 s of 2.1 held
+    assert not unplain_take(take(circle), read_words("a person jogs in a circle"))
+    assert not unplain_take(take(stops, held=42), read_words("a man kicks"))       # a kick, then standing

@@ -6,8 +6,8 @@ prompts toward (``core/generation/typical_pace.py``), written into a model folde
 Per gait (walk, jog, run): the median root speed (``eval.gait.mean_speed``: the pelvis's
 horizontal path over the clip's length) of the training split's captures of it on the average
 body (``norm_joints``: betas 0, the body a prompt without shape words gets; strides scaled by the
-pelvis height) that go straight (the smoothed root's start-to-end distance at least ``STRAIGHT``
-of its path: a turning or circling capture is a different task), in their performer's plain way:
+pelvis height) that go straight (``typical_pace.straight``: the smoothed root's start-to-end
+distance at least 0.9 of its path; a turning or circling capture is a different task), in their performer's plain way:
 the clips labelled ``style: normal`` (the Bandai captures: one actor's plain way of doing it among
 the styled ones: active, tired, proud, ...) or, for a gait with fewer than ``--least`` of those
 (jog), its clips with no style label. Augmented copies are left out. Writes ``typical_pace.json``
@@ -23,7 +23,6 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
 
-STRAIGHT = 0.9
 GAITS = ("walk", "jog", "run")
 
 
@@ -32,6 +31,7 @@ def gait_speeds(data: Path, split: str = "train") -> dict[str, dict[str, list[fl
     from shapemove.core.data.built_meta import iter_meta
     from shapemove.core.eval.gait import mean_speed
     from shapemove.core.generation.track import root_centre
+    from shapemove.core.generation.typical_pace import straight
 
     ids = set((Path(data) / f"{split}.txt").read_text().split())
     out: dict[str, dict[str, list[float]]] = {}
@@ -47,9 +47,7 @@ def gait_speeds(data: Path, split: str = "train") -> dict[str, dict[str, list[fl
         if not path.is_file():
             continue
         joints = np.load(path)
-        c = root_centre(joints)
-        along = float(np.linalg.norm(np.diff(c, axis=0), axis=1).sum())
-        if along <= 0 or np.linalg.norm(c[-1] - c[0]) < STRAIGHT * along:
+        if not straight(root_centre(joints)):
             continue
         out.setdefault(actions[0], {}).setdefault("normal" if style else "unstyled", []).append(
             mean_speed(joints, float(meta.get("fps", 20))))
@@ -58,7 +56,7 @@ def gait_speeds(data: Path, split: str = "train") -> dict[str, dict[str, list[fl
 
 def table(found: dict, least: int) -> dict:
     """The ``typical_pace.json`` content: per gait its speed, the clips and which captures."""
-    from shapemove.core.generation.typical_pace import FORMAT
+    from shapemove.core.generation.typical_pace import FORMAT, STRAIGHT
 
     gaits = {}
     for gait in GAITS:

@@ -52,7 +52,7 @@ from .sampling_params import (DEFAULT_GUIDANCE, check_candidates, check_guidance
                               check_retrieval_prefix, check_retrieved, check_sampling)
 from .request import Request
 from .slow_steps import slow_motion
-from .typical_pace import leg_ratio, load_typical_speeds, slow_take, typical_paced
+from .typical_pace import leg_ratio, load_typical_speeds, slow_take, typical_paced, unplain_take
 from .turn_words import turn_motion
 
 
@@ -244,7 +244,8 @@ class Generator:
             words = r.words if r.words is not None else read_words(r.prompt)
             windows = [w for w in (self._windows(r, lo, hi, side) if captured else [])   # of the asked action,
                        if action_credit(asked, w.action) is not None                    # at a plain gait's pace
-                       and not slow_take(w, words, self.typical_speeds, self.body)]
+                       and not slow_take(w, words, self.typical_speeds, self.body)
+                       and not unplain_take(w, words)]
             cands, sources, beta = (self._from_action_clips(r, found) if found    # the user's clips: as captured
                                     else self._sampled(r, lo, hi, g, library=not windows))   # takes, or as codes
             best = 0
@@ -537,7 +538,7 @@ class Generator:
             by_parts = words is not None and (words.parts is not None or words.side is not None or not edited)
             standing = words is not None and words.stand_still and self.rest_code is not None
             motion = self.standing(r) if standing else \
-                generate_by_parts(self, asked, words if edited else None) if by_parts else None
+                generate_by_parts(self, asked, words if edited else None, captured=stop is None) if by_parts else None
             came_from = motion.provenance if motion is not None else None   # kept through the edits below
             if motion is not None and stop is not None:
                 motion.prompt = r.prompt

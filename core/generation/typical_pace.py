@@ -15,6 +15,9 @@ followed 0.75 m off, a walk at 2x sliding 0.77 mm a frame), so a slow chosen wal
 Instead a captured take slower than ``SLOW_TAKE`` of the typical speed (on its performer's body)
 does not compete for a plain gait (``slow_take``): the data's walks include strolls, which the TMA
 chose for "a man walks" as readily as plain walks (median 0.93x typical with them, 0.97x without).
+Nor does a take that stops or circles (``unplain_take``: held on its last pose for more than
+``MOST_HELD`` of the window, or its root's path not ``straight``, the typical speeds' own test of a
+straight capture): a 1.9 s jog around a bend, then standing, was "a person jogs" at 0.48x.
 The feet are planted again (``track.replanted``). Nothing is retimed when the words ask a pace ("quickly"),
 a distance, a number of steps, a stop, a course, a turn, a direction other than forward, a count,
 two things at once or a side (``plan.words.Words``); the user's ``--speed`` applies after.
@@ -38,6 +41,8 @@ from ..errors import ShapeMoveError
 from .pace_words import gait_speed
 
 FORMAT = "shapemove-typical-pace/1"
+STRAIGHT = 0.9   # a straight capture: start-to-end at least this share of its smoothed root's path
+MOST_HELD = 0.1  # a plain gait's take held on its last pose longer than this share of the window stops
 TABLE = "typical_pace.json"
 MAX_BYTES = 64 << 10
 GAITS = ("walk", "jog", "run")
@@ -139,6 +144,29 @@ def typical_paced(motion, body, words, speeds: dict, ik_refine_iters: int = 10):
         else:
             hi = mid
     return replanted(motion, body, resample(Track(track.joints[:hi], track.contacts[:hi]), n), ik_refine_iters)
+
+
+def straight(centre) -> bool:
+    """Whether a smoothed root path (T,2) goes straight: its start-to-end distance at least
+    ``STRAIGHT`` of its length (a turning or circling capture is another task)."""
+    c = np.asarray(centre, np.float64)
+    along = float(np.linalg.norm(np.diff(c, axis=0), axis=1).sum())
+    return along > 0 and float(np.linalg.norm(c[-1] - c[0])) >= STRAIGHT * along
+
+
+def unplain_take(window, words) -> bool:
+    """Whether the captured take ``window`` is not the plain gait the words ask for (``plain_gait``):
+    it stops (held on its last pose for more than ``MOST_HELD`` of the window: a 1.9 s jog, then
+    standing) or turns off its line (its root's smoothed path is not ``straight``: a jog around a
+    circle). Like a slow take, it does not compete."""
+    from .track import root_centre
+
+    if plain_gait(words) is None:
+        return False
+    n = len(window.root) - window.held
+    if window.held > MOST_HELD * len(window.root) or n < 2:
+        return True
+    return not straight(root_centre(np.asarray(window.root, np.float64)[:n, None, :]))
 
 
 def slow_take(window, words, speeds: dict, body) -> bool:
