@@ -64,3 +64,14 @@ def test_one_repetition_of_a_repeated_action_plays_on(openbody):
     assert looped_repetition(rot, root, con, J, len(rot)) is None                 # long enough: nothing to do
     rise = np.concatenate([np.zeros(10), np.linspace(0.0, 0.8, 30), np.full(10, 0.8)])
     assert looped_repetition(*_take(openbody, rise, 0.0), 120) is None            # ends up high: held
+
+
+def test_one_cycle_of_a_gait_goes_on_at_its_pace(openbody):
+    """One stride cycle that walks on at 1 m/s (a single-cycle capture, as DeepMimic's): played
+    again, each repeat moved on by the cycle's travel, so the root keeps its pace across the seams."""
+    stride = 0.15 * np.sin(2 * np.pi * np.arange(20) / 20)
+    rot, root, con, J = _take(openbody, stride, forward=0.05)
+    assert looped_take(rot, root, con, J, 100) is None             # one cycle: nothing repeats in it
+    r, rt, c, first = looped_repetition(rot, root, con, J, 100)
+    assert len(rt) == 100 and first == 20
+    assert np.allclose(np.diff(rt[:, 2]), 0.05, atol=1e-4)         # 1 m/s all along, seams included

@@ -20,8 +20,10 @@ the cycle's advance on the floor; the contacts repeat with the frames, so planti
 window (``retarget.planted_retarget``) plants the repeats as the take's own steps.
 
 A take of one repetition of an action done over and over by its nature (``actions.REPEATED``: a
-single arm circle of 1.2 s) has no second cycle to find; ``looped_repetition`` plays its busy
-stretch again when the stretch ends where it began (the same seam and heading conditions).
+single arm circle of 1.9 s; or a gait, ``plan.vocabulary.GAITS``: DeepMimic's one-cycle jog) has no
+second cycle to find; ``looped_repetition`` plays its busy stretch again when the stretch ends where
+it began (the same seam and heading conditions): on the spot, or moved on by the stretch's advance
+when its root travels faster than ``TRAVELS``.
 """
 from __future__ import annotations
 
@@ -36,6 +38,7 @@ SEAM_STEP = 1.5        # the seam's step against the 99th percentile of the take
 MOST_TURN = 20.0       # degrees of heading per cycle
 STILL = 0.25           # a frame whose largest step is under this x the 90th percentile stands
 BUSY = 0.5             # the cycle's mean step against the busy stretch's
+TRAVELS = 0.2          # m/s: a repetition whose root goes on faster than this travels (a gait's one cycle)
 REPEAT = 0.5           # a neighbouring cycle's pose difference against the cycle's own spread
 
 
@@ -77,7 +80,9 @@ def looped_repetition(rotations, root, contacts, joints, frames: int):
     if busy is None or busy[2] - busy[1] < SHORTEST_CYCLE * FPS:
         return None
     steps, a, b = busy
-    return _played_on(rotations, root, contacts, J, steps, headings(J), a, b, b - 1, frames, travel=False)
+    r = np.asarray(root, np.float64)
+    moves = np.linalg.norm((r[b - 1] - r[a])[[0, 2]]) > TRAVELS * (b - 1 - a) / FPS   # a gait's one cycle
+    return _played_on(rotations, root, contacts, J, steps, headings(J), a, b, b - 1, frames, travel=moves)
 
 
 def _busy(J):
@@ -100,7 +105,8 @@ def _played_on(rotations, root, contacts, J, steps, h, a: int, b: int, on: int, 
     if abs(np.degrees(np.angle(np.exp(1j * (h[on] - h[a]))))) > MOST_TURN:
         return None
     root = np.asarray(root, np.float32)
-    advance = (root[on] - root[a]) * np.array([1.0, 0.0, 1.0], np.float32) * float(travel)
+    per_frame = (b - a) / max(1, on - a)   # the last frame's root stands one frame short of the next cycle's
+    advance = (root[on] - root[a]) * np.array([1.0, 0.0, 1.0], np.float32) * float(travel) * per_frame
     seam = np.linalg.norm(J[a] + advance - J[b - 1], axis=-1).max()
     if seam > SEAM_STEP * np.percentile(steps, 99):
         return None
