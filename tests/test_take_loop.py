@@ -66,9 +66,9 @@ def test_one_repetition_of_a_repeated_action_plays_on(openbody):
     assert looped_repetition(*_take(openbody, rise, 0.0), 120) is None            # ends up high: held
 
 
-def test_one_cycle_of_a_gait_goes_on_at_its_pace(openbody):
-    """One stride cycle that walks on at 1 m/s (a single-cycle capture, as DeepMimic's): played
-    again, each repeat moved on by the cycle's travel, so the root keeps its pace across the seams."""
+def test_one_repetition_on_the_move_goes_on_at_its_pace(openbody):
+    """One repetition that moves on at 1 m/s (a dribble while walking): played again, each repeat
+    moved on by the repetition's travel, so the root keeps its pace across the seams."""
     stride = 0.15 * np.sin(2 * np.pi * np.arange(20) / 20)
     rot, root, con, J = _take(openbody, stride, forward=0.05)
     assert looped_take(rot, root, con, J, 100) is None             # one cycle: nothing repeats in it

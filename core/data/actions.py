@@ -228,9 +228,9 @@ GENERIC_OF = {"walk in a figure eight": ("walk",), "walk in a circle": ("walk",)
               "hop": ("jump",)}
 
 
-# actions done over and over by their nature (and the gaits, ``plan.vocabulary.GAITS``): a take of one
-# repetition plays on as a loop of it (``generation.take_loop.looped_repetition``); a kick or a
-# throw done once is held instead
+# actions done over and over by their nature: a take of one repetition plays on as a loop of it
+# (``generation.take_loop.looped_repetition``); a kick or a throw done once is held instead (a
+# gait's one-cycle take too: docs/design-notes.md)
 REPEATED = frozenset({"arm circles", "jumping jacks", "dribble", "elbow to knee", "side twist"})
 
 

@@ -45,7 +45,6 @@ from ..constants import FPS
 from ..errors import ShapeMoveError
 from ..scene.motion_file import Motion
 from ..data.actions import REPEATED
-from ..plan.vocabulary import GAITS
 from .take_loop import looped_repetition, looped_take
 
 TAKES = 5              # captured windows offered per prompt
@@ -213,8 +212,7 @@ class TakePool:
         if len(rot) < want:   # a take that repeats plays on as a loop, another is held on its last pose
             posed = self.proc.pose_on(rot, root, t["betas"], 1.0, con)
             again = looped_take(rot, root, con, posed, want)
-            if again is None and (self.actions[i] in REPEATED or self.actions[i] in GAITS):   # one arm circle,
-                # one jog cycle: done again
+            if again is None and self.actions[i] in REPEATED:   # one arm circle: circled again
                 again = looped_repetition(rot, root, con, posed, want)
             if again is not None:
                 rot, root, con, first = again

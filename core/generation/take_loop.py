@@ -20,8 +20,7 @@ the cycle's advance on the floor; the contacts repeat with the frames, so planti
 window (``retarget.planted_retarget``) plants the repeats as the take's own steps.
 
 A take of one repetition of an action done over and over by its nature (``actions.REPEATED``: a
-single arm circle of 1.9 s; or a gait, ``plan.vocabulary.GAITS``: DeepMimic's one-cycle jog) has no
-second cycle to find; ``looped_repetition`` plays its busy stretch again when the stretch ends where
+single arm circle of 1.9 s) has no second cycle to find; ``looped_repetition`` plays its busy stretch again when the stretch ends where
 it began (the same seam and heading conditions): on the spot, or moved on by the stretch's advance
 when its root travels faster than ``TRAVELS``.
 """
@@ -38,7 +37,7 @@ SEAM_STEP = 1.5        # the seam's step against the 99th percentile of the take
 MOST_TURN = 20.0       # degrees of heading per cycle
 STILL = 0.25           # a frame whose largest step is under this x the 90th percentile stands
 BUSY = 0.5             # the cycle's mean step against the busy stretch's
-TRAVELS = 0.2          # m/s: a repetition whose root goes on faster than this travels (a gait's one cycle)
+TRAVELS = 0.2          # m/s: a repetition whose root goes on faster than this travels (a dribble on the move)
 REPEAT = 0.5           # a neighbouring cycle's pose difference against the cycle's own spread
 
 
@@ -81,7 +80,7 @@ def looped_repetition(rotations, root, contacts, joints, frames: int):
         return None
     steps, a, b = busy
     r = np.asarray(root, np.float64)
-    moves = np.linalg.norm((r[b - 1] - r[a])[[0, 2]]) > TRAVELS * (b - 1 - a) / FPS   # a gait's one cycle
+    moves = np.linalg.norm((r[b - 1] - r[a])[[0, 2]]) > TRAVELS * (b - 1 - a) / FPS   # moving on as it repeats
     return _played_on(rotations, root, contacts, J, steps, headings(J), a, b, b - 1, frames, travel=moves)
 
 
