@@ -12,14 +12,16 @@ moves most (a take is mirrored when offered). The arms are put on the legs track
 (``part_compose.compose_arms``) and the whole is planted on the legs track's foot contacts
 (``decode.motion_from_joints``; a captured legs take's measured contacts as they are). A motion
 with a captured part keeps no tokens and says where each part came from ("legs: captured: ...;
-arms: generated"); another body plants it again by its rotations (``retarget.replant``). A single action naming a side ("kick with
-the left foot") is generated as usual and mirrored when the other side moves most in the planted
-motion (planting, the foot roll above all, changes how far a foot travels).
+arms: generated"); another body plants it again by its rotations (``retarget.replant``). A
+single action naming a side ("kick with the left foot") is generated as usual and mirrored when the
+other side moves most in the planted motion (planting, the foot roll above all, changes how far a
+foot travels).
 
 A motion of two sets of codes keeps what re-decoding needs: ``tokens`` (the legs, or the whole
-motion), ``arms_tokens`` and the two mirror flags; ``features`` are those of the planted motion, computed as the dataset builder computes a clip's
-(``motion.features.posed_features``: the posed joints, their IK rotations, the planted contacts),
-so every later reader of the features (the part judge, the TMA) sees what the rig plays.
+motion), ``arms_tokens`` and the two mirror flags; ``features`` are those of the planted motion,
+computed as the dataset builder computes a clip's (``motion.features.posed_features``: the posed
+joints, their IK rotations, the planted contacts), so every later reader of the features (the part
+judge, the TMA) sees what the rig plays.
 """
 from __future__ import annotations
 
