@@ -129,7 +129,9 @@ def test_eval_report_writes_the_paraphrase_table(tmp_path):
     rep = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(rep)
     (tmp_path / "p.json").write_text(json.dumps(_para_result(0.612, 0.949, 0.362, 0.092, 141)))
-    (tmp_path / "b.json").write_text(json.dumps(_para_result(0.55, 0.949, 0.30, 0.08, 188)))
+    blind = _para_result(0.55, 0.949, 0.30, 0.08, 188)
+    blind["motion"]["accuracy_merged"] = 0.58
+    (tmp_path / "b.json").write_text(json.dumps(blind))
     readme = tmp_path / "README.md"
     readme.write_text("x\n<!-- eval:paraphrase -->\nstale table\n<!-- /eval:paraphrase -->\ny\n")
     none = ["--recon", str(tmp_path / "no.json"), "--generate", str(tmp_path / "no.json")]
@@ -147,6 +149,8 @@ def test_eval_report_writes_the_paraphrase_table(tmp_path):
     rows = {ln.split(" | ")[0].strip("| "): ln.split(" | ")[1:] for ln in readme.read_text().splitlines()
             if ln.startswith("| ")}
     assert [c.strip(" |") for c in rows[strict]] == ["61.2 %", "55.0 %"]
+    merged = "generated motion, merged (a pair the judge does not tell apart in real windows counts)"
+    assert [c.strip(" |") for c in rows[merged]] == ["—", "58.0 %"]   # older results have no merged figure
     plain = tmp_path / "PLAIN.md"
     plain.write_text("no paraphrase block\n")
     assert rep.main(none + ["--paraphrase", str(tmp_path / "p.json"), "--page", str(plain)]) == 0
