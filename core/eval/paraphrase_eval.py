@@ -231,18 +231,22 @@ def eval_paraphrase(model_dir=None, prompts=None, tma=None, seed: int | list[int
 
 def _indistinct(clfs: dict, data, seconds: float | None) -> dict:
     """Per judge, the pairs of actions whose real windows of the played length it does not tell apart,
-    their windows' confusion and the takes per action (``indistinct_actions.py``)."""
+    their windows' confusion, the takes per action and each action's real windows named right with
+    those pairs merged (``windows_right``: what a real performance of that length is credited with)
+    (``indistinct_actions.py``)."""
     from ..constants import FPS
-    from .indistinct_actions import indistinct_pairs, take_counts, window_confusion
+    from .indistinct_actions import indistinct_pairs, take_counts, window_accuracy, window_confusion
 
     frames = int(round((seconds or 4.0) * FPS))   # the model's own length: the evaluation's 4 s
-    out: dict = {"frames": frames, "pairs": {}, "confusion": {}, "takes": {}}
+    out: dict = {"frames": frames, "pairs": {}, "confusion": {}, "takes": {}, "windows_right": {}}
     for k, c in clfs.items():
         if c is None or data is None:
             continue
         conf, takes = window_confusion(c, data, frames), take_counts(c)
-        out["pairs"][k] = sorted(sorted(p) for p in indistinct_pairs(conf, takes))
+        pairs = indistinct_pairs(conf, takes)
+        out["pairs"][k] = sorted(sorted(p) for p in pairs)
         out["confusion"][k], out["takes"][k] = conf, takes
+        out["windows_right"][k] = window_accuracy(conf, pairs)
     return out
 
 

@@ -72,6 +72,11 @@ class Window:
     mirrored: bool = False
     looped: int = 0         # frames of the take's own cycle played again (take_loop.py)
 
+    @property
+    def arrays(self) -> dict:
+        """The window as a take's arrays (``retarget.planted_retarget``, ``retarget.shaped_take``)."""
+        return {"rotations": self.rotations, "root": self.root, "rest": self.rest, "contacts": self.contacts}
+
 
 def hold(rotations, root, contacts, frames: int):
     """A take shorter than ``frames`` held on its last pose (its contacts, or both feet down when
@@ -267,8 +272,7 @@ def captured_motion(w: Window, body, betas, ik_refine_iters: int = 10, prompt: s
     with its provenance."""
     from .retarget import planted_retarget
 
-    out = planted_retarget({"rotations": w.rotations, "root": w.root, "rest": w.rest, "contacts": w.contacts},
-                           body, betas, ik_refine_iters)
+    out = planted_retarget(w.arrays, body, betas, ik_refine_iters)
     out.prompt = prompt
     out.provenance = w.provenance
     if w.looped:

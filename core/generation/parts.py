@@ -39,6 +39,7 @@ from ..plan.words import read_words
 from .course_walk import ACTIONS as COURSE_ACTIONS, course_motion, on_course
 from .decode import motion_from_joints
 from .part_compose import compose_arms, mirror_track, needs_mirror
+from .retarget import shaped_take
 from .track import Track, decoded_track
 
 
@@ -82,12 +83,13 @@ class Part:
 
 def part_of(gen, choice, betas, side: tuple[str, str] | None = None) -> Part:
     """The joint track of one part's ``Generator.choose`` on the body ``betas``: a captured take's
-    window moved by its own rotations (``captured_takes.captured_motion``: its posed joints and
-    measured contacts; already mirrored to ``side``), or the codes decoded, mirrored when ``side``
-    names the side that moves less."""
-    if choice.window is not None:
-        m = gen.chosen_motion(choice, betas)
-        return Part(Track(m.network_joints, m.contacts), None, bool(choice.window.mirrored), m.provenance)
+    window posed by its own rotations (``retarget.shaped_take``; its measured contacts; already
+    mirrored to ``side``), or the codes decoded, mirrored when ``side`` names the side that moves
+    less."""
+    w = choice.window
+    if w is not None:
+        track = Track(shaped_take(w.arrays, gen.body, betas, gen.ik_refine_iters), np.asarray(w.contacts, np.uint8))
+        return Part(track, None, bool(w.mirrored), w.provenance)
     track, flipped = _side_fixed(choice.codes, gen.vae, gen.body, betas, side) if side is not None else \
         (_track(choice.codes, gen.vae, gen.body, betas, False), False)
     return Part(track, [int(c) for c in choice.codes], flipped, decoded_provenance(choice.kept))

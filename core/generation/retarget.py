@@ -228,13 +228,23 @@ def planted_retarget(arrays: dict, body, betas, ik_refine_iters: int = 10) -> Mo
     from .decode import motion_from_joints
 
     betas = check_betas(betas)
-    proc = processor(body, ik_refine_iters)
     contacts = np.asarray(arrays["contacts"], np.uint8)
-    rotations, root = start_at_origin(arrays["rotations"], arrays["root"], arrays["rest"])
-    shaped = proc.pose_on(rotations, root, betas, proc.stride_scale(arrays["rest"], betas), contacts)
+    shaped = shaped_take(arrays, body, betas, ik_refine_iters)
     out = motion_from_joints(body, betas, shaped, contacts, ik_refine_iters, known_contacts=True, smooth=0.0)
     validate(out)
     return out
+
+
+def shaped_take(arrays: dict, body, betas, ik_refine_iters: int = 10) -> np.ndarray:
+    """(T,22,3) float32 joints of a take's arrays (rotations, root, rest, contacts) posed on the
+    body ``betas``: started at the origin facing +Z (``start_at_origin``), the stride scaled by leg
+    length and grounded on the take's contacts (``ClipProcessor.pose_on``). What
+    ``planted_retarget`` plants, and what a captured part is composed from (``parts.part_of``)."""
+    betas = check_betas(betas)
+    proc = processor(body, ik_refine_iters)
+    rotations, root = start_at_origin(arrays["rotations"], arrays["root"], arrays["rest"])
+    return proc.pose_on(rotations, root, betas, proc.stride_scale(arrays["rest"], betas),
+                        np.asarray(arrays["contacts"], np.uint8))
 
 
 def replant(motion: Motion, body, betas, ik_refine_iters: int = 10) -> Motion:
