@@ -29,11 +29,12 @@ $(VENV)/.installed: pyproject.toml
 $(GLTF_VALIDATOR): | $(VENV)/.installed
 	npm install --no-audit --no-fund --prefix $(VENV)/node gltf-validator@2.0.0-dev.3.10
 
+# two worker processes (pytest-xdist), a test file each at a time: the 2-core machine's cores both busy
 test: setup
-	$(PY) -m pytest -q --durations=25
+	$(PY) -m pytest -q -n 2 --dist loadfile --durations=25
 
 test-fast: setup
-	$(PY) -m pytest -q -m "not slow"
+	$(PY) -m pytest -q -n 2 --dist loadfile -m "not slow"
 
 demo: setup
 	$(PY) -m shapemove demo --prompt "$(PROMPT)" --shape-text "$(SHAPE)" --out out/demo
