@@ -58,6 +58,14 @@ def test_paraphrase_eval_on_a_tiny_model(tiny_bundle, tmp_path, capsys):  # noqa
     raw_right = sum(r["motion_features_pred"] == r["action"] for r in rows if r["action"] in fr["actions"])
     assert fr["motion_features"]["prompts"] == fr["motion"]["prompts"]          # the frequent actions by the raw judge
     assert fr["motion_features"]["accuracy"] == pytest.approx(raw_right / max(1, fr["motion"]["prompts"]))
+    # each action's real windows named right, its pairs merged: read off the windows' confusion by hand
+    ind = res["indistinct"]
+    assert ind["windows_right"] and set(ind["windows_right"]) == set(ind["confusion"])
+    for judge, acc in ind["windows_right"].items():
+        pairs = {frozenset(p) for p in ind["pairs"][judge]}
+        for a, row in ind["confusion"][judge].items():
+            named = sum(n for b, n in row.items() if b == a or frozenset((a, b)) in pairs)
+            assert acc[a] == pytest.approx(named / sum(row.values()))
 
     # two seeds: every prompt generated once per seed, seed 0's generations as in the one-seed run,
     # and the accuracies counted over all the generations
