@@ -40,6 +40,7 @@ from .parts import CLAUSE_NEAR, generate_by_parts, is_by_parts, redecode_parts
 from .prompts import check_prompt
 from .rerank import CandidatePicker
 from .retrieval_seeds import seed_prefixes, seeded_count
+from .held_arms import held_motion
 from .on_the_spot import on_the_spot
 from ..plan.plan import plan_text, read_plan
 from ..plan.reader import without_numbers
@@ -567,6 +568,8 @@ class Generator:
                               turn_motion(motion, self.body, turn, self.ik_refine_iters))         # turn_words.py
                     motion = slow_motion(motion, self.body, words, self.ik_refine_iters)      # slow_steps.py
                     motion = typical_paced(motion, self.body, words, self.typical_speeds, self.ik_refine_iters)
+            if words is not None and words.arms_held and words.gestures_only and words.parts is None:
+                motion = held_motion(motion, self.body, self.ik_refine_iters)   # "stands with her arms raised"
             if words is not None:   # "jogs in place": the data's gaits all travel; stepped on the spot instead
                 motion = on_the_spot(motion, self.body, words.in_place, self.ik_refine_iters)   # on_the_spot.py
             motion.plan = plan_text(plan) if plan is not None else None

@@ -40,7 +40,8 @@ from .course_walk import ACTIONS as COURSE_ACTIONS, course_motion, on_course
 from .decode import motion_from_joints
 from .part_compose import compose_arms, mirror_track, needs_mirror
 from .retarget import shaped_take
-from .track import Track, decoded_track
+from .held_arms import held_from_peak, held_note
+from .track import Track, decoded_track, fitted
 
 
 def _mirrored(track: Track) -> Track:
@@ -93,15 +94,6 @@ def part_of(gen, choice, betas, side: tuple[str, str] | None = None) -> Part:
     track, flipped = _side_fixed(choice.codes, gen.vae, gen.body, betas, side) if side is not None else \
         (_track(choice.codes, gen.vae, gen.body, betas, False), False)
     return Part(track, [int(c) for c in choice.codes], flipped, decoded_provenance(choice.kept))
-
-
-def fitted(track: Track, frames: int) -> Track:
-    """``track`` cut to ``frames`` frames, or its last frame held to that length."""
-    extra = frames - len(track)
-    if extra <= 0:
-        return Track(track.joints[:frames], track.contacts[:frames])
-    return Track(np.concatenate([track.joints, np.repeat(track.joints[-1:], extra, 0)]),
-                 np.concatenate([track.contacts, np.repeat(track.contacts[-1:], extra, 0)]))
 
 
 CLAUSE_NEAR = 0.5   # MiniLM cosine from which a clause takes the action of its nearest training caption
@@ -169,7 +161,9 @@ def generate_by_parts(gen, r, words=None, captured: bool = True) -> Motion | Non
                                    action=plan.arms_action)
     arms_choice = gen.choose(arms_req, plan.arms_side, captured, body_of=r, library_as_captured=False)
     arms = part_of(gen, arms_choice, betas, plan.arms_side)
-    legs_track, arms_track = legs.track, fitted(arms.track, len(legs.track))
+    held = (words if words is not None else read_words(r.prompt)).arms_held   # "with both arms raised"
+    kept = held_from_peak(arms.track) if held else arms.track   # played to the raise's top, held there
+    legs_track, arms_track = legs.track, fitted(kept, len(legs.track))
     played = legs.codes is None or arms.codes is None   # a take in it: played by rotations, no tokens
     tokens = {} if played else dict(tokens=np.asarray(legs.codes, np.int32),
                                     arms_tokens=np.asarray(arms.codes, np.int32), arms_mirrored=arms.mirrored)
@@ -181,6 +175,8 @@ def generate_by_parts(gen, r, words=None, captured: bool = True) -> Motion | Non
     if played:   # another body plants it again by its rotations (retarget.replant), as a take
         m.contacts_measured = True
         m.provenance = f"legs: {legs.provenance}; arms: {arms.provenance}"
+    if kept is not arms.track:
+        m.notes.append(held_note(arms.track))
     m.shape_source = source
     m.part_prompts = (plan.legs_prompt, plan.arms_prompt)
     m.retrieved_clips = legs_choice.clips + arms_choice.clips

@@ -66,6 +66,15 @@ def decoded_track(codes: list[int], vae, body, betas) -> tuple[Track, np.ndarray
     return Track(joints, contacts_from_features(f)), f
 
 
+def fitted(track: Track, frames: int) -> Track:
+    """``track`` cut to ``frames`` frames, or its last frame held to that length."""
+    extra = frames - len(track)
+    if extra <= 0:
+        return Track(track.joints[:frames], track.contacts[:frames])
+    return Track(np.concatenate([track.joints, np.repeat(track.joints[-1:], extra, 0)]),
+                 np.concatenate([track.contacts, np.repeat(track.contacts[-1:], extra, 0)]))
+
+
 def resample(track: Track, n: int, advance=None) -> Track:
     """``track`` resampled to ``n`` frames. Open: frame 0 and the last frame stay where they are.
     A loop (``advance`` (3,)): the ``n`` frames sample one cycle of ``len(track)`` frames, frame

@@ -231,6 +231,11 @@ def asks_on_the_spot(prompt: str) -> bool:
     return travel_of(prompt).in_place and any(sp[2] in LEGS for sp in action_spans(prompt))
 
 
+def arms_held(prompt: str) -> bool:
+    """Whether the words keep the arms raised ("with both arms raised", "keeps his hand up")."""
+    return bool(V.ARMS_HELD.search(str(prompt).lower()))
+
+
 def gestures_only(prompt: str) -> bool:
     """Whether the words name actions and all of them are arms actions ("he waves")."""
     found = set(find_actions(str(prompt).lower()))
@@ -248,7 +253,7 @@ def without_numbers(prompt: str) -> str:
 _TAKEN = (V.COUNT_TIMES, V.FAST, V.SLOW, V.STOP, V.STEPS, V.STEPS_ALONE, V.STILL, V.SPOKEN_DISTANCE, V.CLOCKWISE,
           V.COUNTER_CLOCKWISE, V.BACK_AND_FORTH, V.ZIGZAG, V.DIAGONAL, V.COURSE_WORDS, V.COURSE_WAY, V.TURN_WHOLE,
           V.TURN_HALF, V.TURN_QUARTER, V.FORWARD, V.BACKWARD, V.IN_PLACE, V.TRAVEL_SIDE, V.SIDEWAYS, V.SIDE,
-          V.DIRECTION, V.SUBJECT, V.TURN_TWICE)
+          V.DIRECTION, V.SUBJECT, V.TURN_TWICE, V.ARMS_HELD)
 
 
 def unused_words(text: str, body_words=(), idle=()) -> list[str]:

@@ -121,6 +121,11 @@ TRAVEL_SIDE = re.compile(_GOING + r"(?:\W+\w+){0,3}?\W+(?:to|towards?|over to) (
                          re.I)
 SIDEWAYS = re.compile(_GOING + r"(?:\W+\w+){0,3}?\W+(sideways|sidewards)\b", re.I)
 
+# -- arms held raised: a state ("with both arms raised", "keeps his hand up"), not the act of raising --------
+ARMS_HELD = re.compile(r"\b(?:with|keeps?|keeping|holds?|holding)\s+(?:[\w-]+\s+){0,2}?(?:arms?|hands?)\s+(?:held\s+)?"
+                       r"(?:raised|lifted|up|high|aloft|above(?:\s+(?:his|her|their|the)\s+heads?)?|overhead|in the air)\b|"
+                       r"\b(?:arms?|hands?)\s+(?:held\s+)?(?:raised|lifted|aloft|up high)\b")
+
 # -- body parts, sides, subjects, clauses -----------------------------------------------------------
 # "and" joins two clauses, not the pairs "back and forth", "to and fro", "up and down", "round and round"
 CONNECTOR = re.compile(r",|;|\b(?:while|whilst|as|and(?!\s+(?:forth|fro|forwards|down|round)\b)|with|at the same time|"
@@ -200,6 +205,9 @@ WORD_CLASSES = (
     WordClass("pace", "quickly, briskly, fast / slowly, at a leisurely pace (with a gait)",
               "fast: the fastest third of the candidates; slow: played slower or shorter strides",
               "a woman walks slowly", {"pace": "slow"}),
+    WordClass("arms held", "with both arms raised, hands raised, keeps a hand up, holding his arms up high",
+              "the arms raised once and held there: the raise played to its highest point, that pose kept for the rest",
+              "a man walks with both arms raised", {"arms_held": True, "legs": "a man walks"}),
     WordClass("order", "then, and then, after that, finally, followed by, after / before + a clause",
               "segments one after the other, each its share of the length", "a person walks forward, then sits down",
               {"segments": 2}),

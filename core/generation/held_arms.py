@@ -1,0 +1,70 @@
+"""Arms held raised: "walks with both arms raised", "a woman stands, hands raised".
+
+The raise-hand takes and samples raise the arms and lower them again within a couple of seconds;
+words that describe a state (``plan.vocabulary.ARMS_HELD``: "with both arms raised", "keeps his
+hand up", "holding his arms above his head") want the raise kept. The motion is played to the
+frame where a wrist is highest above the pelvis, and that pose is held for the rest:
+
+- two things at once ("runs with both arms raised"): the arms track alone (``parts.py``); the
+  legs go on, the held arms ride on their chest;
+- the raise alone (every action named is a gesture: "a woman stands with her arms raised"): the
+  whole body, replanted (``track.replanted``; a captured take's measured contacts as they are).
+
+    track = held_from_peak(track)
+    motion = held_motion(motion, body, ik_refine_iters)
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..constants import FPS
+from ..scene.motion_file import Motion
+from .track import Track, fitted, replanted, track_of
+
+WRISTS = (20, 21)
+PELVIS = 0
+
+
+def peak_frame(joints) -> int:
+    """The first frame where a wrist is highest above the pelvis, of (T,>=22,3) joints (Y up)."""
+    j = np.asarray(joints, np.float64)
+    above = j[:, WRISTS, 1].max(1) - j[:, PELVIS, 1]
+    return int(np.argmax(above))
+
+
+def held_from_peak(track: Track) -> Track:
+    """``track`` played to its ``peak_frame`` and held there for the rest of its length (the same
+    track when the peak is its last frame)."""
+    p = max(peak_frame(track.joints), 1)
+    if p >= len(track) - 1:
+        return track
+    return fitted(Track(track.joints[:p + 1], track.contacts[:p + 1]), len(track))
+
+
+def held_motion(motion: Motion, body, ik_refine_iters: int = 10) -> Motion:
+    """``motion`` played to its ``peak_frame`` and held there, planted again; it keeps no tokens
+    (an edit of its frames) and says from when the pose is held."""
+    from ..motion.features import motion_features
+    from .decode import motion_from_joints
+
+    track = track_of(motion)
+    held = held_from_peak(track)
+    if held is track:
+        return motion
+    if motion.contacts_measured:   # a captured take: its measured contacts planted as they are
+        out = motion_from_joints(body, motion.betas, held.joints, held.contacts, ik_refine_iters, prompt=motion.prompt,
+                                 known_contacts=True, smooth=0.0)
+        out.features = motion_features(out)
+        for key in ("shape_source", "retrieved_clips", "part_prompts", "warnings", "notes"):
+            if hasattr(motion, key):
+                setattr(out, key, getattr(motion, key))
+    else:
+        out = replanted(motion, body, held, ik_refine_iters)
+    out.provenance = motion.provenance
+    out.notes = list(motion.notes) + [held_note(track)]
+    return out
+
+
+def held_note(track: Track) -> str:
+    """What the motion says of a track held at its peak."""
+    return f"the raised arms are held from {peak_frame(track.joints) / FPS:.1f} s (the words keep them raised)"
