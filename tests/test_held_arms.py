@@ -72,3 +72,13 @@ def test_the_default_model_keeps_the_arms_raised():
     assert _above_head(run)[last].min() > 0.05 and any("held from" in n for n in run.notes)
     assert np.linalg.norm(run.transl[-1, [0, 2]] - run.transl[0, [0, 2]]) > 4.0     # the legs still run
     assert _above_head(raise_)[last].max() < 0.0 and not any("held from" in n for n in raise_.notes)
+
+    # both parts generated from codes: the hold is an edit, so no tokens are kept to decode it away again
+    gen.set_captured(False)
+    try:
+        coded = gen.generate_batch([Request("a man walks with both arms raised", seconds=4.0, seed=0)])[0]
+    finally:
+        gen.set_captured(True)
+    assert coded.provenance.startswith("generated") or "legs: generated" in coded.provenance
+    assert any("held from" in n for n in coded.notes) and _above_head(coded)[last].min() > 0.0
+    assert (coded.tokens is None or len(coded.tokens) == 0) and coded.arms_tokens is None

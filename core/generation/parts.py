@@ -165,8 +165,9 @@ def generate_by_parts(gen, r, words=None, captured: bool = True) -> Motion | Non
     kept = held_from_peak(arms.track) if held else arms.track   # played to the raise's top, held there
     legs_track, arms_track = legs.track, fitted(kept, len(legs.track))
     played = legs.codes is None or arms.codes is None   # a take in it: played by rotations, no tokens
-    tokens = {} if played else dict(tokens=np.asarray(legs.codes, np.int32),
-                                    arms_tokens=np.asarray(arms.codes, np.int32), arms_mirrored=arms.mirrored)
+    tokens = {} if played or kept is not arms.track else dict(    # a held raise is an edit: no tokens kept
+        tokens=np.asarray(legs.codes, np.int32), arms_tokens=np.asarray(arms.codes, np.int32),
+        arms_mirrored=arms.mirrored)
     if course is not None:  # the codec does not carry turning: the words' course is walked (course_walk.py)
         right = read_words(plan.legs_prompt).course_right
         legs_track, tokens = on_course(legs_track, course, right, whole=r.whole_course), {}   # an edit: no tokens kept
