@@ -182,11 +182,11 @@ def test_clauses_the_patterns_miss_are_named_by_the_nearest_caption(gen):
     from shapemove.core.plan.part_prompts import clauses, plan_parts
     from shapemove.core.generation.parts import plan_of
 
-    text = "a man marches with his right arm raised"
-    assert clauses(text) == ["a man marches", "his right arm raised"]
-    assert plan_parts(text) is None                  # "arm raised" is none of the action patterns
+    text = "a man marches, swinging his right arm overhead"
+    assert clauses(text) == ["a man marches", "swinging his right arm overhead"]
+    assert plan_parts(text) is None                  # "swinging ... overhead" is none of the action patterns
     plan, side = plan_of(text, gen)
-    assert (plan.legs_prompt, plan.arms_prompt) == ("a man marches", "a man his right arm raised")
+    assert (plan.legs_prompt, plan.arms_prompt) == ("a man marches", "a man swinging his right arm overhead")
     assert (plan.legs_action, plan.arms_action) == ("march", "raise hand") and side is None
     assert plan.arms_side == ("right", "hand")
     # single actions stay whole: no part named by the patterns, a subject alone, "as fast as"

@@ -94,7 +94,8 @@ _EVERYDAY = {
     "wave goodbye": (r"\bfarewell\b", r"\bsee[- ]you[- ]later\b",),
     "raise hand": (r"\bhold\w* (one|an|both|a) arms? (straight )?up\b", r"\barms? (straight )?up in the air\b",
                    r"\b(arms?|hands?) (held )?(raised|lifted|aloft|up high)\b",
-                   r"\b(keep|keeps|keeping|hold|holds|holding) (\w+ ){0,2}(arms?|hands?) (up|raised|high|aloft|above|overhead)\b",),
+                   r"\b(with|keep|keeps|keeping|hold|holds|holding) (\w+ ){0,2}(arms?|hands?) (held )?(up|raised|high|aloft|above|"
+                   r"overhead|in the air)\b",),
     "bow": (r"\bbend\w* (\w+ )?at the waist\b",),
     "beckon": (r"\bmotion\w* for (\w+ ){0,3}to come\b", r"\bcome closer\b",),
     "punch": (r"\bone-two\b", r"\bshadow ?box", r"\buppercut",),
