@@ -6,6 +6,7 @@ import pytest
 
 from shapemove.core.generation.held_arms import held_from_peak, peak_frame
 from shapemove.core.generation.track import Track
+from shapemove.core.plan.reading import said
 from shapemove.core.plan.words import read_words
 
 
@@ -23,6 +24,7 @@ def test_the_words_of_a_held_raise(text, held):
     assert w.arms_held is held
     assert "raise hand" in w.actions or not held          # the state is a raise of the hands
     assert ("arms_held" in w.understood()) is held
+    assert ("arms held raised" in said(w.understood())) is held   # the line the CLI prints
     if held:   # every word of the state is taken
         assert not {"raised", "arms", "hands", "hand", "head", "above", "holding", "keeps"} & set(w.unused)
 

@@ -47,6 +47,8 @@ def said(reading: dict) -> str:
         bits.append(reading["pace"])
     if "side" in reading:
         bits.append(f"side: {reading['side']}")
+    if reading.get("arms_held"):
+        bits.append("arms held raised")
     said = "; ".join(bits) if bits else "no word the readers act on (the model reads the prompt whole)"
     if reading.get("unused"):   # named, never dropped in silence
         said += "; not used: " + ", ".join(repr(w) for w in reading["unused"])
