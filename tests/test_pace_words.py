@@ -165,3 +165,23 @@ def test_slow_motion_gives_a_jog_shorter_strides_at_the_same_cadence():
         slide += list(np.linalg.norm(np.diff(slow.joints[:, j, [0, 2]], axis=0), axis=1)[on])
     assert len(slide) > 10 and np.mean(slide) < 0.002
 
+
+
+def test_two_things_at_once_asked_slowly_go_slower_and_on():
+    """"walks slowly while waving": the composed motion is played slower (a jog: shorter strides),
+    and a jog asked slowly is never a captured one-cycle jog held still for the rest."""
+    from shapemove.core.generation.generate import Request
+    from shapemove.core.generation.loaded_generator import loaded_generator
+
+    gen = loaded_generator(None)
+
+    def speed(prompt):
+        m = gen.generate_batch([Request(prompt, seconds=4.0, seed=0)])[0]
+        return float(np.linalg.norm(m.transl[-1, [0, 2]] - m.transl[0, [0, 2]])) / 4.0, m
+
+    walk, _ = speed("a man walks while waving")
+    slow_walk, m = speed("a man walks slowly while waving")
+    assert slow_walk < 0.9 * walk and m.part_prompts == ("a man walks slowly", "a person waving")
+    jog, _ = speed("a woman jogs along, waving")
+    slow_jog, m = speed("a woman jogs slowly, waving")
+    assert 0.6 * jog < slow_jog < 0.9 * jog and "deepmimic_jog (MIT)" not in m.provenance

@@ -115,3 +115,10 @@ def test_a_take_that_stops_or_circles_is_no_plain_gait():
     assert not unplain_take(take(stops[:42], held=4), plain)                        # the last 0.2 s of 2.1 held
     assert not unplain_take(take(circle), read_words("a person jogs in a circle"))
     assert not unplain_take(take(stops, held=42), read_words("a man kicks"))       # a kick, then standing
+    # a gait asked slowly or quickly still goes on: a take that stops does not compete,
+    # a circling one may (only the plain gait asks for a straight line)
+    for going in ("a person jogs slowly", "she jogs quickly ahead"):
+        assert unplain_take(take(stops, held=42), read_words(going)), going
+        assert not unplain_take(take(stops[:42], held=4), read_words(going)), going
+    assert not unplain_take(take(circle), read_words("a person jogs slowly"))
+    assert not unplain_take(take(stops, held=42), read_words("a person jogs and stops"))   # asked to stop

@@ -155,18 +155,29 @@ def straight(centre) -> bool:
 
 
 def unplain_take(window, words) -> bool:
-    """Whether the captured take ``window`` is not the plain gait the words ask for (``plain_gait``):
-    it stops (held on its last pose for more than ``MOST_HELD`` of the window: a 1.9 s jog, then
-    standing) or turns off its line (its root's smoothed path is not ``straight``: a jog around a
-    circle). Like a slow take, it does not compete."""
+    """Whether the captured take ``window`` is not the gait the words ask for: it stops (held on its
+    last pose for more than ``MOST_HELD`` of the window: a 1.9 s jog, then standing) where the words
+    ask a gait that goes on (``going_gait``: "jogs", "jogs slowly"), or it turns off its line (its
+    root's smoothed path is not ``straight``: a jog around a circle) where they ask the plain gait
+    (``plain_gait``). Like a slow take, it does not compete."""
     from .track import root_centre
 
+    n = len(window.root) - window.held
+    if going_gait(words) is not None and (window.held > MOST_HELD * len(window.root) or n < 2):
+        return True
     if plain_gait(words) is None:
         return False
-    n = len(window.root) - window.held
-    if window.held > MOST_HELD * len(window.root) or n < 2:
-        return True
     return not straight(root_centre(np.asarray(window.root, np.float64)[:n, None, :]))
+
+
+def going_gait(words) -> str | None:
+    """The one gait of ``GAITS`` the words name when they ask it to go on (no stop, steps, distance or
+    standing: "jogs slowly", "walks forward, waving"); None otherwise."""
+    if words is None or len(words.actions) != 1 or words.actions[0] not in GAITS:
+        return None
+    if words.stop or words.steps is not None or words.distance_m is not None or words.stand_still:
+        return None
+    return words.actions[0]
 
 
 def slow_take(window, words, speeds: dict, body) -> bool:
