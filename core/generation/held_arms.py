@@ -44,22 +44,12 @@ def held_from_peak(track: Track) -> Track:
 def held_motion(motion: Motion, body, ik_refine_iters: int = 10) -> Motion:
     """``motion`` played to its ``peak_frame`` and held there, planted again; it keeps no tokens
     (an edit of its frames) and says from when the pose is held."""
-    from ..motion.features import motion_features
-    from .decode import motion_from_joints
-
     track = track_of(motion)
     held = held_from_peak(track)
     if held is track:
         return motion
-    if motion.contacts_measured:   # a captured take: its measured contacts planted as they are
-        out = motion_from_joints(body, motion.betas, held.joints, held.contacts, ik_refine_iters, prompt=motion.prompt,
-                                 known_contacts=True, smooth=0.0)
-        out.features = motion_features(out)
-        for key in ("shape_source", "retrieved_clips", "part_prompts", "warnings", "notes"):
-            if hasattr(motion, key):
-                setattr(out, key, getattr(motion, key))
-    else:
-        out = replanted(motion, body, held, ik_refine_iters)
+    # a captured take: its measured contacts planted as they are
+    out = replanted(motion, body, held, ik_refine_iters, measured=bool(motion.contacts_measured))
     out.provenance = motion.provenance
     out.notes = list(motion.notes) + [held_note(track)]
     return out

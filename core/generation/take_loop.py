@@ -20,9 +20,9 @@ the cycle's advance on the floor; the contacts repeat with the frames, so planti
 window (``retarget.planted_retarget``) plants the repeats as the take's own steps.
 
 A take of one repetition of an action done over and over by its nature (``actions.REPEATED``: a
-single arm circle of 1.9 s) has no second cycle to find; ``looped_repetition`` plays its busy stretch again when the stretch ends where
-it began (the same seam and heading conditions): on the spot, or moved on by the stretch's advance
-when its root travels faster than ``TRAVELS``.
+single arm circle of 1.9 s) has no second cycle to find; ``looped_repetition`` plays its busy
+stretch again when the stretch ends where it began (the same seam and heading conditions): on the
+spot, or moved on by the stretch's advance when its root travels faster than ``TRAVELS``.
 """
 from __future__ import annotations
 

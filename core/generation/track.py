@@ -108,15 +108,19 @@ def plant(body, betas, track: Track, ik_refine_iters: int = 10, prompt: str | No
     return m
 
 
-def replanted(motion: Motion, body, track: Track, ik_refine_iters: int = 10) -> Motion:
+def replanted(motion: Motion, body, track: Track, ik_refine_iters: int = 10, measured: bool = False) -> Motion:
     """A generated motion after an edit of its track (a circle walked, a turn given back): planted
     again (``plant``), its features computed as the dataset builder computes a clip's (what the
     judges and the TMA read), and what generation said of it kept (body source, retrieved clips,
     part prompts, warnings, notes). Like every edit, it keeps no tokens: a new body keeps the motion
-    rather than re-decoding it."""
+    rather than re-decoding it. ``measured``: the track's contacts are a captured take's, planted as
+    they are (``decode.motion_from_joints`` with known contacts, no smoothing)."""
     from ..motion.features import motion_features
+    from .decode import motion_from_joints
 
-    out = plant(body, motion.betas, track, ik_refine_iters, prompt=motion.prompt)
+    out = motion_from_joints(body, motion.betas, track.joints, track.contacts, ik_refine_iters, prompt=motion.prompt,
+                             known_contacts=True, smooth=0.0) if measured else \
+        plant(body, motion.betas, track, ik_refine_iters, prompt=motion.prompt)
     out.features = motion_features(out)
     for key in ("shape_source", "retrieved_clips", "part_prompts", "warnings", "notes"):
         if hasattr(motion, key):

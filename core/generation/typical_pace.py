@@ -77,15 +77,15 @@ def load_typical_speeds(model_dir) -> dict[str, float]:
 def plain_gait(words) -> str | None:
     """The one gait of ``GAITS`` the words (``plan.words.Words``) name when they ask nothing else of
     it (module doc); None otherwise."""
-    if words is None or len(words.actions) != 1 or words.actions[0] not in GAITS:
+    gait = going_gait(words)   # one gait, no stop, steps, distance or standing
+    if gait is None:
         return None
-    asked = (words.pace, words.stop, words.steps, words.distance_m, words.course, words.turn, words.count,
-             words.parts, words.side)
-    if any(a not in (None, False) for a in asked) or words.in_place or words.stand_still:
+    asked = (words.pace, words.course, words.turn, words.count, words.parts, words.side)
+    if any(a not in (None, False) for a in asked) or words.in_place:
         return None
     if words.travel.forward < 0 or words.travel.side or words.travel.sideways:
         return None
-    return words.actions[0]
+    return gait
 
 
 def leg_length(rest) -> float:
