@@ -5,7 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from shapemove.core.generation.count_words import DIP, LIFT, MIN_RUN, counter, dips, flights, nearest_count
+from shapemove.core.generation.count_words import (DIP, LIFT, MIN_RUN, counter, dip_spans, flight_spans, nearest_count,
+                                                   raise_spans, repetitions)
+from shapemove.core.plan.vocabulary import COUNTED
 from shapemove.core.plan.reader import asked_count
 
 
@@ -30,7 +32,7 @@ def test_the_words_that_count_jumps_and_squats(text, want):
     got = asked_count(text)
     assert (got and got[1]) == want
     if want is not None:
-        assert counter(got[0]) is (dips if "squat" in text else flights)
+        assert COUNTED[got[0]] == ("dips" if "squat" in text else "raises" if "jacks" in text else "flights")
 
 
 def _features(heights) -> np.ndarray:
@@ -46,9 +48,9 @@ def test_flights_are_runs_of_both_feet_in_the_air():
     h[10:20] = 0.03 + 2 * LIFT             # a jump
     h[30:30 + MIN_RUN - 1] = 0.5        # too short: a glitch, not a flight
     h[40:50] = 0.03 + LIFT / 2             # too low: a shuffle
-    assert flights(_features(h)) == 1
+    assert flight_spans(_features(h)) == [(10, 20)]
     h[40:50] = 0.03 + 1.5 * LIFT
-    assert flights(_features(h)) == 2
+    assert len(flight_spans(_features(h))) == 2
 
 
 def test_dips_are_runs_of_the_root_well_under_standing():
@@ -57,9 +59,21 @@ def test_dips_are_runs_of_the_root_well_under_standing():
     f[10:20, 3] = 0.95 - 2 * DIP          # a squat
     f[30:34, 3] = 0.95 - DIP / 2           # a bob: not deep enough
     f[40:40 + MIN_RUN - 1, 3] = 0.3        # too short
-    assert dips(f) == 1
+    assert dip_spans(f) == [(10, 20)]
     f[45:55, 3] = 0.95 - 1.5 * DIP
-    assert dips(f) == 2
+    assert len(dip_spans(f)) == 2 and counter("squat")(f) == 2
+
+
+def test_raises_are_runs_of_both_hands_over_the_head():
+    """A jumping jack is counted by its hands: both wrists (20, 21) above the head (15)."""
+    f = np.zeros((60, 263))
+    for j, y in ((15, 1.6), (20, 1.0), (21, 1.0)):
+        f[:, 4 + (j - 1) * 3 + 1] = y
+    f[10:18, 4 + 19 * 3 + 1] = f[10:18, 4 + 20 * 3 + 1] = 1.8    # both hands up: a jack
+    f[30:38, 4 + 19 * 3 + 1] = 1.8                              # one hand: a wave, no jack
+    f[45:45 + MIN_RUN - 1, 4 + 19 * 3 + 1] = f[45:45 + MIN_RUN - 1, 4 + 20 * 3 + 1] = 1.8   # too short
+    assert raise_spans(f) == [(10, 18)]
+    assert repetitions("jumping jacks", f) == [(10, 18)] and counter("jumping jacks")(f) == 1
 
 
 def test_the_nearest_count_competes():

@@ -45,6 +45,8 @@ from ..constants import FPS
 from ..errors import ShapeMoveError
 from ..scene.motion_file import Motion
 from ..data.actions import REPEATED
+from ..plan.vocabulary import COUNTED
+from .repeated_takes import repeated_stretch
 from .take_loop import looped_repetition, looped_take
 
 TAKES = 5              # captured windows offered per prompt
@@ -201,24 +203,35 @@ class TakePool:
         draw(range(len(self)), max(0, count - len(chosen)))
         return chosen
 
-    def window(self, i: int, frames: int, seed: int, side=None, longest: int | None = None) -> Window:
+    def window(self, i: int, frames: int, seed: int, side=None, longest: int | None = None,
+               times: int | None = None) -> Window:
         """Take ``i`` cut to ``frames`` (the seed picks the start), or held to it when shorter;
         ``longest``: the length is the model's (``frames`` the least), the take plays whole up to
         ``longest`` frames. ``side``: ("left" | "right", "hand" | "foot") mirrors a take whose
-        other side moves most."""
+        other side moves most. A take of a counted action plays its repetitions, ``times`` of them
+        when asked (``repeated_takes.py``)."""
         from .part_compose import needs_mirror
 
         t = self.take(i)
-        n = len(t["rotations"])
+        rot, root, con, exact = t["rotations"], t["root"], t["contacts"], False
+        if self.actions[i] in COUNTED:
+            def posed(r, rt, c):
+                j = self.proc.pose_on(r, rt, t["betas"], 1.0, c)
+                return j, self.proc.features(j, r, c)
+
+            rot, root, con, exact = repeated_stretch(rot, root, con, posed, self.actions[i], times, seed)
+        n = len(rot)
         want = min(max(frames, n), longest) if longest is not None else frames
-        lo = 0 if n <= want else busiest_start(t["rotations"], want, seed)
-        rot, root, con = (np.asarray(t[k][lo:lo + want]) for k in ("rotations", "root", "contacts"))
+        lo = 0 if n <= want else busiest_start(rot, want, seed)
+        rot, root, con = (np.asarray(a[lo:lo + want]) for a in (rot, root, con))
         held = looped = 0
         if len(rot) < want:   # a take that repeats plays on as a loop, another is held on its last pose
-            posed = self.proc.pose_on(rot, root, t["betas"], 1.0, con)
-            again = looped_take(rot, root, con, posed, want)
-            if again is None and self.actions[i] in REPEATED:   # one arm circle: circled again
-                again = looped_repetition(rot, root, con, posed, want)
+            again = None      # (a take cut to the repetitions asked is held: a loop would add more)
+            if not exact:
+                posed_joints = self.proc.pose_on(rot, root, t["betas"], 1.0, con)
+                again = looped_take(rot, root, con, posed_joints, want)
+                if again is None and self.actions[i] in REPEATED:   # one arm circle: circled again
+                    again = looped_repetition(rot, root, con, posed_joints, want)
             if again is not None:
                 rot, root, con, first = again
                 looped = want - first
@@ -233,8 +246,9 @@ class TakePool:
                       t["provenance"] + (", mirrored" if flip else ""), held, flip, looped)
 
     def windows(self, text: np.ndarray, action: str | None, seed: int, frames: int, side=None,
-                longest: int | None = None, count: int = TAKES) -> list[Window]:
-        return [self.window(i, frames, seed, side, longest) for i in self.nearest(text, action, seed, count)]
+                longest: int | None = None, count: int = TAKES, times: int | None = None) -> list[Window]:
+        """One window of each take offered (``nearest``); ``times``: the repetitions the words ask."""
+        return [self.window(i, frames, seed, side, longest, times) for i in self.nearest(text, action, seed, count)]
 
 
 def action_credit(asked: str | None, action: str) -> float | None:

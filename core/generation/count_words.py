@@ -4,17 +4,22 @@ times", "does five jumping jacks", "she hops once", "does three squats".
 The T5 writes jumps and squats, but not how many: the default model gave "a man jumps forward
 twice" one, two or three jumps by seed, and the TMA that chooses among the candidates (``rerank``)
 does not count. Its candidates differ in how many times they leave the floor or go down, so when
-the plan names a countable action (``plan/vocabulary.COUNTED``) and a count, only the candidates whose count is
-nearest the asked one compete. Both counts are read from the candidate's features, the same way
-for a generated candidate and a retrieved clip:
+the plan names a countable action (``plan/vocabulary.COUNTED``) and a count, only the candidates
+whose count is nearest the asked one compete. The counts are read from the candidate's features,
+the same way for a generated candidate, a retrieved clip and a captured take (which
+``repeated_takes.py`` cuts to the repetitions asked):
 
-- a flight (jumps, hops, jumping jacks): a run of at least ``MIN_RUN`` frames in which every foot
-  joint (both ankles and both toes) is more than ``LIFT`` above the clip's floor;
+- a flight (jumps, hops): a run of at least ``MIN_RUN`` frames in which every foot joint (both
+  ankles and both toes) is more than ``LIFT`` above the clip's floor;
+- a raise (jumping jacks): a run of at least ``MIN_RUN`` frames with both wrists above the head
+  (a captured jumping jack lifts the feet 5-10 cm, under what a jump's flight clears, but every
+  jack brings both hands over the head);
 - a dip (squats): a run of at least ``MIN_RUN`` frames with the root more than ``DIP`` under its
   standing height (the clip's 90th percentile).
 
     read_words("a man jumps forward twice").count   # ("jump forward", 2)  (plan/words.py)
     counter("jump forward")(features)               # flights of a (T, 263) candidate
+    repetitions("squat", features)                  # [(start, end)) of each squat
 """
 from __future__ import annotations
 
@@ -24,36 +29,55 @@ from ..motion.contacts import runs
 from ..plan.vocabulary import COUNTED
 
 FOOT_JOINTS = (7, 8, 10, 11)   # ankles, toes
+WRISTS, HEAD = (20, 21), 15
 LIFT = 0.08                    # metres over the floor (the clip's 10th percentile of its lowest foot joint)
 DIP = 0.20                     # metres under the standing root height
 MIN_RUN = 3                    # frames (0.15 s)
 
 
-def _runs_of(mask) -> int:
-    return sum(1 for a, b in runs(mask) if b - a >= MIN_RUN)
+def _spans(mask) -> list[tuple[int, int]]:
+    return [(a, b) for a, b in runs(mask) if b - a >= MIN_RUN]
 
 
-def flights(features) -> int:
-    """Flights in a (T, 263) feature clip: runs of at least ``MIN_RUN`` frames with every foot
-    joint more than ``LIFT`` above the clip's floor."""
+def _height(f, joint: int) -> np.ndarray:
+    return f[:, 4 + (joint - 1) * 3 + 1]
+
+
+def flight_spans(features) -> list[tuple[int, int]]:
+    """[(start, end)) of the flights of a (T, 263) feature clip: runs of at least ``MIN_RUN``
+    frames with every foot joint more than ``LIFT`` above the clip's floor."""
     f = np.asarray(features, dtype=np.float64)
-    heights = np.stack([f[:, 4 + (j - 1) * 3 + 1] for j in FOOT_JOINTS], axis=1).min(axis=1)
-    return _runs_of(heights > np.percentile(heights, 10) + LIFT)
+    heights = np.stack([_height(f, j) for j in FOOT_JOINTS], axis=1).min(axis=1)
+    return _spans(heights > np.percentile(heights, 10) + LIFT)
 
 
-def dips(features) -> int:
-    """Squats in a (T, 263) feature clip: runs of at least ``MIN_RUN`` frames with the root more
-    than ``DIP`` under its standing height."""
+def raise_spans(features) -> list[tuple[int, int]]:
+    """[(start, end)) of the raises of both hands over the head: runs of at least ``MIN_RUN`` frames
+    with both wrists above the head joint."""
+    f = np.asarray(features, dtype=np.float64)
+    wrists = np.minimum(_height(f, WRISTS[0]), _height(f, WRISTS[1]))
+    return _spans(wrists > _height(f, HEAD))
+
+
+def dip_spans(features) -> list[tuple[int, int]]:
+    """[(start, end)) of the squats of a (T, 263) feature clip: runs of at least ``MIN_RUN`` frames
+    with the root more than ``DIP`` under its standing height."""
     y = np.asarray(features, dtype=np.float64)[:, 3]
-    return _runs_of(y < np.percentile(y, 90) - DIP)
+    return _spans(y < np.percentile(y, 90) - DIP)
 
 
-MEASURES = {"flights": flights, "dips": dips}   # the measures of ``plan/vocabulary.COUNTED``
+MEASURES = {"flights": flight_spans, "raises": raise_spans, "dips": dip_spans}   # ``plan/vocabulary.COUNTED``'s
+
+
+def repetitions(action: str, features) -> list[tuple[int, int]]:
+    """[(start, end)) of each repetition of a countable action (``plan/vocabulary.COUNTED``) in a
+    (T, 263) feature clip."""
+    return MEASURES[COUNTED[action]](features)
 
 
 def counter(action: str):
-    """The measure that counts a countable action (``plan/vocabulary.COUNTED``) in a feature clip."""
-    return MEASURES[COUNTED[action]]
+    """How many times a countable action is done in a feature clip: ``counter(action)(features)``."""
+    return lambda features: len(repetitions(action, features))
 
 
 def nearest_count(counts, want: int, among: np.ndarray) -> np.ndarray:

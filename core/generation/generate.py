@@ -189,15 +189,18 @@ class Generator:
 
     def _windows(self, r: Request, action: str | None, lo: int, hi: int, side=None) -> list[Window]:
         """Windows of the captured takes of ``action`` (and the nearest captions) offered for ``r``
-        (``captured_takes.TakePool``)."""
+        (``captured_takes.TakePool``), cut to the repetitions its words count."""
         pool = self.pool if self.captured_on else None
         if pool is None or not len(pool):
             return []
         down = self.vae.cfg.downsample
         text = self._embed_texts([r.prompt])[0]
+        count = (r.words if r.words is not None else read_words(r.prompt)).count   # "three jumping jacks"
+        times = count[1] if count is not None else None
         if r.seconds is None:   # the model's length: a take plays whole, at least UNASKED_SECONDS
-            return pool.windows(text, action, r.seed, self._length(UNASKED_SECONDS)[0] * down, side, hi * down)
-        return pool.windows(text, action, r.seed, lo * down, side)
+            return pool.windows(text, action, r.seed, self._length(UNASKED_SECONDS)[0] * down, side, hi * down,
+                                times=times)
+        return pool.windows(text, action, r.seed, lo * down, side, times=times)
 
     # -- tokens ------------------------------------------------------------------------------
     def _length(self, seconds: float | None) -> tuple[int, int]:

@@ -27,7 +27,7 @@ COUNT_TIMES = re.compile(rf"\b(?:(once|twice|thrice)|({QUANTITY}|\d{{1,2}})\s+(?
                          re.I)
 # the countable actions and what counts them (``generation/count_words.MEASURES``)
 COUNTED = {"jump": "flights", "jump forward": "flights", "spin jump": "flights", "hop": "flights",
-           "jumping jacks": "flights", "squat": "dips"}
+           "jumping jacks": "raises", "squat": "dips"}
 MAX_COUNT = 12
 
 # -- pace -------------------------------------------------------------------------------------
