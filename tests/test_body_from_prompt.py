@@ -20,3 +20,21 @@ def test_prompt_words_set_the_body_and_no_words_give_the_average_adult(openbody)
     b, _ = body_from_prompt(openbody, "a muscular man walks forward")
     np.testing.assert_allclose(a, b)
     assert pm.from_betas(a)[2] >= 0.7
+
+
+def test_a_child_is_the_youngest_and_smallest_body_the_model_makes(openbody):
+    """OpenBody makes no one under 13: "a child" / "a kid" is a 13-year-old, very short body
+    (150 cm), not the average adult (169 cm) it was when the word was unknown; a height said wins."""
+    from shapemove.core.body.measure import measure
+
+    from shapemove.core.text.shape_words import parse_shape_words
+
+    for prompt in ("a child hops on one foot", "a kid runs across the yard"):
+        assert parse_shape_words(prompt).age == 13.0
+        betas, src = body_from_prompt(openbody, prompt)
+        assert src == "prompt words"
+        assert measure(openbody, betas)["height_cm"] < 153
+    tall, _ = body_from_prompt(openbody, "a tall kid runs")
+    assert measure(openbody, tall)["height_cm"] > 180
+    adult, src = body_from_prompt(openbody, "an old child walks")   # ages that disagree: no body from them
+    assert src == "average adult"

@@ -102,7 +102,12 @@ AGE_WORDS: dict[str, tuple[float, float, float]] = {
     "college aged": (20.0, 18.0, 24.0), "twenty something": (25.0, 20.0, 29.0),
     "teenage": (16.0, 13.0, 19.0), "teenaged": (16.0, 13.0, 19.0), "teenager": (16.0, 13.0, 19.0),
     "teen": (16.0, 13.0, 19.0), "adolescent": (16.0, 13.0, 19.0),
+    # a child: the youngest body the body model makes (PERSON_RANGES["age"]; OpenBody makes no younger),
+    # "very short" unless a height is said (``CHILD_WORDS``)
+    "child": (13.0, 13.0, 13.0), "children": (13.0, 13.0, 13.0), "kid": (13.0, 13.0, 13.0),
+    "kids": (13.0, 13.0, 13.0), "youngster": (13.0, 13.0, 13.0),
 }
+CHILD_WORDS = ("child", "children", "kid", "kids", "youngster")
 # nouns that imply an age: a default when the text states none (never a conflict)
 NOUN_AGES = {"boy": 16.0, "girl": 16.0, "schoolboy": 15.0, "schoolgirl": 15.0, "lad": 18.0, "lass": 18.0,
              "grandfather": 72.0, "grandpa": 72.0, "granddad": 72.0, "grandad": 72.0, "grandmother": 72.0,
@@ -409,6 +414,9 @@ def _read_words(text: str, out: ShapeWords) -> None:
             out.build_words.append(w)
         out.words.append(w)
     t = _phrase_pattern(vocab).sub(" ", t)
+    if any(w in CHILD_WORDS for w in age_hits) and not any(ADJECTIVES[w][0] for w in out.size_words
+                                                           if w in ADJECTIVES):
+        out.size_words.append("very short")   # the smallest the words can ask for
     genders = []
     for m in _phrase_pattern(GENDER_WORDS).finditer(t):
         w = _canon(m.group(1), GENDER_WORDS)
