@@ -145,12 +145,16 @@ ORDER_WORDS = re.compile(r"\b(then|after|afterwards|before|followed by|next|fina
 
 # -- order: segments ----------------------------------------------------------------------------
 # words that put what follows after what precedes ("then"): a cut with that order
-THEN = re.compile(r"\s*(?:[,;.]\s*)?\b(?:and\s+)?(?:then|after\s+that|afterwards?|next(?!\s+to\b)|finally|followed\s+by|"
+THEN = re.compile(r"\s*(?:[,;.]\s*)?\b(?:and\s+)?(?:then|after\s+that|afterwards?|after\s+which|next(?!\s+to\b)|finally|"
+                  r"(?:(?:a|one|some)\s+(?:few\s+)?(?:moments?|minutes?|seconds?|while)\s+)?later(?:\s+on)?|subsequently|eventually|"
+                  r"followed\s+by|"
+                  r"(?:finish(?:es|ing)?|end(?:s|ing)?)\s+(?:off\s+|up\s+)?(?:with|by)|"
                   r"and\s+(?:finally|afterwards?))\b\s*,?\s*")
 # "before" / "after" in front of a clause: a participle or a pronoun follows ("runs after the ball" is no cut)
 _CLAUSE_AHEAD = r"(?=[a-z'-]+ing\b|(?:he|she|they|someone|somebody|i|we|you)\b)"
 BEFORE_AFTER = re.compile(r"\s*,?\s*\b(before|after)\s+" + _CLAUSE_AHEAD)
-LEADING_BEFORE_AFTER = re.compile(r"^\s*(before|after)\s+" + _CLAUSE_AHEAD)
+# ... and at the start, before a noun phrase and its comma too ("after a bow, the actor walks away")
+LEADING_BEFORE_AFTER = re.compile(r"^\s*(before|after)\s+(?:" + _CLAUSE_AHEAD + r"|(?=(?:a|an|the|his|her|their)\s[^,]{1,30},))")
 FIRST = re.compile(r"\b(?:first(?:ly)?|at first|initially|to begin with|to start with)\b\s*,?\s*")
 PARTICIPLE = re.compile(r"^(?!(?:spring|bring|swing|sing|string|ring|thing|sling|sting|wing|cling|fling)\b)[a-z'-]{2,}ing\b")
 
@@ -208,7 +212,8 @@ WORD_CLASSES = (
     WordClass("arms held", "with both arms raised, hands raised, keeps a hand up, holding his arms up high",
               "the arms raised once and held there: the raise played to its highest point, that pose kept for the rest",
               "a man walks with both arms raised", {"arms_held": True, "legs": "a man walks"}),
-    WordClass("order", "then, and then, after that, finally, followed by, after / before + a clause",
+    WordClass("order", "then, and then, after that, after which, next, finally, (a minute) later, eventually, "
+              "subsequently, followed by, finishes / ends with, after / before + a clause",
               "segments one after the other, each its share of the length", "a person walks forward, then sits down",
               {"segments": 2}),
 )
