@@ -187,16 +187,15 @@ class Generator:
         """Captured takes compete with the samples (on, the default) or not (generation only)."""
         self.captured_on = bool(on)
 
-    def _windows(self, r: Request, action: str | None, lo: int, hi: int, side=None) -> list[Window]:
+    def _windows(self, r: Request, action: str | None, lo: int, hi: int, side=None,
+                 times: int | None = None) -> list[Window]:
         """Windows of the captured takes of ``action`` (and the nearest captions) offered for ``r``
-        (``captured_takes.TakePool``), cut to the repetitions its words count."""
+        (``captured_takes.TakePool``), cut to the ``times`` repetitions its words count."""
         pool = self.pool if self.captured_on else None
         if pool is None or not len(pool):
             return []
         down = self.vae.cfg.downsample
         text = self._embed_texts([r.prompt])[0]
-        count = (r.words if r.words is not None else read_words(r.prompt)).count   # "three jumping jacks"
-        times = count[1] if count is not None else None
         if r.seconds is None:   # the model's length: a take plays whole, at least UNASKED_SECONDS
             return pool.windows(text, action, r.seed, self._length(UNASKED_SECONDS)[0] * down, side, hi * down,
                                 times=times)
@@ -246,7 +245,8 @@ class Generator:
             found = self._action_clips(r, lo, hi)
             asked = self._taken(self._asked(r))   # a take of another action than the words ask does not compete
             words = r.words if r.words is not None else read_words(r.prompt)
-            windows = [w for w in (self._windows(r, asked, lo, hi, side) if captured else [])   # of the asked action,
+            times = words.count[1] if words.count is not None else None          # "three jumping jacks"
+            windows = [w for w in (self._windows(r, asked, lo, hi, side, times) if captured else [])   # of the asked action,
                        if action_credit(asked, w.action) is not None                    # at a plain gait's pace
                        and not slow_take(w, words, self.typical_speeds, self.body)
                        and not unplain_take(w, words)]
