@@ -42,6 +42,12 @@ from shapemove.core.plan.segments import SEGMENT_SECONDS, split_segments
     ("she jogs for a while and finishes with a bow", ["she jogs for a while", "she does a bow"]),
     ("she sprints ahead and ends by jumping forward", ["she sprints ahead", "she is jumping forward"]),
     ("after a bow, the actor walks away", ["the actor does a bow", "the actor walks away"]),
+    # "and" with a change of posture on one side orders
+    ("an old man gets up and walks away", ["an old man gets up", "an old man walks away"]),
+    ("she walks to the chair and sits down", ["she walks to the chair", "she sits down"]),
+    ("he lies down and rolls over", ["he lies down", "he rolls over"]),
+    ("a man crawls, then stands up and runs", ["a man crawls", "a man stands up", "a man runs"]),
+    ("a woman squats, then stands up and waves", ["a woman squats", "a woman stands up and waves"]),  # the squat's end
 ])
 def test_ordering_words_make_segments_in_the_order_they_happen(prompt, segments):
     assert split_segments(prompt) == segments
@@ -61,6 +67,8 @@ def test_ordering_words_make_segments_in_the_order_they_happen(prompt, segments)
     "Favoring one leg after twisting an ankle.", "Someone stretching their arms overhead after waking up",
     "the man later waves", "after the rain, he jogs", "a man walks to the end of the room",
     "she walks to the end of the hall",
+    "a skater jumps and twirls in the air", "a martial artist whirls around and kicks", "the man stands and waves",
+    "someone stands up and down", "he squats and stands up", "a woman walks and waves",
 ])
 def test_and_alone_courses_and_things_at_once_stay_one_segment(prompt):
     assert split_segments(prompt) == [prompt]

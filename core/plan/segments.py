@@ -7,8 +7,10 @@
 Only words that order make segments: "then", "and then", ", then", "after that", "afterwards",
 "next", "finally", "followed by", "first ... then", and "before" / "after" in front of a clause
 ("after waving, she jogs", "she jogs after waving", "before sitting down he waves": the wave
-first). "And" alone never cuts: two things at once ("jogs and waves") are one segment made by body
-part (``generation/parts.py``), and "back and forth", "to and fro", "up and down" are courses.
+first). "And" cuts only beside a change of posture ("gets up and walks away", "walks over and
+sits down"; ``vocabulary.POSTURE_CHANGES``), never after a squat's own standing up: two things at
+once ("jogs and waves") are one segment made by body part (``generation/parts.py``), "jumps and
+twirls" one action, and "back and forth", "to and fro", "up and down" are courses.
 "After" / "before" cut only before a participle or a pronoun ("runs after the ball" is one thing).
 Both sides of a "before" / "after" must name an action ("jumps and turns before landing" is one),
 and what follows "then" must say what someone does ("bends the knees, then straightens" is one
@@ -25,7 +27,8 @@ import re
 
 from ..data.actions import find_actions
 from .part_prompts import SUBJECT, _has_verb, _subject, _with_subject
-from .vocabulary import BEFORE_AFTER as MIDDLE, FIRST, LEADING_BEFORE_AFTER as LEADING, PARTICIPLE, STOP, THEN
+from .vocabulary import (AND, BEFORE_AFTER as MIDDLE, FIRST, LEADING_BEFORE_AFTER as LEADING, PARTICIPLE,
+                         POSTURE_CHANGES, RISEN_FROM, STOP, THEN)
 
 DEFAULT_SUBJECT = "a person"
 SEGMENT_SECONDS = 3.0       # a segment's length when the prompt's length is the model's to choose
@@ -71,6 +74,27 @@ def _ordered(piece: str) -> list[str]:
     return [piece]
 
 
+def _changes_posture(action: str, before: list[str]) -> bool:
+    """Whether ``action`` changes the body's posture after actions ``before``: standing up after a
+    squat or a bend is that action's own end."""
+    return action in POSTURE_CHANGES and not (action == "get up" and any(x in RISEN_FROM for x in before))
+
+
+def _posture_and(piece: str, before: str = "") -> list[str]:
+    """A piece cut at an "and" with a change of posture on one side, each side naming its own action
+    ("stands up and runs", "walks to the chair and sits down"); the piece itself otherwise. Standing
+    up after a squat or a bend (``before``: what precedes the piece) is that action's own end, no
+    action of its own ("squats, then stands up and waves" is two)."""
+    for m in AND.finditer(piece):
+        a, b = piece[:m.start()], piece[m.end():]
+        first, then = find_actions(a), find_actions(b)
+        if not (first and then and first[0] != then[0] and _has_verb(b)):
+            continue
+        if _changes_posture(first[0], find_actions(before)) or _changes_posture(then[0], first):
+            return [a] + _posture_and(b, a)
+    return [piece]
+
+
 def _says_something(piece: str) -> bool:
     """Whether a piece holds a word beyond its subject ("then he" and "then 123" do not)."""
     subject = SUBJECT.match(piece)
@@ -98,7 +122,9 @@ def split_segments(prompt: str) -> list[str]:
             pieces[-1] = f"{pieces[-1]}, then {p}"   # the gait's own stop, or no motion of its own ("then straighten")
         else:
             pieces.append(p)
-    ordered = [q for p in pieces if p for q in _ordered(p) if _says_something(_tidy(q))]
+    ordered = [q for p in pieces if p for q in _ordered(p)]
+    ordered = [q for i, o in enumerate(ordered) for q in _posture_and(o, ordered[i - 1] if i else "")
+               if _says_something(_tidy(q))]
     if len(ordered) < 2:
         return [str(prompt).strip()]
     subject = next((_subject(q) for q in ordered if SUBJECT.match(q)), DEFAULT_SUBJECT)

@@ -156,6 +156,11 @@ BEFORE_AFTER = re.compile(r"\s*,?\s*\b(before|after)\s+" + _CLAUSE_AHEAD)
 # ... and at the start, before a noun phrase and its comma too ("after a bow, the actor walks away")
 LEADING_BEFORE_AFTER = re.compile(r"^\s*(before|after)\s+(?:" + _CLAUSE_AHEAD + r"|(?=(?:a|an|the|his|her|their)\s[^,]{1,30},))")
 FIRST = re.compile(r"\b(?:first(?:ly)?|at first|initially|to begin with|to start with)\b\s*,?\s*")
+# "and" that orders: a change of posture on one side ("stands up and runs", "walks over and sits down");
+# any other "and" joins two things at once or one action ("jumps and twirls": a spin jump)
+POSTURE_CHANGES = frozenset({"get up", "lie down", "sit"})
+RISEN_FROM = frozenset({"squat", "bend over", "pick up", "put down"})   # "squats, then stands up": the squat's own end
+AND = re.compile(r"\s*,?\s*\band\s+")
 PARTICIPLE = re.compile(r"^(?!(?:spring|bring|swing|sing|string|ring|thing|sling|sting|wing|cling|fling)\b)[a-z'-]{2,}ing\b")
 
 # -- words no reader needs to act on (the model reads them with the rest) ---------------------------
@@ -213,7 +218,8 @@ WORD_CLASSES = (
               "the arms raised once and held there: the raise played to its highest point, that pose kept for the rest",
               "a man walks with both arms raised", {"arms_held": True, "legs": "a man walks"}),
     WordClass("order", "then, and then, after that, after which, next, finally, (a minute) later, eventually, "
-              "subsequently, followed by, finishes / ends with, after / before + a clause",
+              "subsequently, followed by, finishes / ends with, after / before + a clause, "
+              "and beside a change of posture (gets up and walks, walks over and sits down)",
               "segments one after the other, each its share of the length", "a person walks forward, then sits down",
               {"segments": 2}),
 )
