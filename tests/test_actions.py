@@ -39,6 +39,14 @@ def test_vocabulary():
     ("the class does star jumps", ["jumping jacks"]),
     ("a knight swings a longsword", ["slash"]),
     ("a pony trots around the field", ["jog"]),
+    ("a guard paces ahead", ["walk"]),
+    ("circling the yard on foot", ["walk in a circle", "walk"]),
+    ("a boy throws a stick for the dog", ["throw"]),
+    ("a boxer throws a left hook", ["punch"]),
+    ("she throws two quick jabs", ["punch"]),
+    ("a fan with one fist thrust up in the air", ["raise hand"]),
+    ("she paces the room", []),                       # a course (back and forth), not an action
+    ("a dancer circling his arms", ["dance"]),        # no circle walk: arm circles are the plan's (vocabulary.ARM_CIRCLES)
 ])
 def test_find_actions(text, expected):
     assert find_actions(text) == expected

@@ -34,13 +34,15 @@ class Action:
 _EVERYDAY = {
     "walk": (
         r"\bambl(e|es|ing)\b", r"\bsaunter", r"\btrudg", r"\bwander", r"\bon foot\b",
-        r"\bone foot after the other\b",
+        r"\bone foot after the other\b", r"\bpac(e|es|ing) (ahead|forward|along|onward|on)\b",
     ),
     "walk backward": (r"\bin reverse\b", r"\bbacks? away\b", r"\bretreat",),
     "sidestep": (r"\blike a crab\b", r"\blaterally\b",),
     "turn": (r"\babout[- ]face\b", r"\bswivel",),
     "walk in a circle": (
         r"\bcircular (path|route|track)\b", r"\bround and round\b", r"\bcircles? the room\b", r"\bin a loop\b",
+        r"\bcircl(es|ed|ing) (around )?(the|a) (room|yard|field|track|park|block|hall|square|pond|fountain|tree|table|"
+        r"garden|courtyard|lobby|stage|ring|arena)\b",
     ),
     "walk in a figure eight": (r"\b(eight|infinity)[- ]shaped\b", r"\binfinity (sign|shape|path)\b",),
     "run": (r"\brac(e|es|ing) (down|ahead|along|across|around|off|away)\b",),
@@ -93,17 +95,21 @@ _EVERYDAY = {
     ),
     "wave goodbye": (r"\bfarewell\b", r"\bsee[- ]you[- ]later\b",),
     "raise hand": (r"\bhold\w* (one|an|both|a) arms? (straight )?up\b", r"\barms? (straight )?up in the air\b",
+                   r"\b(arms?|hands?|fists?) (thrust|shot|flung|stretched|reaching) (straight )?((up|upward|skyward)"
+                   r"( (in|into) the air)?|overhead|into the air)\b",
                    r"\b(arms?|hands?) (held )?(raised|lifted|aloft|up high)\b",
                    r"\b(with|keep|keeps|keeping|hold|holds|holding) (\w+ ){0,2}(arms?|hands?) (held )?(up|raised|high|aloft|above|"
                    r"overhead|in the air)\b",),
     "bow": (r"\bbend\w* (\w+ )?at the waist\b",),
     "beckon": (r"\bmotion\w* for (\w+ ){0,3}to come\b", r"\bcome closer\b",),
-    "punch": (r"\bone-two\b", r"\bshadow ?box", r"\buppercut",),
+    "punch": (r"\bone-two\b", r"\bshadow ?box", r"\buppercut", r"\bthrow\w* (\w+ ){0,2}(punch(es)?|jabs?|hooks?|uppercuts?)\b",),
     "kick": (r"\blash\w* out with (a|the|one|his|her) (foot|leg)\b", r"\bboot(s)? \w+ away\b",),
     "spin kick": (r"\bwhirl\w* around and kicks?\b",),
     "slash": (r"\bblade\b", r"\b\w*sword\b", r"\bswing\w* (a |an |the )?\w*sword\b",),
     "kick ball": (r"\bstrik\w* the ball\b",),
-    "throw": (r"\bhurl", r"\btoss", r"\bpitch\w* (a|the) (base)?ball\b",),
+    "throw": (r"\bhurl", r"\btoss", r"\bpitch\w* (a|the) (base)?ball\b",
+              r"\bthrow\w* (a|an|the|his|her|their|some) (\w+ )?(stick|stone|rock|frisbee|javelin|spear|dart|disc|"
+              r"discus|bottle|snowball|pillow|bag|box|object|rope|bone)s?\b",),
     "dribble": (r"\bbounc\w* the (basket)?ball\b",),
     "shoot": (r"\bjump shot\b", r"\bshot at the (hoop|basket)\b",),
     "dance": (r"\bgroov", r"\bboogie",),
