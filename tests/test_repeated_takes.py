@@ -102,3 +102,16 @@ def test_the_default_model_plays_captured_jumping_jacks_and_squats_as_many_times
     plain = gen.generate_batch([Request("a woman does jumping jacks", seed=0, seconds=8)])[0]
     assert plain.provenance.startswith("captured:")
     assert _raises(plain.joints) >= 6   # a jack about every 1.1 s: the take's jacks played on, nothing else
+
+
+def test_every_repetition_asked_plays_when_the_length_is_the_models():
+    """"12 squats" need about 14-19 s of captured squats: with no length asked all twelve play (the
+    model's own length stops at 10 s, which held 10); a length asked that holds fewer says so."""
+    from shapemove.core.generation.generate import Generator, Request
+
+    gen = Generator(None)
+    m = gen.generate_batch([Request("a man does 12 squats", seed=0)])[0]
+    assert m.provenance.startswith("captured:") and _squats(m.joints) == 12 and len(m.joints) > 200
+    short = gen.generate_batch([Request("a man does 12 squats", seed=0, seconds=6)])[0]
+    assert len(short.joints) == 120 and _squats(short.joints) < 12
+    assert any("the repetitions asked take" in n and "hold fewer" in n for n in short.notes)

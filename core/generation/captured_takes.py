@@ -73,6 +73,7 @@ class Window:
     held: int = 0           # frames held on the last pose
     mirrored: bool = False
     looped: int = 0         # frames of the take's own cycle played again (take_loop.py)
+    cut: int = 0            # frames of the repetitions asked that the length asked leaves out
 
     @property
     def arrays(self) -> dict:
@@ -209,7 +210,7 @@ class TakePool:
         ``longest``: the length is the model's (``frames`` the least), the take plays whole up to
         ``longest`` frames. ``side``: ("left" | "right", "hand" | "foot") mirrors a take whose
         other side moves most. A take of a counted action plays its repetitions, ``times`` of them
-        when asked (``repeated_takes.py``)."""
+        when asked (``repeated_takes.py``), all of them when the length is the model's, however long."""
         from .part_compose import needs_mirror
 
         t = self.take(i)
@@ -222,6 +223,8 @@ class TakePool:
             rot, root, con, exact = repeated_stretch(rot, root, con, posed, self.actions[i], times, seed)
         n = len(rot)
         want = min(max(frames, n), longest) if longest is not None else frames
+        if exact and longest is not None:   # the length is the model's: every repetition asked plays
+            want = max(frames, n)
         lo = 0 if n <= want else busiest_start(rot, want, seed)
         rot, root, con = (np.asarray(a[lo:lo + want]) for a in (rot, root, con))
         held = looped = 0
@@ -243,7 +246,8 @@ class TakePool:
             rot, root, con = mirrored(rot, root, con)
             joints = self.proc.pose_on(rot, root, t["betas"], 1.0, con)
         return Window(rot, root, con, t["rest"], self.proc.features(joints, rot, con), self.actions[i], self.ids[i],
-                      t["provenance"] + (", mirrored" if flip else ""), held, flip, looped)
+                      t["provenance"] + (", mirrored" if flip else ""), held, flip, looped,
+                      max(0, n - want) if exact else 0)
 
     def windows(self, text: np.ndarray, action: str | None, seed: int, frames: int, side=None,
                 longest: int | None = None, count: int = TAKES, times: int | None = None) -> list[Window]:
@@ -292,6 +296,9 @@ def captured_motion(w: Window, body, betas, ik_refine_iters: int = 10, prompt: s
     if w.looped:
         out.notes.append(f"the captured take lasts {(len(w.rotations) - w.looped) / FPS:.1f} s: its own cycle "
                          f"repeats for the remaining {w.looped / FPS:.1f} s")
+    if w.cut:
+        out.notes.append(f"the repetitions asked take {(len(w.rotations) + w.cut) / FPS:.1f} s: the "
+                         f"{len(w.rotations) / FPS:.1f} s asked hold fewer of them")
     if w.held:
         out.notes.append(f"the captured take lasts {(len(w.rotations) - w.held) / FPS:.1f} s: its last pose is held "
                          f"for the remaining {w.held / FPS:.1f} s")
