@@ -4,10 +4,11 @@
     [s.text for s in plan.segments]  -> ["she is waving", "she jogs"]
     plan.lengths(6.0)                -> [3.0, 3.0]
 
-Only words that order make segments: "then", "and then", ", then", "after that", "afterwards",
-"next", "finally", "followed by", "first ... then", and "before" / "after" in front of a clause
-("after waving, she jogs", "she jogs after waving", "before sitting down he waves": the wave
-first). "And" cuts only beside a change of posture ("gets up and walks away", "walks over and
+Only words that order make segments (``vocabulary.THEN``): "then", "and then", ", then", "after
+that", "afterwards", "after which", "next", "finally", "(a minute) later", "eventually",
+"subsequently", "followed by", "finishes / ends with", "first ... then", and "before" / "after" in
+front of a clause ("after waving, she jogs", "she jogs after waving", "before sitting down he
+waves": the wave first; at the start also in front of a noun and its comma: "after a bow, ..."). "And" cuts only beside a change of posture ("gets up and walks away", "walks over and
 sits down"; ``vocabulary.POSTURE_CHANGES``), never after a squat's own standing up: two things at
 once ("jogs and waves") are one segment made by body part (``generation/parts.py``), "jumps and
 twirls" one action, and "back and forth", "to and fro", "up and down" are courses.
