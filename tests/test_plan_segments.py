@@ -81,6 +81,17 @@ def test_lengths_share_the_seconds_or_take_a_default_each():
     assert plan.lengths(None) == pytest.approx([SEGMENT_SECONDS] * 3)
 
 
+
+def test_a_counted_segment_takes_as_long_as_its_repetitions_when_the_length_is_the_models():
+    """"six jumping jacks, then waves": 7 x 1.1 s for the jacks (one more for the start and the end),
+    the default for the wave; a total asked is shared as before; few repetitions keep the default."""
+    plan = read_plan("she does six jumping jacks, then waves")
+    assert plan.lengths(None) == pytest.approx([7.7, SEGMENT_SECONDS])
+    assert plan.lengths(6.0) == pytest.approx([3.0, 3.0])
+    assert read_plan("he squats twice, then jumps").lengths(None) == pytest.approx([4.2, SEGMENT_SECONDS])
+    assert read_plan("he jumps once, then waves").lengths(None) == pytest.approx([SEGMENT_SECONDS] * 2)
+
+
 def test_the_readings_are_the_generators():
     assert understood("a man walks 3 metres forward and stops") == {
         "actions": ["walk"], "travel": "forward", "distance_m": 3.0, "stop": True}

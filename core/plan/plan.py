@@ -24,6 +24,7 @@ from dataclasses import dataclass, replace
 
 from ..errors import ShapeMoveError
 from .segments import MIN_SEGMENT_SECONDS, SEGMENT_SECONDS, split_segments
+from .vocabulary import REPETITION_SECONDS
 from .words import Words, read_words
 
 MAX_SEGMENTS = 32          # as a timeline (``generation/sequence.MAX_SEGMENTS``)
@@ -50,12 +51,23 @@ class Plan:
         return len(self.segments) > 1
 
     def lengths(self, total: float | None) -> list[float]:
-        """Each segment's seconds of a motion ``total`` seconds long (None: ``SEGMENT_SECONDS`` each);
-        a segment's own seconds win."""
+        """Each segment's seconds of a motion ``total`` seconds long (None: ``SEGMENT_SECONDS`` each,
+        or the time a counted action's repetitions take, ``counted_seconds``); a segment's own
+        seconds win."""
         if all(s.seconds is not None for s in self.segments):
             return [float(s.seconds) for s in self.segments]
-        total = SEGMENT_SECONDS * len(self.segments) if total is None else float(total)
-        return [float(s.seconds) if s.seconds is not None else s.share * total for s in self.segments]
+        if total is None:
+            return [float(s.seconds) if s.seconds is not None else counted_seconds(s.words) for s in self.segments]
+        return [float(s.seconds) if s.seconds is not None else s.share * float(total) for s in self.segments]
+
+
+def counted_seconds(words: Words) -> float:
+    """A segment's seconds when the length is the model's: ``SEGMENT_SECONDS``, or as long as its
+    counted repetitions take ("six jumping jacks": 6 x 1.1 s and one more for the start and the end)."""
+    if words.count is None:
+        return SEGMENT_SECONDS
+    action, times = words.count
+    return max(SEGMENT_SECONDS, (times + 1) * REPETITION_SECONDS.get(action, 0.0))
 
 
 def read_plan(prompt: str, seconds: float | None = None) -> Plan:

@@ -20,7 +20,8 @@ stops": one segment that stops, ``vocabulary.STOP``). "Followed by a jump": "a p
 a jump".
 A segment without a subject gets the prompt's ("a man walks, then sits" -> "a man sits"); a bare
 participle is said as a clause ("waving" -> "she is waving"). Each segment gets an equal share of
-the length (``SEGMENT_SECONDS`` each when no length is asked).
+the length (``SEGMENT_SECONDS`` each when no length is asked, or what a counted action's
+repetitions take: ``plan.counted_seconds``).
 """
 from __future__ import annotations
 

@@ -29,6 +29,11 @@ COUNT_TIMES = re.compile(rf"\b(?:(once|twice|thrice)|({QUANTITY}|\d{{1,2}})\s+(?
 COUNTED = {"jump": "flights", "jump forward": "flights", "spin jump": "flights", "hop": "flights",
            "jumping jacks": "raises", "squat": "dips"}
 MAX_COUNT = 12
+# seconds a repetition takes: the median start-to-start of repetitions in a row in the built-in
+# library's takes (jumping jacks, jumps, jumps forward; 2026-11-29), a lone squat take's length; a
+# spin jump as a jump forward, a hop as a jump (no take repeats them)
+REPETITION_SECONDS = {"jump": 0.7, "jump forward": 1.7, "spin jump": 1.7, "hop": 0.7, "jumping jacks": 1.1,
+                      "squat": 1.4}
 
 # -- pace -------------------------------------------------------------------------------------
 FAST = re.compile(r"\b(quick(?:ly)?|fast(?:er)?|brisk(?:ly)?|rapid(?:ly)?|swift(?:ly)?|hurried(?:ly)?|hurr(?:y|ies|ying)|"
