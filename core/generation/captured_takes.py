@@ -46,6 +46,7 @@ from ..errors import ShapeMoveError
 from ..scene.motion_file import Motion
 from ..data.actions import REPEATED
 from ..plan.vocabulary import COUNTED
+from .posture_change import POSTURE
 from .repeated_takes import repeated_stretch
 from .take_loop import looped_repetition, looped_take
 
@@ -210,7 +211,9 @@ class TakePool:
         ``longest``: the length is the model's (``frames`` the least), the take plays whole up to
         ``longest`` frames. ``side``: ("left" | "right", "hand" | "foot") mirrors a take whose
         other side moves most. A take of a counted action plays its repetitions, ``times`` of them
-        when asked (``repeated_takes.py``), all of them when the length is the model's, however long."""
+        when asked (``repeated_takes.py``), all of them when the length is the model's, however long;
+        a take of a change of posture (``posture_change.POSTURE``: getting up, lying down) is cut to
+        its end."""
         from .part_compose import needs_mirror
 
         t = self.take(i)
@@ -225,7 +228,10 @@ class TakePool:
         want = min(max(frames, n), longest) if longest is not None else frames
         if exact and longest is not None:   # the length is the model's: every repetition asked plays
             want = max(frames, n)
-        lo = 0 if n <= want else busiest_start(rot, want, seed)
+        if n <= want:
+            lo = 0
+        else:   # a change of posture ends where the take does (up, or lying): its busiest stretch may not
+            lo = n - want if self.actions[i] in POSTURE else busiest_start(rot, want, seed)
         rot, root, con = (np.asarray(a[lo:lo + want]) for a in (rot, root, con))
         held = looped = 0
         if len(rot) < want:   # a take that repeats plays on as a loop, another is held on its last pose

@@ -11,9 +11,10 @@ Travel and pace words come first: a candidate whose root travel goes against "fo
 "backwards", "in place" or "steps to the left" is set aside before the TMA chooses
 (``travel_words``), for "walks quickly" or "a brisk walk" only the fastest candidates compete
 (``pace_words``), and for "jumps twice" or "three squats" only those that leave the floor or go
-down the number of times nearest the asked one (``count_words``), and for "walks 3 metres" those
-whose path gets that far (``stop_words``), since the TMA reads what the body does, not which way,
-how fast, how far or how many times.
+down the number of times nearest the asked one (``count_words``), for "walks 3 metres" those
+whose path gets that far (``stop_words``), and for "gets up" or "lies down" those that rise or go
+down (``posture_change``), since the TMA reads what the body does, not which way, how fast, how far
+or how many times, and weighs who does it as much as what.
 
 Bias to keep in mind: R-precision and the paraphrase classifier also read TMA embeddings, so
 ``eval generate`` scores the generator with one candidate, and ``eval paraphrase`` also reports a
@@ -26,6 +27,7 @@ import numpy as np
 from ..plan.words import read_words
 from .count_words import counter, nearest_count
 from .pace_words import fastest, gait_speed
+from .posture_change import posture_kept
 from .stop_words import reaching
 from .travel_words import allowed
 
@@ -57,5 +59,6 @@ class CandidatePicker:
         if words.count is not None:
             action, want = words.count
             keep = nearest_count([counter(action)(f) for f in feats], want, keep)
+        keep = posture_kept(words.actions[0] if words.actions else None, feats, keep)
         scores = self.scores(prompt, feats) + (0.0 if bonus is None else np.asarray(bonus, np.float64))
         return int(np.argmax(np.where(keep, scores, -np.inf)))
