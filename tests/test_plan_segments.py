@@ -69,6 +69,7 @@ def test_ordering_words_make_segments_in_the_order_they_happen(prompt, segments)
     "she walks to the end of the hall",
     "a skater jumps and twirls in the air", "a martial artist whirls around and kicks", "the man stands and waves",
     "someone stands up and down", "he squats and stands up", "a woman walks and waves",
+    "A see-you-later gesture to a friend leaving.", "she says see you later and walks away",
 ])
 def test_and_alone_courses_and_things_at_once_stay_one_segment(prompt):
     assert split_segments(prompt) == [prompt]

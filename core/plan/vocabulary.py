@@ -151,7 +151,8 @@ ORDER_WORDS = re.compile(r"\b(then|after|afterwards|before|followed by|next|fina
 # -- order: segments ----------------------------------------------------------------------------
 # words that put what follows after what precedes ("then"): a cut with that order
 THEN = re.compile(r"\s*(?:[,;.]\s*)?\b(?:and\s+)?(?:then|after\s+that|afterwards?|after\s+which|next(?!\s+to\b)|finally|"
-                  r"(?:(?:a|one|some)\s+(?:few\s+)?(?:moments?|minutes?|seconds?|while)\s+)?later(?:\s+on)?|subsequently|eventually|"
+                  r"(?:(?:a|one|some)\s+(?:few\s+)?(?:moments?|minutes?|seconds?|while)\s+)?(?<!-)(?<!you\s)later(?:\s+on)?|"
+                  r"subsequently|eventually|"
                   r"followed\s+by|"
                   r"(?:finish(?:es|ing)?|end(?:s|ing)?)\s+(?:off\s+|up\s+)?(?:with|by)|"
                   r"and\s+(?:finally|afterwards?))\b\s*,?\s*")
