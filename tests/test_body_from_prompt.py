@@ -34,6 +34,11 @@ def test_a_child_is_the_youngest_and_smallest_body_the_model_makes(openbody):
         betas, src = body_from_prompt(openbody, prompt)
         assert src == "prompt words"
         assert measure(openbody, betas)["height_cm"] < 153
+    boy, src = body_from_prompt(openbody, "a little boy jumps")   # a child, and a boy
+    said = parse_shape_words("a little boy jumps")
+    assert src == "prompt words" and said.age == 13.0 and said.gender == 0.0
+    assert measure(openbody, boy)["height_cm"] < 153
+    assert parse_shape_words("a boy runs").age == 16.0   # a boy alone: a teenager, as before
     tall, _ = body_from_prompt(openbody, "a tall kid runs")
     assert measure(openbody, tall)["height_cm"] > 180
     adult, src = body_from_prompt(openbody, "an old child walks")   # ages that disagree: no body from them

@@ -108,6 +108,7 @@ AGE_WORDS: dict[str, tuple[float, float, float]] = {
     "kids": (13.0, 13.0, 13.0), "youngster": (13.0, 13.0, 13.0),
 }
 CHILD_WORDS = ("child", "children", "kid", "kids", "youngster")
+LITTLE_ONE = re.compile(r"\b(?:little|small) (?:boy|girl|son|daughter)s?\b")
 # nouns that imply an age: a default when the text states none (never a conflict)
 NOUN_AGES = {"boy": 16.0, "girl": 16.0, "schoolboy": 15.0, "schoolgirl": 15.0, "lad": 18.0, "lass": 18.0,
              "grandfather": 72.0, "grandpa": 72.0, "granddad": 72.0, "grandad": 72.0, "grandmother": 72.0,
@@ -400,7 +401,7 @@ def _read_words(text: str, out: ShapeWords) -> None:
     t = re.sub(r"[^a-z']+", " ", text.replace("-", " "))
     t = " " + re.sub(r"'s\b", "", t) + " "
     # age words first ("young adult" before "adult"), then build/size words, then gender nouns
-    age_hits = []
+    age_hits = ["child"] if LITTLE_ONE.search(t) else []   # "a little girl": a child, and a girl
     for m in _phrase_pattern(AGE_WORDS).finditer(t):
         age_hits.append(_canon(m.group(1), AGE_WORDS))
     t = _phrase_pattern(AGE_WORDS).sub(" ", t)
