@@ -45,6 +45,13 @@ def test_vocabulary():
     ("a boxer throws a left hook", ["punch"]),
     ("she throws two quick jabs", ["punch"]),
     ("a fan with one fist thrust up in the air", ["raise hand"]),
+    ("a person does sit-ups", []),                    # no sitting down
+    ("a person does sit ups", []),
+    ("a child skips happily", ["hop"]),
+    ("she skips rope", []),
+    ("a drunk man staggers", ["walk"]),
+    ("someone lifts a heavy box", ["pick up"]),
+    ("running flat out, she lifts one hand high", ["run", "raise hand"]),
     ("she paces the room", []),                       # a course (back and forth), not an action
     ("a dancer circling his arms", ["dance"]),        # no circle walk: arm circles are the plan's (vocabulary.ARM_CIRCLES)
 ])

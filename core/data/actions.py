@@ -34,7 +34,7 @@ class Action:
 _EVERYDAY = {
     "walk": (
         r"\bambl(e|es|ing)\b", r"\bsaunter", r"\btrudg", r"\bwander", r"\bon foot\b",
-        r"\bone foot after the other\b", r"\bpac(e|es|ing) (ahead|forward|along|onward|on)\b",
+        r"\bone foot after the other\b", r"\bpac(e|es|ing) (ahead|forward|along|onward|on)\b", r"\bstagger",
     ),
     "walk backward": (r"\bin reverse\b", r"\bbacks? away\b", r"\bretreat",),
     "sidestep": (r"\blike a crab\b", r"\blaterally\b",),
@@ -61,7 +61,8 @@ _EVERYDAY = {
     "jump": (r"\bsprings? (up|into the air)\b", r"\bvault(s|ed|ing)?\b",),
     "jump forward": (r"\b(broad|standing long) jumps?\b", r"\bleap\w* as far\b",),
     "spin jump": (r"\b(jump|leap)\w* (up )?and (twirl|spin|turn|rotat)\w*",),
-    "hop": (r"\bskip\w* (along )?on one (leg|foot)\b", r"\bbounc\w* on (both|two) feet\b",),
+    "hop": (r"\bskip\w* (along )?on one (leg|foot)\b", r"\bbounc\w* on (both|two) feet\b",
+            r"\bskip(s|ping|ped)?\b(?!\s+(rope|over|the|a|an)\b)",),
     "jumping jacks": (r"\bstar[- ]?jumps?\b",),
     "backflip": (r"\bsomersault\w* backwards?\b", r"\bback tuck\b", r"\bflip\w* over backwards?\b",),
     "sideflip": (r"\bflip\w* over sideways\b", r"\baerial twist to the side\b",),
@@ -81,6 +82,8 @@ _EVERYDAY = {
     "pick up": (
         r"\blift\w* (a|an|the) \w+ (off|from) (the )?(floor|ground)\b",
         r"\bcollect\w* (an? |the )?\w+ (lying )?on the (floor|ground)\b",
+        r"\blift\w* (a|an|the|some|his|her|their) (heavy |big |small |large |light )?(box|bag|crate|package|parcel|"
+        r"suitcase|bucket|weight|barbell|dumbbell|rock|stone)s?\b",
     ),
     "put down": (r"\bset\w* (a|an|the) \w+ down\b",),
     "reach up": (r"\bextend\w* an arm overhead\b", r"\breach\w* overhead\b",),
@@ -95,6 +98,7 @@ _EVERYDAY = {
     ),
     "wave goodbye": (r"\bfarewell\b", r"\bsee[- ]you[- ]later\b",),
     "raise hand": (r"\bhold\w* (one|an|both|a) arms? (straight )?up\b", r"\barms? (straight )?up in the air\b",
+                   r"\blift\w* (one|a|both|his|her|their|the) (\w+ )?hands?\b",
                    r"\b(arms?|hands?|fists?) (thrust|shot|flung|stretched|reaching) (straight )?((up|upward|skyward)"
                    r"( (in|into) the air)?|overhead|into the air)\b",
                    r"\b(arms?|hands?) (held )?(raised|lifted|aloft|up high)\b",
@@ -165,7 +169,7 @@ _LIST = [
        [r"\bget(s|ting)? up\b", r"\bstand(s|ing)? up\b", r"\bgetup\b"]),
     _a("lie down", "floor", ["lies down on the floor", "lies down"],
        [r"\blie(s)? down", r"\blying down", r"\blays? down"]),
-    _a("sit", "floor", ["sits down", "sits"], [r"\bsit(s|ting)?\b", r"\bsat\b"]),
+    _a("sit", "floor", ["sits down", "sits"], [r"\bsit(s|ting)?\b(?![- ]?ups?\b)", r"\bsat\b"]),
     _a("climb", "sport", ["climbs", "climbs up"], [r"\bclimb"]),
     _a("hang", "sport", ["hangs from a bar"], [r"\bhang(s|ing)?\b"]),
     _a("swing", "sport", ["swings from a bar"], [r"\bswing(s|ing)?\b(?! (\w+ )?arms?)"]),
