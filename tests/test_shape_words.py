@@ -41,6 +41,7 @@ def test_the_reader_is_a_leaf_and_the_only_definition():
     ("a grandmother", dict(gender=1.0, age=72.0, age_implied=True)),
     ("a middle-aged, heavy-set guy", dict(gender=0.0, age=48.0, weight=0.85)),
     ("a ripped young woman", dict(gender=1.0, age=24.0, muscle=0.95)),
+    ("a young girl", dict(gender=1.0, age=16.0)),       # the noun's age, young, wins over young's 24
     ("170-180 cm tall", dict(height_cm=175.0)),
 ])
 def test_words_and_numbers(text, want):

@@ -454,6 +454,9 @@ def _combine_age(age_hits: list[str], genders: list[str], out: ShapeWords) -> No
                                      f"and {out.age:g} years old: they disagree")
         else:
             out.age = min(max(sum(AGE_WORDS[w][0] for w in age_hits) / len(age_hits), lo), hi)
+            fits = [NOUN_AGES[w] for w in genders if w in NOUN_AGES and lo <= NOUN_AGES[w] <= hi]
+            if fits:   # "a young girl": the girl's 16 is young, and nearer what is meant than young's 24
+                out.age = fits[0]
     if out.age is None:
         implied = [NOUN_AGES[w] for w in genders if w in NOUN_AGES]
         if implied:
