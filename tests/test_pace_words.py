@@ -169,7 +169,8 @@ def test_slow_motion_gives_a_jog_shorter_strides_at_the_same_cadence():
 
 def test_two_things_at_once_asked_slowly_go_slower_and_on():
     """"walks slowly while waving": the composed motion is played slower (a jog: shorter strides),
-    and a jog asked slowly is never a captured one-cycle jog held still for the rest."""
+    and a jog asked slowly is never a captured one-cycle jog held still for the rest (DeepMimic's
+    jog cycle loops on its stride)."""
     from shapemove.core.generation.generate import Request
     from shapemove.core.generation.loaded_generator import loaded_generator
 
@@ -184,4 +185,6 @@ def test_two_things_at_once_asked_slowly_go_slower_and_on():
     assert slow_walk < 0.9 * walk and m.part_prompts == ("a man walks slowly", "a person waving")
     jog, _ = speed("a woman jogs along, waving")
     slow_jog, m = speed("a woman jogs slowly, waving")
-    assert 0.6 * jog < slow_jog < 0.9 * jog and "deepmimic_jog (MIT)" not in m.provenance
+    assert 0.6 * jog < slow_jog < 0.9 * jog
+    last = float(np.linalg.norm(m.transl[-1, [0, 2]] - m.transl[-21, [0, 2]]))   # the last second
+    assert last > 0.7 * slow_jog and not any("is held" in n for n in m.notes)   # jogs on to the end

@@ -75,3 +75,33 @@ def test_one_repetition_on_the_move_goes_on_at_its_pace(openbody):
     r, rt, c, first = looped_repetition(rot, root, con, J, 100)
     assert len(rt) == 100 and first == 20
     assert np.allclose(np.diff(rt[:, 2]), 0.05, atol=1e-4)         # 1 m/s all along, seams included
+
+
+def test_a_gait_loops_on_its_last_stride(openbody):
+    """Four steps from standing, the contacts measured: the left foot down at frames 10 and 26 (a
+    stride of 0.8 s), the right at 18 and 34; played on from the right foot's stride, the latest, to
+    the frame its pose comes back, each repeat moved on by that stride's advance."""
+    from shapemove.core.generation.take_loop import last_stride, looped_gait
+
+    T = 40
+    t = np.arange(T)
+    swing = np.where(t >= 10, 0.15 * np.sin(2 * np.pi * (t - 10) / 16), 0.0)     # arms swing with the steps
+    rot, root, con, J = _take(openbody, swing, forward=0.0)
+    pace = np.where(t >= 10, 0.07, 0.0)
+    root[:, 2] = np.cumsum(pace)
+    J[:, :, 2] += np.cumsum(pace)[:, None]
+    for foot, downs in ((0, (10, 26)), (1, (18, 34))):
+        for d in downs:
+            con[d:d + 5, foot] = 1
+    con[:5, :2] = 1                                                  # standing: both down, never touching down
+    assert last_stride(con) == (18, 34)
+    r, rt, c, first = looped_gait(rot, root, con, J, 100)
+    order = r[:, 0, 0, 0].astype(int)
+    assert len(r) == 100 and first == 34 and np.array_equal(order[:34], np.arange(34))
+    assert np.array_equal(order[34:50], np.arange(18, 34))          # the stride again
+    assert np.allclose(np.diff(rt[30:, 2]), 0.07, atol=1e-4)         # at its pace across the seams
+    assert np.array_equal(c[34:50], con[18:34])                      # its steps' contacts with it
+    assert looped_gait(rot, root, con, J, T) is None                 # long enough: nothing to do
+    still = np.zeros_like(con)
+    still[:, :2] = 1
+    assert last_stride(still) is None and looped_gait(rot, root, still, J, 100) is None   # no step: held

@@ -48,7 +48,8 @@ from ..data.actions import REPEATED
 from ..plan.vocabulary import COUNTED
 from .posture_change import POSTURE
 from .repeated_takes import repeated_stretch
-from .take_loop import looped_repetition, looped_take
+from .straight_gait import STRAIGHTENED, straightened
+from .take_loop import looped_gait, looped_repetition, looped_take
 
 TAKES = 5              # captured windows offered per prompt
 POOL = 2               # drawn by the seed from the POOL x TAKES nearest
@@ -206,14 +207,15 @@ class TakePool:
         return chosen
 
     def window(self, i: int, frames: int, seed: int, side=None, longest: int | None = None,
-               times: int | None = None) -> Window:
+               times: int | None = None, straight: bool = False) -> Window:
         """Take ``i`` cut to ``frames`` (the seed picks the start), or held to it when shorter;
         ``longest``: the length is the model's (``frames`` the least), the take plays whole up to
         ``longest`` frames. ``side``: ("left" | "right", "hand" | "foot") mirrors a take whose
         other side moves most. A take of a counted action plays its repetitions, ``times`` of them
         when asked (``repeated_takes.py``), all of them when the length is the model's, however long;
         a take of a change of posture (``posture_change.POSTURE``: getting up, lying down) is cut to
-        its end."""
+        its end. ``straight``: a take of a plain gait is played off its bend (``straight_gait.py``)
+        and, shorter than asked, loops on its last stride (``take_loop.looped_gait``)."""
         from .part_compose import needs_mirror
 
         t = self.take(i)
@@ -233,12 +235,18 @@ class TakePool:
         else:   # a change of posture ends where the take does (up, or lying): its busiest stretch may not
             lo = n - want if self.actions[i] in POSTURE else busiest_start(rot, want, seed)
         rot, root, con = (np.asarray(a[lo:lo + want]) for a in (rot, root, con))
+        gait = straight and self.actions[i] in STRAIGHTENED
+        if gait:
+            rot, root = straightened(rot, root, self.proc.pose_on(rot, root, t["betas"], 1.0, con))
         held = looped = 0
         if len(rot) < want:   # a take that repeats plays on as a loop, another is held on its last pose
             again = None      # (a take cut to the repetitions asked is held: a loop would add more)
             if not exact:
                 posed_joints = self.proc.pose_on(rot, root, t["betas"], 1.0, con)
-                again = looped_take(rot, root, con, posed_joints, want)
+                if gait:   # on its last stride
+                    again = looped_gait(rot, root, con, posed_joints, want)
+                else:
+                    again = looped_take(rot, root, con, posed_joints, want)
                 if again is None and self.actions[i] in REPEATED:   # one arm circle: circled again
                     again = looped_repetition(rot, root, con, posed_joints, want)
             if again is not None:
@@ -256,9 +264,12 @@ class TakePool:
                       max(0, n - want) if exact else 0)
 
     def windows(self, text: np.ndarray, action: str | None, seed: int, frames: int, side=None,
-                longest: int | None = None, count: int = TAKES, times: int | None = None) -> list[Window]:
-        """One window of each take offered (``nearest``); ``times``: the repetitions the words ask."""
-        return [self.window(i, frames, seed, side, longest, times) for i in self.nearest(text, action, seed, count)]
+                longest: int | None = None, count: int = TAKES, times: int | None = None,
+                straight: bool = False) -> list[Window]:
+        """One window of each take offered (``nearest``); ``times``: the repetitions the words ask;
+        ``straight``: the words ask a plain gait (``window``)."""
+        return [self.window(i, frames, seed, side, longest, times, straight)
+                for i in self.nearest(text, action, seed, count)]
 
 
 def action_credit(asked: str | None, action: str) -> float | None:
@@ -300,7 +311,7 @@ def captured_motion(w: Window, body, betas, ik_refine_iters: int = 10, prompt: s
     out.prompt = prompt
     out.provenance = w.provenance
     if w.looped:
-        out.notes.append(f"the captured take lasts {(len(w.rotations) - w.looped) / FPS:.1f} s: its own cycle "
+        out.notes.append(f"the captured take plays {(len(w.rotations) - w.looped) / FPS:.1f} s: its own cycle "
                          f"repeats for the remaining {w.looped / FPS:.1f} s")
     if w.cut:
         out.notes.append(f"the repetitions asked take {(len(w.rotations) + w.cut) / FPS:.1f} s: the "

@@ -54,6 +54,7 @@ from .sampling_params import (DEFAULT_GUIDANCE, check_candidates, check_guidance
 from .request import Request
 from .slow_steps import slow_motion
 from .typical_pace import leg_ratio, load_typical_speeds, slow_take, typical_paced, unplain_take
+from .straight_gait import straight_asked
 from .turn_words import turn_motion
 
 
@@ -196,10 +197,11 @@ class Generator:
             return []
         down = self.vae.cfg.downsample
         text = self._embed_texts([r.prompt])[0]
+        straight = straight_asked(r.words if r.words is not None else read_words(r.prompt))
         if r.seconds is None:   # the model's length: a take plays whole, at least UNASKED_SECONDS
             return pool.windows(text, action, r.seed, self._length(UNASKED_SECONDS)[0] * down, side, hi * down,
-                                times=times)
-        return pool.windows(text, action, r.seed, lo * down, side, times=times)
+                                times=times, straight=straight)
+        return pool.windows(text, action, r.seed, lo * down, side, times=times, straight=straight)
 
     # -- tokens ------------------------------------------------------------------------------
     def _length(self, seconds: float | None) -> tuple[int, int]:
@@ -571,8 +573,8 @@ class Generator:
                     motion = (course_motion(motion, self.body, course, words.course_right, self.ik_refine_iters, r.whole_course)
                               if course is not None else                                          # course_walk.py
                               turn_motion(motion, self.body, turn, self.ik_refine_iters))         # turn_words.py
-                    motion = slow_motion(motion, self.body, words, self.ik_refine_iters)      # slow_steps.py
                     motion = typical_paced(motion, self.body, words, self.typical_speeds, self.ik_refine_iters)
+                    motion = slow_motion(motion, self.body, words, self.ik_refine_iters)      # slow_steps.py
             if words is not None and words.arms_held and words.gestures_only and words.parts is None:
                 motion = held_motion(motion, self.body, self.ik_refine_iters)   # "stands with her arms raised"
             if words is not None:   # "jogs in place": the data's gaits all travel; stepped on the spot instead

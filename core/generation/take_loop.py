@@ -23,6 +23,12 @@ A take of one repetition of an action done over and over by its nature (``action
 single arm circle of 1.9 s) has no second cycle to find; ``looped_repetition`` plays its busy
 stretch again when the stretch ends where it began (the same seam and heading conditions): on the
 spot, or moved on by the stretch's advance when its root travels faster than ``TRAVELS``.
+
+A take of a gait (four jogging steps from standing) is looped on its steps (``looped_gait``): its
+last stride, from one foot's touching down to the same foot's next, the latest such stride of either
+foot, as the measured contacts say (a toe or a heel down after both were up), played again and
+again moved on by its own advance (the same seam and heading conditions); its end is the frame,
+within ``CONTACT_SLACK`` of the second touch-down, whose pose is nearest the first's.
 """
 from __future__ import annotations
 
@@ -39,6 +45,7 @@ STILL = 0.25           # a frame whose largest step is under this x the 90th per
 BUSY = 0.5             # the cycle's mean step against the busy stretch's
 TRAVELS = 0.2          # m/s: a repetition whose root goes on faster than this travels (a dribble on the move)
 REPEAT = 0.5           # a neighbouring cycle's pose difference against the cycle's own spread
+CONTACT_SLACK = 2      # frames a measured touch-down may be off by (a stride's end is sought this near)
 
 
 def looped_take(rotations, root, contacts, joints, frames: int):
@@ -126,3 +133,40 @@ def _repeated(J, a: int, b: int) -> bool:
     spread = np.linalg.norm(cycle - cycle.mean(0), axis=-1).mean()
     others = [rel[c:c + P] for c in (a - P, b) if c >= 0 and c + P <= len(J)]
     return any(np.linalg.norm(o - cycle, axis=-1).mean() <= REPEAT * spread for o in others)
+
+
+def looped_gait(rotations, root, contacts, joints, frames: int):
+    """As ``looped_take`` for a take of a gait: its last stride (module doc) played on to ``frames``
+    frames; None when the take has no stride of ``SHORTEST_CYCLE`` s or more, the stride turns or its
+    seam steps too far, or the take is long enough."""
+    from .track import headings
+
+    if len(rotations) >= frames:
+        return None
+    stride = last_stride(contacts)
+    if stride is None:
+        return None
+    J = np.asarray(joints, np.float64)
+    a, b = stride
+    rel = J - J[:, :1]
+    near = range(max(a + 1, b - CONTACT_SLACK), min(len(J), b + CONTACT_SLACK + 1))
+    b = min(near, key=lambda k: np.linalg.norm(rel[k] - rel[a], axis=-1).mean())   # the frame a's pose comes back
+    steps = np.linalg.norm(np.diff(J, axis=0), axis=-1).max(-1)
+    return _played_on(rotations, root, contacts, J, steps, headings(J), a, b, b, frames)
+
+
+def last_stride(contacts) -> tuple[int, int] | None:
+    """(a, b): the latest stride of the ``contacts`` (T,4) (columns: left ankle, right ankle, left
+    toe, right toe): a foot touching down at a and again at b, at least ``SHORTEST_CYCLE`` s later;
+    b < T, so frame b shows the next stride's first pose. None when no foot touches down twice."""
+    c = np.asarray(contacts) > 0
+    best = None
+    for foot in ((0, 2), (1, 3)):
+        down = c[:, foot].any(1)
+        onsets = np.flatnonzero(down[1:] & ~down[:-1]) + 1
+        for a, b in zip(onsets[::-1][1:], onsets[::-1]):
+            if b - a >= SHORTEST_CYCLE * FPS:
+                if best is None or b > best[1]:
+                    best = (int(a), int(b))
+                break
+    return best

@@ -74,13 +74,14 @@ def load_typical_speeds(model_dir) -> dict[str, float]:
     return speeds
 
 
-def plain_gait(words) -> str | None:
+def plain_gait(words, slow: bool = False) -> str | None:
     """The one gait of ``GAITS`` the words (``plan.words.Words``) name when they ask nothing else of
-    it (module doc); None otherwise."""
+    it (module doc); None otherwise. ``slow``: a slow pace asked of it counts as plain (a slow gait
+    is slowed from its typical speed, not from a brisk one's)."""
     gait = going_gait(words)   # one gait, no stop, steps, distance or standing
     if gait is None:
         return None
-    asked = (words.pace, words.course, words.turn, words.count, words.parts, words.side)
+    asked = (None if slow and words.pace == "slow" else words.pace, words.course, words.turn, words.count, words.parts, words.side)
     if any(a not in (None, False) for a in asked) or words.in_place:
         return None
     if words.travel.forward < 0 or words.travel.side or words.travel.sideways:
@@ -116,13 +117,15 @@ def body_speed(typical: float, body, betas) -> float:
 
 def typical_paced(motion, body, words, speeds: dict, ik_refine_iters: int = 10):
     """``motion`` brought down to its plain gait's typical speed on its body (module doc); the
-    motion itself when the words ask more than a plain gait, the table lacks the gait, or it is no
-    more than ``TOLERANCE`` above typical."""
+    motion itself when the words ask more than a plain gait (or a slow one: ``plain_gait``), the table
+    lacks the gait, or it is no more than ``TOLERANCE`` above typical. A gait asked slowly is
+    brought down here before ``slow_steps`` slows it: "jogs slowly" goes slower than "jogs" whichever
+    take or sample was chosen (a 2.5 m/s DeepMimic jog slowed by a fifth outran a plain jog)."""
     from ..motion.root_speed import mean_speed
     from .stride_scale import scaled_strides
     from .track import Track, replanted, resample, track_of
 
-    gait = plain_gait(words)
+    gait = plain_gait(words, slow=True)
     if gait is None or gait not in speeds or motion.num_frames < 4 or motion.network_joints is None:
         return motion
     want = body_speed(speeds[gait], body, motion.betas)
