@@ -549,7 +549,9 @@ class Generator:
             if motion is not None and stop is not None:
                 motion.prompt = r.prompt
                 motion = self.stopped(motion, stop[1], r.seconds, metres)   # both parts stop (stop_words.py)
-            if motion is not None and words.parts is not None:   # "walks slowly, waving": both parts slower
+            if motion is not None and words.parts is not None:   # the legs' gait at its typical pace, and
+                legs = read_words(words.parts.legs_prompt)          # "walks slowly, waving": both parts slower
+                motion = typical_paced(motion, self.body, legs, self.typical_speeds, self.ik_refine_iters)
                 motion = slow_motion(motion, self.body, words, self.ik_refine_iters)   # (slow_steps.py)
             course = self.asks_course(words, check, edited) if words is not None else None   # course_walk.py
             if motion is None:  # one action, no side named: the motion as the model writes it
