@@ -28,7 +28,8 @@ A take of a gait (four jogging steps from standing) is looped on its steps (``lo
 last stride, from one foot's touching down to the same foot's next, the latest such stride of either
 foot, as the measured contacts say (a toe or a heel down after both were up), played again and
 again moved on by its own advance (the same seam and heading conditions); its end is the frame,
-within ``CONTACT_SLACK`` of the second touch-down, whose pose is nearest the first's.
+within ``CONTACT_SLACK`` of the second touch-down, whose pose is nearest the first's. The take plays
+from its first touch-down under way (``UNDER_WAY`` of that stride's pace), not from standing.
 """
 from __future__ import annotations
 
@@ -46,6 +47,7 @@ BUSY = 0.5             # the cycle's mean step against the busy stretch's
 TRAVELS = 0.2          # m/s: a repetition whose root goes on faster than this travels (a dribble on the move)
 REPEAT = 0.5           # a neighbouring cycle's pose difference against the cycle's own spread
 CONTACT_SLACK = 2      # frames a measured touch-down may be off by (a stride's end is sought this near)
+UNDER_WAY = 0.85       # a gait's take plays from the first touch-down going this share of its last stride's pace
 
 
 def looped_take(rotations, root, contacts, joints, frames: int):
@@ -151,8 +153,25 @@ def looped_gait(rotations, root, contacts, joints, frames: int):
     rel = J - J[:, :1]
     near = range(max(a + 1, b - CONTACT_SLACK), min(len(J), b + CONTACT_SLACK + 1))
     b = min(near, key=lambda k: np.linalg.norm(rel[k] - rel[a], axis=-1).mean())   # the frame a's pose comes back
+    s = _under_way(root, contacts, a, b)   # the standing start left out
+    J = J[s:]
     steps = np.linalg.norm(np.diff(J, axis=0), axis=-1).max(-1)
-    return _played_on(rotations, root, contacts, J, steps, headings(J), a, b, b, frames)
+    return _played_on(np.asarray(rotations)[s:], np.asarray(root)[s:], np.asarray(contacts)[s:], J, steps,
+                      headings(J), a - s, b - s, b - s, frames)
+
+
+def _under_way(root, contacts, a: int, b: int) -> int:
+    """The first frame of a gait's take under way: the earliest touch-down (or frame 0) from which the
+    root covers a stride's time at ``UNDER_WAY`` x the last stride a..b's speed or more."""
+    r = np.asarray(root, np.float64)[:, [0, 2]]
+    period = b - a
+    pace = np.linalg.norm(r[b] - r[a]) / period
+    c = np.asarray(contacts) > 0
+    down = np.concatenate([np.flatnonzero(c[1:, f].any(1) & ~c[:-1, f].any(1)) + 1 for f in ((0, 2), (1, 3))])
+    for s in sorted(set(down.tolist()) | {0}):
+        if s >= a or np.linalg.norm(r[s + period] - r[s]) >= UNDER_WAY * pace * period:
+            return min(s, a)
+    return a
 
 
 def last_stride(contacts) -> tuple[int, int] | None:
