@@ -23,6 +23,8 @@ def test_which_words_get_a_typical_pace():
                   "takes three steps and stops", "a person jogs in place"):
         assert plain_gait(read_words(asked)) is None, asked
     assert plain_gait(None) is None
+    assert plain_gait(read_words("a man runs slowly"), slow=True) == "run"   # slowed from the typical pace
+    assert plain_gait(read_words("a person walks quickly"), slow=True) is None
 
 
 def test_the_table_is_read_bounded_and_checked(tmp_path):
@@ -122,3 +124,31 @@ def test_a_take_that_stops_or_circles_is_no_plain_gait():
         assert not unplain_take(take(stops[:42], held=4), read_words(going)), going
     assert not unplain_take(take(circle), read_words("a person jogs slowly"))
     assert not unplain_take(take(stops, held=42), read_words("a person jogs and stops"))   # asked to stop
+
+
+def test_an_edited_take_is_planted_again_on_a_new_body():
+    """"a man walks slowly": a captured walk played slower, an edit that keeps no codes, is planted
+    again by its own rotations on a taller body (``retarget.replant``), not kept with the old body's
+    stride: the same frames, its speed up by the taller leg, its planted feet still."""
+    from shapemove.core.generation.generate import Request
+    from shapemove.core.generation.loaded_generator import loaded_generator
+    from shapemove.core.generation.typical_pace import leg_ratio
+    from shapemove.core.motion.root_speed import mean_speed
+
+    gen = loaded_generator(None)
+    m = gen.generate_batch([Request("a man walks slowly", seconds=4, seed=0)])[0]
+    assert m.tokens is None and m.remakeable and m.planted_take
+    tall = np.array([2.0, 1.5, 0, 0, 0, 0, 0, 0, 0, 0], np.float32)
+    o = gen.redecode(m, tall)
+    assert o.num_frames == m.num_frames and o.provenance == m.provenance
+    ratio = mean_speed(o.joints, o.fps) / mean_speed(m.joints, m.fps)
+    assert ratio == pytest.approx(leg_ratio(gen.body, m.betas, tall), rel=0.05) and ratio > 1.05
+
+    def slide(x):   # mm a frame of the balls of the feet where planted
+        s = []
+        for k, j in ((2, 10), (3, 11)):
+            on = (x.contacts[1:, k] > 0) & (x.contacts[:-1, k] > 0)
+            s += list(np.linalg.norm(np.diff(x.joints[:, j, [0, 2]], axis=0), axis=1)[on])
+        return 1000 * float(np.mean(s))
+
+    assert slide(o) < 1.0

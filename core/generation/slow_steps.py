@@ -7,7 +7,7 @@ length (``track.resample``). A jog or a run (``Words.slow_flight``) keeps its ca
 its flights, which played slower would hang in the air, and takes shorter strides instead
 (``stride_scale.scaled_strides`` at ``SLOW_SPEED``: the root's path and the feet's reach shortened
 together). Either way the feet are planted again (``track.replanted``): an edit, like a turn the
-words name (``turn_words.py``), so the motion keeps no tokens and a new body keeps it rather than
+words name (``turn_words.py``), so the motion keeps no tokens and a new body plants it again by its rotations rather than
 re-decoding it. Choosing the slowest candidates instead cost the gait (limps and creeps):
 ``docs/prompts.md``.
 """

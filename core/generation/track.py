@@ -112,9 +112,11 @@ def replanted(motion: Motion, body, track: Track, ik_refine_iters: int = 10, mea
     """A generated motion after an edit of its track (a circle walked, a turn given back): planted
     again (``plant``), its features computed as the dataset builder computes a clip's (what the
     judges and the TMA read), and what generation said of it kept (body source, retrieved clips,
-    part prompts, warnings, notes). Like every edit, it keeps no tokens: a new body keeps the motion
-    rather than re-decoding it. ``measured``: the track's contacts are a captured take's, planted as
-    they are (``decode.motion_from_joints`` with known contacts, no smoothing)."""
+    part prompts, warnings, notes). Like every edit, it keeps no tokens: a new body plants it again
+    by its own rotations on the contacts it is planted on here (``contacts_measured``:
+    ``Motion.planted_take``, ``retarget.replant``), stride scaled by leg length, rather than
+    re-decoding it. ``measured``: the track's contacts are a captured take's, planted as they are
+    (``decode.motion_from_joints`` with known contacts, no smoothing)."""
     from ..motion.features import motion_features
     from .decode import motion_from_joints
 
@@ -122,6 +124,7 @@ def replanted(motion: Motion, body, track: Track, ik_refine_iters: int = 10, mea
                              known_contacts=True, smooth=0.0) if measured else \
         plant(body, motion.betas, track, ik_refine_iters, prompt=motion.prompt)
     out.features = motion_features(out)
+    out.contacts_measured = out.contacts is not None   # the contacts it is planted on: planted on again
     for key in ("shape_source", "retrieved_clips", "part_prompts", "warnings", "notes"):
         if hasattr(motion, key):
             setattr(out, key, getattr(motion, key))
