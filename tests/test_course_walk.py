@@ -224,3 +224,42 @@ def test_generation_walks_the_eight_at_a_walking_pace():
     d = gen.generate_batch([Request("a woman walks diagonally to the right", seconds=4, seed=0)])[0]
     r = root_centre(d.joints)
     assert -55 < np.degrees(np.arctan2(*(r[-1] - r[0]))) < -35 and travel(d.joints)[-1] > 3.0   # before: -3 degrees
+
+
+def test_a_course_asked_no_length_gets_the_time_to_go_once_round():
+    """Once round at the gait's typical pace, over 0.9 of it: a circle walked 6.28 m at 1.194 m/s in
+    5.8 s, jogged (1.564 m/s) in 4.5 s, a figure eight walked in 11.7 s; no round for a diagonal."""
+    from shapemove.core.generation.course_walk import UNASKED_LEAST, UNASKED_MOST, course_seconds
+
+    assert course_seconds(CIRCLE, 1.194) == pytest.approx(2 * np.pi / (0.9 * 1.194))
+    assert course_seconds(CIRCLE, 1.564) == pytest.approx(4.46, abs=0.01)
+    assert course_seconds(EIGHT, 1.194) == pytest.approx(4 * np.pi / (0.9 * 1.194))
+    assert course_seconds(CIRCLE, 2.87) == UNASKED_LEAST and course_seconds(EIGHT, 0.3) == UNASKED_MOST
+    assert course_seconds(DIAGONAL, 1.2) is None
+
+
+@pytest.mark.parametrize("text, turn", [
+    ("a woman walks in a circle", 2 * np.pi),
+    ("she jogs in a circle", 2 * np.pi),
+    ("a man walks slowly in a circle", 2 * np.pi),    # its length for the slowed pace
+])
+def test_generation_goes_once_round_with_no_length_asked(text, turn):
+    """No length asked, the model's own (a retrieved 1.6 s clip) went a quarter round; the course's
+    time goes all the way round, a captured gait made straight and bent onto it."""
+    from shapemove.core.generation.generate import Generator, Request
+
+    gen = Generator(None)
+    m = gen.generate_batch([Request(text, seed=0)])[0]
+    h = np.unwrap(headings(m.joints))
+    assert h[-1] - h[0] > 0.9 * turn and m.num_frames >= 80
+    assert m.provenance.startswith("captured: ") and m.remakeable
+
+
+def test_generation_goes_round_the_whole_eight_with_no_length_asked():
+    from shapemove.core.generation.generate import Generator, Request
+
+    gen = Generator(None)
+    m = gen.generate_batch([Request("he walks in a figure eight", seed=0)])[0]
+    h = np.unwrap(headings(m.joints))
+    assert h.max() - h[0] > 1.75 * np.pi and abs(h[-1] - h[0]) < 0.3   # round one loop, back round the other
+    assert m.joints[:, :, 1].min() > -0.05

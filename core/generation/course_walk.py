@@ -36,6 +36,10 @@ circles and eights the model learnt them from turn, and decoded without their tu
 0.3-0.6 m/s (a plain walk 1.1 m/s), so a 10 s eight went half round one loop. A motion that does
 not travel (a wave, a sit, "rocks back and forth") is left as it is.
 
+With no length asked, a course is given the time to go once round at its gait's typical pace
+(``course_seconds``: a circle walked 5.8 s, jogged 4.5 s; a figure eight walked 11.7 s), where the
+model's own length (a retrieved 2.6 s walk) went a quarter of an eight.
+
     w = read_words("a woman walks around in a circle, waving")     # plan/words.py
     track = on_course(track, w.course, w.course_right)
 """
@@ -58,6 +62,9 @@ LEG_MIN, LEG_MAX = 1.0, 5.0         # m: back and forth's legs
 ZIG, ZIG_ANGLE, ZIG_TURN = 1.5, np.pi / 4, 0.15   # m, radians, share of a leg
 DIAGONAL_ANGLE, DIAGONAL_EASE = np.pi / 4, 0.6   # radians, m
 STEP = 0.005                        # m: a course's heading integrated at this step
+UNASKED_PACE = 0.9                  # no length asked: once round at this share of the gait's typical pace
+UNASKED_LEAST, UNASKED_MOST = 4.0, 12.0   # s: and within these
+WALK_SPEED = 1.2                    # m/s: a walk's pace where the model folder has no typical pace table
 
 def radius_for(distance: float) -> float:
     """The radius (m) of a circle once round in ``distance`` metres, within MIN..MAX_RADIUS."""
@@ -124,6 +131,17 @@ COURSES = {
     ZIGZAG: Course(_zigzag, 0.0, lambda d: 2 * ZIG),
     DIAGONAL: Course(_diagonal, DIAGONAL_ANGLE, lambda d: 2 * d + 10.0),
 }
+
+
+def course_seconds(course: str, speed: float) -> float | None:
+    """The length (s) a motion with no length asked gets to walk ``course`` once round at ``speed``
+    m/s (its gait's typical pace): the course's shortest period over ``UNASKED_PACE`` of that speed
+    (a slower sample still gets round), within ``UNASKED_LEAST`` .. ``UNASKED_MOST``; None for a
+    course with no round (a diagonal)."""
+    if course == DIAGONAL or course not in COURSES or speed <= 0:
+        return None
+    period = COURSES[course].period_for(0.0)
+    return float(np.clip(period / (UNASKED_PACE * speed), UNASKED_LEAST, UNASKED_MOST))
 
 
 def whole_period(course: str, distance: float) -> float:

@@ -32,7 +32,7 @@ from ..scene.motion_file import Motion
 from ..torch_threads import one_torch_thread
 from .action_clips import ACTION_CLIPS, UNASKED_SECONDS, action_clips
 from .captured_takes import TakePool, Window, action_credit, captured_motion, decoded_provenance
-from .course_walk import ACTIONS as COURSE_ACTIONS, course_motion
+from .course_walk import ACTIONS as COURSE_ACTIONS, WALK_SPEED, course_motion, course_seconds
 from .decode import decode_features, decode_tokens, redecode
 from .library_takes import captured_window, read_take, window_fit
 from .model_bundle import model_files, part_warnings, resolve_model_dir
@@ -361,6 +361,17 @@ class Generator:
             return []
         return seed_prefixes(self.t5.memory, self.tok, r.prompt, seeded_count(n), r.retrieval_prefix)
 
+    def course_seconds(self, words) -> float | None:
+        """The length a course the words name gets when none is asked: once round at the typical
+        pace of its gait (walk, jog or run; a walk's for another gait), slowed when asked slowly,
+        ``course_walk.course_seconds``."""
+        from .pace_words import SLOW_SPEED
+
+        gait = words.course_gait[1] if words.course_gait else None
+        speeds = self.typical_speeds
+        speed = speeds.get(gait) or speeds.get("walk") or WALK_SPEED
+        return course_seconds(words.course, speed * (SLOW_SPEED if words.pace == "slow" else 1.0))
+
     @staticmethod
     def asks_course(words, check, edited: bool = False) -> str | None:
         """The course a prompt asks to walk (``course_walk.COURSES``), or None: the plan's
@@ -541,6 +552,8 @@ class Generator:
             asked = dataclasses.replace(r, prompt=stop[0], seconds=r.seconds if r.seconds or not metres else
                                         min(DISTANCE_SECONDS, metres / DISTANCE_PACE + 1.0)) if stop else r
             asked = dataclasses.replace(asked, plan=None, words=None)
+            if asked.seconds is None and words is not None and words.course is not None:   # once round
+                asked = dataclasses.replace(asked, seconds=self.course_seconds(words))   # (course_walk.py)
             by_parts = words is not None and (words.parts is not None or words.side is not None or not edited)
             standing = words is not None and words.stand_still and self.rest_code is not None
             motion = self.standing(r) if standing else \
@@ -551,7 +564,7 @@ class Generator:
                 motion = self.stopped(motion, stop[1], r.seconds, metres)   # both parts stop (stop_words.py)
             if motion is not None and words.parts is not None:   # the legs' gait at its typical pace, and
                 legs = read_words(words.parts.legs_prompt)          # "walks slowly, waving": both parts slower
-                motion = typical_paced(motion, self.body, legs, self.typical_speeds, self.ik_refine_iters)
+                motion = typical_paced(motion, self.body, legs, self.typical_speeds, self.ik_refine_iters, course=False)
                 motion = slow_motion(motion, self.body, words, self.ik_refine_iters)   # (slow_steps.py)
             course = self.asks_course(words, check, edited) if words is not None else None   # course_walk.py
             if motion is None:  # one action, no side named: the motion as the model writes it
@@ -561,7 +574,7 @@ class Generator:
                 # in the codes (stop_words.py), a course is a plain gait bent and a turn is given back to
                 # the decoded motion, so those are asked of the samples alone
                 turn = words.turn if words is not None else None   # turn_words.py: given back after
-                choice = self.choose(sampled, captured=stop is None and course is None and turn is None, reach=metres,
+                choice = self.choose(sampled, captured=stop is None and turn is None, reach=metres,
                                      body_of=r)
                 betas, source = choice.body, choice.body_source
                 motion = self.chosen_motion(choice, betas, r.prompt)
@@ -571,12 +584,13 @@ class Generator:
                 motion.shape_source = source
                 motion.retrieved_clips = choice.clips
                 self._say_if_short(motion, choice.kept, r.seconds)
-                if words is not None:  # the codec does not carry turning: a course or a turn the words name, given back
+                if words is not None:  # its gait's pace, slowed when asked, then (the codec does not carry
+                    # turning) a course or a turn the words name given back on the paced track
+                    motion = typical_paced(motion, self.body, words, self.typical_speeds, self.ik_refine_iters)
+                    motion = slow_motion(motion, self.body, words, self.ik_refine_iters)      # slow_steps.py
                     motion = (course_motion(motion, self.body, course, words.course_right, self.ik_refine_iters, r.whole_course)
                               if course is not None else                                          # course_walk.py
                               turn_motion(motion, self.body, turn, self.ik_refine_iters))         # turn_words.py
-                    motion = typical_paced(motion, self.body, words, self.typical_speeds, self.ik_refine_iters)
-                    motion = slow_motion(motion, self.body, words, self.ik_refine_iters)      # slow_steps.py
             if words is not None and words.arms_held and words.gestures_only and words.parts is None:
                 motion = held_motion(motion, self.body, self.ik_refine_iters)   # "stands with her arms raised"
             if words is not None:   # "jogs in place": the data's gaits all travel; stepped on the spot instead

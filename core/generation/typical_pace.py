@@ -115,17 +115,30 @@ def body_speed(typical: float, body, betas) -> float:
     return typical * leg_ratio(body, None, betas)
 
 
-def typical_paced(motion, body, words, speeds: dict, ik_refine_iters: int = 10):
+def paced_gait(words, course: bool = True) -> str | None:
+    """The gait of ``GAITS`` whose typical pace a motion of the words is brought down to: a plain
+    gait, one asked slowly (``plain_gait``), or, with ``course``, the gait of a course ("jogs in a
+    circle": its gait is made straight, then bent onto the course, ``course_walk.py``) asked no
+    faster; None otherwise."""
+    gait = plain_gait(words, slow=True)
+    if gait is None and course and words is not None and words.course is not None and words.pace != "fast":
+        walked = words.course_gait
+        gait = walked[1] if walked and walked[1] in GAITS else None
+    return gait
+
+
+def typical_paced(motion, body, words, speeds: dict, ik_refine_iters: int = 10, course: bool = True):
     """``motion`` brought down to its plain gait's typical speed on its body (module doc); the
     motion itself when the words ask more than a plain gait (or a slow one: ``plain_gait``), the table
     lacks the gait, or it is no more than ``TOLERANCE`` above typical. A gait asked slowly is
     brought down here before ``slow_steps`` slows it: "jogs slowly" goes slower than "jogs" whichever
-    take or sample was chosen (a 2.5 m/s DeepMimic jog slowed by a fifth outran a plain jog)."""
+    take or sample was chosen (a 2.5 m/s DeepMimic jog slowed by a fifth outran a plain jog). So is
+    a course's gait, before it is bent onto the course (``paced_gait``; ``course`` False: not)."""
     from ..motion.root_speed import mean_speed
     from .stride_scale import scaled_strides
     from .track import Track, replanted, resample, track_of
 
-    gait = plain_gait(words, slow=True)
+    gait = paced_gait(words, course)
     if gait is None or gait not in speeds or motion.num_frames < 4 or motion.network_joints is None:
         return motion
     want = body_speed(speeds[gait], body, motion.betas)
