@@ -244,8 +244,8 @@ def test_a_course_asked_no_length_gets_the_time_to_go_once_round():
     ("a man walks slowly in a circle", 2 * np.pi),    # its length for the slowed pace
 ])
 def test_generation_goes_once_round_with_no_length_asked(text, turn):
-    """No length asked, the model's own (a retrieved 1.6 s clip) went a quarter round; the course's
-    time goes all the way round, a captured gait made straight and bent onto it."""
+    """No length asked: not the model's own (a retrieved 1.6 s clip goes a quarter round) but the
+    course's time, all the way round, a captured gait made straight and bent onto it."""
     from shapemove.core.generation.generate import Generator, Request
 
     gen = Generator(None)

@@ -37,8 +37,8 @@ circles and eights the model learnt them from turn, and decoded without their tu
 not travel (a wave, a sit, "rocks back and forth") is left as it is.
 
 With no length asked, a course is given the time to go once round at its gait's typical pace
-(``course_seconds``: a circle walked 5.8 s, jogged 4.5 s; a figure eight walked 11.7 s), where the
-model's own length (a retrieved 2.6 s walk) went a quarter of an eight.
+(``course_seconds``: a circle walked 5.8 s, jogged 4.5 s; a figure eight walked 11.7 s), not the
+model's own length (a retrieved 2.6 s walk goes a quarter of an eight).
 
     w = read_words("a woman walks around in a circle, waving")     # plan/words.py
     track = on_course(track, w.course, w.course_right)
