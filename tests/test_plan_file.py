@@ -120,3 +120,13 @@ def test_a_plan_of_any_shape_is_read_or_refused_in_a_sentence():
         except ShapeMoveError:
             refused += 1
     assert 200 < refused < 600   # many refused, many read
+
+
+def test_the_length_the_words_ask_is_the_motions(tmp_path, capsys):
+    """"for 3 seconds" makes a 3 s motion, said on the understood line; ``--seconds`` wins and says so."""
+    out = tmp_path / "m.npz"
+    assert main(["generate", "--prompt", "a person waves for 3 seconds", "--candidates", "1", "--out", str(out)]) == 0
+    assert "for 3 s" in capsys.readouterr().out and load_motion(out).num_frames == 60
+    assert main(["generate", "--prompt", "a person waves for 3 seconds", "--seconds", "2", "--candidates", "1",
+                 "--out", str(out)]) == 0
+    assert "--seconds 2 won over the 3 s" in capsys.readouterr().out and load_motion(out).num_frames == 40

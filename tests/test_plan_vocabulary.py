@@ -85,3 +85,41 @@ def test_the_typed_reading_is_what_the_generator_acts_on():
     assert read_words("someone turns around to the right").turn == pytest.approx(-3.14159, abs=1e-4)
     assert read_words("he jumps three times").count == ("jump", 3)
     assert read_words("a person jogs slowly").slow_flight and read_words("a person walks slowly").slow_steps
+
+
+@pytest.mark.parametrize("text, seconds", [
+    ("a person jogs for ten seconds", 10.0),
+    ("a man walks for 8 seconds", 8.0),
+    ("she runs for half a minute", 30.0),
+    ("he dances for about a minute", 60.0),
+    ("a 10-second jog forward", 10.0),
+    ("someone waves for 2.5 s", 2.5),
+    ("jumps for a few seconds", 3.0),
+    ("a woman runs for 2 minutes", 60.0),        # the most a motion lasts
+    ("a man walks for a while", None),           # no length
+    ("walks 10 m in 5 seconds", None),           # a pace, not a length
+    ("a man walks for 5 metres", None),
+])
+def test_the_length_the_words_ask(text, seconds):
+    w = read_words(text)
+    assert w.seconds == seconds
+    assert ("seconds" not in w.unused and "minute" not in w.unused) or seconds is None
+
+
+def test_the_words_length_sets_the_motion_and_its_segments():
+    """A single segment asks its length of the generator; in a sequence each segment that says one
+    is that long, the others ``SEGMENT_SECONDS``; a length given outright shares out as before, and
+    the option says it won."""
+    from shapemove.core.plan.option_conflicts import option_notes
+    from shapemove.core.plan.plan import plan_to_json
+    from shapemove.core.plan.segments import SEGMENT_SECONDS
+
+    one = read_plan("a person jogs for ten seconds")
+    assert plan_to_json(one)["segments"][0]["seconds"] == 10.0
+    two = read_plan("a man jogs for 6 seconds, then waves for 2 seconds, then bows")
+    assert two.lengths(None) == [6.0, 2.0, SEGMENT_SECONDS]
+    assert two.lengths(9.0) == [3.0, 3.0, 3.0]
+    assert option_notes("a man jogs for 6 seconds", seconds=4.0) == [
+        "--seconds 4 won over the 6 s the words ask (leave out --seconds for theirs)"]
+    assert option_notes("a man jogs for 6 seconds", seconds=6.0) == []
+    assert option_notes("a man jogs", seconds=4.0) == []

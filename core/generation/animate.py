@@ -99,5 +99,6 @@ def animate(gen, req, a: Animation, progress=None, cancel=None) -> Motion:
     motion.provenance = motion.provenance or keep[4]   # a captured take stays captured through the edits
     motion.plan = keep[5]
     if req.by_parts:   # the words an option overrides, said (plan/option_conflicts.py)
-        motion.notes += option_notes(req.prompt, loop=a.loop, in_place=a.in_place, path=a.path is not None)
+        motion.notes += option_notes(req.prompt, loop=a.loop, in_place=a.in_place, path=a.path is not None,
+                                     seconds=req.seconds)
     return motion

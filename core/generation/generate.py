@@ -552,11 +552,13 @@ class Generator:
             asked = dataclasses.replace(r, prompt=stop[0], seconds=r.seconds if r.seconds or not metres else
                                         min(DISTANCE_SECONDS, metres / DISTANCE_PACE + 1.0)) if stop else r
             asked = dataclasses.replace(asked, plan=None, words=None)
+            if asked.seconds is None and words is not None and words.seconds is not None:   # "for ten seconds"
+                asked = dataclasses.replace(asked, seconds=words.seconds)
             if asked.seconds is None and words is not None and words.course is not None:   # once round
                 asked = dataclasses.replace(asked, seconds=self.course_seconds(words))   # (course_walk.py)
             by_parts = words is not None and (words.parts is not None or words.side is not None or not edited)
             standing = words is not None and words.stand_still and self.rest_code is not None
-            motion = self.standing(r) if standing else \
+            motion = self.standing(dataclasses.replace(r, seconds=asked.seconds)) if standing else \
                 generate_by_parts(self, asked, words if edited else None, captured=stop is None) if by_parts else None
             came_from = motion.provenance if motion is not None else None   # kept through the edits below
             if motion is not None and stop is not None:

@@ -6,7 +6,8 @@ said as notes (``Motion.notes``, printed by the command line as ``note:`` lines)
   stops"), and over segments in order ("walks, then sits": the prompt is looped as one motion);
 - ``--path`` sets where the body goes: it wins over a course and a named turn;
 - ``--in-place`` removes the root's travel: it wins over a course's travel (its turning is kept)
-  and over a distance.
+  and over a distance;
+- ``--seconds`` sets the length: it wins over a length the words ask ("jogs for ten seconds").
 """
 from __future__ import annotations
 
@@ -18,12 +19,17 @@ def _course(reading: dict) -> str:
     return COURSE_NAMES.get(reading["course"], reading["course"])
 
 
-def option_notes(prompt: str, loop: bool = False, in_place: bool = False, path: bool = False) -> list[str]:
+def option_notes(prompt: str, loop: bool = False, in_place: bool = False, path: bool = False,
+                 seconds: float | None = None) -> list[str]:
     """One note per request of ``prompt`` that an option overrides (module doc); [] when none does."""
-    if not (loop or in_place or path):
+    if not (loop or in_place or path or seconds is not None):
         return []
     plan = read_plan(prompt)
     notes = []
+    said = [s.words.seconds for s in plan.segments if s.words.seconds is not None]
+    if seconds is not None and said and (plan.is_sequence or abs(said[0] - seconds) > 1e-6):
+        asked = " + ".join(f"{x:g} s" for x in said)
+        notes.append(f"--seconds {seconds:g} won over the {asked} the words ask (leave out --seconds for theirs)")
     if loop and plan.is_sequence:
         notes.append(f"--loop won over the order of {len(plan.segments)} motions: the prompt is looped as one motion "
                      "(leave out --loop for one after the other)")

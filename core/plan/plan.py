@@ -12,7 +12,8 @@ back, edited, and says which field is wrong when one is. In a segment's ``unders
 may change, add or remove: ``actions`` (the first is the segment's action: a new one replaces the
 action's words in the text the model reads), ``side`` ("left hand"), ``course`` and ``course_way``,
 ``turn_degrees``, ``travel``, ``in_place``, ``distance_m``, ``steps``, ``stop``, ``stand_still``,
-``count``, ``pace``; a segment's ``text`` and ``seconds`` too. A field left out asks nothing. The
+``count``, ``pace``, ``seconds`` (the length its words ask); a segment's ``text`` and ``seconds``
+(its length, which wins) too. A field left out asks nothing. The
 motion keeps the plan (``Motion.plan``), so a timeline re-decoded for a new body or a strip
 regenerated acts on its edited segments again (``generation/sequence.plan_readings``).
 """
@@ -51,13 +52,14 @@ class Plan:
         return len(self.segments) > 1
 
     def lengths(self, total: float | None) -> list[float]:
-        """Each segment's seconds of a motion ``total`` seconds long (None: ``SEGMENT_SECONDS`` each,
-        or the time a counted action's repetitions take, ``counted_seconds``); a segment's own
-        seconds win."""
+        """Each segment's seconds of a motion ``total`` seconds long (None: the length its words
+        ask, "for ten seconds", else ``SEGMENT_SECONDS``, or the time a counted action's repetitions
+        take, ``counted_seconds``); a segment's own seconds (an edited plan's) win."""
         if all(s.seconds is not None for s in self.segments):
             return [float(s.seconds) for s in self.segments]
-        if total is None:
-            return [float(s.seconds) if s.seconds is not None else counted_seconds(s.words) for s in self.segments]
+        if total is None:   # the words' own length ("for ten seconds"), else the model's
+            return [float(s.seconds) if s.seconds is not None else
+                    s.words.seconds if s.words.seconds is not None else counted_seconds(s.words) for s in self.segments]
         return [float(s.seconds) if s.seconds is not None else s.share * float(total) for s in self.segments]
 
 
@@ -81,7 +83,7 @@ def read_plan(prompt: str, seconds: float | None = None) -> Plan:
 def plan_to_json(plan: Plan) -> dict:
     """The plan as the JSON ``--explain`` prints (``explain.plan_json`` adds the option notes)."""
     lengths = plan.lengths(plan.seconds) if plan.is_sequence or plan.seconds is not None or \
-        plan.segments[0].seconds is not None else [None]
+        plan.segments[0].seconds is not None or plan.segments[0].words.seconds is not None else [None]
     return {"prompt": plan.prompt, "seconds": plan.seconds,
             "segments": [{"text": s.text, "share": round(s.share, 4),
                           "seconds": None if sec is None else round(sec, 3), "understood": s.words.understood()}
@@ -129,7 +131,7 @@ def _choice(value, where: str, options) -> str:
 
 
 UNDERSTOOD_KEYS = ("actions", "legs", "arms", "course", "course_way", "turn_degrees", "travel", "in_place",
-                   "distance_m", "steps", "stop", "stand_still", "count", "pace", "side", "unused")
+                   "distance_m", "steps", "stop", "stand_still", "count", "pace", "seconds", "side", "unused")
 
 
 def _swap_action(text: str, old: str | None, new: str) -> str:
@@ -224,12 +226,14 @@ def _edited_words(seg: dict, where: str, text: str) -> tuple[str, Words]:
                        "the segment names none")
         count = (countable[0], n)
     pace = None if said.get("pace") is None else _choice(said["pace"], f"{where}.understood.pace", ("fast", "slow"))
+    length = None if said.get("seconds") is None else _number(said["seconds"], f"{where}.understood.seconds",
+                                                              MIN_SEGMENT_SECONDS, MAX_SECONDS)
     gait_text = read.gait_text if read.stop else (text if stop else None)
     flight = pace == "slow" and any(a in ("jog", "run", "sprint") for a in (actions or read.actions))
     return text, replace(read, parts=parts, side=None if parts is not None else side, course=course,
                          course_right=way == "right", turn=turn, travel=replace(travel, in_place=in_place),
                          in_place=in_place, stop=stop, steps=steps, distance_m=metres, gait_text=gait_text,
-                         stand_still=stand and not stop, count=count, pace=pace, slow_flight=flight)
+                         stand_still=stand and not stop, count=count, pace=pace, slow_flight=flight, seconds=length)
 
 
 def plan_from_json(data, seconds: float | None = None) -> Plan:

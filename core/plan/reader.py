@@ -113,6 +113,21 @@ def asked_distance(text: str) -> float | None:
     return metres if 0 < metres <= V.MAX_METRES else None
 
 
+def asked_seconds(text: str) -> float | None:
+    """Seconds the words ask the motion to last ("for ten seconds", "for 2.5 s", "for half a minute",
+    "a 10-second jog"), brought within ``MIN_SECONDS`` .. ``MAX_SECONDS`` ("for two minutes": 60 s,
+    the most a motion lasts); None when they ask none."""
+    m = V.DURATION.search(str(text).lower())
+    if m is None:
+        return None
+    if m.group(5):   # "a 10-second jog"
+        n, unit = m.group(5), m.group(6)
+    else:
+        n, unit = ("0.5" if m.group(1) else m.group(2) or m.group(3)), m.group(4)
+    seconds = (float(n) if n[0].isdigit() else float(V.NUMBERS[n])) * V.TIME_UNITS[unit]
+    return float(min(max(seconds, V.MIN_SECONDS), V.MAX_SECONDS))
+
+
 def asks_stand_still(text: str) -> bool:
     """Whether a prompt only asks the body to stand still ("a person stands still", "she waits",
     "he pauses"): a still word and no action (a timeline's segment of standing)."""
@@ -253,7 +268,7 @@ def without_numbers(prompt: str) -> str:
 _TAKEN = (V.COUNT_TIMES, V.FAST, V.SLOW, V.STOP, V.STEPS, V.STEPS_ALONE, V.STILL, V.SPOKEN_DISTANCE, V.CLOCKWISE,
           V.COUNTER_CLOCKWISE, V.BACK_AND_FORTH, V.ZIGZAG, V.DIAGONAL, V.COURSE_WORDS, V.COURSE_WAY, V.TURN_WHOLE,
           V.TURN_HALF, V.TURN_QUARTER, V.FORWARD, V.BACKWARD, V.IN_PLACE, V.TRAVEL_SIDE, V.SIDEWAYS, V.SIDE,
-          V.DIRECTION, V.SUBJECT, V.TURN_TWICE, V.ARMS_HELD)
+          V.DIRECTION, V.SUBJECT, V.TURN_TWICE, V.ARMS_HELD, V.DURATION)
 
 
 def unused_words(text: str, body_words=(), idle=()) -> list[str]:

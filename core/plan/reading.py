@@ -5,8 +5,8 @@
 
 The dict is ``words.Words.understood`` of ``words.read_words``: the reading the generator acts on
 (the actions, two things at once, the course and its way round, a turn, the travel, a gait kept
-in place, a distance, counted steps and a stop, standing still, a count, a pace, a named side, and
-the words no class took). Readings that are absent are left out.
+in place, a distance, counted steps and a stop, standing still, a count, a pace, a length, a named
+side, and the words no class took). Readings that are absent are left out.
 """
 from __future__ import annotations
 
@@ -45,6 +45,8 @@ def said(reading: dict) -> str:
         bits.append(f"{reading['count']} times")
     if "pace" in reading:
         bits.append(reading["pace"])
+    if "seconds" in reading:
+        bits.append(f"for {reading['seconds']:g} s")
     if "side" in reading:
         bits.append(f"side: {reading['side']}")
     if reading.get("arms_held"):

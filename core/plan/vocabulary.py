@@ -68,6 +68,15 @@ MAX_METRES = 100.0
 MAX_STEPS = 20
 NUMBER = re.compile(r"\d+(?:[.,]\d+)?(?:\s*(?:[a-z]+\.?|'|\"))?")   # "10 m", "5 seconds": not a body's words
 
+# -- how long ("for ten seconds", "for 5 s", "for half a minute", "a 10-second jog") ----------------
+TIME_UNITS = {"second": 1.0, "seconds": 1.0, "sec": 1.0, "secs": 1.0, "s": 1.0,
+              "minute": 60.0, "minutes": 60.0, "min": 60.0, "mins": 60.0}
+_TIME_UNIT = "|".join(sorted(map(re.escape, TIME_UNITS), key=len, reverse=True))
+DURATION = re.compile(r"\bfor\s+(?:(?:about|around|roughly|some|nearly|almost|another|a\s+good)\s+)?"
+                      r"(?:(half)\s+a|(\d{1,3}(?:\.\d+)?)|(" + NUMBER_WORDS + r"))\s*(" + _TIME_UNIT + r")\b|"
+                      r"\b(\d{1,2}|" + QUANTITY + r")[-\s](second|minute)\b(?=\s+\w)", re.I)
+MIN_SECONDS, MAX_SECONDS = 0.4, 60.0   # a length said outside these is not one the generator makes
+
 # -- courses ----------------------------------------------------------------------------------
 CLOCKWISE = re.compile(r"(?<![-\w])(?:clockwise|to the right|rightward)\b")
 COUNTER_CLOCKWISE = re.compile(r"\b(?:counter|anti)[- ]?clockwise\b")
@@ -215,6 +224,9 @@ WORD_CLASSES = (
               "a person walks forward and stops", {"stop": True}),
     WordClass("stand still", "stands still, waits, pauses (and no action)", "the model's standing code",
               "a person stands still", {"stand_still": True}),
+    WordClass("length", "for ten seconds, for 5 s, for half a minute, a 10-second jog",
+              "the motion (or its segment of a sequence) is that long, unless a length is set", "a man jogs for 8 seconds",
+              {"seconds": 8.0}),
     WordClass("count", "once, twice, three times, five jumping jacks (jumps, hops, squats)",
               "the candidates whose count is nearest the asked one compete", "a man jumps twice", {"count": 2}),
     WordClass("pace", "quickly, briskly, fast / slowly, at a leisurely pace (with a gait)",
