@@ -130,3 +130,16 @@ def test_the_length_the_words_ask_is_the_motions(tmp_path, capsys):
     assert main(["generate", "--prompt", "a person waves for 3 seconds", "--seconds", "2", "--candidates", "1",
                  "--out", str(out)]) == 0
     assert "--seconds 2 won over the 3 s" in capsys.readouterr().out and load_motion(out).num_frames == 40
+
+
+def test_the_panel_shows_the_words_length_and_zero_gives_it_up():
+    from shapemove.core.plan.panel_fields import edited_plan, plan_fields
+    from shapemove.core.plan.plan import plan_from_json
+
+    plan = plan_json("a man jogs for 6 seconds, then waves")
+    fields = plan_fields(plan)
+    assert [f["seconds"] for f in fields] == [6.0, 3.0]
+    assert plan_from_json(edited_plan(plan, fields)).lengths(None) == [6.0, 3.0]
+    fields[0]["seconds"] = fields[1]["seconds"] = 0.0                 # both the segment's share again
+    back = plan_from_json(edited_plan(plan, fields))
+    assert back.segments[0].words.seconds is None and back.lengths(8.0) == [4.0, 4.0]

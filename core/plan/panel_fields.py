@@ -6,7 +6,7 @@
     edited_plan(plan, fields)   # the plan's JSON with the fields' values, for ``plan.plan_from_json``
 
 A field's empty value asks nothing: side "" (no side), course "", distance 0, count 0; seconds 0
-is the segment's share of the length. The other readings of a segment (its travel, a turn, a
+is the segment's share of the length (a length its words asked, "for ten seconds", included). The other readings of a segment (its travel, a turn, a
 pace, two things at once) are kept as the words gave them.
 """
 from __future__ import annotations
@@ -65,6 +65,8 @@ def edited_plan(plan: dict, fields: list[dict]) -> dict:
         else:
             said.pop("count", None)
         seg["seconds"] = float(f["seconds"]) if f["seconds"] > 0 else None
+        if f["seconds"] <= 0:   # the segment's share: the length its words asked goes too
+            said.pop("seconds", None)
     if all(seg["seconds"] is not None for seg in out["segments"]):
         out["seconds"] = round(sum(seg["seconds"] for seg in out["segments"]), 3)
     return out
