@@ -80,3 +80,15 @@ def test_a_plain_jog_plays_a_captured_jog_straight_and_on(openbody):
     d = c[-1] - c[0]
     across = np.abs(np.cross(d / np.linalg.norm(d), c - c[0]))
     assert np.linalg.norm(d) > 4.5 and across.max() < 0.3                    # 4 s of jog on a line
+
+
+def test_which_words_ask_a_gait_on_a_line():
+    from shapemove.core.generation.straight_gait import straight_asked
+    from shapemove.core.plan.words import read_words
+
+    for text in ("a man jogs", "someone trots along slowly", "a woman walks forward quickly", "he runs"):
+        assert straight_asked(read_words(text)), text
+    for text in ("she jogs in a circle", "a man jogs to the left", "he runs backwards", "she walks sideways",
+                 "a man jogs in place", "someone turns around", "a woman jogs while waving", "a man waves",
+                 "a man walks 3 metres and stops"):
+        assert not straight_asked(read_words(text)), text

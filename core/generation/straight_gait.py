@@ -19,8 +19,8 @@ What stays of the bend is where the feet land across the line and, for some take
 up to 12 degrees off it (the performer looked into the turn).
 
 Which prompts: one gait that goes on (``typical_pace.going_gait``: "jogs", "trots along slowly",
-"walks forward quickly"), with no course, turn, place or second thing asked (``straight_asked``);
-"jogs in a circle" keeps the takes' bends.
+"walks forward quickly"), with no course, turn, place, second thing or way other than forward asked
+(``straight_asked``); "jogs in a circle" or "jogs to the left" keeps the takes' bends.
 
     rotations, root = straightened(rotations, root, joints)   # (T,24,3,3), (T,3); joints (T,J,3)
 """
@@ -42,7 +42,8 @@ def straight_asked(words) -> bool:
     from .typical_pace import going_gait
 
     return (going_gait(words) is not None and words.course is None and words.turn is None
-            and not words.in_place and words.parts is None)
+            and not words.in_place and words.parts is None and words.travel.forward >= 0
+            and not words.travel.side and not words.travel.sideways)
 
 
 def straightened(rotations, root, joints) -> tuple[np.ndarray, np.ndarray]:
