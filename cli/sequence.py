@@ -13,7 +13,8 @@ from ..core.scene.motion_file import load_motion, save_motion
 
 def add_arguments(p):
     p.add_argument("--prompt", action="append", default=[], help="a segment's motion text (repeat, in order)")
-    p.add_argument("--seconds", action="append", type=float, default=[], help="that segment's length (one per --prompt)")
+    p.add_argument("--seconds", action="append", type=float, default=[],
+                   help="that segment's length (one per --prompt; none: each the length its words ask, else 3 s)")
     p.add_argument("--shape-text", default=None, help="body text for the whole timeline")
     p.add_argument("--betas", default=None, help="explicit body shape b0,...,b9")
     p.add_argument("--seed", type=int, default=0)
@@ -54,9 +55,14 @@ def run(args) -> int:
         if len(args.prompt) > 1 or len(args.seconds) > 1:
             raise ShapeMoveError("with --regenerate give at most one --prompt and one --seconds (the segment's new ones)")
     else:
-        if len(args.prompt) != len(args.seconds):
-            raise ShapeMoveError(f"give one --seconds per --prompt ({len(args.prompt)} prompts, {len(args.seconds)} lengths)")
-        segments = check_segments(list(zip(args.prompt, args.seconds)))
+        if args.seconds and len(args.prompt) != len(args.seconds):
+            raise ShapeMoveError(f"give one --seconds per --prompt, or none ({len(args.prompt)} prompts, "
+                                 f"{len(args.seconds)} lengths)")
+        from ..core.plan.plan import own_seconds
+        from ..core.plan.words import read_words
+
+        lengths = args.seconds or [own_seconds(read_words(str(p))) for p in args.prompt]   # "for ten seconds", else 3 s
+        segments = check_segments(list(zip(args.prompt, lengths)))
     ensure_parent(args.out)
     from ..core.generation.generate import parse_betas
     from ..core.generation.loaded_generator import loaded_generator

@@ -478,3 +478,15 @@ def test_worker_ops_animate_and_sequence(tmp_path, gen):
     assert reshaped["measurements"]["height_cm"] > again["measurements"]["height_cm"] + 3
     with pytest.raises(ShapeMoveError, match="segments"):
         jobs_animation.sequence({"segments": [{"prompt": "x"}], "out": str(tmp_path / "u.npz")}, lambda f, m: None, never)
+
+
+def test_a_sequence_without_lengths_takes_each_segments_own(tmp_path):
+    """No --seconds: each segment the length its words ask ("for 2 seconds"), else 3 s."""
+    from shapemove.cli import main
+    from shapemove.core.scene.motion_file import load_motion
+
+    out = tmp_path / "seq.npz"
+    assert main(["sequence", "--prompt", "a man waves for 2 seconds", "--prompt", "he bows", "--candidates", "1",
+                 "--out", str(out)]) == 0
+    m = load_motion(out)
+    assert [(int(b) - int(a)) / m.fps for a, b in m.segment_bounds] == pytest.approx([2.0, 3.0], abs=0.21)

@@ -58,9 +58,14 @@ class Plan:
         if all(s.seconds is not None for s in self.segments):
             return [float(s.seconds) for s in self.segments]
         if total is None:   # the words' own length ("for ten seconds"), else the model's
-            return [float(s.seconds) if s.seconds is not None else
-                    s.words.seconds if s.words.seconds is not None else counted_seconds(s.words) for s in self.segments]
+            return [float(s.seconds) if s.seconds is not None else own_seconds(s.words) for s in self.segments]
         return [float(s.seconds) if s.seconds is not None else s.share * float(total) for s in self.segments]
+
+
+def own_seconds(words: Words) -> float:
+    """A segment's seconds when no length is set: the length its words ask ("for ten seconds"),
+    else ``counted_seconds``."""
+    return float(words.seconds) if words.seconds is not None else counted_seconds(words)
 
 
 def counted_seconds(words: Words) -> float:
