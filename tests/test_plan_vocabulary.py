@@ -123,3 +123,4 @@ def test_the_words_length_sets_the_motion_and_its_segments():
         "--seconds 4 won over the 6 s the words ask (leave out --seconds for theirs)"]
     assert option_notes("a man jogs for 6 seconds", seconds=6.0) == []
     assert option_notes("a man jogs", seconds=4.0) == []
+    assert option_notes("a man jogs for 6 seconds", loop=True)[0].startswith("--loop won over the 6 s the words ask")

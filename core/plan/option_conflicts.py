@@ -7,7 +7,8 @@ said as notes (``Motion.notes``, printed by the command line as ``note:`` lines)
 - ``--path`` sets where the body goes: it wins over a course and a named turn;
 - ``--in-place`` removes the root's travel: it wins over a course's travel (its turning is kept)
   and over a distance;
-- ``--seconds`` sets the length: it wins over a length the words ask ("jogs for ten seconds").
+- ``--seconds`` sets the length: it wins over a length the words ask ("jogs for ten seconds"), and
+  so does ``--loop`` (one cycle).
 """
 from __future__ import annotations
 
@@ -27,8 +28,11 @@ def option_notes(prompt: str, loop: bool = False, in_place: bool = False, path: 
     plan = read_plan(prompt)
     notes = []
     said = [s.words.seconds for s in plan.segments if s.words.seconds is not None]
-    if seconds is not None and said and (plan.is_sequence or abs(said[0] - seconds) > 1e-6):
-        asked = " + ".join(f"{x:g} s" for x in said)
+    asked = " + ".join(f"{x:g} s" for x in said)
+    if loop and said:
+        notes.append(f"--loop won over the {asked} the words ask: a loop is one cycle, played for as long as the "
+                     "scene runs (leave out --loop for that length)")
+    elif seconds is not None and said and (plan.is_sequence or abs(said[0] - seconds) > 1e-6):
         notes.append(f"--seconds {seconds:g} won over the {asked} the words ask (leave out --seconds for theirs)")
     if loop and plan.is_sequence:
         notes.append(f"--loop won over the order of {len(plan.segments)} motions: the prompt is looped as one motion "
