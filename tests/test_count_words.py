@@ -27,12 +27,17 @@ from shapemove.core.plan.reader import asked_count
     ("a man walks twice around", None),    # no jump
     ("a man jumps over two boxes", None),  # two of something else
     ("a woman jumps 100 times", None),     # beyond MAX_COUNT
+    ("she kicks twice", 2),
+    ("a man does three kicks", 3),
+    ("he kicks three times with his left leg", 3),
+    ("someone kicks the ball twice", None),  # a ball's kick is not counted
 ])
 def test_the_words_that_count_jumps_and_squats(text, want):
     got = asked_count(text)
     assert (got and got[1]) == want
     if want is not None:
-        assert COUNTED[got[0]] == ("dips" if "squat" in text else "raises" if "jacks" in text else "flights")
+        assert COUNTED[got[0]] == ("dips" if "squat" in text else "raises" if "jacks" in text else
+                                   "kicks" if "kick" in text else "flights")
 
 
 def _features(heights) -> np.ndarray:
@@ -109,3 +114,25 @@ def test_the_default_model_jumps_and_squats_as_many_times_as_asked():
            for p, sec, count, _ in asks}
     right = sum(n == want for (p, _, _, want) in asks for n in got[p])
     assert right >= 8, got
+
+
+def test_kicks_are_one_ankle_high_while_the_other_stands():
+    """Each single front kick of the built-in library (HDM05 kickLFront1Reps, DeepMimic's kick)
+    counts one, its standing foot rising on its toes as it kicks; no squat, sidestep or jog take
+    counts any."""
+    from shapemove.core.generation.count_words import kick_spans
+    from shapemove.core.generation.generate import Generator
+
+    gen = Generator(None)
+    pool = gen.pool
+    counted = {}
+    for i, a in enumerate(pool.actions):
+        single = "1Reps" in pool.ids[i] and a == "kick" or pool.ids[i] == "deepmimic_kick"
+        if not single and a not in ("squat", "sidestep", "jog"):
+            continue
+        t = pool.take(i)
+        joints = pool.proc.pose_on(t["rotations"], t["root"], t["betas"], 1.0, t["contacts"])
+        n = len(kick_spans(pool.proc.features(joints, t["rotations"], t["contacts"])))
+        counted.setdefault("kick" if single else a, []).append(n)
+    assert len(counted["kick"]) >= 16 and set(counted["kick"]) == {1}
+    assert all(set(v) == {0} for k, v in counted.items() if k != "kick")

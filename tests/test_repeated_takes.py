@@ -82,6 +82,15 @@ def _squats(joints) -> int:
     return sum(1 for a, b in runs(_squatting(joints)) if b - a >= 3)
 
 
+def _kicking(joints) -> np.ndarray:
+    """One ankle half a metre over the other (a kick's), counted on the played joints."""
+    return np.abs(joints[:, 7, 1] - joints[:, 8, 1]) > 0.5
+
+
+def _kicks(joints) -> int:
+    return sum(1 for a, b in runs(_kicking(joints)) if b - a >= 3)
+
+
 def test_the_default_model_plays_captured_jumping_jacks_and_squats_as_many_times_as_asked():
     """The built-in library's jumping jacks (CMU 14: three jacks, then jogging, squats, side twists)
     and single HDM05 squats, counted on the played joints: "three jumping jacks" three jacks,
@@ -93,7 +102,8 @@ def test_the_default_model_plays_captured_jumping_jacks_and_squats_as_many_times
     gen = Generator(None)
     for prompt, count, inside, want in [("a woman does three jumping jacks", _raises, _hands_up, 3),
                                         ("a man does five squats", _squats, _squatting, 5),
-                                        ("someone squats twice", _squats, _squatting, 2)]:
+                                        ("someone squats twice", _squats, _squatting, 2),
+                                        ("a man does three kicks", _kicks, _kicking, 3)]:
         for seed in (0, 1):
             m = gen.generate_batch([Request(prompt, seed=seed)])[0]
             assert m.provenance.startswith("captured:"), (prompt, m.provenance)

@@ -1,9 +1,9 @@
-"""Do counted prompts do the thing that many times? Eight prompts that count jumps, hops, squats
-and jumping jacks, each generated on seeds 0-3 at a fixed length; every count is read on the
+"""Do counted prompts do the thing that many times? Ten prompts that count jumps, hops, squats,
+jumping jacks and kicks, each generated on seeds 0-3 at a fixed length; every count is read on the
 planted motion's joints, independently of ``core/generation/count_words.py`` (which reads
 features): a jump is 3+ frames with no foot contact in which the lowest foot joint clears 8 cm, a
 squat 3+ frames with the pelvis 20 cm under its standing height, a jumping jack 3+ frames with both
-wrists above the head.
+wrists above the head, a kick 3+ frames with one ankle 50 cm over the other.
 
     python tools/count_check.py [--model weights/default] [--seeds 4]
 """
@@ -16,7 +16,8 @@ import numpy as np
 ASKS = [("a man jumps forward twice", 4, "jumps", 2), ("someone does four jumps in place", 4, "jumps", 4),
         ("she hops once", 4, "jumps", 1), ("a man squats twice", 6, "squats", 2),
         ("a woman does four squats", 6, "squats", 4), ("a person does three squats", 6, "squats", 3),
-        ("a woman does three jumping jacks", 6, "jacks", 3), ("someone does five jumping jacks", 8, "jacks", 5)]
+        ("a woman does three jumping jacks", 6, "jacks", 3), ("someone does five jumping jacks", 8, "jacks", 5),
+        ("she kicks twice", 4, "kicks", 2), ("a man does three kicks", 6, "kicks", 3)]
 
 
 def _runs(mask) -> list[tuple[int, int]]:
@@ -33,6 +34,8 @@ def count(kind: str, motion) -> int:
         return sum(1 for a, b in _runs(air) if y[a:b].max() > y.min() + 0.08)
     if kind == "squats":
         return len(_runs(j[:, 0, 1] < np.percentile(j[:, 0, 1], 90) - 0.2))
+    if kind == "kicks":
+        return len(_runs(np.abs(j[:, 7, 1] - j[:, 8, 1]) > 0.5))
     return len(_runs(np.minimum(j[:, 20, 1], j[:, 21, 1]) > j[:, 15, 1]))
 
 

@@ -1,5 +1,5 @@
-"""How many times the words ask for a jump or a squat: "jumps twice", "a person jumps three
-times", "does five jumping jacks", "she hops once", "does three squats".
+"""How many times the words ask for a jump, a squat or a kick: "jumps twice", "a person jumps three
+times", "does five jumping jacks", "she hops once", "does three squats", "kicks twice".
 
 The T5 writes jumps and squats, but not how many: the default model gave "a man jumps forward
 twice" one, two or three jumps by seed, and the TMA that chooses among the candidates (``rerank``)
@@ -15,7 +15,10 @@ the same way for a generated candidate, a retrieved clip and a captured take (wh
   (a captured jumping jack lifts the feet 5-10 cm, under what a jump's flight clears, but every
   jack brings both hands over the head);
 - a dip (squats): a run of at least ``MIN_RUN`` frames with the root more than ``DIP`` under its
-  standing height (the clip's 90th percentile).
+  standing height (the clip's 90th percentile);
+- a kick: a run of at least ``MIN_RUN`` frames with one ankle more than ``KICK_LIFT`` above the
+  floor and the other under ``KICK_STANCE`` (each of the 16 single front kicks of the built-in
+  library counts one; a run, whose heels swing high, is not asked to kick).
 
     read_words("a man jumps forward twice").count   # ("jump forward", 2)  (plan/words.py)
     counter("jump forward")(features)               # flights of a (T, 263) candidate
@@ -29,10 +32,13 @@ from ..motion.contacts import runs
 from ..plan.vocabulary import COUNTED
 
 FOOT_JOINTS = (7, 8, 10, 11)   # ankles, toes
+ANKLES = (7, 8)
 WRISTS, HEAD = (20, 21), 15
 LIFT = 0.08                    # metres over the floor (the clip's 10th percentile of its lowest foot joint)
 DIP = 0.20                     # metres under the standing root height
 MIN_RUN = 3                    # frames (0.15 s)
+KICK_LIFT = 0.45               # metres: a kicking ankle over the floor (a captured front kick's: 0.9-1.4 m)
+KICK_STANCE = 0.30             # metres: the standing foot under this (it rises on its toes as the other kicks)
 
 
 def _spans(mask) -> list[tuple[int, int]]:
@@ -66,7 +72,20 @@ def dip_spans(features) -> list[tuple[int, int]]:
     return _spans(y < np.percentile(y, 90) - DIP)
 
 
-MEASURES = {"flights": flight_spans, "raises": raise_spans, "dips": dip_spans}   # ``plan/vocabulary.COUNTED``'s
+def kick_spans(features) -> list[tuple[int, int]]:
+    """[(start, end)) of the kicks of a (T, 263) feature clip: runs of at least ``MIN_RUN`` frames with
+    one ankle more than ``KICK_LIFT`` above the clip's floor while the other stays under
+    ``KICK_STANCE`` (a run's heels also swing high, but both feet are never down then for long)."""
+    f = np.asarray(features, dtype=np.float64)
+    feet = np.stack([_height(f, j) for j in FOOT_JOINTS], axis=1)
+    floor = np.percentile(feet.min(axis=1), 10)
+    left, right = _height(f, ANKLES[0]) - floor, _height(f, ANKLES[1]) - floor
+    spans = _spans((left > KICK_LIFT) & (right < KICK_STANCE)) + _spans((right > KICK_LIFT) & (left < KICK_STANCE))
+    return sorted(spans)
+
+
+MEASURES = {"flights": flight_spans, "raises": raise_spans, "dips": dip_spans,
+            "kicks": kick_spans}   # ``plan/vocabulary.COUNTED``'s
 
 
 def repetitions(action: str, features) -> list[tuple[int, int]]:

@@ -227,7 +227,7 @@ def _edited_words(seg: dict, where: str, text: str) -> tuple[str, Words]:
         n = _number(said["count"], f"{where}.understood.count", 1, MAX_COUNT, whole=True)
         countable = [a for a in (actions or read.actions) if a in COUNTED]
         if not countable:
-            raise _bad(f"{where}.understood.count", f"counts jumps, hops or squats ({', '.join(COUNTED)}); "
+            raise _bad(f"{where}.understood.count", f"counts jumps, hops, squats or kicks ({', '.join(COUNTED)}); "
                        "the segment names none")
         count = (countable[0], n)
     pace = None if said.get("pace") is None else _choice(said["pace"], f"{where}.understood.pace", ("fast", "slow"))

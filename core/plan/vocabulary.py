@@ -23,17 +23,18 @@ NUMBER_WORDS = "|".join(sorted(map(re.escape, NUMBERS), key=len, reverse=True))
 QUANTITY = "|".join(sorted(map(re.escape, set(NUMBERS) - {"a"}), key=len, reverse=True))
 
 # -- a count of a countable action ("jumps twice", "does three squats") ----------------------------
-COUNT_TIMES = re.compile(rf"\b(?:(once|twice|thrice)|({QUANTITY}|\d{{1,2}})\s+(?:times\b|(?:\w+\s+)?(?:jump|hop|leap|squat)\w*))",
+COUNT_TIMES = re.compile(rf"\b(?:(once|twice|thrice)|({QUANTITY}|\d{{1,2}})\s+(?:times\b|(?:\w+\s+)?(?:jump|hop|leap|squat|kick)\w*))",
                          re.I)
 # the countable actions and what counts them (``generation/count_words.MEASURES``)
 COUNTED = {"jump": "flights", "jump forward": "flights", "spin jump": "flights", "hop": "flights",
-           "jumping jacks": "raises", "squat": "dips"}
+           "jumping jacks": "raises", "squat": "dips", "kick": "kicks"}
 MAX_COUNT = 12
 # seconds a repetition takes: the median start-to-start of repetitions in a row in the built-in
-# library's takes (jumping jacks, jumps, jumps forward; 2026-11-29), a lone squat take's length; a
-# spin jump as a jump forward, a hop as a jump (no take repeats them)
+# library's takes (jumping jacks, jumps, jumps forward; 2026-11-29), a lone squat take's length, a
+# lone front kick's busy stretch (HDM05); a spin jump as a jump forward, a hop as a jump (no take
+# repeats them)
 REPETITION_SECONDS = {"jump": 0.7, "jump forward": 1.7, "spin jump": 1.7, "hop": 0.7, "jumping jacks": 1.1,
-                      "squat": 1.4}
+                      "squat": 1.4, "kick": 1.5}
 
 # -- pace -------------------------------------------------------------------------------------
 FAST = re.compile(r"\b(quick(?:ly)?|fast(?:er)?|brisk(?:ly)?|rapid(?:ly)?|swift(?:ly)?|hurried(?:ly)?|hurr(?:y|ies|ying)|"
@@ -227,7 +228,7 @@ WORD_CLASSES = (
     WordClass("length", "for ten seconds, for 5 s, for half a minute, a 10-second jog",
               "the motion (or its segment of a sequence) is that long, unless a length is set", "a man jogs for 8 seconds",
               {"seconds": 8.0}),
-    WordClass("count", "once, twice, three times, five jumping jacks (jumps, hops, squats)",
+    WordClass("count", "once, twice, three times, five jumping jacks (jumps, hops, squats, kicks)",
               "the candidates whose count is nearest the asked one compete", "a man jumps twice", {"count": 2}),
     WordClass("pace", "quickly, briskly, fast / slowly, at a leisurely pace (with a gait)",
               "fast: the fastest third of the candidates; slow: played slower or shorter strides",
