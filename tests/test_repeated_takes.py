@@ -125,3 +125,11 @@ def test_every_repetition_asked_plays_when_the_length_is_the_models():
     short = gen.generate_batch([Request("a man does 12 squats", seed=0, seconds=6)])[0]
     assert len(short.joints) == 120 and _squats(short.joints) < 12
     assert any("the repetitions asked take" in n and "hold fewer" in n for n in short.notes)
+
+
+def test_a_kick_is_cut_to_its_repetitions_only_when_a_number_is_asked():
+    from shapemove.core.generation.repeated_takes import cut_for
+
+    assert cut_for("kick", 2) and not cut_for("kick", None)          # "a man kicks": the take's busiest window
+    assert cut_for("squat", None) and cut_for("jumping jacks", 3)     # done over and over: its bout
+    assert not cut_for("walk", 2) and not cut_for("punch", 3)         # not counted

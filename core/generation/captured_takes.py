@@ -45,9 +45,8 @@ from ..constants import FPS
 from ..errors import ShapeMoveError
 from ..scene.motion_file import Motion
 from ..data.actions import REPEATED
-from ..plan.vocabulary import COUNTED
 from .posture_change import POSTURE
-from .repeated_takes import repeated_stretch
+from .repeated_takes import cut_for, repeated_stretch
 from .straight_gait import STRAIGHTENED, straightened
 from .take_loop import looped_gait, looped_repetition, looped_take
 
@@ -220,7 +219,7 @@ class TakePool:
 
         t = self.take(i)
         rot, root, con, exact = t["rotations"], t["root"], t["contacts"], False
-        if self.actions[i] in COUNTED:
+        if cut_for(self.actions[i], times):
             def posed(r, rt, c):
                 j = self.proc.pose_on(r, rt, t["betas"], 1.0, c)
                 return j, self.proc.features(j, r, c)

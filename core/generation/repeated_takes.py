@@ -16,7 +16,8 @@ counts them in any candidate (``count_words.repetitions``):
   and is measured and cut again. The caller then holds its last pose for the rest of the window;
   a take that cannot give the number plays its bout as it is, and the candidates' counts decide
   (``rerank``);
-- asked no number, the bout plays as any take does (the busiest window, a loop, a hold).
+- asked no number, the bout plays as any take does (the busiest window, a loop, a hold); a kick,
+  done once by its nature, is not cut then (``WHEN_ASKED``): its take plays as any other.
 
     rot, root, con, exact = repeated_stretch(rot, root, con, posed, "jumping jacks", 3, seed=0)
     # posed(rot, root, con) -> ((T, J, 3) joints, (T - 1, 263) features) on the performer's body
@@ -30,6 +31,16 @@ from .count_words import repetitions
 
 BOUT_GAP = 2.0   # s: repetitions further apart than this are different bouts
 LONE_PAD = 1.0   # s kept on either side of a lone repetition
+WHEN_ASKED = ("kick",)   # done once by its nature: cut to its repetitions only when a number is asked
+
+
+def cut_for(action: str, times: int | None) -> bool:
+    """Whether a take of ``action`` is cut to its repetitions: a counted action
+    (``plan/vocabulary.COUNTED``), and for one done once by its nature (a kick: its take's busiest
+    window plays otherwise) only when a number is asked."""
+    from ..plan.vocabulary import COUNTED
+
+    return action in COUNTED and (times is not None or action not in WHEN_ASKED)
 
 
 def bouts(spans, gap: int) -> list[list[tuple[int, int]]]:
