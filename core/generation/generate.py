@@ -573,11 +573,12 @@ class Generator:
                 sampled = asked if course is None else dataclasses.replace(asked, prompt=read_words(asked.prompt).straight_text)
                 sampled = dataclasses.replace(sampled, words=words) if edited else sampled
                 # samples and captured takes, one choice (captured_takes.py); a stop or a distance is cut
-                # in the codes (stop_words.py), a course is a plain gait bent and a turn is given back to
-                # the decoded motion, so those are asked of the samples alone
+                # in the codes (stop_words.py) and a turn is given back to the decoded motion, so those are
+                # asked of the samples alone; a course bends a plain gait, a captured one made straight
+                # (straight_gait.py) as read from the straight words (an edited plan's course: samples alone)
                 turn = words.turn if words is not None else None   # turn_words.py: given back after
-                choice = self.choose(sampled, captured=stop is None and turn is None, reach=metres,
-                                     body_of=r)
+                captured = stop is None and turn is None and (course is None or not edited)
+                choice = self.choose(sampled, captured=captured, reach=metres, body_of=r)
                 betas, source = choice.body, choice.body_source
                 motion = self.chosen_motion(choice, betas, r.prompt)
                 came_from = motion.provenance

@@ -132,7 +132,7 @@ def typical_paced(motion, body, words, speeds: dict, ik_refine_iters: int = 10, 
     motion itself when the words ask more than a plain gait (or a slow one: ``plain_gait``), the table
     lacks the gait, or it is no more than ``TOLERANCE`` above typical. A gait asked slowly is
     brought down here before ``slow_steps`` slows it: "jogs slowly" goes slower than "jogs" whichever
-    take or sample was chosen (a 2.5 m/s DeepMimic jog slowed by a fifth outran a plain jog). So is
+    take or sample was chosen (a 2.5 m/s DeepMimic jog slowed by a fifth would outrun a plain jog). So is
     a course's gait, before it is bent onto the course (``paced_gait``; ``course`` False: not)."""
     from ..motion.root_speed import mean_speed
     from .stride_scale import scaled_strides
