@@ -48,6 +48,7 @@ TRAVELS = 0.2          # m/s: a repetition whose root goes on faster than this t
 REPEAT = 0.5           # a neighbouring cycle's pose difference against the cycle's own spread
 CONTACT_SLACK = 2      # frames a measured touch-down may be off by (a stride's end is sought this near)
 UNDER_WAY = 0.85       # a gait's take plays from the first touch-down going this share of its last stride's pace
+FEET = ((0, 2), (1, 3))   # the contacts' columns of each foot: (ankle, toe), left then right
 
 
 def looped_take(rotations, root, contacts, joints, frames: int):
@@ -166,8 +167,7 @@ def _under_way(root, contacts, a: int, b: int) -> int:
     r = np.asarray(root, np.float64)[:, [0, 2]]
     period = b - a
     pace = np.linalg.norm(r[b] - r[a]) / period
-    c = np.asarray(contacts) > 0
-    down = np.concatenate([np.flatnonzero(c[1:, f].any(1) & ~c[:-1, f].any(1)) + 1 for f in ((0, 2), (1, 3))])
+    down = np.concatenate([touch_downs(contacts, foot) for foot in FEET])
     for s in sorted(set(down.tolist()) | {0}):
         if s >= a or np.linalg.norm(r[s + period] - r[s]) >= UNDER_WAY * pace * period:
             return min(s, a)
@@ -178,14 +178,19 @@ def last_stride(contacts) -> tuple[int, int] | None:
     """(a, b): the latest stride of the ``contacts`` (T,4) (columns: left ankle, right ankle, left
     toe, right toe): a foot touching down at a and again at b, at least ``SHORTEST_CYCLE`` s later;
     b < T, so frame b shows the next stride's first pose. None when no foot touches down twice."""
-    c = np.asarray(contacts) > 0
     best = None
-    for foot in ((0, 2), (1, 3)):
-        down = c[:, foot].any(1)
-        onsets = np.flatnonzero(down[1:] & ~down[:-1]) + 1
+    for foot in FEET:
+        onsets = touch_downs(contacts, foot)
         for a, b in zip(onsets[::-1][1:], onsets[::-1]):
             if b - a >= SHORTEST_CYCLE * FPS:
                 if best is None or b > best[1]:
                     best = (int(a), int(b))
                 break
     return best
+
+
+def touch_downs(contacts, foot) -> np.ndarray:
+    """Frames where ``foot`` (its columns of the (T,4) contacts: ``FEET``) touches down: a heel or toe
+    down after neither was."""
+    down = (np.asarray(contacts) > 0)[:, list(foot)].any(1)
+    return np.flatnonzero(down[1:] & ~down[:-1]) + 1
