@@ -44,6 +44,7 @@ def run(args) -> int:
     check_sampling(args.seed, args.temperature, args.top_k)
     candidates = check_candidates(DEFAULT_CANDIDATES if args.candidates is None else args.candidates)
     guidance = check_guidance(args.guidance)
+    overridden = []   # (prompt, the seconds its words ask, the --seconds that won)
     if args.regenerate is not None:
         if args.motion is None:
             raise ShapeMoveError("--regenerate needs --motion (the timeline to change)")
@@ -63,6 +64,8 @@ def run(args) -> int:
 
         lengths = args.seconds or [own_seconds(read_words(str(p))) for p in args.prompt]   # "for ten seconds", else 3 s
         segments = check_segments(list(zip(args.prompt, lengths)))
+        overridden = [(p, read_words(str(p)).seconds, sec) for p, sec in zip(args.prompt, args.seconds)
+                      if read_words(str(p)).seconds not in (None, sec)]
     ensure_parent(args.out)
     from ..core.generation.generate import parse_betas
     from ..core.generation.loaded_generator import loaded_generator
@@ -95,6 +98,8 @@ def run(args) -> int:
 
     for w in motion.warnings:
         print(f"warning: {w}", file=sys.stderr)
+    for p, said, sec in overridden:
+        print(f"note: --seconds {sec:g} won over the {said:g} s {p!r} asks (leave out --seconds for its words' lengths)")
     print(f"wrote {args.out}: {motion.num_frames} frames ({motion.num_frames / motion.fps:.1f} s), "
           f"{len(motion.segment_bounds)} segments, IK error {motion.ik_error_cm:.2f} cm")
     n = len(motion.segment_bounds)

@@ -480,8 +480,9 @@ def test_worker_ops_animate_and_sequence(tmp_path, gen):
         jobs_animation.sequence({"segments": [{"prompt": "x"}], "out": str(tmp_path / "u.npz")}, lambda f, m: None, never)
 
 
-def test_a_sequence_without_lengths_takes_each_segments_own(tmp_path):
-    """No --seconds: each segment the length its words ask ("for 2 seconds"), else 3 s."""
+def test_a_sequence_without_lengths_takes_each_segments_own(tmp_path, capsys):
+    """No --seconds: each segment the length its words ask ("for 2 seconds"), else 3 s; with them,
+    the option wins and says so."""
     from shapemove.cli import main
     from shapemove.core.scene.motion_file import load_motion
 
@@ -490,3 +491,6 @@ def test_a_sequence_without_lengths_takes_each_segments_own(tmp_path):
                  "--out", str(out)]) == 0
     m = load_motion(out)
     assert [(int(b) - int(a)) / m.fps for a, b in m.segment_bounds] == pytest.approx([2.0, 3.0], abs=0.21)
+    assert main(["sequence", "--prompt", "a man waves for 2 seconds", "--seconds", "1", "--prompt", "he bows",
+                 "--seconds", "1", "--candidates", "1", "--out", str(out)]) == 0
+    assert "--seconds 1 won over the 2 s 'a man waves for 2 seconds' asks" in capsys.readouterr().out
