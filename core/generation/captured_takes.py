@@ -45,7 +45,7 @@ from ..constants import FPS
 from ..errors import ShapeMoveError
 from ..scene.motion_file import Motion
 from ..data.actions import REPEATED
-from .posture_change import POSTURE
+from ..plan.vocabulary import POSTURE_CHANGES
 from .repeated_takes import cut_for, repeated_stretch
 from .straight_gait import STRAIGHTENED, straightened
 from .take_loop import looped_gait, looped_repetition, looped_take
@@ -212,7 +212,7 @@ class TakePool:
         ``longest`` frames. ``side``: ("left" | "right", "hand" | "foot") mirrors a take whose
         other side moves most. A take of a counted action plays its repetitions, ``times`` of them
         when asked (``repeated_takes.py``), all of them when the length is the model's, however long;
-        a take of a change of posture (``posture_change.POSTURE``: getting up, lying down) is cut to
+        a take of a change of posture (``plan/vocabulary.POSTURE_CHANGES``: getting up, lying down) is cut to
         its end. ``straight``: a take of a plain gait is played off its bend (``straight_gait.py``)
         and, shorter than asked, loops on its last stride (``take_loop.looped_gait``)."""
         from .part_compose import needs_mirror
@@ -232,7 +232,7 @@ class TakePool:
         if n <= want:
             lo = 0
         else:   # a change of posture ends where the take does (up, or lying): its busiest stretch may not
-            lo = n - want if self.actions[i] in POSTURE else busiest_start(rot, want, seed)
+            lo = n - want if self.actions[i] in POSTURE_CHANGES else busiest_start(rot, want, seed)
         rot, root, con = (np.asarray(a[lo:lo + want]) for a in (rot, root, con))
         gait = straight and self.actions[i] in STRAIGHTENED
         if gait:

@@ -174,7 +174,7 @@ LEADING_BEFORE_AFTER = re.compile(r"^\s*(before|after)\s+(?:" + _CLAUSE_AHEAD + 
 FIRST = re.compile(r"\b(?:first(?:ly)?|at first|initially|to begin with|to start with)\b\s*,?\s*")
 # "and" that orders: a change of posture on one side ("stands up and runs", "walks over and sits down");
 # any other "and" joins two things at once or one action ("jumps and twirls": a spin jump)
-POSTURE_CHANGES = frozenset({"get up", "lie down", "sit"})
+POSTURE_CHANGES = {"get up": 1.0, "lie down": -1.0, "sit": -1.0}   # the changes of posture: the way the root goes (up, down)
 RISEN_FROM = frozenset({"squat", "bend over", "pick up", "put down"})   # "squats, then stands up": the squat's own end
 AND = re.compile(r"\s*,?\s*\band\s+")
 PARTICIPLE = re.compile(r"^(?!(?:spring|bring|swing|sing|string|ring|thing|sling|sting|wing|cling|fling)\b)[a-z'-]{2,}ing\b")
