@@ -62,10 +62,11 @@ def run(args) -> int:
         from ..core.plan.plan import own_seconds
         from ..core.plan.words import read_words
 
-        lengths = args.seconds or [own_seconds(read_words(str(p))) for p in args.prompt]   # "for ten seconds", else 3 s
+        readings = [read_words(str(p)) for p in args.prompt]
+        lengths = args.seconds or [own_seconds(w) for w in readings]   # "for ten seconds", else 3 s
         segments = check_segments(list(zip(args.prompt, lengths)))
-        overridden = [(p, read_words(str(p)).seconds, sec) for p, sec in zip(args.prompt, args.seconds)
-                      if read_words(str(p)).seconds not in (None, sec)]
+        overridden = [(p, w.seconds, sec) for p, w, sec in zip(args.prompt, readings, args.seconds)
+                      if w.seconds not in (None, sec)]
     ensure_parent(args.out)
     from ..core.generation.generate import parse_betas
     from ..core.generation.loaded_generator import loaded_generator

@@ -18,9 +18,9 @@ line:
 What stays of the bend is where the feet land across the line and, for some takes, a body facing
 up to 12 degrees off it (the performer looked into the turn).
 
-Which prompts: one gait that goes on (``typical_pace.going_gait``: "jogs", "trots along slowly",
-"walks forward quickly"), with no course, turn, place, second thing or way other than forward asked
-(``straight_asked``); "jogs in a circle" or "jogs to the left" keeps the takes' bends.
+Which prompts: one gait that goes on along a line (``typical_pace.lined_gait``: "jogs", "trots
+along slowly", "walks forward quickly"; no course, turn, place, second thing or way other than
+forward asked; ``straight_asked``); "jogs in a circle" or "jogs to the left" keeps the takes' bends.
 
     rotations, root = straightened(rotations, root, joints)   # (T,24,3,3), (T,3); joints (T,J,3)
 """
@@ -29,7 +29,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..geometry.rotations import axis_angle_to_matrix, yaw_matrix
-from ..motion.skeleton_ops import facing_directions, gaussian_smooth, heading_angles
+from ..motion.skeleton_ops import facing_directions, gaussian_smooth, heading_angles, smooth_directions
 from .track import HEADING_SIGMA
 
 STRAIGHTENED = ("walk", "jog", "run")   # the plain gaits whose takes are played off their bends
@@ -38,12 +38,11 @@ NECK, FEET = 12, (7, 8, 10, 11)         # the lean: the neck over the ankles' an
 
 
 def straight_asked(words) -> bool:
-    """Whether the words (``plan.words.Words``) ask one gait going on along a line (module doc)."""
-    from .typical_pace import going_gait
+    """Whether the words (``plan.words.Words``) ask one gait going on along a line (module doc;
+    ``typical_pace.lined_gait``)."""
+    from .typical_pace import lined_gait
 
-    return (going_gait(words) is not None and words.course is None and words.turn is None
-            and not words.in_place and words.parts is None and words.travel.forward >= 0
-            and not words.travel.side and not words.travel.sideways)
+    return lined_gait(words) is not None
 
 
 def straightened(rotations, root, joints) -> tuple[np.ndarray, np.ndarray]:
@@ -95,5 +94,4 @@ def lean(joints, facing=None) -> np.ndarray:
 
 def _facing(J) -> np.ndarray:
     """(T,3) unit horizontal facing directions, the step's hip swing smoothed away."""
-    f = gaussian_smooth(facing_directions(J), HEADING_SIGMA)
-    return f / np.maximum(np.linalg.norm(f, axis=1, keepdims=True), 1e-9)
+    return smooth_directions(facing_directions(J), HEADING_SIGMA)

@@ -37,6 +37,7 @@ import numpy as np
 
 from ..constants import FPS
 from ..errors import ShapeMoveError
+from ..motion.contacts import runs
 
 SHORTEST_CYCLE = 0.5   # s
 MOST_OF_TAKE = 0.45    # the longest cycle, as a share of the take
@@ -193,4 +194,4 @@ def touch_downs(contacts, foot) -> np.ndarray:
     """Frames where ``foot`` (its columns of the (T,4) contacts: ``FEET``) touches down: a heel or toe
     down after neither was."""
     down = (np.asarray(contacts) > 0)[:, list(foot)].any(1)
-    return np.flatnonzero(down[1:] & ~down[:-1]) + 1
+    return np.array([a for a, _ in runs(down) if a > 0], dtype=np.int64)

@@ -78,11 +78,20 @@ def plain_gait(words, slow: bool = False) -> str | None:
     """The one gait of ``GAITS`` the words (``plan.words.Words``) name when they ask nothing else of
     it (module doc); None otherwise. ``slow``: a slow pace asked of it counts as plain (a slow gait
     is slowed from its typical speed, not from a brisk one's)."""
+    gait = lined_gait(words)
+    if gait is None:
+        return None
+    asked = (None if slow and words.pace == "slow" else words.pace, words.count, words.side)
+    return None if any(a not in (None, False) for a in asked) else gait
+
+
+def lined_gait(words) -> str | None:
+    """The one gait of ``GAITS`` the words ask to go on along a line (``going_gait``, with no course,
+    turn, place, second thing or way other than forward asked), at any pace; None otherwise."""
     gait = going_gait(words)   # one gait, no stop, steps, distance or standing
     if gait is None:
         return None
-    asked = (None if slow and words.pace == "slow" else words.pace, words.course, words.turn, words.count, words.parts, words.side)
-    if any(a not in (None, False) for a in asked) or words.in_place:
+    if any(a not in (None, False) for a in (words.course, words.turn, words.parts)) or words.in_place:
         return None
     if words.travel.forward < 0 or words.travel.side or words.travel.sideways:
         return None
