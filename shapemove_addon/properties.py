@@ -88,7 +88,8 @@ _SIDES = [("NONE", "No side", "No side named"), ("left hand", "Left hand", ""), 
           ("left foot", "Left foot", ""), ("right foot", "Right foot", "")]
 _COURSES = [("NONE", "No course", "Straight, as the words go"), ("walk in a circle", "Circle", ""),
             ("walk in a figure eight", "Figure eight", ""), ("back and forth", "Back and forth", ""),
-            ("zigzag", "Zigzag", ""), ("diagonal", "Diagonal", "")]
+            ("zigzag", "Zigzag", ""), ("diagonal", "Diagonal", ""),
+            ("aside", "To the side", "")]
 
 
 class ShapeMovePlanSegment(bpy.types.PropertyGroup):

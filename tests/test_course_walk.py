@@ -3,7 +3,7 @@ forth, a zigzag, walked by a straight track the named way; a motion that does no
 import numpy as np
 import pytest
 
-from shapemove.core.generation.course_walk import (BACK_AND_FORTH, CIRCLE, DIAGONAL, EIGHT, MAX_RADIUS, MIN_RADIUS, U_RADIUS,
+from shapemove.core.generation.course_walk import (ASIDE, BACK_AND_FORTH, CIRCLE, DIAGONAL, EIGHT, MAX_RADIUS, MIN_RADIUS, U_RADIUS,
                                                    ZIG, ZIG_ANGLE, ZIGZAG, course_line, course_turn, radius_for)
 from shapemove.core.generation.course_walk import on_course as _on_course
 from shapemove.core.plan.reader import course_named, straight_gait, turns_right
@@ -131,6 +131,11 @@ def test_generation_walks_the_circle_the_prompt_asks_for():
     ("a woman walks diagonally to the right", DIAGONAL, ("a woman walks", "walk")),
     ("someone runs off at an angle", DIAGONAL, ("someone runs off", "run")),
     ("the dancer moves diagonally", None, None),                     # no gait
+    ("a man runs to the left", ASIDE, ("a man runs", "run")),        # a gait to one side: turns that way
+    ("she jogs off to her right", ASIDE, ("she jogs off", "jog")),
+    ("he steps to the left", None, None),                            # a step aside is a sidestep
+    ("a woman sidesteps to the right", None, None),
+    ("a man turns to the left", None, None),                         # a turn, no gait
 ])
 def test_the_words_name_the_course_and_the_gait_walked_straight(text, course, straight):
     assert course_named(text) == course and straight_gait(text) == straight
@@ -181,6 +186,22 @@ def test_the_diagonal_turns_to_45_degrees_and_keeps_it():
     d = line.point([5.0])[0] - line.point([1.0])[0]
     assert d == pytest.approx(4.0 * np.array([-1.0, 1.0]) / np.sqrt(2), abs=0.01)
     assert course_turn(np.zeros(11), np.linspace(0, 5.0, 11), DIAGONAL, False)[-1] == pytest.approx(np.pi / 4)
+
+
+def test_a_gait_to_one_side_turns_a_quarter_and_goes_on_that_way():
+    """Hand-derived: "runs to the left" heads +90 degrees (+X, the body's left) once past its first
+    ASIDE_EASE (1.2) m and goes straight on; to the right -90 degrees; "she jogs off to her right" is
+    the right. In a timeline each segment turns a quarter from the way the last left it."""
+    from shapemove.core.plan.words import read_words
+
+    left, right = course_line(6.0, ASIDE, right=False), course_line(6.0, ASIDE, right=True)
+    assert left.heading([0.0])[0] == pytest.approx(0.0, abs=0.1)
+    assert left.heading([1.5, 4.0, 6.0]) == pytest.approx([np.pi / 2] * 3, abs=0.01)
+    assert right.heading([1.5, 6.0]) == pytest.approx([-np.pi / 2] * 2, abs=0.01)
+    d = left.point([6.0])[0] - left.point([2.0])[0]
+    assert d == pytest.approx([4.0, 0.0], abs=0.01)
+    assert course_turn(np.zeros(11), np.linspace(0, 5.0, 11), ASIDE, True)[-1] == pytest.approx(-np.pi / 2)
+    assert read_words("she jogs off to her right").course_right and not read_words("a man runs to the left").course_right
 
 
 def test_a_timeline_segment_turns_whole_periods_of_its_course():

@@ -29,6 +29,9 @@ the next segment goes on the way the course leaves it. Left first unless the wor
 - ``DIAGONAL`` ("walks diagonally to the right", "runs off at an angle"): ``DIAGONAL_ANGLE`` to the
   named side (left unless it says right), turned to over the first ``DIAGONAL_EASE`` metres; in a
   timeline the segments after it go on that way.
+- ``ASIDE`` ("runs to the left", "jogs off to her right"): a quarter turn to the named side over the
+  first ``ASIDE_EASE`` metres, then on that way; each "to the left / right" turns from the way the
+  walker goes ("runs to the left, then to the right": left, then on as at the start).
 
 The gait is generated without the course's words when the rest still names one ("a person walks in
 a figure eight" -> "a person walks"; "paces", "zigzags" -> "walks"; ``plan.reader.straight_gait``): the captured
@@ -51,8 +54,8 @@ from typing import Callable
 import numpy as np
 
 from ..constants import FPS
-from ..plan.vocabulary import (BACK_AND_FORTH_COURSE as BACK_AND_FORTH, CIRCLE, COURSE_ACTIONS as ACTIONS,
-                               DIAGONAL_COURSE as DIAGONAL, EIGHT, ZIGZAG_COURSE as ZIGZAG)
+from ..plan.vocabulary import (ASIDE_COURSE as ASIDE, BACK_AND_FORTH_COURSE as BACK_AND_FORTH, CIRCLE,
+                               COURSE_ACTIONS as ACTIONS, DIAGONAL_COURSE as DIAGONAL, EIGHT, ZIGZAG_COURSE as ZIGZAG)
 from .polyline import MIN_SPEED, Polyline, follow_track
 from .track import Track, motion_speed, travel
 
@@ -61,6 +64,7 @@ U_RADIUS = 0.3                      # m: back and forth's U-turns
 LEG_MIN, LEG_MAX = 1.0, 5.0         # m: back and forth's legs
 ZIG, ZIG_ANGLE, ZIG_TURN = 1.5, np.pi / 4, 0.15   # m, radians, share of a leg
 DIAGONAL_ANGLE, DIAGONAL_EASE = np.pi / 4, 0.6   # radians, m
+ASIDE_ANGLE, ASIDE_EASE = np.pi / 2, 1.2         # radians, m
 STEP = 0.005                        # m: a course's heading integrated at this step
 UNASKED_PACE = 0.9                  # no length asked: once round at this share of the gait's typical pace
 UNASKED_LEAST, UNASKED_MOST = 4.0, 12.0   # s: and within these
@@ -103,10 +107,10 @@ def _zigzag(u, period):
     return ZIG_ANGLE * (_ease(u / (w / 2)) - 2 * _ease((u - 0.5 + w / 2) / w) + _ease((u - 1 + w / 2) / (w / 2)))
 
 
-def _diagonal(u, period):
-    """DIAGONAL_ANGLE, turned to over the first DIAGONAL_EASE metres; the period is longer than
-    any motion (``COURSES``), so it never starts again."""
-    return DIAGONAL_ANGLE * _ease(u * period / DIAGONAL_EASE)
+def _veer(angle: float, ease: float) -> Callable:
+    """A heading profile that turns to ``angle`` over the first ``ease`` metres and keeps it; its
+    period is longer than any motion (``COURSES``), so it never starts again."""
+    return lambda u, period: angle * _ease(u * period / ease)
 
 
 @dataclass(frozen=True)
@@ -129,7 +133,8 @@ COURSES = {
     EIGHT: Course(_eight, 0.0, lambda d: 4 * np.pi * radius_for(d / 2)),
     BACK_AND_FORTH: Course(_stadium, 2 * np.pi, lambda d: 2 * _leg_for(d) + 2 * np.pi * U_RADIUS),
     ZIGZAG: Course(_zigzag, 0.0, lambda d: 2 * ZIG),
-    DIAGONAL: Course(_diagonal, DIAGONAL_ANGLE, lambda d: 2 * d + 10.0),
+    DIAGONAL: Course(_veer(DIAGONAL_ANGLE, DIAGONAL_EASE), DIAGONAL_ANGLE, lambda d: 2 * d + 10.0),
+    ASIDE: Course(_veer(ASIDE_ANGLE, ASIDE_EASE), ASIDE_ANGLE, lambda d: 2 * d + 10.0),
 }
 
 
@@ -137,8 +142,8 @@ def course_seconds(course: str, speed: float) -> float | None:
     """The length (s) a motion with no length asked gets to walk ``course`` once round at ``speed``
     m/s (its gait's typical pace): the course's shortest period over ``UNASKED_PACE`` of that speed
     (a slower sample still gets round), within ``UNASKED_LEAST`` .. ``UNASKED_MOST``; None for a
-    course with no round (a diagonal)."""
-    if course == DIAGONAL or course not in COURSES or speed <= 0:
+    course with no round (a diagonal, a gait to one side)."""
+    if course in (DIAGONAL, ASIDE) or course not in COURSES or speed <= 0:
         return None
     period = COURSES[course].period_for(0.0)
     return float(np.clip(period / (UNASKED_PACE * speed), UNASKED_LEAST, UNASKED_MOST))

@@ -149,6 +149,8 @@ def course_named(text: str) -> str | None:
                         (V.DIAGONAL_COURSE, V.DIAGONAL)):
         if gait and words.search(str(text)):
             return name
+    if any(a in LEGS_ACTIONS and a not in ("sidestep", "walk backward") for a in acts) and V.ASIDE.search(str(text)):
+        return V.ASIDE_COURSE   # "runs to the left"
     return None
 
 

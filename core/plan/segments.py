@@ -6,9 +6,15 @@
 
 Only words that order make segments (``vocabulary.THEN``): "then", "and then", ", then", "after
 that", "afterwards", "after which", "next", "finally", "(a minute) later", "eventually",
-"subsequently", "followed by", "finishes / ends with", "first ... then", and "before" / "after" in
-front of a clause ("after waving, she jogs", "she jogs after waving", "before sitting down he
-waves": the wave first; at the start also in front of a noun and its comma: "after a bow, ..."). "And" cuts only beside a change of posture ("gets up and walks away", "walks over and
+"subsequently", "followed by", "finishes / ends with", "follows it with", "first ... then", and
+"before" / "after" in front of a clause ("after waving, she jogs", "she jogs after waving", "before
+sitting down he waves": the wave first; at the start also in front of a noun and its comma, or a
+noun and the main clause's subject: "after a bow, ...", "after a long walk she sits down"). Where
+an order word cuts, the commas of a list of steps before it cut too ("walks ahead, spins around,
+then waves": three; ``vocabulary.LIST_STEP``), but not before a participle ("jogs, waving": two
+things at once) nor before a turn (the turn ends its gait). A way alone after an order word goes
+on with the verb before it ("runs to the left, then to the right": "runs to the right";
+``vocabulary.WAY_ALONE``). "And" cuts only beside a change of posture ("gets up and walks away", "walks over and
 sits down"; ``vocabulary.POSTURE_CHANGES``), never after a squat's own standing up: two things at
 once ("jogs and waves") are one segment made by body part (``generation/parts.py``), "jumps and
 twirls" one action, and "back and forth", "to and fro", "up and down" are courses.
@@ -29,8 +35,8 @@ import re
 
 from ..data.actions import find_actions
 from .part_prompts import SUBJECT, _has_verb, _subject, _with_subject
-from .vocabulary import (AND, BEFORE_AFTER as MIDDLE, FIRST, LEADING_BEFORE_AFTER as LEADING, PARTICIPLE,
-                         POSTURE_CHANGES, RISEN_FROM, STOP, THEN)
+from .vocabulary import (AND, BEFORE_AFTER as MIDDLE, FIRST, LEADING_BEFORE_AFTER as LEADING, LIST_STEP, PARTICIPLE,
+                         POSTURE_CHANGES, RISEN_FROM, STOP, THEN, WAY_ALONE)
 
 DEFAULT_SUBJECT = "a person"
 SEGMENT_SECONDS = 3.0       # a segment's length when the prompt's length is the model's to choose
@@ -112,6 +118,27 @@ def _as_prompt(piece: str, subject: str) -> str:
     return _with_subject(piece, subject)
 
 
+def _gone_on(before: str, way: str) -> str:
+    """A way alone after an order word said with the verb of the piece before it: ("a man runs to the
+    left", "to the right") -> "a man runs to the right"."""
+    subject = SUBJECT.match(before)
+    verb = re.match(r"\s*([a-z'-]+)", before[subject.end():] if subject else before)
+    return f"{subject.group(0) if subject else ''} {verb.group(1) if verb else 'walks'} {way}".strip()
+
+
+def _list_steps(piece: str) -> list[str]:
+    """A piece cut at its commas where a verb of an action of its own follows ("she walks ahead, spins
+    around" -> two); "jogs, waving" (two things at once) is one, and so is a gait's turn ("walks
+    forward, turns around": the turn ends the walk, as a stop does)."""
+    out, start = [], 0
+    for m in LIST_STEP.finditer(piece):
+        step = re.split(r",", piece[m.end():], maxsplit=1)[0]
+        if set(find_actions(step)) - {"turn"} and find_actions(piece[start:m.start()]) and _has_verb(step):
+            out.append(piece[start:m.start()])
+            start = m.end()
+    return out + [piece[start:]]
+
+
 def split_segments(prompt: str) -> list[str]:
     """The prompts of ``prompt``'s segments in the order they happen (module doc); one when no word
     orders it, the prompt itself."""
@@ -120,10 +147,14 @@ def split_segments(prompt: str) -> list[str]:
     for p in (_tidy(p) for p in THEN.split(t)):
         subject = SUBJECT.match(p)
         rest = p[subject.end():] if subject else p
-        if pieces and p and (STOP.match(rest) or not (find_actions(rest) or _has_verb(rest))):
+        if pieces and p and WAY_ALONE.match(rest):
+            pieces.append(_gone_on(pieces[-1], rest))   # "runs to the left, then to the right"
+        elif pieces and p and (STOP.match(rest) or not (find_actions(rest) or _has_verb(rest))):
             pieces[-1] = f"{pieces[-1]}, then {p}"   # the gait's own stop, or no motion of its own ("then straighten")
         else:
             pieces.append(p)
+    if len(pieces) > 1:   # a list of steps: "walks ahead, spins around, then waves"
+        pieces = [q for p in pieces for q in _list_steps(p)]
     ordered = [q for p in pieces if p for q in _ordered(p)]
     ordered = [q for i, o in enumerate(ordered) for q in _posture_and(o, ordered[i - 1] if i else "")
                if _says_something(_tidy(q))]

@@ -79,7 +79,7 @@ DURATION = re.compile(r"\bfor\s+(?:(?:about|around|roughly|some|nearly|almost|an
 MIN_SECONDS, MAX_SECONDS = 0.4, 60.0   # a length said outside these is not one the generator makes
 
 # -- courses ----------------------------------------------------------------------------------
-CLOCKWISE = re.compile(r"(?<![-\w])(?:clockwise|to the right|rightward)\b")
+CLOCKWISE = re.compile(r"(?<![-\w])(?:clockwise|to (?:the|his|her|their|its|your) right|rightward)\b")
 COUNTER_CLOCKWISE = re.compile(r"\b(?:counter|anti)[- ]?clockwise\b")
 # "paces" is back and forth only where nothing sends it on: "paces the room", "is pacing nervously", "paces
 # back and forth", "she paces." -- not "paces ahead at a steady clip", "paces along the road"
@@ -91,6 +91,11 @@ _PACE = (r"\bpac(?:es|ing)\b(?=\s+(?:(?:around|about|round)\s+)?(?:the|a|his|her
 BACK_AND_FORTH = re.compile(rf"\b(?:{_TO_AND_FRO}|{_UP_AND_DOWN})\b|{_PACE}", re.I)
 ZIGZAG = re.compile(r"\bzig[- ]?zag(?:s|ging|ged)?\b", re.I)
 DIAGONAL = re.compile(r"\bdiagonal(?:ly)?\b|\bat an angle\b", re.I)
+# a gait that goes to one side: the walker turns that way and goes on ("runs to the left", "jogs off to his
+# right"); a step, a shuffle or a slide to one side is a sidestep (``TRAVEL_SIDE``), not a turn
+ASIDE = re.compile(r"\b(?:walk|run|jog|sprint|march|sneak|limp|stroll|trot|dash|hurr(?:y|ie)|head|go)(?:s|es|ing|ed)?\b"
+                   r"(?:\s+(?:off|away|on|over|quickly|slowly|briskly))?\s+(?:to|towards?)\s+(?:the|his|her|their|its|your)\s+"
+                   r"(left|right)\b", re.I)
 COURSE_VERB = re.compile(rf"{_PACE}|\bzig[- ]?zag(?:s|ging|ged)\b", re.I)   # the course as the verb: "walks"
 # the course in words, cut out for its gait: "in a circle", "around in circles", "a figure-8 path",
 # "in a zigzag", "back and forth", "up and down the room"
@@ -102,13 +107,15 @@ COURSE_WORDS = re.compile(
 # circles the arms make, not the walk: "rotating your arms in circles", "swinging the arms around in circles"
 ARM_CIRCLES = re.compile(r"\b(?:arms?|hands?|fists?|wrists?)\b(?:\s+[\w-]+){0,2}?\s+(?:(?:a)?round\s+)?in\s+"
                          r"(?:(?:big|small|wide|large)\s+)?circles?\b", re.I)
-COURSE_WAY = re.compile(r"\s+(?:(?:counter|anti)[- ]?)?clockwise\b|\s+(?:to the (?:right|left)|rightwards?|leftwards?)\b",
+COURSE_WAY = re.compile(r"\s+(?:(?:counter|anti)[- ]?)?clockwise\b|"
+                        r"\s+(?:to (?:the|his|her|their|its|your) (?:right|left)|rightwards?|leftwards?)\b",
                         re.I)   # the course's way round, not the gait's ("runs in a circle to the right")
 # the courses by name (``generation/course_walk.COURSES`` draws them)
 CIRCLE = "walk in a circle"
 EIGHT = "walk in a figure eight"
 BACK_AND_FORTH_COURSE = "back and forth"
 ZIGZAG_COURSE = "zigzag"
+ASIDE_COURSE = "aside"
 DIAGONAL_COURSE = "diagonal"
 COURSE_ACTIONS = (CIRCLE, EIGHT)     # the courses that are actions of the data (``data.actions``)
 COURSE_NAMES = {CIRCLE: "in a circle", EIGHT: "in a figure eight"}   # as people say them
@@ -165,12 +172,22 @@ THEN = re.compile(r"\s*(?:[,;.]\s*)?\b(?:and\s+)?(?:then|after\s+that|afterwards
                   r"subsequently|eventually|"
                   r"followed\s+by|"
                   r"(?:finish(?:es|ing)?|end(?:s|ing)?)\s+(?:off\s+|up\s+)?(?:with|by)|"
+                  r"follow(?:s|ed|ing)?\s+(?:it|this|that|them)\s+(?:up\s+)?with|"
                   r"and\s+(?:finally|afterwards?))\b\s*,?\s*")
 # "before" / "after" in front of a clause: a participle or a pronoun follows ("runs after the ball" is no cut)
 _CLAUSE_AHEAD = r"(?=[a-z'-]+ing\b|(?:he|she|they|someone|somebody|i|we|you)\b)"
 BEFORE_AFTER = re.compile(r"\s*,?\s*\b(before|after)\s+" + _CLAUSE_AHEAD)
-# ... and at the start, before a noun phrase and its comma too ("after a bow, the actor walks away")
-LEADING_BEFORE_AFTER = re.compile(r"^\s*(before|after)\s+(?:" + _CLAUSE_AHEAD + r"|(?=(?:a|an|the|his|her|their)\s[^,]{1,30},))")
+# ... and at the start, before a noun phrase and its comma, or a noun phrase and the main clause's subject
+# ("after a bow, the actor walks away", "after a long walk she sits down")
+LEADING_BEFORE_AFTER = re.compile(r"^\s*(before|after)\s+(?:" + _CLAUSE_AHEAD + r"|(?=(?:a|an|the|his|her|their)\s[^,]{1,30},)|"
+                                  r"(?=(?:a|an|the|his|her|their)\s(?:[a-z'-]+\s){1,3}(?:he|she|they|someone|somebody|"
+                                  r"(?:a|an|the)\s)))")
+# a way to go alone after an order word: the gait before it goes on that way ("runs to the left, then to the
+# right" -> "runs to the right")
+WAY_ALONE = re.compile(r"^(?:(?:back\s+)?to\s+(?:the|his|her|their|its)\s+(?:left|right)|(?:back|for)wards?|ahead|sideways|"
+                       r"(?:the\s+)?other\s+way)(?:\s+(?:again|too|as\s+well))?$")
+# a step of a list whose last step an order word starts ("walks ahead, spins around, then waves"): a comma and a verb
+LIST_STEP = re.compile(r",\s*(?=[a-z'-]{3,}s\b)")
 FIRST = re.compile(r"\b(?:first(?:ly)?|at first|initially|to begin with|to start with)\b\s*,?\s*")
 # "and" that orders: a change of posture on one side ("stands up and runs", "walks over and sits down");
 # any other "and" joins two things at once or one action ("jumps and twirls": a spin jump)
@@ -206,7 +223,8 @@ WORD_CLASSES = (
               "a woman jogs while waving", {"legs": "a woman jogs", "arms": "a person waving"}),
     WordClass("side", "left / right with a hand or foot word, or with an action of one part",
               "the motion mirrored so that side moves", "a man kicks with his left foot", {"side": "left foot"}),
-    WordClass("course", "in a circle, in a figure eight, back and forth, zigzag, diagonally (clockwise / to the right)",
+    WordClass("course", "in a circle, in a figure eight, back and forth, zigzag, diagonally (clockwise / to the right), "
+              "a gait to the left / right (runs to the left: turns that way and goes on)",
               "the gait walked straight, then bent along the course", "a man walks in a circle clockwise",
               {"course": CIRCLE, "course_way": "right"}),
     WordClass("turn", "turns around / back (180), turns left / right, a quarter turn (90), spins, a full turn (360), twice",
@@ -237,7 +255,8 @@ WORD_CLASSES = (
               "the arms raised once and held there: the raise played to its highest point, that pose kept for the rest",
               "a man walks with both arms raised", {"arms_held": True, "legs": "a man walks"}),
     WordClass("order", "then, and then, after that, after which, next, finally, (a minute) later, eventually, "
-              "subsequently, followed by, finishes / ends with, after / before + a clause, "
+              "subsequently, followed by, finishes / ends with, follows it with, after / before + a clause, "
+              "a list of steps before an order word (walks ahead, spins, then waves), "
               "and beside a change of posture (gets up and walks, walks over and sits down)",
               "segments one after the other, each its share of the length", "a person walks forward, then sits down",
               {"segments": 2}),
