@@ -18,6 +18,12 @@ from shapemove.core.plan.part_prompts import named_side, plan_parts
     ("a man jogs to and fro and waves", "a man jogs to and fro", "a person waves", ("jog", "wave")),
     # a subject the table does not list is kept: no "a person" put before "a coach"
     ("a coach runs ahead, waving to the team", "a coach runs ahead", "a person waving to the team", ("run", "wave")),
+    # "with" says how an action is done; the clauses are joined at "while", ",": not cut at the "with"
+    ("a man waves with his right hand while walking slowly", "a person walking slowly", "a man waves with his right hand",
+     ("walk", "wave")),
+    ("marching with high knees, he waves both hands", "a person marching with high knees", "he waves both hands",
+     ("march", "wave")),
+    ("a woman jogs with her arms raised", "a woman jogs", "a person her arms raised", ("jog", "raise hand")),
 ])
 def test_two_things_split_into_a_legs_and_an_arms_prompt(text, legs, arms, acts):
     plan = plan_parts(text)

@@ -12,8 +12,9 @@ captions, labels and prompts). A prompt is **two things at once** when it names 
 arm gesture (``ARMS``: wave, punch, throw, raise a hand, beckon, reach up, arm circles, ...) and
 no order between them ("then", "after", "before": a sequence is the timeline's job,
 ``generation/sequence.py``). The text is cut between the two at the connector that joins them (",", "while",
-"as", "and", "with", ...; else where the second action starts); each clause becomes its own
-prompt, the one without a subject getting "a person".
+"as", "and", ...; "with" only where no other joins them: "waves with his right hand while walking"
+is cut at "while"; else where the second action starts); each clause becomes its own prompt, the
+one without a subject getting "a person".
 
 A **named side** is "left" or "right" with a body part ("left hand", "his right leg", "the left
 one"...) or with an action of one part ("kicks left" is a foot, "punches with the right" a hand).
@@ -143,8 +144,9 @@ def plan_parts(text: str, classify=None) -> PartPlan | None:
     if legs is None or arms is None:
         return _plan_by_clauses(t, classify) if classify is not None else None
     first, second = sorted([legs, arms])
-    cuts = [m.start() for m in CONNECTOR.finditer(t, first[1], second[0])]
-    cut = cuts[0] if cuts else second[0]
+    found = list(CONNECTOR.finditer(t, first[1], second[0]))
+    joins = [m for m in found if m.group(0) != "with"] or found   # "waves with his right hand while walking": "with" says how
+    cut = joins[0].start() if joins else second[0]
     a, b = _tidy(t[:cut]), _tidy(t[cut:])
     if not a or not b:
         return None
