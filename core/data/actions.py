@@ -35,12 +35,14 @@ _EVERYDAY = {
     "walk": (
         r"\bambl(e|es|ing)\b", r"\bsaunter", r"\btrudg", r"\bwander", r"\bon foot\b",
         r"\bone foot after the other\b", r"\bpac(e|es|ing) (ahead|forward|along|onward|on)\b", r"\bstagger",
+        r"\bdrag\w* (his|her|their|your) feet\b",
     ),
     "walk backward": (r"\bin reverse\b", r"\bbacks? away\b", r"\bretreat",),
     "sidestep": (r"\blike a crab\b", r"\blaterally\b",),
     "turn": (r"\babout[- ]face\b", r"\bswivel",),
     "walk in a circle": (
         r"\bcircular (path|route|track)\b", r"\bround and round\b", r"\bcircles? the room\b", r"\bin a loop\b",
+        r"\b(walk|run|jog|stroll|march)\w* a (\w+ )?loop\b", r"\bloop(s|ing)? (a)?round\b",
         r"\bcircl(es|ed|ing) (around )?(the|a) (room|yard|field|track|park|block|hall|square|pond|fountain|tree|table|"
         r"garden|courtyard|lobby|stage|ring|arena)\b",
     ),
@@ -77,8 +79,8 @@ _EVERYDAY = {
         r"\btak(e|es|ing) a seat\b", r"\bplops? down\b", r"\blower\w* (yourself|himself|herself|themselves) onto\b",
     ),
     "climb": (r"\bscal(e|es|ing) (a|the) (ladder|wall|rope)\b", r"\bladder\b",),
-    "squat": (r"\bknee bends?\b", r"\bcrouch\w* down\b", r"\blower\w* the hips\b", r"\bsink\w* down by bending\b",),
-    "bend over": (r"\bfold\w* forward\b",),
+    "squat": (r"\bknee bends?\b", r"\bcrouch(es|ed|ing)?\b(?! (over|forward)\b)", r"\blower\w* the hips\b", r"\bsink\w* down by bending\b",),
+    "bend over": (r"\bfold\w* forward\b", r"\btouch\w* (his|her|their|your|the) toes\b",),
     "pick up": (
         r"\blift\w* (a|an|the) \w+ (off|from) (the )?(floor|ground)\b",
         r"\bcollect\w* (an? |the )?\w+ (lying )?on the (floor|ground)\b",
