@@ -113,7 +113,8 @@ def test_generation_walks_the_circle_the_prompt_asks_for():
     ("someone jogs a figure-8 path clockwise, waving", EIGHT, ("someone jogs, waving", "jog")),
     ("a man runs in a circle to the right", CIRCLE, ("a man runs", "run")),
     ("walks in circles counter-clockwise", CIRCLE, ("walks", "walk")),
-    ("a person goes around in a circle", CIRCLE, None),            # no gait left to walk straight
+    ("a person goes around in a circle", CIRCLE, ("a person walks", "walk")),   # no gait left: a walk
+    ("she circles the room", CIRCLE, ("she walks", "walk")),
     ("a man walks forward to the right", None, None),
     ("a man paces back and forth", BACK_AND_FORTH, ("a man walks", "walk")),
     ("a nervous woman is pacing up and down the hallway", BACK_AND_FORTH, ("a nervous woman is walking", "walk")),

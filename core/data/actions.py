@@ -43,6 +43,7 @@ _EVERYDAY = {
     "walk in a circle": (
         r"\bcircular (path|route|track)\b", r"\bround and round\b", r"\bcircles? the room\b", r"\bin a loop\b",
         r"\b(walk|run|jog|stroll|march)\w* a (\w+ )?loop\b", r"\bloop(s|ing)? (a)?round\b",
+        r"\bcircl(e|es|ed|ing) (a)?round\b",
         r"\bcircl(es|ed|ing) (around )?(the|a) (room|yard|field|track|park|block|hall|square|pond|fountain|tree|table|"
         r"garden|courtyard|lobby|stage|ring|arena)\b",
     ),

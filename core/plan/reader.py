@@ -164,14 +164,21 @@ def straight_gait(text: str) -> tuple[str, str] | None:
     """(the words without the course they name and its way round, the gait left in them) --
     "someone jogs in a figure eight clockwise, waving" -> ("someone jogs, waving", "jog"), "a man
     paces back and forth" -> ("a man walks", "walk") -- or None when the words name no course
-    (``course_named``) or what is left names no gait ("goes around in a circle")."""
+    (``course_named``). A circle or an eight whose words name no gait is walked ("a man goes around in
+    a circle", "she circles the room" -> ("a man walks", "walk"), ("she walks", "walk"))."""
     text = str(text)
-    if course_named(text) is None:
+    course = course_named(text)
+    if course is None:
         return None
     straight = V.COURSE_VERB.sub(_walk_verb, V.COURSE_WORDS.sub("", text))
     straight = re.sub(r"\s+([,.;])", r"\1", V.COURSE_WAY.sub("", straight)).strip()
     gaits = [a for a in find_actions(straight) if a in LEGS_ACTIONS and a not in V.COURSE_ACTIONS]
-    return (straight, gaits[0]) if gaits else None
+    if gaits:
+        return straight, gaits[0]
+    if course in V.COURSE_ACTIONS:
+        subject = V.SUBJECT.match(straight.lower())
+        return f"{subject.group(0) if subject else 'a person'} walks", "walk"
+    return None
 
 
 def walked_straight(text: str) -> str:
@@ -270,7 +277,7 @@ def without_numbers(prompt: str) -> str:
 _TAKEN = (V.COUNT_TIMES, V.FAST, V.SLOW, V.STOP, V.STEPS, V.STEPS_ALONE, V.STILL, V.SPOKEN_DISTANCE, V.CLOCKWISE,
           V.COUNTER_CLOCKWISE, V.BACK_AND_FORTH, V.ZIGZAG, V.DIAGONAL, V.COURSE_WORDS, V.COURSE_WAY, V.TURN_WHOLE,
           V.TURN_HALF, V.TURN_QUARTER, V.FORWARD, V.BACKWARD, V.IN_PLACE, V.TRAVEL_SIDE, V.SIDEWAYS, V.SIDE,
-          V.DIRECTION, V.SUBJECT, V.TURN_TWICE, V.ARMS_HELD, V.DURATION)
+          V.DIRECTION, V.SUBJECT, V.TURN_TWICE, V.ARMS_HELD, V.DURATION, V.ASIDE, V.CONNECTOR, V.THEN)
 
 
 def unused_words(text: str, body_words=(), idle=()) -> list[str]:
