@@ -52,9 +52,11 @@ def test_vocabulary():
     ("a drunk man staggers", ["walk"]),
     ("a tired man drags his feet", ["walk"]),
     ("a man crouches and looks around", ["squat"]),
+    ("the character creeps forward, crouched low", ["sneak"]),   # a posture of the sneak, not a squat
     ("he crouches over the table", []),               # leaning over something, not a squat
     ("a woman touches her toes", ["bend over"]),
     ("the man walks a loop around the yard", ["walk in a circle"]),
+    ("a woman walks around in a big loop", ["walk in a circle", "walk"]),
     ("someone lifts a heavy box", ["pick up"]),
     ("running flat out, she lifts one hand high", ["run", "raise hand"]),
     ("she paces the room", []),                       # a course (back and forth), not an action

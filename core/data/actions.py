@@ -41,7 +41,7 @@ _EVERYDAY = {
     "sidestep": (r"\blike a crab\b", r"\blaterally\b",),
     "turn": (r"\babout[- ]face\b", r"\bswivel",),
     "walk in a circle": (
-        r"\bcircular (path|route|track)\b", r"\bround and round\b", r"\bcircles? the room\b", r"\bin a loop\b",
+        r"\bcircular (path|route|track)\b", r"\bround and round\b", r"\bcircles? the room\b", r"\bin a (\w+ )?loop\b",
         r"\b(walk|run|jog|stroll|march)\w* a (\w+ )?loop\b", r"\bloop(s|ing)? (a)?round\b",
         r"\bcircl(e|es|ed|ing) (a)?round\b",
         r"\bcircl(es|ed|ing) (around )?(the|a) (room|yard|field|track|park|block|hall|square|pond|fountain|tree|table|"
@@ -80,7 +80,7 @@ _EVERYDAY = {
         r"\btak(e|es|ing) a seat\b", r"\bplops? down\b", r"\blower\w* (yourself|himself|herself|themselves) onto\b",
     ),
     "climb": (r"\bscal(e|es|ing) (a|the) (ladder|wall|rope)\b", r"\bladder\b",),
-    "squat": (r"\bknee bends?\b", r"\bcrouch(es|ed|ing)?\b(?! (over|forward)\b)", r"\blower\w* the hips\b", r"\bsink\w* down by bending\b",),
+    "squat": (r"\bknee bends?\b", r"\bcrouch(es)?\b(?! (over|forward)\b)", r"\bcrouch\w* down\b", r"\blower\w* the hips\b", r"\bsink\w* down by bending\b",),
     "bend over": (r"\bfold\w* forward\b", r"\btouch\w* (his|her|their|your|the) toes\b",),
     "pick up": (
         r"\blift\w* (a|an|the) \w+ (off|from) (the )?(floor|ground)\b",
