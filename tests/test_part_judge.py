@@ -137,6 +137,30 @@ def test_reachable_parts_averages_the_expected_classes_of_the_prompts():
     assert out["both"] == pytest.approx((0.9 * 1.0 + 0.0 + 0.0) / 3)
 
 
+def test_the_bar_leaves_out_single_take_classes_and_is_0_9x_the_real_reach():
+    """Hand-derived: the march + wave prompt is left out (march has one take); over the two walk
+    prompts legs are right 2 of 2, arms 1 of 2, both 1 of 2; real copies are credited with legs
+    0.9, arms 1.0 x 0.5 = ... per prompt (wave 1.0, punch 0.5): arms 0.75, both (0.9 + 0.45) / 2."""
+    from shapemove.core.eval.parts_eval import barred_parts
+
+    reach = {"legs": {"per_class": {"walk": {"accuracy": 0.9, "takes": 150}, "march": {"accuracy": 0.0, "takes": 1}}},
+             "arms": {"per_class": {"wave": {"accuracy": 1.0, "takes": 150}, "punch": {"accuracy": 0.5, "takes": 4}}}}
+    rows = [{"pair": "walk + wave", "legs": "walk", "arms": "wave goodbye", "legs_right": True, "arms_right": True,
+             "both_right": True},
+            {"pair": "walk + punch", "legs": "walk", "arms": "punch", "legs_right": True, "arms_right": False,
+             "both_right": False},
+            {"pair": "march + wave", "legs": "march", "arms": "wave", "legs_right": True, "arms_right": True,
+             "both_right": True}]
+    b = barred_parts(rows, reach)
+    assert b["prompts"] == 2 and b["left_out"] == ["march + wave"]
+    assert (b["both"], b["legs"], b["arms"]) == (0.5, 1.0, 0.5)
+    assert b["reachable"] == pytest.approx({"legs": 0.9, "arms": 0.75, "both": (0.9 + 0.45) / 2})
+    assert b["bar"] == pytest.approx({"legs": 0.81, "arms": 0.675, "both": 0.9 * 0.675})
+    assert b["met"] is False                         # arms 0.5 < 0.675
+    rows[1]["arms_right"] = rows[1]["both_right"] = True
+    assert barred_parts(rows, reach)["met"] is True
+
+
 def test_format_results_names_what_copies_could_score():
     from shapemove.core.eval.parts_eval import TARGETS, format_results, reachable_parts
 

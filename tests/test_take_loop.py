@@ -106,3 +106,41 @@ def test_a_gait_loops_on_its_last_stride(openbody):
     still = np.zeros_like(con)
     still[:, :2] = 1
     assert last_stride(still) is None and looped_gait(rot, root, still, J, 100) is None   # no step: held
+
+
+def test_two_steps_loop_as_a_step_and_its_mirror_image(openbody):
+    """Two sneaking steps from standing: the left foot down at frame 8, the right at 20, neither
+    twice, the left shoulder held turned (a sneak's arms are not symmetric). Played as performed to
+    frame 20, then the step mirrored (the right foot leading, down at 20), then the step again (the
+    left down at 32), the walker going on at its pace across every seam; the mirrored step starts
+    from the pose before it, the shoulder's difference faded out over STEP_FADE frames."""
+    from shapemove.core.generation.captured_takes import mirrored
+    from shapemove.core.generation.take_loop import STEP_FADE, last_step, last_stride, looped_steps
+    from shapemove.core.geometry.rotations import yaw_matrix
+
+    T = 30
+    t = np.arange(T)
+    _, root, con, J = _take(openbody, np.zeros(T), forward=0.0)
+    rot = np.repeat(np.eye(3, dtype=np.float32)[None, None], T, 0).repeat(24, 1)
+    rot[:, 16] = yaw_matrix(0.5)                                       # the left shoulder turned
+    pace = np.where(t >= 8, 0.05, 0.0)
+    root[:, 2] = np.cumsum(pace)
+    J[:, :, 2] += np.cumsum(pace)[:, None]
+    con[8:13, 0] = 1                                                   # the left ankle down at 8
+    con[20:25, 1] = 1                                                  # the right at 20
+    con[:5, :2] = 1
+    assert last_stride(con) is None and last_step(con) == (8, 20)
+    r, rt, c, first = looped_steps(rot, root, con, J, 80, mirrored)
+    assert len(r) == 80 and first == 20
+    assert np.allclose(np.diff(rt[8:, 2]), 0.05, atol=1e-4)            # at its pace, the seams too
+    assert np.allclose(rt[:, 0], root[0, 0], atol=1e-5)                # straight on
+    assert c[20, 1] == 1 and c[20, 0] == 0 and c[32, 0] == 1           # right, then left again
+    assert np.array_equal(c[20:32], con[8:20][:, [1, 0, 3, 2]])        # the step's contacts, mirrored
+    assert np.allclose(r[20], r[19], atol=1e-5)                        # from the pose before it
+    m_rot = mirrored(rot[8:20], root[8:20], con[8:20])[0]
+    assert np.allclose(r[20 + STEP_FADE:32], m_rot[STEP_FADE:], atol=1e-5)   # then the mirror image itself
+    assert np.allclose(r[20 + STEP_FADE, 17], yaw_matrix(-0.5), atol=1e-5)   # the right shoulder turned the other way
+    assert looped_steps(rot, root, con, J, T, mirrored) is None        # long enough: nothing to do
+    still = np.zeros_like(con)
+    still[:, :2] = 1
+    assert last_step(still) is None and looped_steps(rot, root, still, J, 80, mirrored) is None

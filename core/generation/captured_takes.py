@@ -45,10 +45,10 @@ from ..constants import FPS
 from ..errors import ShapeMoveError
 from ..scene.motion_file import Motion
 from ..data.actions import REPEATED
-from ..plan.vocabulary import POSTURE_CHANGES
+from ..plan.vocabulary import GAITS, POSTURE_CHANGES
 from .repeated_takes import cut_for, repeated_stretch
 from .straight_gait import STRAIGHTENED, straightened
-from .take_loop import looped_gait, looped_repetition, looped_take
+from .take_loop import looped_gait, looped_repetition, looped_steps, looped_take
 
 TAKES = 5              # captured windows offered per prompt
 POOL = 2               # drawn by the seed from the POOL x TAKES nearest
@@ -214,7 +214,9 @@ class TakePool:
         when asked (``repeated_takes.py``), all of them when the length is the model's, however long;
         a take of a change of posture (``plan/vocabulary.POSTURE_CHANGES``: getting up, lying down) is cut to
         its end. ``straight``: a take of a plain gait is played off its bend (``straight_gait.py``)
-        and, shorter than asked, loops on its last stride (``take_loop.looped_gait``)."""
+        and, shorter than asked, loops on its last stride (``take_loop.looped_gait``); a take of any
+        other gait (``vocabulary.GAITS``: two sneaking steps) shorter than asked and without two
+        cycles of its own loops on its last stride too."""
         from .part_compose import needs_mirror
 
         t = self.take(i)
@@ -246,6 +248,9 @@ class TakePool:
                     again = looped_gait(rot, root, con, posed_joints, want)
                 else:
                     again = looped_take(rot, root, con, posed_joints, want)
+                    if again is None and self.actions[i] in GAITS:   # on its last stride, else its last step
+                        again = looped_gait(rot, root, con, posed_joints, want) or \
+                            looped_steps(rot, root, con, posed_joints, want, mirrored)   # and the step's mirror image
                 if again is None and self.actions[i] in REPEATED:   # one arm circle: circled again
                     again = looped_repetition(rot, root, con, posed_joints, want)
             if again is not None:

@@ -40,6 +40,9 @@ from ..errors import ShapeMoveError
 from ..motion.contacts import runs
 
 SHORTEST_CYCLE = 0.5   # s
+SHORTEST_STEP = 0.25   # s: one foot's touch-down to the other's
+STEP_FADE = 8          # frames: a mirrored step starts from the pose before it, the difference faded out over these
+LOWER = 12             # joints 0..11: the pelvis, spine's base and legs, which must meet at a step's seam
 MOST_OF_TAKE = 0.45    # the longest cycle, as a share of the take
 SEAM_STEP = 1.5        # the seam's step against the 99th percentile of the take's steps
 MOST_TURN = 20.0       # degrees of heading per cycle
@@ -173,6 +176,89 @@ def _under_way(root, contacts, a: int, b: int) -> int:
         if s >= a or np.linalg.norm(r[s + period] - r[s]) >= UNDER_WAY * pace * period:
             return min(s, a)
     return a
+
+
+def looped_steps(rotations, root, contacts, joints, frames: int, mirror):
+    """A gait's take of one step of each foot, no foot touching down twice (two sneaking steps from
+    standing), played on to ``frames``: as performed to the end of its last step (one foot's
+    touch-down to the other's), then that step's mirror image (the other foot leading) and the step
+    again, over and over, each moved on by the step's advance (the mirror image's sideways part
+    mirrored, so the pair goes straight on). The mirror image is taken about the vertical plane of
+    the walker's heading halfway through the step (the step twists the hips one way, the mirror
+    image twists them back, so each seam meets the pose it follows). ``mirror(rotations, root, contacts)`` mirrors frames
+    facing +Z (``captured_takes.mirrored``). Returns (rotations, root, contacts, first) as
+    ``looped_take``; None when the take is long enough, has no such step of ``SHORTEST_STEP`` s or
+    more, the step turns more than ``MOST_TURN`` or a seam steps its pelvis or legs farther than
+    ``SEAM_STEP`` x the take's 99th-percentile step. The arms and head need not be symmetric (a
+    sneak's are not): each step starts from the pose before it, the difference faded out over
+    ``STEP_FADE`` frames (``faded_in``)."""
+    from ..data.mirror import mirror_joints
+    from ..geometry.rotations import yaw_matrix
+    from .track import headings
+
+    if len(rotations) >= frames:
+        return None
+    step = last_step(contacts)
+    if step is None:
+        return None
+    a, b = step
+    J = np.asarray(joints, np.float64)
+    h = headings(J)
+    turn = float(np.angle(np.exp(1j * (h[b] - h[a]))))
+    if abs(np.degrees(turn)) > MOST_TURN:
+        return None
+    mid = h[a] + turn / 2    # the step twists the hips one way, its mirror image back: mirrored about the mid heading
+    to_step, back = yaw_matrix(-mid), yaw_matrix(mid)
+    pivot = np.array([root[a][0], 0.0, root[a][2]])
+    rot = np.array(rotations, np.float32)
+    rot[:, 0] = to_step.astype(np.float32) @ rot[:, 0]
+    rt = (np.asarray(root, np.float64) - pivot) @ to_step.T           # facing +Z mid-step, a over the origin
+    con = np.asarray(contacts)
+    m_rot, m_rt, m_con = mirror(rot[a:b], rt[a:b].astype(np.float32), con[a:b])
+    adv = (rt[b] - rt[a]) * np.array([1.0, 0.0, 1.0])
+    m_adv = adv * np.array([-1.0, 1.0, 1.0])
+    Js = (J - pivot) @ to_step.T
+    mJ = mirror_joints(Js[a:b])
+    steps = np.linalg.norm(np.diff(J, axis=0), axis=-1).max(-1)
+    seams = (np.linalg.norm(mJ[0] + adv - Js[b - 1], axis=-1)[:LOWER].max(),
+             np.linalg.norm(Js[a] + adv + m_adv - (mJ[-1] + adv), axis=-1)[:LOWER].max())
+    if max(seams) > SEAM_STEP * np.percentile(steps, 99):
+        return None
+    period, pair = 2 * (b - a), adv + m_adv
+    reps = -(-(frames - b) // period)
+    # the arms and head of a sneak are not symmetric: each block starts from the pose before it, faded out
+    m_rot, o_rot = faded_in(m_rot, rot[b - 1]), faded_in(rot[a:b], m_rot[-1])
+    rots = [rot[:b]] + [np.concatenate([m_rot, o_rot])] * reps
+    roots = [rt[:b]] + [np.concatenate([m_rt + adv, rt[a:b] + pair]) + k * pair for k in range(reps)]
+    cons = [con[:b]] + [np.concatenate([m_con, con[a:b]])] * reps
+    out_rot = np.concatenate(rots)[:frames]
+    out_rot[:, 0] = back.astype(np.float32) @ out_rot[:, 0]
+    out_root = (np.concatenate(roots)[:frames] @ back.T + pivot).astype(np.float32)
+    return out_rot, out_root, np.concatenate(cons)[:frames], b
+
+
+def faded_in(rotations, before, frames: int = STEP_FADE) -> np.ndarray:
+    """``rotations`` (T,J,3,3) starting from the pose ``before`` (J,3,3): each joint's difference
+    from its first frame carried in and faded out (smoothstep) over ``frames`` frames."""
+    from ..geometry.rotations import axis_angle_to_matrix, matrix_to_axis_angle
+
+    rot = np.array(rotations, np.float32)
+    n = min(frames, len(rot))
+    delta = matrix_to_axis_angle(np.swapaxes(rot[0], -1, -2).astype(np.float64) @ np.asarray(before, np.float64))
+    u = np.arange(n) / max(n, 1)
+    w = 1.0 - u * u * (3.0 - 2.0 * u)
+    rot[:n] = (rot[:n] @ axis_angle_to_matrix(w[:, None, None] * delta[None])).astype(np.float32)
+    return rot
+
+
+def last_step(contacts) -> tuple[int, int] | None:
+    """(a, b): the latest step of the ``contacts`` (T,4): one foot touching down at a, the other at
+    b, at least ``SHORTEST_STEP`` s later, no touch-down between; None without one."""
+    downs = sorted((int(t), f) for f, foot in enumerate(FEET) for t in touch_downs(contacts, foot))
+    for (a, fa), (b, fb) in zip(downs[::-1][1:], downs[::-1]):
+        if fa != fb and b - a >= SHORTEST_STEP * FPS and b < len(contacts):
+            return a, b
+    return None
 
 
 def last_stride(contacts) -> tuple[int, int] | None:
