@@ -285,3 +285,22 @@ def test_generation_goes_round_the_whole_eight_with_no_length_asked():
     h = np.unwrap(headings(m.joints))
     assert h.max() - h[0] > 1.75 * np.pi and abs(h[-1] - h[0]) < 0.3   # round one loop, back round the other
     assert m.joints[:, :, 1].min() > -0.05
+
+
+def test_a_course_too_short_to_go_round_is_noted():
+    """Hand-derived: 4 m walked on a figure eight goes 4 / (4 pi x 1 m) = 32 % of it (loops of at
+    least MIN_RADIUS); 2 pi m on a circle goes once round; a diagonal has no round."""
+    from shapemove.core.generation.course_walk import course_note, round_share
+
+    assert round_share(EIGHT, 4.0) == pytest.approx(4.0 / (4 * np.pi * MIN_RADIUS))
+    assert round_share(CIRCLE, 2 * np.pi) == pytest.approx(1.0) and round_share(DIAGONAL, 4.0) is None
+    walk = _straight_walk(frames=80)                                  # 4 s
+    from shapemove.core.generation.track import travel
+
+    d = travel(walk.joints)[-1]
+    note = course_note(EIGHT, walk.joints, 20.0)
+    share = d / (4 * np.pi * max(MIN_RADIUS, d / (4 * np.pi)))
+    assert note == (f"4.0 s goes {share:.0%} of the way round the figure eight: once round takes about "
+                    f"{4.0 / share:.0f} s at this pace (ask for that length to go round)")
+    assert course_note(CIRCLE, _straight_walk(frames=200).joints, 20.0) is None   # 10 s: round
+    assert course_note(DIAGONAL, walk.joints, 20.0) is None

@@ -149,6 +149,30 @@ def course_seconds(course: str, speed: float) -> float | None:
     return float(np.clip(period / (UNASKED_PACE * speed), UNASKED_LEAST, UNASKED_MOST))
 
 
+ROUND = {CIRCLE: "circle", EIGHT: "figure eight", BACK_AND_FORTH: "way out and back"}   # the courses gone round
+NOTE_BELOW = 0.9   # a course gone round less than this share of once is noted
+
+
+def round_share(course: str | None, distance: float) -> float | None:
+    """The share of once round ``course`` a motion that travels ``distance`` metres goes (its
+    period at that distance: a circle's radius is at least ``MIN_RADIUS``); None for a course with
+    no round (a zigzag, a diagonal, a gait to one side)."""
+    if course not in ROUND or distance <= 0:
+        return None
+    return float(distance / COURSES[course].period_for(distance))
+
+
+def course_note(course: str | None, joints, fps: float = FPS) -> str | None:
+    """A note for the user when the motion is too short to go once round its course (a figure eight
+    asked for 4 s), with the length that would; None otherwise."""
+    share = round_share(course, float(travel(joints)[-1]))
+    if share is None or share >= NOTE_BELOW:
+        return None
+    seconds = len(joints) / fps
+    return (f"{seconds:.1f} s goes {share:.0%} of the way round the {ROUND[course]}: once round takes about "
+            f"{seconds / share:.0f} s at this pace (ask for that length to go round)")
+
+
 def whole_period(course: str, distance: float) -> float:
     """The period (m) of ``course`` fitted to ``distance`` a whole number of times (at least once)."""
     return distance / max(1, round(distance / COURSES[course].period_for(distance)))

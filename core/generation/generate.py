@@ -32,7 +32,7 @@ from ..scene.motion_file import Motion
 from ..torch_threads import one_torch_thread
 from .action_clips import ACTION_CLIPS, UNASKED_SECONDS, action_clips
 from .captured_takes import TakePool, Window, action_credit, captured_motion, decoded_provenance
-from .course_walk import ACTIONS as COURSE_ACTIONS, WALK_SPEED, course_motion, course_seconds
+from .course_walk import ACTIONS as COURSE_ACTIONS, WALK_SPEED, course_motion, course_note, course_seconds
 from .decode import decode_features, decode_tokens, redecode
 from .library_takes import captured_window, read_take, window_fit
 from .model_bundle import model_files, part_warnings, resolve_model_dir
@@ -594,6 +594,8 @@ class Generator:
                     motion = (course_motion(motion, self.body, course, words.course_right, self.ik_refine_iters, r.whole_course)
                               if course is not None else                                          # course_walk.py
                               turn_motion(motion, self.body, turn, self.ik_refine_iters))         # turn_words.py
+                    if course is not None and (note := course_note(course, motion.joints, motion.fps)):
+                        motion.notes.append(note)   # "a figure eight" in 4 s goes a third of the way round
             if words is not None and words.arms_held and words.gestures_only and words.parts is None:
                 motion = held_motion(motion, self.body, self.ik_refine_iters)   # "stands with her arms raised"
             if words is not None:   # "jogs in place": the data's gaits all travel; stepped on the spot instead
