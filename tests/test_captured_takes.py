@@ -214,3 +214,22 @@ def test_an_action_without_takes_draws_on_the_takes_of_its_general_action(openbo
     assert feet.max() - feet.min() > 0.15                 # in the air
     gen.set_captured(False)
     assert gen._taken("hop") == "hop"
+
+
+def test_a_short_gait_take_goes_on_instead_of_standing(openbody):
+    """Asked for 8 s, the built-in library's gait takes that cannot loop on two cycles of their own
+    go on: HDM05's two sneaking steps (one step of each foot) as the step and its mirror image,
+    DeepMimic's stealthy walk (one cycle whose contacts miss the right toe) as one repetition; each
+    keeps walking to the end (the root moves in the last second) instead of holding its last pose."""
+    from shapemove.core.generation.generate import Generator
+    from shapemove.core.generation.track import travel
+
+    pool = Generator(None, body=openbody).pool
+    for cid in ("HDM_bd_sneak2StepsLStart_001_120", "deepmimic_stealthy_walk"):
+        i = pool.ids.index(cid)
+        n = len(pool.take(i)["rotations"])
+        w = pool.window(i, 160, 0)
+        assert n < 100 and w.looped >= 160 - n - 20 and w.held == 0, (cid, n, w.looped, w.held)
+        j = pool.proc.pose_on(w.rotations, w.root, pool.take(i)["betas"], 1.0, w.contacts)
+        last = travel(j[-20:])[-1]
+        assert last > 0.2, (cid, last)                      # still sneaking on in the last second

@@ -216,7 +216,8 @@ class TakePool:
         its end. ``straight``: a take of a plain gait is played off its bend (``straight_gait.py``)
         and, shorter than asked, loops on its last stride (``take_loop.looped_gait``); a take of any
         other gait (``vocabulary.GAITS``: two sneaking steps) shorter than asked and without two
-        cycles of its own loops on its last stride too."""
+        cycles of its own loops on its last stride too, else on its last step and the step's mirror
+        image, else (a cycle whose contacts do not show its steps) whole, as one repetition."""
         from .part_compose import needs_mirror
 
         t = self.take(i)
@@ -251,8 +252,8 @@ class TakePool:
                     if again is None and self.actions[i] in GAITS:   # on its last stride, else its last step
                         again = looped_gait(rot, root, con, posed_joints, want) or \
                             looped_steps(rot, root, con, posed_joints, want, mirrored)   # and the step's mirror image
-                if again is None and self.actions[i] in REPEATED:   # one arm circle: circled again
-                    again = looped_repetition(rot, root, con, posed_joints, want)
+                if again is None and (self.actions[i] in REPEATED or self.actions[i] in GAITS):
+                    again = looped_repetition(rot, root, con, posed_joints, want)   # one arm circle, one gait cycle
             if again is not None:
                 rot, root, con, first = again
                 looped = want - first
