@@ -185,8 +185,8 @@ def looped_steps(rotations, root, contacts, joints, frames: int, mirror):
     again, over and over, each moved on by the step's advance (the mirror image's sideways part
     mirrored, so the pair goes straight on). The mirror image is taken about the vertical plane of
     the walker's heading halfway through the step (the step twists the hips one way, the mirror
-    image twists them back, so each seam meets the pose it follows). ``mirror(rotations, root, contacts)`` mirrors frames
-    facing +Z (``captured_takes.mirrored``). Returns (rotations, root, contacts, first) as
+    image twists them back, so each seam meets the pose it follows). ``mirror(rotations, root,
+    contacts)`` mirrors frames facing +Z (``captured_takes.mirrored``). Returns (rotations, root, contacts, first) as
     ``looped_take``; None when the take is long enough, has no such step of ``SHORTEST_STEP`` s or
     more, the step turns more than ``MOST_TURN`` or a seam steps its pelvis or legs farther than
     ``SEAM_STEP`` x the take's 99th-percentile step. The arms and head need not be symmetric (a

@@ -145,7 +145,8 @@ def plan_parts(text: str, classify=None) -> PartPlan | None:
         return _plan_by_clauses(t, classify) if classify is not None else None
     first, second = sorted([legs, arms])
     found = list(CONNECTOR.finditer(t, first[1], second[0]))
-    joins = [m for m in found if m.group(0) != "with"] or found   # "waves with his right hand while walking": "with" says how
+    # "waves with his right hand while walking": the "with" says how, the "while" joins
+    joins = [m for m in found if m.group(0) != "with"] or found
     cut = joins[0].start() if joins else second[0]
     a, b = _tidy(t[:cut]), _tidy(t[cut:])
     if not a or not b:
