@@ -117,15 +117,17 @@ def run(args) -> int:
 
         if args.prompt is None:
             raise ShapeMoveError("--explain shows the plan of one --prompt TEXT")
+        from ..core.generation.course_shapes import model_course_seconds
         from ..core.plan.explain import plan_json
 
+        once_round = model_course_seconds(args.model)   # a course's segment: the model's typical pace, no torch
         if plan is not None:
             from ..core.plan.plan import plan_to_json
 
-            shown = plan_to_json(plan)
+            shown = plan_to_json(plan, once_round)
         else:
             shown = plan_json(args.prompt, args.seconds, loop=args.loop, in_place=args.in_place,
-                              path=args.path is not None, by_parts=not args.no_parts)
+                              path=args.path is not None, by_parts=not args.no_parts, course_seconds=once_round)
         if args.out is not None:   # kept to edit and generate from (--plan)
             from ..core.atomic import atomic_write_json
 

@@ -59,11 +59,13 @@ def run(args) -> int:
         if args.seconds and len(args.prompt) != len(args.seconds):
             raise ShapeMoveError(f"give one --seconds per --prompt, or none ({len(args.prompt)} prompts, "
                                  f"{len(args.seconds)} lengths)")
+        from ..core.generation.course_shapes import model_course_seconds
         from ..core.plan.plan import own_seconds
         from ..core.plan.words import read_words
 
         readings = [read_words(str(p)) for p in args.prompt]
-        lengths = args.seconds or [own_seconds(w) for w in readings]   # "for ten seconds", else 3 s
+        once_round = model_course_seconds(args.model)   # "walks in a circle": the time to go once round
+        lengths = args.seconds or [own_seconds(w, once_round) for w in readings]   # "for ten seconds", else 3 s
         segments = check_segments(list(zip(args.prompt, lengths)))
         overridden = [(p, w.seconds, sec) for p, w, sec in zip(args.prompt, readings, args.seconds)
                       if w.seconds not in (None, sec)]

@@ -51,13 +51,16 @@ class SHAPEMOVE_OT_read_plan(ReportingOperator, bpy.types.Operator):
     bl_label = "Read Plan"
 
     def start(self, context):
+        from ..core.generation.course_shapes import model_course_seconds
         from ..core.plan.explain import plan_json
+        from .preferences import setting
 
         s = context.scene.shapemove
         prompt = s.prompt.strip()
         if not prompt:
             raise ShapeMoveError("the prompt is empty: describe a motion, e.g. 'a person jogs forward and waves'")
-        show_plan(s, plan_json(prompt, s.seconds if s.use_seconds else None), prompt)
+        once_round = model_course_seconds(setting("active_model") or None)   # a course's segment: once round
+        show_plan(s, plan_json(prompt, s.seconds if s.use_seconds else None, course_seconds=once_round), prompt)
         n = len(s.plan_segments)
         return f"plan: {n} segment{'s' if n > 1 else ''}"
 

@@ -3,8 +3,9 @@ forth, a zigzag, walked by a straight track the named way; a motion that does no
 import numpy as np
 import pytest
 
-from shapemove.core.generation.course_walk import (ASIDE, BACK_AND_FORTH, CIRCLE, DIAGONAL, EIGHT, MAX_RADIUS, MIN_RADIUS, U_RADIUS,
-                                                   ZIG, ZIG_ANGLE, ZIGZAG, course_line, course_turn, radius_for)
+from shapemove.core.generation.course_shapes import (ASIDE, BACK_AND_FORTH, CIRCLE, DIAGONAL, EIGHT, MAX_RADIUS, MIN_RADIUS,
+                                                    U_RADIUS, ZIG, ZIG_ANGLE, ZIGZAG, radius_for)
+from shapemove.core.generation.course_walk import course_line, course_turn
 from shapemove.core.generation.course_walk import on_course as _on_course
 from shapemove.core.plan.reader import course_named, straight_gait, turns_right
 from shapemove.core.plan.words import read_words
@@ -251,7 +252,7 @@ def test_generation_walks_the_eight_at_a_walking_pace():
 def test_a_course_asked_no_length_gets_the_time_to_go_once_round():
     """Once round at the gait's typical pace, over 0.9 of it: a circle walked 6.28 m at 1.194 m/s in
     5.8 s, jogged (1.564 m/s) in 4.5 s, a figure eight walked in 11.7 s; no round for a diagonal."""
-    from shapemove.core.generation.course_walk import UNASKED_LEAST, UNASKED_MOST, course_seconds
+    from shapemove.core.generation.course_shapes import UNASKED_LEAST, UNASKED_MOST, course_seconds
 
     assert course_seconds(CIRCLE, 1.194) == pytest.approx(2 * np.pi / (0.9 * 1.194))
     assert course_seconds(CIRCLE, 1.564) == pytest.approx(4.46, abs=0.01)
@@ -290,7 +291,8 @@ def test_generation_goes_round_the_whole_eight_with_no_length_asked():
 def test_a_course_too_short_to_go_round_is_noted():
     """Hand-derived: 4 m walked on a figure eight goes 4 / (4 pi x 1 m) = 32 % of it (loops of at
     least MIN_RADIUS); 2 pi m on a circle goes once round; a diagonal has no round."""
-    from shapemove.core.generation.course_walk import course_note, round_share
+    from shapemove.core.generation.course_shapes import round_share
+    from shapemove.core.generation.course_walk import course_note
 
     assert round_share(EIGHT, 4.0) == pytest.approx(4.0 / (4 * np.pi * MIN_RADIUS))
     assert round_share(CIRCLE, 2 * np.pi) == pytest.approx(1.0) and round_share(DIAGONAL, 4.0) is None

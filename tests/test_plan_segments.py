@@ -3,6 +3,7 @@
 (core/plan/option_conflicts.py) and `generate --explain` (no model loaded)."""
 import json
 
+import numpy as np
 import pytest
 
 from shapemove.cli import main
@@ -93,6 +94,23 @@ def test_lengths_share_the_seconds_or_take_a_default_each():
     assert plan.lengths(6.0) == pytest.approx([2.0, 2.0, 2.0])
     assert plan.lengths(None) == pytest.approx([SEGMENT_SECONDS] * 3)
 
+
+
+def test_a_course_segment_takes_the_time_to_go_once_round_when_the_length_is_the_models():
+    """Hand-derived from the default model's typical walk (1.194 m/s) and jog (1.564 m/s): a circle
+    of 1 m walked once round at 0.9 of that pace, 2 pi / (0.9 x 1.194) = 5.85 s, jogged 4.46 s; a gait
+    to one side has no round; a total asked is shared as before; without the pace, the default."""
+    from shapemove.core.generation.course_shapes import model_course_seconds
+
+    once_round = model_course_seconds(None)
+    plan = read_plan("a man walks a loop around the tree, then waves")
+    assert plan.lengths(None, once_round) == pytest.approx([2 * np.pi / (0.9 * 1.194), SEGMENT_SECONDS], abs=0.01)
+    assert read_plan("she jogs in a circle, then sits").lengths(None, once_round)[0] == pytest.approx(4.46, abs=0.01)
+    assert read_plan("he runs to the left, then waves").lengths(None, once_round) == pytest.approx([SEGMENT_SECONDS] * 2)
+    assert plan.lengths(6.0, once_round) == pytest.approx([3.0, 3.0])
+    assert plan.lengths(None) == pytest.approx([SEGMENT_SECONDS] * 2)
+    shown = plan_json("a man walks a loop around the tree, then waves", course_seconds=once_round)
+    assert [s["seconds"] for s in shown["segments"]] == pytest.approx([5.847, 3.0], abs=0.001)
 
 
 def test_a_counted_segment_takes_as_long_as_its_repetitions_when_the_length_is_the_models():

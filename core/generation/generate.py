@@ -32,7 +32,8 @@ from ..scene.motion_file import Motion
 from ..torch_threads import one_torch_thread
 from .action_clips import ACTION_CLIPS, UNASKED_SECONDS, action_clips
 from .captured_takes import TakePool, Window, action_credit, captured_motion, decoded_provenance
-from .course_walk import ACTIONS as COURSE_ACTIONS, WALK_SPEED, course_motion, course_note, course_seconds
+from .course_shapes import ACTIONS as COURSE_ACTIONS, unasked_seconds
+from .course_walk import course_motion, course_note
 from .decode import decode_features, decode_tokens, redecode
 from .library_takes import captured_window, read_take, window_fit
 from .model_bundle import model_files, part_warnings, resolve_model_dir
@@ -363,18 +364,12 @@ class Generator:
 
     def course_seconds(self, words) -> float | None:
         """The length a course the words name gets when none is asked: once round at the typical
-        pace of its gait (walk, jog or run; a walk's for another gait), slowed when asked slowly,
-        ``course_walk.course_seconds``."""
-        from .pace_words import SLOW_SPEED
-
-        gait = words.course_gait[1] if words.course_gait else None
-        speeds = self.typical_speeds
-        speed = speeds.get(gait) or speeds.get("walk") or WALK_SPEED
-        return course_seconds(words.course, speed * (SLOW_SPEED if words.pace == "slow" else 1.0))
+        pace of its gait (``course_shapes.unasked_seconds`` on the model folder's table)."""
+        return unasked_seconds(words, self.typical_speeds)
 
     @staticmethod
     def asks_course(words, check, edited: bool = False) -> str | None:
-        """The course a prompt asks to walk (``course_walk.COURSES``), or None: the plan's
+        """The course a prompt asks to walk (``course_shapes.COURSES``), or None: the plan's
         (``words``: a ``plan.words.Words``; ``edited``: the user's plan, taken as it is), or by its
         nearest training caption ("pace around in a loop"), read from its ``check_text`` (None: no
         known captions) as ``parts.clause_classifier`` reads a clause's."""
@@ -594,8 +589,9 @@ class Generator:
                     motion = (course_motion(motion, self.body, course, words.course_right, self.ik_refine_iters, r.whole_course)
                               if course is not None else                                          # course_walk.py
                               turn_motion(motion, self.body, turn, self.ik_refine_iters))         # turn_words.py
-                    if course is not None and (note := course_note(course, motion.joints, motion.fps)):
-                        motion.notes.append(note)   # "a figure eight" in 4 s goes a third of the way round
+                    note = course_note(course, motion.joints, motion.fps) if course and not r.whole_course else None
+                    if note:   # "a figure eight" in 4 s goes a third of the way round (a segment: whole rounds)
+                        motion.notes.append(note)
             if words is not None and words.arms_held and words.gestures_only and words.parts is None:
                 motion = held_motion(motion, self.body, self.ik_refine_iters)   # "stands with her arms raised"
             if words is not None:   # "jogs in place": the data's gaits all travel; stepped on the spot instead
@@ -629,7 +625,7 @@ class Generator:
         (``Plan.lengths``), one body for all."""
         from .sequence import generate_sequence
 
-        lengths = plan.lengths(r.seconds)
+        lengths = plan.lengths(r.seconds, self.course_seconds)   # a course's segment: once round
         if min(lengths) < MIN_SEGMENT_SECONDS:
             raise ShapeMoveError(f"{r.prompt!r} is {len(lengths)} motions in order: {r.seconds:g} s gives each "
                                  f"{min(lengths):.2f} s, under the {MIN_SEGMENT_SECONDS:g} s one needs; ask for more seconds")

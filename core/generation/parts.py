@@ -36,7 +36,8 @@ from ..scene.motion_file import Motion
 from .captured_takes import decoded_provenance
 from ..plan.part_prompts import PartPlan, plan_parts
 from ..plan.words import read_words
-from .course_walk import ACTIONS as COURSE_ACTIONS, course_motion, course_note, on_course
+from .course_shapes import ACTIONS as COURSE_ACTIONS
+from .course_walk import course_motion, course_note, on_course
 from .decode import motion_from_joints
 from .part_compose import compose_arms, mirror_track, needs_mirror
 from .retarget import shaped_take
@@ -150,7 +151,7 @@ def generate_by_parts(gen, r, words=None, captured: bool = True) -> Motion | Non
         if course is None:
             return m
         m = course_motion(m, gen.body, course, words.course_right, gen.ik_refine_iters, r.whole_course)
-        if note := course_note(course, m.joints, m.fps):
+        if not r.whole_course and (note := course_note(course, m.joints, m.fps)):
             m.notes.append(note)   # too short to go round its course
         return m
     course = plan.legs_action if plan.legs_action in COURSE_ACTIONS else read_words(plan.legs_prompt).course
@@ -182,7 +183,7 @@ def generate_by_parts(gen, r, words=None, captured: bool = True) -> Motion | Non
         m.provenance = f"legs: {legs.provenance}; arms: {arms.provenance}"
     if kept is not arms.track:
         m.notes.append(held_note(arms.track))
-    if course is not None and (note := course_note(course, m.joints, m.fps)):
+    if course is not None and not r.whole_course and (note := course_note(course, m.joints, m.fps)):
         m.notes.append(note)   # too short to go round its course
     m.shape_source = source
     m.part_prompts = (plan.legs_prompt, plan.arms_prompt)

@@ -17,14 +17,15 @@ from .reading import said
 
 
 def plan_json(prompt: str, seconds: float | None = None, loop: bool = False, in_place: bool = False,
-              path: bool = False, by_parts: bool = True) -> dict:
+              path: bool = False, by_parts: bool = True, course_seconds=None) -> dict:
     """The plan of ``prompt`` (module doc), with the notes of the options it is asked with;
-    ``by_parts`` False (``--no-parts``): the prompt whole, one segment, nothing read of its words."""
+    ``by_parts`` False (``--no-parts``): the prompt whole, one segment, nothing read of its words;
+    ``course_seconds``: a course segment's time to go once round (``plan.Plan.lengths``)."""
     if not by_parts:
         return {"prompt": str(prompt), "seconds": None if seconds is None else float(seconds),
                 "segments": [{"text": str(prompt), "share": 1.0, "seconds": None if seconds is None else float(seconds),
                               "understood": {}}]}
-    out = plan_to_json(read_plan(prompt, seconds))
+    out = plan_to_json(read_plan(prompt, seconds), course_seconds)
     notes = option_notes(prompt, loop=loop, in_place=in_place, path=path)
     if notes:
         out["notes"] = notes

@@ -51,21 +51,27 @@ class Plan:
     def is_sequence(self) -> bool:
         return len(self.segments) > 1
 
-    def lengths(self, total: float | None) -> list[float]:
+    def lengths(self, total: float | None, course_seconds=None) -> list[float]:
         """Each segment's seconds of a motion ``total`` seconds long (None: the length its words
-        ask, "for ten seconds", else ``SEGMENT_SECONDS``, or the time a counted action's repetitions
-        take, ``counted_seconds``); a segment's own seconds (an edited plan's) win."""
+        ask, "for ten seconds", else ``own_seconds``); a segment's own seconds (an edited plan's)
+        win. ``course_seconds(words) -> seconds | None``: the time a segment's course takes to go
+        once round (the model's typical pace: ``generation.course_shapes.unasked_seconds``)."""
         if all(s.seconds is not None for s in self.segments):
             return [float(s.seconds) for s in self.segments]
         if total is None:   # the words' own length ("for ten seconds"), else the model's
-            return [float(s.seconds) if s.seconds is not None else own_seconds(s.words) for s in self.segments]
+            return [float(s.seconds) if s.seconds is not None else own_seconds(s.words, course_seconds)
+                    for s in self.segments]
         return [float(s.seconds) if s.seconds is not None else s.share * float(total) for s in self.segments]
 
 
-def own_seconds(words: Words) -> float:
+def own_seconds(words: Words, course_seconds=None) -> float:
     """A segment's seconds when no length is set: the length its words ask ("for ten seconds"),
-    else ``counted_seconds``."""
-    return float(words.seconds) if words.seconds is not None else counted_seconds(words)
+    else the time its course takes to go once round (``course_seconds(words)``, when given and the
+    course has a round: "walks a loop around the tree"), else ``counted_seconds``."""
+    if words.seconds is not None:
+        return float(words.seconds)
+    once = course_seconds(words) if course_seconds is not None and words.course is not None else None
+    return float(once) if once is not None else counted_seconds(words)
 
 
 def counted_seconds(words: Words) -> float:
@@ -85,9 +91,10 @@ def read_plan(prompt: str, seconds: float | None = None) -> Plan:
                 None if seconds is None else float(seconds))
 
 
-def plan_to_json(plan: Plan) -> dict:
-    """The plan as the JSON ``--explain`` prints (``explain.plan_json`` adds the option notes)."""
-    lengths = plan.lengths(plan.seconds) if plan.is_sequence or plan.seconds is not None or \
+def plan_to_json(plan: Plan, course_seconds=None) -> dict:
+    """The plan as the JSON ``--explain`` prints (``explain.plan_json`` adds the option notes);
+    ``course_seconds`` as ``Plan.lengths``."""
+    lengths = plan.lengths(plan.seconds, course_seconds) if plan.is_sequence or plan.seconds is not None or \
         plan.segments[0].seconds is not None or plan.segments[0].words.seconds is not None else [None]
     return {"prompt": plan.prompt, "seconds": plan.seconds,
             "segments": [{"text": s.text, "share": round(s.share, 4),
