@@ -62,6 +62,12 @@ TABLE = [   # (prompt, seconds, options)
     ("a woman walks in a circle followed by jumping twice", 2, []), ("a person walks forward, then turns around", 2, PATH),
     ("she jogs in place, then walks 2 metres forward and stops", 2, []),
     ("a man kicks with the left leg and then punches with the right hand", 2, LOOP),
+    # a gait to one side, a list of steps, a way alone after "then", "follows it with", a course's segment
+    ("a man runs to the left", 1, []), ("she jogs off to her right", 1, LOOP), ("a man runs to the left", 1, PATH),
+    ("a woman walks to the right, waving", 1, IN_PLACE), ("a man runs to the left then to the right", 2, SPEED),
+    ("she walks ahead, spins around, then waves", 2, []), ("a man jumps and follows it with a bow", 2, LOOP),
+    ("after a long walk she sits down", 2, []), ("a man walks a loop around the tree, then waves", 2, IN_PLACE),
+    ("a thief tiptoes along", 1, LOOP),
 ]
 
 
