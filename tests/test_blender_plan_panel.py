@@ -81,3 +81,22 @@ def test_the_plan_is_shown_edited_and_generated_from(addon, tmp_path, monkeypatc
     assert bpy.ops.shapemove.generate() == {"FINISHED"}
     assert "plan" not in sent[-1][0]
     assert bpy.ops.shapemove.clear_plan() == {"FINISHED"} and len(s.plan_segments) == 0
+
+
+def test_a_course_segment_shows_the_time_to_go_once_round(addon):
+    """Read Plan gives a course's segment the time to go once round at the active model's typical
+    walk (2 pi / (0.9 x 1.194 m/s) = 5.85 s), as generating makes it, without torch in the panel's
+    process (``course_shapes``)."""
+    import subprocess
+    import sys
+
+    s = bpy.context.scene.shapemove
+    s.prompt = "a man walks a loop around the tree, then waves"
+    assert bpy.ops.shapemove.read_plan() == {"FINISHED"}
+    assert [round(i.seconds, 2) for i in s.plan_segments] == [5.85, 3.0]
+    code = ("import sys; sys.modules['torch'] = None\n"
+            "from shapemove.core.generation.course_shapes import model_course_seconds\n"
+            "from shapemove.core.plan.words import read_words\n"
+            "print(round(model_course_seconds()(read_words('a man walks in a circle')), 2))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0 and out.stdout.strip() == "5.85", out.stderr
