@@ -319,8 +319,9 @@ def captured_motion(w: Window, body, betas, ik_refine_iters: int = 10, prompt: s
         out.notes.append(f"the captured take plays {(len(w.rotations) - w.looped) / FPS:.1f} s: its own cycle "
                          f"repeats for the remaining {w.looped / FPS:.1f} s")
     if w.cut:
-        out.notes.append(f"the repetitions asked take {(len(w.rotations) + w.cut) / FPS:.1f} s: the "
-                         f"{len(w.rotations) / FPS:.1f} s asked hold fewer of them")
+        need, have = (len(w.rotations) + w.cut) / FPS, len(w.rotations) / FPS
+        digits = 1 if need - have >= 0.1 else 2   # "take 3.05 s: the 3.00 s asked", never "3.0 ... 3.0"
+        out.notes.append(f"the repetitions asked take {need:.{digits}f} s: the {have:.{digits}f} s asked hold fewer of them")
     if w.held:
         out.notes.append(f"the captured take lasts {(len(w.rotations) - w.held) / FPS:.1f} s: its last pose is held "
                          f"for the remaining {w.held / FPS:.1f} s")
