@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from shapemove.core.generation.pace_words import fastest, gait_speed
+from shapemove.core.generation.pace_words import STANDING_SPEED, fastest, gait_speed, going
 from shapemove.core.plan.reader import asks_fast
 from shapemove.core.plan.words import read_words
 
@@ -41,6 +41,21 @@ def test_fastest_keeps_the_fastest_third_of_the_allowed():
     assert np.flatnonzero(fastest(speeds, among)).tolist() == [3, 4]
     nobody = np.zeros(7, bool)
     assert fastest(speeds, nobody).tolist() == nobody.tolist()
+
+
+def test_a_gait_asked_to_go_somewhere_sets_aside_the_candidates_that_stand_about():
+    """"A person walks to the door": the 0.17 m/s candidate (0.5 m in 3 s) is set aside, unless all
+    stand about; in place, a distance, counted steps, standing still or no gait keep every one."""
+    from shapemove.core.plan.words import read_words
+
+    speeds = np.array([0.17, 1.1, STANDING_SPEED, 0.05])
+    everyone = np.ones(4, bool)
+    assert going(read_words("a person walks to the door"), speeds, everyone).tolist() == [False, True, True, False]
+    assert going(read_words("she sneaks forward"), speeds, everyone).tolist() == [False, True, True, False]
+    assert going(read_words("a person walks"), np.array([0.1, 0.2, 0.05, 0.0]), everyone).tolist() == [True] * 4
+    for prompt in ("a person jogs in place", "a man walks 3 metres forward", "she takes three steps forward",
+                   "a person stands still", "a man waves"):
+        assert going(read_words(prompt), speeds, everyone).tolist() == [True] * 4, prompt
 
 
 def test_the_picker_takes_a_fast_walk_over_the_tmas_favourite():

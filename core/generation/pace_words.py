@@ -16,7 +16,8 @@ chosen motion of a stepping gait (a walk, march, sneak, limp, ...: no flight pha
 name). A jog or a run asked slowly keeps its cadence and flights and takes ``SLOW_SPEED`` shorter
 strides (played slower, its flights would hang in the air). Both
 paces named ("slowly, then fast") is no pace; a prompt without a gait ("waves quickly") is left to
-the TMA, since its root speed says nothing of a hand's.
+the TMA, since its root speed says nothing of a hand's. Whatever the pace, a gait asked to go
+somewhere is not given a candidate that stands about (``going``: slower than ``STANDING_SPEED``).
 """
 from __future__ import annotations
 
@@ -26,6 +27,7 @@ from ..constants import FPS
 
 FAST_SHARE = 1 / 3  # the fastest third of the candidates compete for a fast pace
 SLOW_SPEED = 0.8    # a stepping gait asked slowly is played at this speed
+STANDING_SPEED = 0.25   # m/s: a candidate of a gait asked to go on slower than this stands about
 
 def path_length(features: np.ndarray) -> float:
     """Metres the root travels along its path over a (T, 263) feature clip (its horizontal
@@ -47,3 +49,18 @@ def fastest(speeds: np.ndarray, among: np.ndarray) -> np.ndarray:
         return among
     keep = among & (speeds >= np.quantile(speeds[among], 1 - FAST_SHARE))
     return keep if keep.any() else among
+
+
+def going(words, speeds: np.ndarray, among: np.ndarray) -> np.ndarray:
+    """(N,) bool: where the words (``plan.words.Words``) ask a gait that goes somewhere (a gait of
+    ``plan/part_prompts.LEGS``; not in place, standing still, steps or a distance counted), the
+    candidates ``among`` that go at ``STANDING_SPEED`` or faster; ``among`` itself otherwise, or when
+    none does. The TMA chose for "a person walks to the door" a sample that went 0.5 m in 3 s."""
+    from ..plan.part_prompts import LEGS
+
+    if not among.any() or words.in_place or words.stand_still or words.steps is not None or \
+            words.distance_m is not None or not any(a in LEGS for a in words.actions):
+        return among
+    keep = among & (np.asarray(speeds, dtype=np.float64) >= STANDING_SPEED)
+    return keep if keep.any() else among
+

@@ -26,7 +26,7 @@ import numpy as np
 
 from ..plan.words import read_words
 from .count_words import counter, nearest_count
-from .pace_words import fastest, gait_speed
+from .pace_words import fastest, gait_speed, going
 from .posture_change import posture_kept
 from .stop_words import reaching
 from .travel_words import allowed
@@ -45,8 +45,8 @@ class CandidatePicker:
         return embed_motions(self.model, feats, self.mean, self.std) @ text
 
     def pick(self, prompt: str, feats: list, bonus=None, words=None, reach: float | None = None) -> int:
-        """Index of the candidate closest to ``prompt`` among those that obey the travel, pace and
-        count of its plan (``words``: a ``plan.words.Words``, else the prompt's reading; the first on
+        """Index of the candidate closest to ``prompt`` among those that obey the travel, pace
+        (a gait that goes somewhere: ``pace_words.going``) and count of its plan (``words``: a ``plan.words.Words``, else the prompt's reading; the first on
         a tie); ``bonus`` (N,): added to the similarities (a captured take of the asked action,
         ``captured_takes.ACTION_BONUS``); ``reach``: a distance (m) asked of a gait cut where it gets
         there (``stop_words.reaching``: those whose path is that long, when one is)."""
@@ -54,8 +54,10 @@ class CandidatePicker:
         keep = allowed(words.travel, feats)
         if reach is not None:
             keep = reaching(feats, reach, keep)
+        speeds = np.array([gait_speed(f) for f in feats])
+        keep = going(words, speeds, keep)   # a gait asked to go somewhere: not one that stands about
         if words.pace == "fast":
-            keep = fastest(np.array([gait_speed(f) for f in feats]), keep)
+            keep = fastest(speeds, keep)
         if words.count is not None:
             action, want = words.count
             keep = nearest_count([counter(action)(f) for f in feats], want, keep)
