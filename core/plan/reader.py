@@ -139,7 +139,8 @@ def asks_stand_still(text: str) -> bool:
 def course_named(text: str) -> str | None:
     """The course the words name (``EIGHT`` before ``CIRCLE``: "a figure eight" is not a circle;
     not the circles the arms make: "walks forward rotating the arms in circles"; back and forth and a
-    zigzag only with a gait to walk it, or as the verb: "sways back and forth" names none), else
+    zigzag only with a gait to walk it, or as the verb: "sways back and forth" names none; a gait
+    to one side, ``ASIDE_COURSE``: "runs to the left", not a sidestep or a walk backward), else
     None."""
     acts = find_actions(text)
     if V.EIGHT in acts or (V.CIRCLE in acts and not V.ARM_CIRCLES.search(str(text))):
