@@ -46,3 +46,30 @@ def test_the_default_model_gets_up_and_lies_down_whoever_does_it():
         down = gen.generate_batch([Request("an exhausted woman lies down on the floor", seed=seed, seconds=3)])[0]
         y = down.joints[:, 0, 1]
         assert y[:5].mean() - y[-5:].mean() > 0.5 and y[-5:].mean() < 0.3, seed
+
+
+def _with_head(y, head) -> np.ndarray:
+    f = _rooted(y)
+    f[:, 47] = head          # joint 15's height in the features (ric: heights are the floor's)
+    return f
+
+
+def test_a_sit_keeps_the_head_up_and_a_lie_down_puts_it_down():
+    """Both go down as far (the root 0.9 -> 0.2 m); lying, the head ends 0.15 m high, under LYING
+    (0.35) of its highest 1.6 m; sitting it stays at 0.9 m. A sit keeps the one whose head stays up
+    (and, with none going down that way, one that does not lie rather than one that does); a
+    lie-down the one whose head goes down."""
+    from shapemove.core.generation.posture_change import LYING, lies
+
+    down = np.linspace(0.9, 0.2, 40)
+    lying = _with_head(down, np.linspace(1.6, 0.15, 40))
+    sitting = _with_head(down, np.linspace(1.6, 0.9, 40))
+    standing = _with_head(np.full(40, 0.9), np.full(40, 1.6))
+    assert lies(lying) and not lies(sitting) and not lies(standing)
+    low = lambda h: _with_head(down, np.r_[np.linspace(1.6, h, 10), np.full(30, h)])   # noqa: E731
+    assert lies(low(0.5)) and not lies(low(0.6)) and 0.5 < LYING * 1.6 < 0.6   # 0.31 and 0.375 of 1.6 m
+    keep = np.ones(3, bool)
+    assert posture_kept("sit", [lying, sitting, standing], keep).tolist() == [False, True, False]
+    assert posture_kept("lie down", [lying, sitting, standing], keep).tolist() == [True, False, False]
+    assert posture_kept("sit", [lying, standing], np.ones(2, bool)).tolist() == [False, True]   # no sit: not lying
+    assert posture_kept("sit", [lying, lying], np.ones(2, bool)).tolist() == [True, True]       # all lie: all

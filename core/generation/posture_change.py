@@ -11,6 +11,14 @@ against the start, as a share of the candidate's highest root, moves by at least
 the way the action goes (the built data's get-ups and lie-downs move 0.7 of it; its walks at most
 0.2). When no candidate makes it, all compete.
 
+A sitting body keeps its head up and a lying one does not, though both bring the root as low (a
+sit on the floor): "a person sits down" chose a sample that lay on the floor, head 0.3 m high. So
+for a sit the candidates whose head stays up compete, and for a lie-down those whose head goes
+down: the head's low height (its ``LOW_QUANTILE``) under ``LYING`` of its highest lies (the built
+data's lie-downs 0.08-0.09, get-ups from the floor 0.09-0.28, squats 0.54-0.73, bends 0.52); a sit
+with none whose head stays up keeps a candidate that does not lie rather than one that does ("no
+sit is better than a body lying on the floor").
+
     keep = posture_kept("get up", feats, keep)     # (N,) bool among (T, 263) candidates
 """
 from __future__ import annotations
@@ -21,6 +29,10 @@ from ..plan.vocabulary import POSTURE_CHANGES
 
 MIN_CHANGE = 0.3   # of the candidate's highest root
 ENDS = 5           # frames averaged at the start and at the end
+LYING = 0.35       # a head whose low height is under this share of its highest lies
+LOW_QUANTILE = 0.1
+HEAD_Y = 47        # the head's height in the (T, 263) features (ric: joint 15's y; heights are the floor's)
+HEAD_DOWN = {"lie down": True, "sit": False}   # where the head goes in the change of posture
 
 
 def posture_change(features) -> float:
@@ -30,11 +42,24 @@ def posture_change(features) -> float:
     return float((y[-ENDS:].mean() - y[:ENDS].mean()) / max(y.max(), 1e-6))
 
 
+def lies(features) -> bool:
+    """Whether a (T, 263) candidate lies on the floor: its head's low height under ``LYING`` of its
+    highest (module doc)."""
+    head = np.asarray(features, dtype=np.float64)[:, HEAD_Y]
+    return bool(np.quantile(head, LOW_QUANTILE) < LYING * max(head.max(), 1e-6))
+
+
 def posture_kept(action: str | None, feats: list, keep: np.ndarray) -> np.ndarray:
     """``keep`` narrowed to the candidates that make ``action``'s change of posture, when it is one
-    and any of them makes it."""
+    and any of them makes it; for a sit or a lie-down, with the head where that posture has it
+    (module doc)."""
     way = POSTURE_CHANGES.get(action or "")
     if way is None:
         return keep
     makes = np.array([way * posture_change(f) >= MIN_CHANGE for f in feats]) & keep
+    if action in HEAD_DOWN:
+        head = np.array([lies(f) for f in feats]) == HEAD_DOWN[action]
+        for narrowed in (makes & head, keep & head):
+            if narrowed.any():
+                return narrowed
     return makes if makes.any() else keep
