@@ -13,10 +13,12 @@ said as notes (``Motion.notes``, printed by the command line as ``note:`` lines)
 from __future__ import annotations
 
 from .plan import read_plan
-from .vocabulary import COURSE_NAMES
+from .vocabulary import ASIDE_COURSE, COURSE_NAMES
 
 
 def _course(reading: dict) -> str:
+    if reading["course"] == ASIDE_COURSE:   # "runs to the left"
+        return f"to the {reading.get('course_way', 'left')}"
     return COURSE_NAMES.get(reading["course"], reading["course"])
 
 
