@@ -145,6 +145,7 @@ def test_an_option_that_overrides_the_words_says_it_won():
         "--in-place won over the distance of 5 m: the travel is removed"]
     assert option_notes("a person walks in a zigzag", path=True) == ["--path won over 'zigzag': the body walks your path"]
     assert option_notes("she jogs off to her right", path=True) == ["--path won over 'to the right': the body walks your path"]
+    assert plan_lines("a man runs to the left") == ["understood: run; course: to the left, a quarter turn; left"]
     assert option_notes("a person walks forward", loop=True, in_place=True) == []
 
 

@@ -13,13 +13,7 @@ said as notes (``Motion.notes``, printed by the command line as ``note:`` lines)
 from __future__ import annotations
 
 from .plan import read_plan
-from .vocabulary import ASIDE_COURSE, COURSE_NAMES
-
-
-def _course(reading: dict) -> str:
-    if reading["course"] == ASIDE_COURSE:   # "runs to the left"
-        return f"to the {reading.get('course_way', 'left')}"
-    return COURSE_NAMES.get(reading["course"], reading["course"])
+from .reading import course_said
 
 
 def option_notes(prompt: str, loop: bool = False, in_place: bool = False, path: bool = False,
@@ -41,7 +35,7 @@ def option_notes(prompt: str, loop: bool = False, in_place: bool = False, path: 
                      "(leave out --loop for one after the other)")
     for reading in (s.words.understood() for s in plan.segments):
         if loop and "course" in reading:
-            notes.append(f"--loop won over '{_course(reading)}': a loop repeats one straight cycle "
+            notes.append(f"--loop won over '{course_said(reading)}': a loop repeats one straight cycle "
                          "(leave out --loop to walk the course)")
         if loop and "turn_degrees" in reading:
             notes.append(f"--loop won over the turn of {reading['turn_degrees']} degrees: a loop comes back to its "
@@ -49,11 +43,11 @@ def option_notes(prompt: str, loop: bool = False, in_place: bool = False, path: 
         if loop and (reading.get("stop") or "distance_m" in reading):
             notes.append("--loop won over the stop: a loop never stops (leave out --loop to stop)")
         if path and "course" in reading:
-            notes.append(f"--path won over '{_course(reading)}': the body walks your path")
+            notes.append(f"--path won over '{course_said(reading)}': the body walks your path")
         if path and "turn_degrees" in reading:
             notes.append(f"--path won over the turn of {reading['turn_degrees']} degrees: the body faces along your path")
         if in_place and "course" in reading:
-            notes.append(f"--in-place won over '{_course(reading)}': its travel is removed, its turning kept")
+            notes.append(f"--in-place won over '{course_said(reading)}': its travel is removed, its turning kept")
         if in_place and "distance_m" in reading:
             notes.append(f"--in-place won over the distance of {reading['distance_m']:g} m: the travel is removed")
     return list(dict.fromkeys(notes))

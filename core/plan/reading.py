@@ -10,12 +10,20 @@ side, and the words no class took). Readings that are absent are left out.
 """
 from __future__ import annotations
 
+from .vocabulary import ASIDE_COURSE, COURSE_NAMES
 from .words import read_words
 
 
 def understood(text: str) -> dict:
     """The readings of ``text`` (module doc): only what the words ask."""
     return read_words(str(text)).understood()
+
+
+def course_said(reading: dict) -> str:
+    """A reading's course as people say it: "in a circle", "zigzag", "to the left" (a gait to one side)."""
+    if reading["course"] == ASIDE_COURSE:
+        return f"to the {reading.get('course_way', 'left')}"
+    return COURSE_NAMES.get(reading["course"], reading["course"])
 
 
 def said(reading: dict) -> str:
@@ -25,7 +33,9 @@ def said(reading: dict) -> str:
         bits.append(f"legs {reading['legs']!r} + arms {reading['arms']!r}")
     elif reading.get("actions"):
         bits.append(", ".join(reading["actions"]))
-    if "course" in reading:
+    if "course" in reading and reading["course"] == ASIDE_COURSE:
+        bits.append(f"course: {course_said(reading)}, a quarter turn")
+    elif "course" in reading:
         bits.append(f"course: {reading['course']} (to the {reading['course_way']})")
     if "turn_degrees" in reading:
         bits.append(f"turn {reading['turn_degrees']} degrees")
