@@ -105,9 +105,14 @@ def on_course(track: Track, course: str | None, right: bool = False, fps: float 
 def course_motion(motion, body, course: str | None, right: bool = False, ik_refine_iters: int = 10,
                   whole: bool = False):
     """A generated ``Motion`` walked along ``course`` (as ``on_course``; ``track.replanted``: an edit,
-    no tokens kept); the motion itself when it does not travel."""
+    no tokens kept); the motion itself when it does not travel. Unless ``whole`` (a timeline's
+    segment: whole rounds), a motion too short to go once round says so (``course_note``)."""
     from .track import replanted, track_of
 
     tr = track_of(motion)
     bent = on_course(tr, course, right, motion.fps, whole)
-    return motion if bent is tr else replanted(motion, body, bent, ik_refine_iters)
+    out = motion if bent is tr else replanted(motion, body, bent, ik_refine_iters)
+    note = None if whole else course_note(course, out.joints, out.fps)
+    if note:   # "a figure eight" in 4 s goes a third of the way round
+        out.notes.append(note)
+    return out

@@ -33,7 +33,7 @@ from ..torch_threads import one_torch_thread
 from .action_clips import ACTION_CLIPS, UNASKED_SECONDS, action_clips
 from .captured_takes import TakePool, Window, action_credit, captured_motion, decoded_provenance
 from .course_shapes import ACTIONS as COURSE_ACTIONS, unasked_seconds
-from .course_walk import course_motion, course_note
+from .course_walk import course_motion
 from .decode import decode_features, decode_tokens, redecode
 from .library_takes import captured_window, read_take, window_fit
 from .model_bundle import model_files, part_warnings, resolve_model_dir
@@ -589,9 +589,6 @@ class Generator:
                     motion = (course_motion(motion, self.body, course, words.course_right, self.ik_refine_iters, r.whole_course)
                               if course is not None else                                          # course_walk.py
                               turn_motion(motion, self.body, turn, self.ik_refine_iters))         # turn_words.py
-                    note = course_note(course, motion.joints, motion.fps) if course and not r.whole_course else None
-                    if note:   # "a figure eight" in 4 s goes a third of the way round (a segment: whole rounds)
-                        motion.notes.append(note)
             if words is not None and words.arms_held and words.gestures_only and words.parts is None:
                 motion = held_motion(motion, self.body, self.ik_refine_iters)   # "stands with her arms raised"
             if words is not None:   # "jogs in place": the data's gaits all travel; stepped on the spot instead

@@ -63,4 +63,3 @@ def going(words, speeds: np.ndarray, among: np.ndarray) -> np.ndarray:
         return among
     keep = among & (np.asarray(speeds, dtype=np.float64) >= STANDING_SPEED)
     return keep if keep.any() else among
-

@@ -148,12 +148,8 @@ def generate_by_parts(gen, r, words=None, captured: bool = True) -> Motion | Non
                          provenance=decoded_provenance(choice.kept))
         m.shape_source = source
         m.retrieved_clips = choice.clips
-        if course is None:
-            return m
-        m = course_motion(m, gen.body, course, words.course_right, gen.ik_refine_iters, r.whole_course)
-        if not r.whole_course and (note := course_note(course, m.joints, m.fps)):
-            m.notes.append(note)   # too short to go round its course
-        return m
+        return m if course is None else course_motion(m, gen.body, course, words.course_right, gen.ik_refine_iters,
+                                                      r.whole_course)
     course = plan.legs_action if plan.legs_action in COURSE_ACTIONS else read_words(plan.legs_prompt).course
     gait = read_words(plan.legs_prompt).course_gait if course is not None else None   # walked straight, then bent
     legs_req = dataclasses.replace(r, prompt=gait[0], action=gait[1]) if gait else \

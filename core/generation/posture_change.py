@@ -25,13 +25,16 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..body.skeleton import JOINT_NAMES
+from ..motion.features import feature_slices
 from ..plan.vocabulary import POSTURE_CHANGES
 
 MIN_CHANGE = 0.3   # of the candidate's highest root
 ENDS = 5           # frames averaged at the start and at the end
 LYING = 0.35       # a head whose low height is under this share of its highest lies
 LOW_QUANTILE = 0.1
-HEAD_Y = 47        # the head's height in the (T, 263) features (ric: joint 15's y; heights are the floor's)
+# the head's height in the (T, 263) features: its y in ``ric`` (joints 1..21, heights the floor's)
+HEAD_Y = feature_slices["ric"].start + 3 * (JOINT_NAMES.index("head") - 1) + 1
 HEAD_DOWN = {"lie down": True, "sit": False}   # where the head goes in the change of posture
 
 

@@ -45,11 +45,12 @@ class CandidatePicker:
         return embed_motions(self.model, feats, self.mean, self.std) @ text
 
     def pick(self, prompt: str, feats: list, bonus=None, words=None, reach: float | None = None) -> int:
-        """Index of the candidate closest to ``prompt`` among those that obey the travel, pace
-        (a gait that goes somewhere: ``pace_words.going``) and count of its plan (``words``: a ``plan.words.Words``, else the prompt's reading; the first on
-        a tie); ``bonus`` (N,): added to the similarities (a captured take of the asked action,
-        ``captured_takes.ACTION_BONUS``); ``reach``: a distance (m) asked of a gait cut where it gets
-        there (``stop_words.reaching``: those whose path is that long, when one is)."""
+        """Index of the candidate closest to ``prompt`` among those that obey the travel, pace (a
+        gait that goes somewhere: ``pace_words.going``) and count of its plan (``words``: a
+        ``plan.words.Words``, else the prompt's reading; the first on a tie); ``bonus`` (N,): added
+        to the similarities (a captured take of the asked action, ``captured_takes.ACTION_BONUS``);
+        ``reach``: a distance (m) asked of a gait cut where it gets there (``stop_words.reaching``:
+        those whose path is that long, when one is)."""
         words = read_words(prompt) if words is None else words
         keep = allowed(words.travel, feats)
         if reach is not None:
