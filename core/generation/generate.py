@@ -54,6 +54,7 @@ from .sampling_params import (DEFAULT_GUIDANCE, check_candidates, check_guidance
                               check_retrieval_prefix, check_retrieved, check_sampling)
 from .request import Request
 from .slow_steps import slow_motion
+from .still_take import still_take
 from .typical_pace import leg_ratio, load_typical_speeds, slow_take, typical_paced, unplain_take
 from .straight_gait import straight_asked
 from .turn_words import turn_motion
@@ -252,7 +253,8 @@ class Generator:
             windows = [w for w in (self._windows(r, asked, lo, hi, side, times) if captured else [])   # of the asked action,
                        if action_credit(asked, w.action) is not None                    # at a plain gait's pace
                        and not slow_take(w, words, self.typical_speeds, self.body)
-                       and not unplain_take(w, words)]
+                       and not unplain_take(w, words)
+                       and not still_take(w, asked, words)]
             cands, sources, beta = (self._from_action_clips(r, found) if found    # the user's clips: as captured
                                     else self._sampled(r, lo, hi, g, library=not windows))   # takes, or as codes
             best = 0
