@@ -75,6 +75,8 @@ def test_a_take_of_another_action_than_the_words_name_does_not_compete():
     assert action_credit("jump forward", "jump") is None                 # not the other way round
     assert action_credit("sit", "lie down") is None                      # no sit take: a lying-down take is not one
     assert action_credit(None, "lie down") == 0.0 and action_credit("sit", "") == 0.0   # nothing named, no label
+    assert action_credit("walk", "sneak") == ACTION_BONUS and action_credit("walk", "walk backward") is None
+    assert action_credit("walk backward", "walk backward") == ACTION_BONUS   # a backward walk only asked by name
 
 
 def test_sitting_down_is_never_a_lying_down_take():

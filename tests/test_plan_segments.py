@@ -60,6 +60,13 @@ from shapemove.core.plan.segments import SEGMENT_SECONDS, split_segments
     ("he lies down and rolls over", ["he lies down", "he rolls over"]),
     ("a man crawls, then stands up and runs", ["a man crawls", "a man stands up", "a man runs"]),
     ("a woman squats, then stands up and waves", ["a woman squats", "a woman stands up and waves"]),  # the squat's end
+    # "and" between two actions one body does not do at once orders, and so do the commas of a list before it
+    ("she runs to the car and jumps in", ["she runs to the car", "she jumps in"]),
+    ("a person walks up to a table and puts down a cup", ["a person walks up to a table", "a person puts down a cup"]),
+    ("a man kicks and punches", ["a man kicks", "a man punches"]),
+    ("she jumps, squats and waves", ["she jumps", "she squats", "she waves"]),
+    ("a woman walks forward, turns around and walks back", ["a woman walks forward, turns around", "a woman walks back"]),
+    ("a person squats down, subsequently stands up and runs", ["a person squats down", "a person stands up and runs"]),
 ])
 def test_ordering_words_make_segments_in_the_order_they_happen(prompt, segments):
     assert split_segments(prompt) == segments
@@ -82,7 +89,9 @@ def test_ordering_words_make_segments_in_the_order_they_happen(prompt, segments)
     "a skater jumps and twirls in the air", "a martial artist whirls around and kicks", "the man stands and waves",
     "someone stands up and down", "he squats and stands up", "a woman walks and waves",
     "A see-you-later gesture to a friend leaving.", "she says see you later and walks away",
-    "after the warm-up the man runs", "a man walks ahead, waves, and nods", "she jumps, squats and waves",
+    "after the warm-up the man runs", "a man walks ahead, waves, and nods",
+    # a gait and an arm gesture at once, a turn beside its gait
+    "a man walks and throws a ball", "a man walks and turns left", "a person turns around and walks away",
 ])
 def test_and_alone_courses_and_things_at_once_stay_one_segment(prompt):
     assert split_segments(prompt) == [prompt]

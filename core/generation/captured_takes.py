@@ -57,6 +57,7 @@ ACTION_BONUS = 0.3     # TMA cosine credited to a take of the asked action (tuni
 UNASKED_SECONDS = 4.0  # the least a take plays when the length is the model's
 BUSIEST = 2            # a long take's busiest windows, one drawn by the seed
 KEPT = 16              # takes kept read at once (rotations as matrices)
+OTHER_WAY = frozenset({"walk backward"})   # specific forms that compete only when asked by name
 USER_FLOOR = 0.5       # TMA caption cosine from which the user's nearest clip is offered whatever its action
 
 
@@ -281,11 +282,15 @@ def action_credit(asked: str | None, action: str) -> float | None:
     """What the choice credits a take of ``action`` for a prompt asking ``asked``: ``ACTION_BONUS``
     for the asked action or a specific form of it (``actions.GENERIC_OF``: a jump forward for a
     jump), nothing when the words name no action or the take has no label, and None for a take of
-    another action, which does not compete (no sit take: a lying-down take is not a sit)."""
+    another action, which does not compete (no sit take: a lying-down take is not a sit), nor does a
+    take of a specific form that travels another way than its generic action (``OTHER_WAY``: a walk
+    backward is no walk)."""
     from ..data.actions import GENERIC_OF
 
     if not asked or not action:
         return 0.0
+    if action in OTHER_WAY and asked != action:   # "walks back" after a turn goes back the way it came
+        return None
     return ACTION_BONUS if action == asked or asked in GENERIC_OF.get(action, ()) else None
 
 

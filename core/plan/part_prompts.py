@@ -34,6 +34,12 @@ ARMS = frozenset(ARMS_ACTIONS)
 FOOT_ACTIONS = frozenset({"kick", "spin kick", "kick ball", "hop"})
 
 
+def at_once(first: str, second: str) -> bool:
+    """Whether one body does the two actions at once, by part: a locomotion (``LEGS``) and an arm
+    gesture (``ARMS``), either way round ("jogs and waves"); any other two follow one another."""
+    return (first in LEGS and second in ARMS) or (first in ARMS and second in LEGS)
+
+
 @dataclass(frozen=True)
 class PartPlan:
     legs_prompt: str

@@ -14,10 +14,12 @@ an order word cuts, the commas of a list of steps before it cut too ("walks ahea
 then waves": three; ``vocabulary.LIST_STEP``), but not before a participle ("jogs, waving": two
 things at once) nor before a turn (the turn ends its gait). A way alone after an order word goes
 on with the verb before it ("runs to the left, then to the right": "runs to the right";
-``vocabulary.WAY_ALONE``). "And" cuts only beside a change of posture ("gets up and walks away", "walks over and
-sits down"; ``vocabulary.POSTURE_CHANGES``), never after a squat's own standing up: two things at
-once ("jogs and waves") are one segment made by body part (``generation/parts.py``), "jumps and
-twirls" one action, and "back and forth", "to and fro", "up and down" are courses.
+``vocabulary.WAY_ALONE``). "And" cuts beside a change of posture ("gets up and walks away", "walks over and
+sits down"; ``vocabulary.POSTURE_CHANGES``), never after a squat's own standing up, and between two
+actions one body does not do at once ("runs to the car and jumps in", "walks forward, turns around
+and walks back"); two things at once ("jogs and waves": a gait and an arm gesture) are one segment
+made by body part (``generation/parts.py``), "jumps and twirls" one action, a turn beside its gait
+one segment ("walks and turns left"), and "back and forth", "to and fro", "up and down" are courses.
 "After" / "before" cut only before a participle or a pronoun ("runs after the ball" is one thing).
 Both sides of a "before" / "after" must name an action ("jumps and turns before landing" is one),
 and what follows "then" must say what someone does ("bends the knees, then straightens" is one
@@ -34,7 +36,7 @@ from __future__ import annotations
 import re
 
 from ..data.actions import find_actions
-from .part_prompts import SUBJECT, _has_verb, _subject, _with_subject
+from .part_prompts import SUBJECT, _has_verb, _subject, _with_subject, at_once
 from .vocabulary import (AND, BEFORE_AFTER as MIDDLE, FIRST, LEADING_BEFORE_AFTER as LEADING, LIST_STEP, PARTICIPLE,
                          POSTURE_CHANGES, RISEN_FROM, STOP, THEN, WAY_ALONE)
 
@@ -88,18 +90,40 @@ def _changes_posture(action: str, before: list[str]) -> bool:
     return action in POSTURE_CHANGES and not (action == "get up" and any(x in RISEN_FROM for x in before))
 
 
-def _posture_and(piece: str, before: str = "") -> list[str]:
-    """A piece cut at an "and" with a change of posture on one side, each side naming its own action
-    ("stands up and runs", "walks to the chair and sits down"); the piece itself otherwise. Standing
+def _one_after_other(first: list[str], then: list[str], whole: list[str]) -> bool:
+    """Whether the actions ``first`` (before an "and") and ``then`` (after it) follow one another: the
+    last of the one and the first of the other are two actions one body does not do at once
+    (``part_prompts.at_once``: "jogs and waves" is one segment made by body part), each its own in
+    the ``whole`` piece ("jumps and twirls" is one spin jump), the second no turn ("walks and turns
+    left": the turn ends the gait) and the first no turn alone ("turns around and walks away": the
+    turn starts the gait); a change of posture on either side has its own rule ("squats and stands
+    up" is one squat)."""
+    last, nxt = first[-1], then[0]
+    if nxt == "turn" or first == ["turn"] or last == nxt or at_once(last, nxt):
+        return False
+    if last in POSTURE_CHANGES or nxt in POSTURE_CHANGES:   # said by the posture's own rule (``_and_steps``)
+        return False
+    return last in whole and nxt in whole
+
+
+def _and_steps(piece: str, before: str = "") -> list[str]:
+    """A piece cut at each "and" between two things done one after the other, each side naming its
+    own action: a change of posture on one side ("stands up and runs", "walks to the chair and sits
+    down"), or two actions one body does not do at once (``_one_after_other``: "runs to the car and
+    jumps in", "walks forward, turns around and walks back"), and, where it cuts, at the commas of a
+    list of steps before it ("jumps, squats and waves": three); the piece itself otherwise. Standing
     up after a squat or a bend (``before``: what precedes the piece) is that action's own end, no
     action of its own ("squats, then stands up and waves" is two)."""
+    whole = find_actions(piece)
     for m in AND.finditer(piece):
         a, b = piece[:m.start()], piece[m.end():]
         first, then = find_actions(a), find_actions(b)
-        if not (first and then and first[0] != then[0] and _has_verb(b)):
+        if not (first and then and _has_verb(b)):
             continue
-        if _changes_posture(first[0], find_actions(before)) or _changes_posture(then[0], first):
-            return [a] + _posture_and(b, a)
+        posture = first[0] != then[0] and (_changes_posture(first[0], find_actions(before))
+                                           or _changes_posture(then[0], first))
+        if posture or _one_after_other(first, then, whole):   # an order: the list of steps before it cuts too
+            return _list_steps(a) + _and_steps(b, a)
     return [piece]
 
 
@@ -156,7 +180,7 @@ def split_segments(prompt: str) -> list[str]:
     if len(pieces) > 1:   # a list of steps: "walks ahead, spins around, then waves"
         pieces = [q for p in pieces for q in _list_steps(p)]
     ordered = [q for p in pieces if p for q in _ordered(p)]
-    ordered = [q for i, o in enumerate(ordered) for q in _posture_and(o, ordered[i - 1] if i else "")
+    ordered = [q for i, o in enumerate(ordered) for q in _and_steps(o, ordered[i - 1] if i else "")
                if _says_something(_tidy(q))]
     if len(ordered) < 2:
         return [str(prompt).strip()]
