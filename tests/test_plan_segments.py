@@ -132,6 +132,15 @@ def test_a_counted_segment_takes_as_long_as_its_repetitions_when_the_length_is_t
     assert read_plan("he jumps once, then waves").lengths(None) == pytest.approx([SEGMENT_SECONDS] * 2)
 
 
+def test_a_lie_down_segment_takes_the_time_a_captured_lie_down_takes():
+    """5.3 s from the root's first drop to lying still (the library's lie-downs); a get-up fits the 3 s
+    default; a total asked is shared as before."""
+    plan = read_plan("a man lies down, then gets up")
+    assert plan.lengths(None) == pytest.approx([5.3, SEGMENT_SECONDS])
+    assert plan.lengths(6.0) == pytest.approx([3.0, 3.0])
+    assert read_plan("she walks over and lies down on the floor").lengths(None) == pytest.approx([SEGMENT_SECONDS, 5.3])
+
+
 def test_the_readings_are_the_generators():
     assert understood("a man walks 3 metres forward and stops") == {
         "actions": ["walk"], "travel": "forward", "distance_m": 3.0, "stop": True}

@@ -48,6 +48,23 @@ def test_the_default_model_gets_up_and_lies_down_whoever_does_it():
         assert y[:5].mean() - y[-5:].mean() > 0.5 and y[-5:].mean() < 0.3, seed
 
 
+def test_a_lie_down_segment_starts_standing_and_ends_lying():
+    """"a man lies down, then gets up": in a 3 s segment the captured lie-down's last 3 s started on
+    its knees (the take's first drop is 4-7 s before its end); its 5.3 s segment starts standing,
+    lies with the head on the floor, and the get-up ends standing (seeds 0-1)."""
+    from shapemove.core.generation.generate import Generator, Request
+
+    gen = Generator(None)
+    for seed in (0, 1):
+        m = gen.generate_batch([Request("a man lies down, then gets up", seed=seed)])[0]
+        (s0, e0), (s1, e1) = m.segment_bounds
+        root, head = m.joints[:, 0, 1], m.joints[:, 15, 1]
+        assert e0 - s0 >= 100, (seed, e0 - s0)                             # 5.2 s (whole codes of 5.3)
+        assert root[:5].mean() > 0.8 and head[:5].mean() > 1.4, seed       # standing at the start
+        assert head[e0 - 10:e0].mean() < 0.35, seed                         # lying at the seam
+        assert root[-5:].mean() > 0.8 and head[-5:].mean() > 1.4, seed      # up again at the end
+
+
 def _with_head(y, head) -> np.ndarray:
     f = _rooted(y)
     f[:, 47] = head          # joint 15's height in the features (ric: heights are the floor's)

@@ -25,7 +25,7 @@ from dataclasses import dataclass, replace
 
 from ..errors import ShapeMoveError
 from .segments import MIN_SEGMENT_SECONDS, SEGMENT_SECONDS, split_segments
-from .vocabulary import REPETITION_SECONDS
+from .vocabulary import POSTURE_SECONDS, REPETITION_SECONDS
 from .words import Words, read_words
 
 MAX_SEGMENTS = 32          # as a timeline (``generation/sequence.MAX_SEGMENTS``)
@@ -76,9 +76,11 @@ def own_seconds(words: Words, course_seconds=None) -> float:
 
 def counted_seconds(words: Words) -> float:
     """A segment's seconds when the length is the model's: ``SEGMENT_SECONDS``, or as long as its
-    counted repetitions take ("six jumping jacks": 6 x 1.1 s and one more for the start and the end)."""
+    counted repetitions take ("six jumping jacks": 6 x 1.1 s and one more for the start and the end),
+    or its change of posture ("lies down": 5.3 s from the first drop to lying still,
+    ``vocabulary.POSTURE_SECONDS``; in 3 s a captured lie-down starts on its knees)."""
     if words.count is None:
-        return SEGMENT_SECONDS
+        return max([SEGMENT_SECONDS] + [POSTURE_SECONDS[a] for a in words.actions if a in POSTURE_SECONDS])
     action, times = words.count
     return max(SEGMENT_SECONDS, (times + 1) * REPETITION_SECONDS.get(action, 0.0))
 

@@ -36,6 +36,11 @@ MAX_COUNT = 12
 REPETITION_SECONDS = {"jump": 0.7, "jump forward": 1.7, "spin jump": 1.7, "hop": 0.7, "jumping jacks": 1.1,
                       "squat": 1.4, "kick": 1.5}
 
+# seconds a change of posture takes, its start to lying still: the median, over the built-in library's
+# 14 lie-down takes, from the root's first drop (below 0.9 of its standing height) to the take's end
+# (2026-11-29); a get-up (2.9 s, two takes) fits the 3 s of a segment
+POSTURE_SECONDS = {"lie down": 5.3}
+
 # -- pace -------------------------------------------------------------------------------------
 FAST = re.compile(r"\b(quick(?:ly)?|fast(?:er)?|brisk(?:ly)?|rapid(?:ly)?|swift(?:ly)?|hurried(?:ly)?|hurr(?:y|ies|ying)|"
                   r"hast(?:y|ily)|speedy|full speed|top speed|flat out|as fast as)\b", re.I)
