@@ -21,7 +21,11 @@ from test_course_walk import _straight_walk
     ("turn clockwise all the way around", -2 * np.pi),
     ("he turns his head", None),                       # a part turns, not the body
     ("back away slowly without turning around", None),  # negated
-    ("walks forward then turns around", None),         # another action too: the timeline's job
+    ("waves, then turns around", None),                # another action too: the timeline's job
+    ("walks forward and turns around", np.pi),         # a gait that turns: turned on its track
+    ("she turns right and jogs on", -np.pi / 2),
+    ("a man runs and spins", None),                    # a spin beside a gait is no turn of the track
+    ("walks and jogs, then turns around", None),       # two gaits
     ("a person turns", None),                          # no amount named
     ("a person waves", None),
 ])
@@ -64,3 +68,20 @@ def test_generation_turns_the_body_as_far_as_the_words_say():
     gen.set_captured(False)   # the model's own motion, as it writes it (no captured take)
     plain = gen.generate_batch([Request("a person turns around", seconds=4, seed=0, by_parts=False)])[0]
     assert plain.tokens is not None
+
+
+def test_a_gait_that_turns_turns_as_far_as_the_words_say():
+    """"walks forward and turns around" and "turns around and walks away" read the turn beside the
+    walk (it was read as an action and not acted on: the walks went on ahead); "jogs and turns
+    left" a quarter turn. Each ends facing that far round (seeds 0-1, 4 s) and keeps going."""
+    from shapemove.core.generation.generate import Generator, Request
+    from shapemove.core.generation.track import travel
+
+    gen = Generator(None)
+    for text, angle in (("a man walks forward and turns around", np.pi),
+                        ("a man turns around and walks away", np.pi), ("a woman jogs and turns left", np.pi / 2)):
+        for seed in (0, 1):
+            m = gen.generate_batch([Request(text, seconds=4, seed=seed)])[0]
+            h = np.unwrap(headings(m.joints))
+            assert h[-1] - h[0] == pytest.approx(angle, abs=0.4), (text, seed, h[-1] - h[0])
+            assert travel(m.joints)[-1] > 1.5, (text, seed)

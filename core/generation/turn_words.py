@@ -4,7 +4,8 @@ The SA-VAE's tokens carry almost nothing of how fast the root turns: a linear pr
 neighbouring codes to the root's yaw rate explains none of its variance on held-out clips, and
 captured clips labelled "turn" that turn 3.2-13.5 rad come back from encoding and decoding turning
 0.1-2.1 rad (``docs/codec.md``). So "a person turns around" steps on the spot without turning,
-whoever writes the tokens. A prompt whose only action is a turn or a spin names the angle; the
+whoever writes the tokens. A prompt whose only action is a turn or a spin, or a turn beside one
+gait ("walks forward and turns around": ``plan/reader.angle_of``), names the angle; the
 decoded track is turned by it about the pelvis, eased in and out over the middle of the motion
 (``TURN_SPAN``), and its feet are planted again, as for any edit:
 

@@ -196,10 +196,14 @@ def turns_right(text: str) -> bool:
 
 # -- turns ------------------------------------------------------------------------------------
 def angle_of(text: str) -> float | None:
-    """The yaw (radians, + = left) a prompt of one turn or spin asks the body to turn; None when
-    the prompt asks for something else too, turns a part or a thing, or names no amount."""
+    """The yaw (radians, + = left) a prompt of one turn or spin asks the body to turn, alone or, a
+    turn, beside one gait ("walks forward and turns around", "turns left and jogs on"); None when the
+    prompt asks for something else too, turns a part or a thing, or names no amount."""
     t = " " + str(text).lower() + " "
     acts = set(specific(find_actions(t)))
+    gaits = acts & LEGS
+    if len(gaits) == 1 and "turn" in acts:   # a gait that turns: the turn is given back on its track
+        acts -= gaits
     if not acts or not acts <= {"turn", "spin"} or V.TURN_NOT_BODY.search(t) or V.TURN_NEGATED.search(t):
         return None
     if V.TURN_WHOLE.search(t) or "spin" in acts:
