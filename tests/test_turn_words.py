@@ -85,3 +85,25 @@ def test_a_gait_that_turns_turns_as_far_as_the_words_say():
             h = np.unwrap(headings(m.joints))
             assert h[-1] - h[0] == pytest.approx(angle, abs=0.4), (text, seed, h[-1] - h[0])
             assert travel(m.joints)[-1] > 1.5, (text, seed)
+
+
+def test_a_return_after_a_segment_that_does_not_turn_turns_back():
+    """"walks forward, then walks back" went on away from where it came ("back" unused, the samples
+    walking backwards won the TMA); the plan gives the return half a turn, "back" is read as walking
+    the way the body faces, and the second segment comes back (seed 0). After a turn, or alone, a
+    return is read as it is."""
+    from shapemove.core.generation.generate import Generator, Request
+    from shapemove.core.plan.plan import read_plan
+
+    turns = lambda p: [s.words.turn for s in read_plan(p).segments]  # noqa: E731
+    assert turns("a man walks forward, then walks back") == [None, pytest.approx(np.pi)]
+    assert turns("a man walks forward, then turns around, then walks back") == [None, pytest.approx(np.pi), None]
+    assert turns("a man walks to the door, then comes back and sits down") == [None, None]   # no gait returns
+    assert turns("a man walks back") == [None]
+    assert read_plan("a man walks forward, then walks back").segments[1].words.travel.forward == 1
+    m = Generator(None).generate_batch([Request("a man walks forward, then walks back", seed=0)])[0]
+    z = m.joints[:, 0, 2]
+    (s1, e1) = m.segment_bounds[1]
+    h = np.unwrap(headings(m.joints))
+    assert h[e1 - 1] - h[s1] == pytest.approx(np.pi, abs=0.5)
+    assert z[s1:].max() - z[-1] > 0.5                       # it comes back along -Z

@@ -628,9 +628,13 @@ class Generator:
         if min(lengths) < MIN_SEGMENT_SECONDS:
             raise ShapeMoveError(f"{r.prompt!r} is {len(lengths)} motions in order: {r.seconds:g} s gives each "
                                  f"{min(lengths):.2f} s, under the {MIN_SEGMENT_SECONDS:g} s one needs; ask for more seconds")
+        # an edited plan's readings are acted on as they are; a read plan's where the plan reads a segment
+        # otherwise than its words alone would ("walks forward, then walks back": the return turns)
+        own = [r.plan is not None or s.words != read_words(s.text) for s in plan.segments]
         motion = generate_sequence(self, [(s.text, sec) for s, sec in zip(plan.segments, lengths)], r.shape_text,
                                    r.betas, r.seed, r.temperature, r.top_k, r.candidates, r.guidance, by_parts=True,
-                                   readings=[s.words for s in plan.segments] if r.plan is not None else None)
+                                   readings=[s.words if o else None for s, o in zip(plan.segments, own)]
+                                   if any(own) else None)
         motion.prompt = r.prompt
         return motion
 

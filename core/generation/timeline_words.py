@@ -83,11 +83,12 @@ def turn_profile(joints: np.ndarray, bounds, prompts, readings=None) -> np.ndarr
 
 def worded_joints(joints: np.ndarray, bounds, prompts, readings=None) -> np.ndarray | None:
     """(T,22,3) joints of a timeline with each segment's strides scaled and turns made as its words
-    ask (``bounds``: (S,2) frames, ``prompts``: S texts; ``readings``: an edited plan's reading of each,
-    else the texts'); None when no segment asks for anything."""
+    ask (``bounds``: (S,2) frames, ``prompts``: S texts; ``readings``: the plan's reading of each, None
+    for the text's own); None when no segment asks for anything."""
     J = np.asarray(joints, np.float64)
     scale = np.ones(len(J))
-    readings = [read_words(p) for p in prompts] if readings is None else readings
+    readings = [read_words(p) if readings is None or readings[i] is None else readings[i]
+                for i, p in enumerate(prompts)]
     for (a, b), w in zip(np.asarray(bounds), readings):
         scale[a:b] = segment_scale(w, J[a:b])
     phi = turn_profile(J, bounds, prompts, readings)

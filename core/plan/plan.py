@@ -25,6 +25,8 @@ from dataclasses import dataclass, replace
 
 from ..errors import ShapeMoveError
 from .segments import MIN_SEGMENT_SECONDS, SEGMENT_SECONDS, split_segments
+from . import vocabulary as V
+from .part_prompts import LEGS
 from .vocabulary import POSTURE_SECONDS, REPETITION_SECONDS
 from .words import Words, read_words
 
@@ -87,10 +89,26 @@ def counted_seconds(words: Words) -> float:
 
 def read_plan(prompt: str, seconds: float | None = None) -> Plan:
     """The plan of ``prompt``: its ordered segments (``segments.split_segments``), each an equal
-    share of the length, each read by ``words.read_words``."""
+    share of the length, each read by ``words.read_words`` and turned back when it returns
+    (``returned``)."""
     texts = split_segments(prompt)
-    return Plan(str(prompt), tuple(Segment(t, 1.0 / len(texts), read_words(t)) for t in texts),
+    words = returned([read_words(t) for t in texts])
+    return Plan(str(prompt), tuple(Segment(t, 1.0 / len(texts), w) for t, w in zip(texts, words)),
                 None if seconds is None else float(seconds))
+
+
+def returned(words: list[Words]) -> list[Words]:
+    """Each segment's reading, a gait's return ("walks back", "runs back": ``vocabulary.RETURN``) after a
+    segment that does not turn given half a turn ("walks forward, then walks back" comes back; its
+    gait turns on its track, ``reader.angle_of``); a return after a turn ("turns around, then walks
+    back"), or with a turn or course of its own, as read."""
+    out = list(words)
+    for i in range(1, len(out)):
+        w, before = out[i], out[i - 1]
+        gait = any(a in LEGS for a in w.actions)
+        if gait and V.RETURN.search(w.text) and w.turn is None and w.course is None and before.turn is None:
+            out[i] = replace(w, turn=math.pi)
+    return out
 
 
 def plan_to_json(plan: Plan, course_seconds=None) -> dict:

@@ -138,7 +138,10 @@ TURN_TWICE = re.compile(r"\b(?:twice|two times|two full)\b")
 TURN_NEGATED = re.compile(r"\b(?:without|not|no|never|don't|doesn't|do not|does not|stop)\s+(?:\w+\s+)?(?:turn|spin)")
 
 # -- travel -----------------------------------------------------------------------------------
-FORWARD = re.compile(r"\b(forwards?|ahead|onwards?|toward(?:s)? (?:the )?(?:camera|viewer))\b", re.I)
+# "walks back" / "comes back" / "heads back": a return, walked facing the way (not "walks backwards", "steps back")
+RETURN = re.compile(r"\b(?:walk|stroll|jog|run|sprint|head|com|go|hurr|wander|march)\w* back(?! and forth| and back)\b(?!-)",
+                    re.I)
+FORWARD = re.compile(r"\b(?:forwards?|ahead|onwards?|toward(?:s)? (?:the )?(?:camera|viewer))\b|" + RETURN.pattern, re.I)
 BACKWARD = re.compile(r"\b(backwards?|in reverse|backs? (?:up|away)|backing (?:up|away)|retreat\w*|"
                       r"(?:steps?|stepping) back(?! and forth))\b", re.I)
 IN_PLACE = re.compile(r"\b(in place|on the spot)\b", re.I)
