@@ -17,7 +17,9 @@ for a sit the candidates whose head stays up compete, and for a lie-down those w
 down: the head's low height (its ``LOW_QUANTILE``) under ``LYING`` of its highest lies (the built
 data's lie-downs 0.08-0.09, get-ups from the floor 0.09-0.28, squats 0.54-0.73, bends 0.52); a sit
 with none whose head stays up keeps a candidate that does not lie rather than one that does ("no
-sit is better than a body lying on the floor").
+sit is better than a body lying on the floor"). Of those, the ones that start standing are kept
+when any does (``starts_standing``): a 3 s segment "sits down" chose the last 3 s of a lie-down's
+codes, which start in a crouch.
 
     keep = posture_kept("get up", feats, keep)     # (N,) bool among (T, 263) candidates
 """
@@ -36,6 +38,7 @@ LOW_QUANTILE = 0.1
 # the head's height in the (T, 263) features: its y in ``ric`` (joints 1..21, heights the floor's)
 HEAD_Y = feature_slices["ric"].start + 3 * (JOINT_NAMES.index("head") - 1) + 1
 HEAD_DOWN = {"lie down": True, "sit": False}   # where the head goes in the change of posture
+STANDING = 0.95    # a root this share of the leg's length high stands (standing: 1.05-1.15)
 
 
 def posture_change(features) -> float:
@@ -62,7 +65,21 @@ def posture_kept(action: str | None, feats: list, keep: np.ndarray) -> np.ndarra
     makes = np.array([way * posture_change(f) >= MIN_CHANGE for f in feats]) & keep
     if action in HEAD_DOWN:
         head = np.array([lies(f) for f in feats]) == HEAD_DOWN[action]
-        for narrowed in (makes & head, keep & head):
+        up = np.array([starts_standing(f) for f in feats])
+        for narrowed in (makes & head & up, makes & head, keep & head):
             if narrowed.any():
                 return narrowed
     return makes if makes.any() else keep
+
+
+def starts_standing(features) -> bool:
+    """Whether a (T, 263) candidate starts standing: its root at the start at least ``STANDING`` of
+    the leg's length (hip to knee to ankle, its first frame), where a body already going down (a
+    lie-down's last seconds: 0.7 of it) is lower."""
+    from ..motion.features import joints_from_features
+
+    f = np.asarray(features, dtype=np.float32)[:ENDS]
+    j = joints_from_features(f).astype(np.float64)
+    leg = np.mean([np.linalg.norm(j[:, h] - j[:, k], axis=-1) + np.linalg.norm(j[:, k] - j[:, a], axis=-1)
+                   for h, k, a in ((1, 4, 7), (2, 5, 8))])
+    return bool(f[:, 3].mean() >= STANDING * max(float(leg), 1e-6))

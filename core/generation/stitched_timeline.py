@@ -81,9 +81,9 @@ def stitch(joints: list[np.ndarray], contacts: list[np.ndarray], blend: int = BL
 def _contacts(m: Motion) -> np.ndarray:
     if m.contacts is not None and len(m.contacts) == m.num_frames:
         return np.asarray(m.contacts, np.uint8)
-    from ..motion.contacts import foot_contacts
+    from ..motion.contacts import detect_contacts
 
-    return np.asarray(foot_contacts(m.joints), np.uint8)
+    return np.asarray(detect_contacts(m.joints, m.fps), np.uint8)
 
 
 def segment_request(base, text: str, seconds: float, body: np.ndarray, seed: int, words=None):
@@ -144,13 +144,24 @@ def stitched_sequence(gen, segments: list[tuple[str, float]], body: np.ndarray, 
                       progress=None, cancel=None) -> Motion:
     """The timeline of ``segments`` [(prompt, seconds)] on the betas ``body``, each segment made as a
     single prompt (module docstring) with ``base``'s sampling (a ``Request``), seeds ``base.seed``,
-    ``base.seed + 1``, ...; ``readings``: an edited plan's reading of each segment."""
-    motions = []
+    ``base.seed + 1``, ...; a segment standing up from the seat of the one before, that sit played
+    backwards (``reversed_rise.py``); ``readings``: the plan's reading of each segment (None: its
+    text's own)."""
+    from ..constants import FPS
+    from ..plan.words import read_words
+    from .reversed_rise import rises_from_seat, sit_reversed
+
+    motions, said = [], []
     for i, (text, sec) in enumerate(segments):
         if cancel is not None and cancel():
             raise ShapeMoveError("cancelled")
-        seg = segment_request(base, text, sec, body, base.seed + i, None if readings is None else readings[i])
-        motions.append(gen.generate_batch([seg])[0])
+        words = readings[i] if readings is not None and readings[i] is not None else read_words(text)
+        if i and rises_from_seat(said[-1], words, motions[-1]):   # standing up from the seat just sat on
+            motions.append(sit_reversed(motions[-1], max(2, int(round(sec * FPS))), i))
+        else:
+            seg = segment_request(base, text, sec, body, base.seed + i, None if readings is None else readings[i])
+            motions.append(gen.generate_batch([seg])[0])
+        said.append(words)
         if progress is not None:
             progress((i + 1) / (len(segments) + 1), f"segment {i + 1}/{len(segments)}: {text}")
     return assembled(gen, motions, [t for t, _ in segments], body)
