@@ -57,6 +57,10 @@ def test_vocabulary():
     ("a woman touches her toes", ["bend over"]),
     ("the man walks a loop around the yard", ["walk in a circle"]),
     ("a woman walks around in a big loop", ["walk in a circle", "walk"]),
+    ("a child runs in a big circle", ["run", "walk in a circle"]),
+    ("a man swings his arms in circles", ["arm circles"]),          # the arms' circles, no course
+    ("she moves both arms around in small circles", ["arm circles"]),
+    ("a man walks in circles", ["walk in a circle", "walk"]),
     ("someone lifts a heavy box", ["pick up"]),
     ("running flat out, she lifts one hand high", ["run", "raise hand"]),
     ("she paces the room", []),                       # a course (back and forth), not an action

@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from shapemove.core.generation.pace_words import STANDING_SPEED, fastest, gait_speed, going
+from shapemove.core.generation.pace_words import STANDING_SPEED, WANDER_SPEED, fastest, gait_speed, going, staying
 from shapemove.core.plan.reader import asks_fast
 from shapemove.core.plan.words import read_words
 
@@ -56,6 +56,22 @@ def test_a_gait_asked_to_go_somewhere_sets_aside_the_candidates_that_stand_about
     for prompt in ("a person jogs in place", "a man walks 3 metres forward", "she takes three steps forward",
                    "a person stands still", "a man waves"):
         assert going(read_words(prompt), speeds, everyone).tolist() == [True] * 4, prompt
+
+
+def test_an_exercise_or_a_gesture_asked_with_no_travel_does_not_walk_off():
+    """"twists her torso side to side" chose a sample walking sideways 4.8 m; "swings his arms in
+    circles" a take walking 5 m. Candidates as fast as WANDER_SPEED are set aside when one is slower;
+    a gait, travel words, a course, an action of another group, or none slower: all kept."""
+    everyone = np.ones(4, bool)
+    speeds = np.array([1.2, 0.1, WANDER_SPEED, 0.3])
+    assert staying(read_words("a woman twists her torso side to side"), speeds, everyone).tolist() == \
+        [False, True, False, True]
+    assert staying(read_words("a man swings his arms in circles"), speeds, everyone).tolist() == [False, True, False, True]
+    assert staying(read_words("someone waves"), speeds, everyone).tolist() == [False, True, False, True]
+    assert staying(read_words("a man waves"), np.full(4, 1.0), everyone).tolist() == [True] * 4   # none slower
+    for prompt in ("a man walks and waves", "she waves while walking forward", "a woman dances",
+                   "the player kicks the ball", "a man does arm circles while jogging", "someone jumps forward"):
+        assert staying(read_words(prompt), speeds, everyone).tolist() == [True] * 4, prompt
 
 
 def test_the_picker_takes_a_fast_walk_over_the_tmas_favourite():

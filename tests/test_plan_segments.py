@@ -67,6 +67,9 @@ from shapemove.core.plan.segments import SEGMENT_SECONDS, split_segments
     ("she jumps, squats and waves", ["she jumps", "she squats", "she waves"]),
     ("a woman walks forward, turns around and walks back", ["a woman walks forward, turns around", "a woman walks back"]),
     ("a person squats down, subsequently stands up and runs", ["a person squats down", "a person stands up and runs"]),
+    # a turn after a gait that counts its steps or a distance comes after them
+    ("the man walks 10 steps and turns left", ["the man walks 10 steps", "the man turns left"]),
+    ("a man walks 3 metres and turns around", ["a man walks 3 metres", "a man turns around"]),
 ])
 def test_ordering_words_make_segments_in_the_order_they_happen(prompt, segments):
     assert split_segments(prompt) == segments

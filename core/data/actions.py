@@ -42,6 +42,7 @@ _EVERYDAY = {
     "turn": (r"\babout[- ]face\b", r"\bswivel",),
     "walk in a circle": (
         r"\bcircular (path|route|track)\b", r"\bround and round\b", r"\bcircles? the room\b", r"\bin a (\w+ )?loop\b",
+        r"\bin a (big|large|small|little|wide|tight|full) circle\b",
         r"\b(walk|run|jog|stroll|march)\w* a (\w+ )?loop\b", r"\bloop(s|ing)? (a)?round\b",
         r"\bcircl(e|es|ed|ing) (a)?round\b",
         r"\bcircl(es|ed|ing) (around )?(the|a) (room|yard|field|track|park|block|hall|square|pond|fountain|tree|table|"
@@ -93,7 +94,9 @@ _EVERYDAY = {
     "stretch": (r"\bflexibility\b", r"\blengthen",),
     "side twist": (r"\b(torso|trunk) rotations?\b", r"\brotat\w* the (torso|trunk|upper body)\b",),
     "elbow to knee": (r"\bcross crunch", r"\belbows? (meeting|touching) (the )?opposite knees?\b",),
-    "arm circles": (r"\bwindmill", r"\bcircular swings? of the arms\b",),
+    "arm circles": (r"\bwindmill", r"\bcircular swings? of the arms\b",
+                    r"\b(swing|swung|mov|rotat|whirl|wav|twirl)\w* (his|her|their|the|both|your|one's)( \w+)? arms "
+                    r"(around )?in (\w+ )?circles\b",),
     "balance": (r"\bflamingo\b", r"\bsingle[- ]leg stance\b", r"\bstand\w* on one (foot|leg)\b",),
     "wave": (
         r"\bsignals? hello\b", r"\bsay(s)? hi\b", r"\bflaps? a hand\b", r"\bwaggl\w* a hand\b",

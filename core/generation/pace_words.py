@@ -17,7 +17,9 @@ name). A jog or a run asked slowly keeps its cadence and flights and takes ``SLO
 strides (played slower, its flights would hang in the air). Both
 paces named ("slowly, then fast") is no pace; a prompt without a gait ("waves quickly") is left to
 the TMA, since its root speed says nothing of a hand's. Whatever the pace, a gait asked to go
-somewhere is not given a candidate that stands about (``going``: slower than ``STANDING_SPEED``).
+somewhere is not given a candidate that stands about (``going``: slower than ``STANDING_SPEED``),
+and an exercise or a gesture asked with no travel not one that walks off (``staying``: as fast
+as ``WANDER_SPEED`` or faster).
 """
 from __future__ import annotations
 
@@ -28,6 +30,8 @@ from ..constants import FPS
 FAST_SHARE = 1 / 3  # the fastest third of the candidates compete for a fast pace
 SLOW_SPEED = 0.8    # a stepping gait asked slowly is played at this speed
 STANDING_SPEED = 0.25   # m/s: a candidate of a gait asked to go on slower than this stands about
+WANDER_SPEED = 0.5      # m/s: a candidate of an action done where one stands this fast walks off
+STAYING_GROUPS = ("exercise", "gesture")   # the vocabulary's groups of actions done where one stands
 
 def path_length(features: np.ndarray) -> float:
     """Metres the root travels along its path over a (T, 263) feature clip (its horizontal
@@ -62,4 +66,19 @@ def going(words, speeds: np.ndarray, among: np.ndarray) -> np.ndarray:
             words.distance_m is not None or not any(a in LEGS for a in words.actions):
         return among
     keep = among & (np.asarray(speeds, dtype=np.float64) >= STANDING_SPEED)
+    return keep if keep.any() else among
+
+
+def staying(words, speeds: np.ndarray, among: np.ndarray) -> np.ndarray:
+    """(N,) bool: where the words (``plan.words.Words``) ask only actions done where one stands (the
+    vocabulary's ``STAYING_GROUPS``: an exercise, a gesture: arm circles, a side twist, a wave) and
+    no travel, the candidates ``among`` slower than ``WANDER_SPEED``; ``among`` itself otherwise, or
+    when none is. "A woman twists her torso side to side" chose a sample that walked sideways 4.8 m
+    (retrieved for "side to side"), "a man swings his arms in circles" a take walking 5 m."""
+    from ..data.actions import ACTIONS
+
+    if not among.any() or not words.actions or words.travel.named or words.course is not None or \
+            not all(a in ACTIONS and ACTIONS[a].group in STAYING_GROUPS for a in words.actions):
+        return among
+    keep = among & (np.asarray(speeds, dtype=np.float64) < WANDER_SPEED)
     return keep if keep.any() else among

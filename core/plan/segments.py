@@ -37,6 +37,7 @@ import re
 
 from ..data.actions import find_actions
 from .part_prompts import SUBJECT, _has_verb, _subject, _with_subject, at_once
+from .reader import stop_request
 from .vocabulary import (AND, BEFORE_AFTER as MIDDLE, FIRST, LEADING_BEFORE_AFTER as LEADING, LIST_STEP, PARTICIPLE,
                          POSTURE_CHANGES, RISEN_FROM, STOP, THEN, WAY_ALONE)
 
@@ -110,7 +111,9 @@ def _and_steps(piece: str, before: str = "") -> list[str]:
     """A piece cut at each "and" between two things done one after the other, each side naming its
     own action: a change of posture on one side ("stands up and runs", "walks to the chair and sits
     down"), or two actions one body does not do at once (``_one_after_other``: "runs to the car and
-    jumps in", "walks forward, turns around and walks back"), and, where it cuts, at the commas of a
+    jumps in", "walks forward, turns around and walks back"), or a turn after a gait that counts its
+    steps or a distance ("walks 10 steps and turns left": the steps, then the turn), and, where it
+    cuts, at the commas of a
     list of steps before it ("jumps, squats and waves": three); the piece itself otherwise. Standing
     up after a squat or a bend (``before``: what precedes the piece) is that action's own end, no
     action of its own ("squats, then stands up and waves" is two)."""
@@ -122,7 +125,8 @@ def _and_steps(piece: str, before: str = "") -> list[str]:
             continue
         posture = first[0] != then[0] and (_changes_posture(first[0], find_actions(before))
                                            or _changes_posture(then[0], first))
-        if posture or _one_after_other(first, then, whole):   # an order: the list of steps before it cuts too
+        counted = then[0] == "turn" and stop_request(a) is not None   # "walks 10 steps and turns left"
+        if posture or counted or _one_after_other(first, then, whole):   # an order: the list of steps before it cuts too
             return _list_steps(a) + _and_steps(b, a)
     return [piece]
 
