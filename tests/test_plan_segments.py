@@ -49,6 +49,8 @@ from shapemove.core.plan.segments import SEGMENT_SECONDS, split_segments
     ("a man runs to the left then to the right", ["a man runs to the left", "a man runs to the right"]),
     ("she sidesteps to the right, then back to the left", ["she sidesteps to the right", "she sidesteps back to the left"]),
     ("he walks ahead, then backwards", ["he walks ahead", "he walks backwards"]),
+    ("a person raises the right hand and then the left hand", ["a person raises the right hand", "a person raises the left hand"]),
+    ("he waves with the left hand, then the other one", ["he waves with the left hand", "he waves the right one"]),
     # a list of steps whose last an order word starts; a turn stays with its gait, a participle is two things at once
     ("she walks ahead, spins around, then waves", ["she walks ahead", "she spins around", "she waves"]),
     ("the boy jumps, squats, then runs off", ["the boy jumps", "the boy squats", "the boy runs off"]),

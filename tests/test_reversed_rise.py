@@ -4,7 +4,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from shapemove.core.generation.reversed_rise import LEAD, ends_seated, sit_reversed
+from shapemove.core.generation.reversed_rise import LEAD, ends_seated, held_low, sit_reversed
 from shapemove.core.scene.motion_file import Motion
 
 pytestmark = pytest.mark.usefixtures("one_thread")
@@ -30,15 +30,26 @@ def test_the_sit_played_backwards_starts_seated_and_ends_standing():
     root = np.r_[np.full(10, 0.9), np.linspace(0.9, 0.45, 20), np.full(30, 0.45)]   # 60 frames, seated from 30
     sit = Motion(_body(root, root + 0.6), np.zeros(10), np.zeros((60, 24, 3)), np.zeros((60, 3)), 20.0, "openbody",
                  contacts=np.ones((60, 4), np.uint8), provenance="generated")
-    same = sit_reversed(sit, 60, 1)
-    assert np.array_equal(same.joints, sit.joints[::-1]) and same.provenance == "the sit of segment 1, played backwards"
-    short = sit_reversed(sit, 30, 2)        # the seated stretch left out but LEAD frames: the rise kept
-    assert len(short.joints) == 30 and short.joints[0, 0, 1] == pytest.approx(0.45)
-    rise = int(np.argmax(short.joints[:, 0, 1] > 0.48))
-    assert rise <= LEAD + 1 and short.joints[-1, 0, 1] > 0.85
-    long = sit_reversed(sit, 90, 1)         # longer: standing held at the end
-    assert len(long.joints) == 90 and np.allclose(long.joints[60:], sit.joints[0]) and long.contacts[60:].all()
-    assert long.tokens is None and long.features is None and len(long.contacts) == 90
+    for frames in (60, 30, 90):
+        up = sit_reversed(sit, frames, 1)
+        y = up.joints[:, 0, 1]
+        assert len(up.joints) == len(up.contacts) == frames and up.provenance == "segment 1 played backwards"
+        # from LEAD frames before the root is 3 cm up (sit frame 27), the sit's way down backwards, then standing
+        assert y[0] == pytest.approx(0.45) and int(np.argmax(y > 0.48)) == LEAD
+        assert np.array_equal(up.joints[LEAD:LEAD + 18], sit.joints[27:9:-1])
+        assert np.allclose(up.joints[LEAD + 18:], sit.joints[0]) and up.contacts[LEAD + 18:].all()
+        assert up.tokens is None and up.features is None
+
+
+def test_a_squat_before_a_stand_up_is_held_at_its_lowest():
+    root = np.r_[np.full(5, 0.9), np.linspace(0.9, 0.4, 10), np.linspace(0.4, 0.9, 10), np.full(15, 0.9)]
+    squat = Motion(_body(root, root + 0.6), np.zeros(10), np.zeros((40, 24, 3)), np.zeros((40, 3)), 20.0, "openbody",
+                   contacts=np.ones((40, 4), np.uint8), notes=["the captured take lasts 1.2 s: its last pose is held "
+                                                               "for the remaining 0.8 s"])
+    low = held_low(squat)
+    assert len(low.joints) == 40 and np.allclose(low.joints[14:, 0, 1], 0.4) and np.array_equal(low.joints[:15], squat.joints[:15])
+    assert low.notes == ["held at its lowest from 0.7 s: the next segment stands up"] and ends_seated(low.joints)
+    assert held_low(low) is low                                  # lowest at its end already
 
 
 def test_sitting_down_then_standing_up_rises_from_the_seat(openbody):
@@ -48,9 +59,23 @@ def test_sitting_down_then_standing_up_rises_from_the_seat(openbody):
     from shapemove.core.generation.generate import Generator, Request
 
     m = Generator(None, body=openbody).generate_batch([Request("a man sits down, then stands up", seed=0)])[0]
-    assert m.provenance.endswith("segment 2: the sit of segment 1, played backwards"), m.provenance
+    assert m.provenance.endswith("segment 2: segment 1 played backwards"), m.provenance
     (a, b), (c, d) = m.segment_bounds
     j = m.joints
     assert np.abs(j[c] - j[c - 1]).max() < 0.05                          # no jump at the seam
     assert j[c:c + 5, 0, 1].mean() < j[:5, 0, 1].mean() - 0.3            # seated when it starts
     assert j[-5:, 0, 1].mean() == pytest.approx(j[:5, 0, 1].mean(), abs=0.08)   # standing again
+
+
+def test_a_held_squat_then_standing_up_rises_from_the_crouch(openbody):
+    """"a person does a squat, holds it, then stands up" (seed 5): the captured squat went down and
+    up again and the stand-up was a get-up from lying face down; now the squat is held at its
+    lowest to its segment's end and the stand-up rises from there."""
+    from shapemove.core.generation.generate import Generator, Request
+
+    m = Generator(None, body=openbody).generate_batch([Request("a person does a squat, holds it, then stands up", seed=5)])[0]
+    assert m.provenance.endswith("segment 2: segment 1 played backwards"), m.provenance
+    (a, b), (c, d) = m.segment_bounds
+    y = m.joints[:, 0, 1]
+    assert y[b - 10:b].max() < 0.6 * y[:5].mean()                        # still down at the end of the squat
+    assert y[-5:].mean() == pytest.approx(y[:5].mean(), abs=0.05)         # up again

@@ -1,14 +1,17 @@
-"""Standing up from a seat: the sit before it played backwards.
+"""Standing up from a seat or a crouch: the segment before it played backwards.
 
 The data hold no capture of standing up from a seat: the built-in library's get-ups (DeepMimic's
 two) start lying on the floor, and the samples are decoded from their codes. So "a man sits down,
 then stands up" sat on a chair, then went down on all fours to push himself up. In a timeline, a
-segment whose words stand up (``get up``) right after one that sits down and ends seated (its
+segment whose words only stand up (``get up``) right after one that sits down and ends seated (its
 root down by ``posture_change.MIN_CHANGE`` of its highest, its head up: not ``lying``) is that sit
 played backwards: it starts in the very pose the sit ends in, and the body rises the way it went
-down. A segment shorter than the sit leaves out the sit's seated stretch (all but ``LEAD``
-frames before the rise); a longer one holds the standing pose the sit started from for the rest. The segment says so (its provenance: "the sit of
-segment 1, played backwards").
+down, its seated stretch left out (all but ``LEAD`` frames before the rise) and, once up, the
+standing pose the sit started from held for the rest of the segment.
+
+A squat or a bend before a stand-up ("squats, holds it, then stands up"; ``LOWERED``) goes down and
+up again as captured, so it is held from its lowest frame on (``held_low``) and the stand-up rises
+from there the same way. The segment says so (its provenance: "segment 1 played backwards").
 
     if rises_from_seat(before_words, words, before_motion):
         motion = sit_reversed(before_motion, frames, 1)
@@ -19,9 +22,11 @@ import dataclasses
 
 import numpy as np
 
+from ..plan.vocabulary import RISEN_FROM
 from .posture_change import ENDS, LYING, MIN_CHANGE
 
 HEAD = 15
+LOWERED = frozenset({"sit"}) | RISEN_FROM   # a seat, a squat, a bend: what a stand-up after it rises from
 SETTLED = 0.03   # m: the root within this of its seated height is still sitting
 LEAD = 5         # frames of sitting kept before the rise
 
@@ -38,11 +43,40 @@ def ends_seated(joints) -> bool:
     return bool(down >= MIN_CHANGE and head[-ENDS:].mean() > LYING * max(head.max(), 1e-6))
 
 
+def stands_up(words) -> bool:
+    """Whether a segment's words (``plan.words.Words``) ask only to stand up."""
+    return list(words.actions) == ["get up"]
+
+
+def lowers(words) -> bool:
+    """Whether a segment's words ask to sit or to go down and up again (``LOWERED``: a squat, a bend)."""
+    return any(a in LOWERED for a in words.actions)
+
+
 def rises_from_seat(before, words, before_motion) -> bool:
     """Whether a segment whose words are ``words`` (``plan.words.Words``) stands up from the seat the
     segment before (words ``before``, its finished ``before_motion``) ends on."""
-    return bool(words.actions) and words.actions[0] == "get up" and "sit" in before.actions \
-        and ends_seated(before_motion.joints)
+    return stands_up(words) and lowers(before) and ends_seated(before_motion.joints)
+
+
+def held_low(motion):
+    """A finished segment that goes down held from its lowest frame on (the root's lowest), so the
+    segment after it can stand up from there: "squats, holds it, then stands up" (a captured squat
+    goes down and up again). The Motion itself when it is lowest at its end already."""
+    j = np.asarray(motion.joints)
+    low = int(np.argmin(j[:, 0, 1]))
+    if (j[low:, 0, 1] - j[low, 0, 1]).max() < SETTLED:   # it stays down to its end already
+        return motion
+    from ..motion.contacts import detect_contacts
+
+    c = np.asarray(motion.contacts if motion.contacts is not None and len(motion.contacts) == len(j)
+                   else detect_contacts(j, motion.fps), np.uint8)
+    held = len(j) - low - 1
+    return dataclasses.replace(
+        motion, joints=np.concatenate([j[:low + 1], np.repeat(j[low:low + 1], held, 0)]),
+        contacts=np.concatenate([c[:low + 1], np.repeat(c[low:low + 1], held, 0)]), tokens=None, features=None,
+        notes=[n for n in motion.notes if "its last pose is held" not in n]   # held low instead
+        + [f"held at its lowest from {low / motion.fps:.1f} s: the next segment stands up"])
 
 
 def sit_reversed(sit, frames: int, index: int):
@@ -56,12 +90,12 @@ def sit_reversed(sit, frames: int, index: int):
                    else detect_contacts(sit.joints, sit.fps), np.uint8)[::-1]
     seated = j[0, 0, 1]
     rise = int(np.argmax(j[:, 0, 1] > seated + SETTLED)) if (j[:, 0, 1] > seated + SETTLED).any() else 0
-    lo = max(0, min(rise - LEAD, len(j) - frames))   # a long sit's seated stretch left out, the rise kept
+    lo = max(0, rise - LEAD)   # the seated stretch left out but LEAD frames: the rise comes first
     j, c = j[lo:lo + frames], c[lo:lo + frames]
     extra = frames - len(j)
     if extra > 0:   # shorter than asked: the standing pose the sit started from, held
         j = np.concatenate([j, np.repeat(j[-1:], extra, 0)])
         c = np.concatenate([c, np.repeat(np.ones((1, c.shape[1]), np.uint8), extra, 0)])
     return dataclasses.replace(sit, joints=np.ascontiguousarray(j), contacts=np.ascontiguousarray(c), tokens=None,
-                               features=None, provenance=f"the sit of segment {index}, played backwards",
+                               features=None, provenance=f"segment {index} played backwards",
                                retrieved_clips=[], notes=[], warnings=[])

@@ -149,19 +149,21 @@ def stitched_sequence(gen, segments: list[tuple[str, float]], body: np.ndarray, 
     text's own)."""
     from ..constants import FPS
     from ..plan.words import read_words
-    from .reversed_rise import rises_from_seat, sit_reversed
+    from .reversed_rise import held_low, lowers, rises_from_seat, sit_reversed, stands_up
 
-    motions, said = [], []
+    said = [readings[i] if readings is not None and readings[i] is not None else read_words(text)
+            for i, (text, _) in enumerate(segments)]
+    motions = []
     for i, (text, sec) in enumerate(segments):
         if cancel is not None and cancel():
             raise ShapeMoveError("cancelled")
-        words = readings[i] if readings is not None and readings[i] is not None else read_words(text)
-        if i and rises_from_seat(said[-1], words, motions[-1]):   # standing up from the seat just sat on
+        if i and rises_from_seat(said[i - 1], said[i], motions[-1]):   # standing up from the seat just sat on
             motions.append(sit_reversed(motions[-1], max(2, int(round(sec * FPS))), i))
         else:
             seg = segment_request(base, text, sec, body, base.seed + i, None if readings is None else readings[i])
             motions.append(gen.generate_batch([seg])[0])
-        said.append(words)
+            if i + 1 < len(segments) and lowers(said[i]) and stands_up(said[i + 1]):   # down, held, then up
+                motions[-1] = held_low(motions[-1])
         if progress is not None:
             progress((i + 1) / (len(segments) + 1), f"segment {i + 1}/{len(segments)}: {text}")
     return assembled(gen, motions, [t for t, _ in segments], body)

@@ -36,7 +36,7 @@ from __future__ import annotations
 import re
 
 from ..data.actions import find_actions
-from .part_prompts import SUBJECT, _has_verb, _subject, _with_subject, at_once
+from .part_prompts import SUBJECT, _has_verb, _subject, _with_subject, at_once, named_side
 from .reader import stop_request
 from .vocabulary import (AND, BEFORE_AFTER as MIDDLE, FIRST, LEADING_BEFORE_AFTER as LEADING, LIST_STEP, PARTICIPLE,
                          POSTURE_CHANGES, RISEN_FROM, STOP, THEN, WAY_ALONE)
@@ -147,8 +147,12 @@ def _as_prompt(piece: str, subject: str) -> str:
 
 
 def _gone_on(before: str, way: str) -> str:
-    """A way alone after an order word said with the verb of the piece before it: ("a man runs to the
-    left", "to the right") -> "a man runs to the right"."""
+    """A way or a side alone after an order word said with the verb of the piece before it: ("a man
+    runs to the left", "to the right") -> "a man runs to the right"; ("raises the right hand", "the
+    other one") -> "raises the left one"."""
+    side = named_side(before)
+    if side is not None and re.search(r"\bother\b(?!\s+way)", way):
+        way = re.sub(r"\bother\b(?!\s+way)", "left" if side[0] == "right" else "right", way)
     subject = SUBJECT.match(before)
     verb = re.match(r"\s*([a-z'-]+)", before[subject.end():] if subject else before)
     return f"{subject.group(0) if subject else ''} {verb.group(1) if verb else 'walks'} {way}".strip()

@@ -194,7 +194,9 @@ LEADING_BEFORE_AFTER = re.compile(r"^\s*(before|after)\s+(?:" + _CLAUSE_AHEAD + 
 # a way to go alone after an order word: the gait before it goes on that way ("runs to the left, then to the
 # right" -> "runs to the right")
 WAY_ALONE = re.compile(r"^(?:(?:back\s+)?to\s+(?:the|his|her|their|its)\s+(?:left|right)|(?:back|for)wards?|ahead|sideways|"
-                       r"(?:the\s+)?other\s+way)(?:\s+(?:again|too|as\s+well))?$")
+                       r"(?:the\s+)?other\s+way|"
+                       r"(?:with\s+)?(?:the|his|her|their|its)\s+(?:left|right|other)(?:\s+(?:hand|arm|leg|foot|one))?)"
+                       r"(?:\s+(?:again|too|as\s+well))?$")   # "raises the right hand, then the left" -> "raises the left"
 # a step of a list whose last step an order word starts ("walks ahead, spins around, then waves"): a comma and a verb
 LIST_STEP = re.compile(r",\s*(?=[a-z'-]{3,}s\b)")
 FIRST = re.compile(r"\b(?:first(?:ly)?|at first|initially|to begin with|to start with)\b\s*,?\s*")
