@@ -21,6 +21,25 @@ def test_an_unedited_plan_reads_back_as_it_was_printed(prompt):
     assert plan_to_json(plan_from_json(json.dumps(printed)))["segments"] == printed["segments"]
 
 
+def test_every_plan_the_tuning_prompts_print_reads_back():
+    """Every prompt of the tuning sets (and forms of each reading: raised arms kept up, both hands,
+    a return, a turn beside a gait): its printed plan loads back with ``--plan`` and prints the same
+    ("with both arms raised" printed ``arms_held``, which ``--plan`` refused as no field of a plan)."""
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1] / "configs"
+    prompts = ["a man walks with both arms raised", "a woman waves with both hands", "a man walks forward, then walks back",
+               "a man turns around and walks away", "a person raises the right hand and then the left hand"]
+    for name in ("heldout_paraphrases.json", "tuning_two_things.json", "tuning_sequences.json"):
+        for p in json.loads((root / name).read_text()).get("prompts", []):
+            prompts.append(p["text"] if isinstance(p, dict) else p[0])
+    for row in json.loads((root / "tuning_pace.json").read_text())["rows"]:
+        prompts += [v for v in (row.values() if isinstance(row, dict) else row) if isinstance(v, str) and " " in v]
+    for prompt in prompts:
+        printed = plan_json(prompt)
+        assert plan_to_json(plan_from_json(json.dumps(printed)))["segments"] == printed["segments"], prompt
+
+
 def test_edited_fields_are_what_the_plan_holds():
     edited = plan_json("a person walks forward", 4)
     edited["segments"][0]["understood"]["actions"] = ["run"]

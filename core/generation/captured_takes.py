@@ -36,6 +36,7 @@ from __future__ import annotations
 
 import random
 from collections import OrderedDict
+from itertools import islice
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -121,6 +122,7 @@ class TakePool:
         self.ids: list[str] = [str(c) for c in library.a["clip_ids"]] if library is not None else []
         self.vectors = np.zeros((n, 0), np.float32)
         self._cache: OrderedDict = OrderedDict()
+        self._both: dict[int, bool] = {}
 
     def __len__(self) -> int:
         return len(self.actions)
@@ -181,8 +183,20 @@ class TakePool:
             self._cache.popitem(last=False)
         return out
 
-    def nearest(self, text: np.ndarray, action: str | None, seed: int, count: int = TAKES) -> list[int]:
-        """Takes offered for a prompt whose TMA text vector is ``text`` (see the module docstring)."""
+    def two_handed(self, i: int) -> bool:
+        """Whether take ``i`` makes its gesture with both hands (``hands_asked.made_with_both``; kept)."""
+        if i not in self._both:
+            from .hands_asked import made_with_both
+
+            t = self.take(i)
+            self._both[i] = made_with_both(self.proc.pose_on(t["rotations"], t["root"], t["betas"], 1.0, t["contacts"]))
+        return self._both[i]
+
+    def nearest(self, text: np.ndarray, action: str | None, seed: int, count: int = TAKES,
+                hands: bool | None = None) -> list[int]:
+        """Takes offered for a prompt whose TMA text vector is ``text`` (see the module docstring);
+        ``hands``: a gesture of both hands (True) or one (False): the takes made so, where any is
+        (``hands_asked.py``)."""
         if not len(self) or not len(self.vectors):
             return []
         sims = self.vectors @ np.asarray(text, np.float32)
@@ -190,7 +204,11 @@ class TakePool:
         chosen: list[int] = []
 
         def draw(ids, k):
-            ids = [i for i in sorted(ids, key=lambda i: -sims[i]) if i not in chosen][:POOL * k]
+            ids = [i for i in sorted(ids, key=lambda i: -sims[i]) if i not in chosen]
+            if hands is not None:   # the nearest made with the hands asked, looked at in order until enough
+                made = list(islice((i for i in ids if self.two_handed(i) == hands), POOL * k))
+                ids = made or ids
+            ids = ids[:POOL * k]
             chosen.extend(ids[j] for j in sorted(rng.sample(range(len(ids)), min(k, len(ids)))))
 
         user = [i for i in range(len(self)) if self.is_user(i)]
@@ -271,11 +289,11 @@ class TakePool:
 
     def windows(self, text: np.ndarray, action: str | None, seed: int, frames: int, side=None,
                 longest: int | None = None, count: int = TAKES, times: int | None = None,
-                straight: bool = False) -> list[Window]:
-        """One window of each take offered (``nearest``); ``times``: the repetitions the words ask;
-        ``straight``: the words ask a plain gait (``window``)."""
+                straight: bool = False, hands: bool | None = None) -> list[Window]:
+        """One window of each take offered (``nearest``, ``hands`` as there); ``times``: the repetitions
+        the words ask; ``straight``: the words ask a plain gait (``window``)."""
         return [self.window(i, frames, seed, side, longest, times, straight)
-                for i in self.nearest(text, action, seed, count)]
+                for i in self.nearest(text, action, seed, count, hands)]
 
 
 def action_credit(asked: str | None, action: str) -> float | None:

@@ -55,6 +55,7 @@ from .sampling_params import (DEFAULT_GUIDANCE, check_candidates, check_guidance
 from .request import Request
 from .slow_steps import slow_motion
 from .still_take import still_take
+from .hands_asked import hands_wanted
 from .typical_pace import leg_ratio, load_typical_speeds, slow_take, typical_paced, unplain_take
 from .straight_gait import straight_asked
 from .turn_words import turn_motion
@@ -199,11 +200,12 @@ class Generator:
             return []
         down = self.vae.cfg.downsample
         text = self._embed_texts([r.prompt])[0]
-        straight = straight_asked(r.words if r.words is not None else read_words(r.prompt))
+        words = r.words if r.words is not None else read_words(r.prompt)
+        straight, hands = straight_asked(words), hands_wanted(words, action)   # one hand unless both are said
         if r.seconds is None:   # the model's length: a take plays whole, at least UNASKED_SECONDS
             return pool.windows(text, action, r.seed, self._length(UNASKED_SECONDS)[0] * down, side, hi * down,
-                                times=times, straight=straight)
-        return pool.windows(text, action, r.seed, lo * down, side, times=times, straight=straight)
+                                times=times, straight=straight, hands=hands)
+        return pool.windows(text, action, r.seed, lo * down, side, times=times, straight=straight, hands=hands)
 
     # -- tokens ------------------------------------------------------------------------------
     def _length(self, seconds: float | None) -> tuple[int, int]:

@@ -12,7 +12,8 @@ back, edited, and says which field is wrong when one is. In a segment's ``unders
 may change, add or remove: ``actions`` (the first is the segment's action: a new one replaces the
 action's words in the text the model reads), ``side`` ("left hand"), ``course`` and ``course_way``,
 ``turn_degrees``, ``travel``, ``in_place``, ``distance_m``, ``steps``, ``stop``, ``stand_still``,
-``count``, ``pace``, ``seconds`` (the length its words ask); a segment's ``text`` and ``seconds``
+``count``, ``pace``, ``seconds`` (the length its words ask), ``arms_held`` (the raised arms kept
+up), ``both_hands`` (a gesture of both hands, else of one); a segment's ``text`` and ``seconds``
 (its length, which wins) too. A field left out asks nothing. The
 motion keeps the plan (``Motion.plan``), so a timeline re-decoded for a new body or a strip
 regenerated acts on its edited segments again (``generation/sequence.plan_readings``).
@@ -163,7 +164,8 @@ def _choice(value, where: str, options) -> str:
 
 
 UNDERSTOOD_KEYS = ("actions", "legs", "arms", "course", "course_way", "turn_degrees", "travel", "in_place",
-                   "distance_m", "steps", "stop", "stand_still", "count", "pace", "seconds", "side", "unused")
+                   "distance_m", "steps", "stop", "stand_still", "count", "pace", "seconds", "side", "arms_held",
+                   "both_hands", "unused")
 
 
 def _swap_action(text: str, old: str | None, new: str) -> str:
@@ -249,6 +251,8 @@ def _edited_words(seg: dict, where: str, text: str) -> tuple[str, Words]:
     if (metres is not None or steps is not None) and not stop:
         raise _bad(f"{where}.understood.stop", "a distance or a count of steps stops there: stop must be true")
     stand = _flag(said.get("stand_still", False), f"{where}.understood.stand_still")
+    both = _flag(said.get("both_hands", False), f"{where}.understood.both_hands")
+    held = _flag(said.get("arms_held", False), f"{where}.understood.arms_held")
     count = None
     if said.get("count") is not None:
         n = _number(said["count"], f"{where}.understood.count", 1, MAX_COUNT, whole=True)
@@ -265,7 +269,8 @@ def _edited_words(seg: dict, where: str, text: str) -> tuple[str, Words]:
     return text, replace(read, parts=parts, side=None if parts is not None else side, course=course,
                          course_right=way == "right", turn=turn, travel=replace(travel, in_place=in_place),
                          in_place=in_place, stop=stop, steps=steps, distance_m=metres, gait_text=gait_text,
-                         stand_still=stand and not stop, count=count, pace=pace, slow_flight=flight, seconds=length)
+                         stand_still=stand and not stop, count=count, pace=pace, slow_flight=flight, seconds=length,
+                         both_hands=both, arms_held=held)
 
 
 def plan_from_json(data, seconds: float | None = None) -> Plan:

@@ -260,6 +260,11 @@ def asks_on_the_spot(prompt: str) -> bool:
     return travel_of(prompt).in_place and any(sp[2] in LEGS for sp in action_spans(prompt))
 
 
+def asks_both_hands(prompt: str) -> bool:
+    """Whether the words ask a gesture of both hands or arms ("waves with both hands", "raises her hands")."""
+    return bool(V.BOTH_HANDS.search(str(prompt).lower()))
+
+
 def arms_held(prompt: str) -> bool:
     """Whether the words keep the arms raised ("with both arms raised", "keeps his hand up")."""
     return bool(V.ARMS_HELD.search(str(prompt).lower()))
@@ -282,7 +287,7 @@ def without_numbers(prompt: str) -> str:
 _TAKEN = (V.COUNT_TIMES, V.FAST, V.SLOW, V.STOP, V.STEPS, V.STEPS_ALONE, V.STILL, V.SPOKEN_DISTANCE, V.CLOCKWISE,
           V.COUNTER_CLOCKWISE, V.BACK_AND_FORTH, V.ZIGZAG, V.DIAGONAL, V.COURSE_WORDS, V.COURSE_WAY, V.TURN_WHOLE,
           V.TURN_HALF, V.TURN_QUARTER, V.FORWARD, V.BACKWARD, V.IN_PLACE, V.TRAVEL_SIDE, V.SIDEWAYS, V.SIDE,
-          V.DIRECTION, V.SUBJECT, V.TURN_TWICE, V.ARMS_HELD, V.DURATION, V.ASIDE, V.CONNECTOR, V.THEN)
+          V.DIRECTION, V.SUBJECT, V.TURN_TWICE, V.ARMS_HELD, V.BOTH_HANDS, V.DURATION, V.ASIDE, V.CONNECTOR, V.THEN)
 
 
 def unused_words(text: str, body_words=(), idle=()) -> list[str]:

@@ -61,6 +61,8 @@ def said(reading: dict) -> str:
         bits.append(f"side: {reading['side']}")
     if reading.get("arms_held"):
         bits.append("arms held raised")
+    if reading.get("both_hands"):
+        bits.append("both hands")
     said = "; ".join(bits) if bits else "no word the readers act on (the model reads the prompt whole)"
     if reading.get("unused"):   # named, never dropped in silence
         said += "; not used: " + ", ".join(repr(w) for w in reading["unused"])
