@@ -28,7 +28,8 @@ def test_every_plan_the_tuning_prompts_print_reads_back():
     from pathlib import Path
 
     root = Path(__file__).resolve().parents[1] / "configs"
-    prompts = ["a man walks with both arms raised", "a woman waves with both hands", "a man walks forward, then walks back",
+    prompts = ["a man walks with both arms raised", "a woman waves with both hands", "he raises a hand",
+               "a man walks forward, then walks back",
                "a man turns around and walks away", "a person raises the right hand and then the left hand"]
     for name in ("heldout_paraphrases.json", "tuning_two_things.json", "tuning_sequences.json"):
         for p in json.loads((root / name).read_text()).get("prompts", []):

@@ -13,7 +13,7 @@ may change, add or remove: ``actions`` (the first is the segment's action: a new
 action's words in the text the model reads), ``side`` ("left hand"), ``course`` and ``course_way``,
 ``turn_degrees``, ``travel``, ``in_place``, ``distance_m``, ``steps``, ``stop``, ``stand_still``,
 ``count``, ``pace``, ``seconds`` (the length its words ask), ``arms_held`` (the raised arms kept
-up), ``both_hands`` (a gesture of both hands, else of one); a segment's ``text`` and ``seconds``
+up), ``hands`` (a gesture's hands: "both" or "one"); a segment's ``text`` and ``seconds``
 (its length, which wins) too. A field left out asks nothing. The
 motion keeps the plan (``Motion.plan``), so a timeline re-decoded for a new body or a strip
 regenerated acts on its edited segments again (``generation/sequence.plan_readings``).
@@ -165,7 +165,7 @@ def _choice(value, where: str, options) -> str:
 
 UNDERSTOOD_KEYS = ("actions", "legs", "arms", "course", "course_way", "turn_degrees", "travel", "in_place",
                    "distance_m", "steps", "stop", "stand_still", "count", "pace", "seconds", "side", "arms_held",
-                   "both_hands", "unused")
+                   "hands", "unused")
 
 
 def _swap_action(text: str, old: str | None, new: str) -> str:
@@ -251,7 +251,7 @@ def _edited_words(seg: dict, where: str, text: str) -> tuple[str, Words]:
     if (metres is not None or steps is not None) and not stop:
         raise _bad(f"{where}.understood.stop", "a distance or a count of steps stops there: stop must be true")
     stand = _flag(said.get("stand_still", False), f"{where}.understood.stand_still")
-    both = _flag(said.get("both_hands", False), f"{where}.understood.both_hands")
+    hands = None if said.get("hands") is None else _choice(said["hands"], f"{where}.understood.hands", ("both", "one"))
     held = _flag(said.get("arms_held", False), f"{where}.understood.arms_held")
     count = None
     if said.get("count") is not None:
@@ -270,7 +270,7 @@ def _edited_words(seg: dict, where: str, text: str) -> tuple[str, Words]:
                          course_right=way == "right", turn=turn, travel=replace(travel, in_place=in_place),
                          in_place=in_place, stop=stop, steps=steps, distance_m=metres, gait_text=gait_text,
                          stand_still=stand and not stop, count=count, pace=pace, slow_flight=flight, seconds=length,
-                         both_hands=both, arms_held=held)
+                         hands=hands, arms_held=held)
 
 
 def plan_from_json(data, seconds: float | None = None) -> Plan:

@@ -21,7 +21,7 @@ import numpy as np
 from ..data.actions import action_spans, find_actions, specific
 from ..data.compose_parts import ARMS_ACTIONS, LEGS_ACTIONS
 from . import vocabulary as V
-from .part_prompts import LEGS
+from .part_prompts import LEGS, named_side
 
 STEPPING = LEGS - {"jog", "run", "sprint"}   # gaits without a flight phase
 
@@ -260,9 +260,13 @@ def asks_on_the_spot(prompt: str) -> bool:
     return travel_of(prompt).in_place and any(sp[2] in LEGS for sp in action_spans(prompt))
 
 
-def asks_both_hands(prompt: str) -> bool:
-    """Whether the words ask a gesture of both hands or arms ("waves with both hands", "raises her hands")."""
-    return bool(V.BOTH_HANDS.search(str(prompt).lower()))
+def hands_asked(prompt: str) -> str | None:
+    """"both" when the words ask a gesture of both hands or arms ("waves with both hands", "raises her
+    hands"), "one" when of one ("raises a hand", "lifts one hand high", "waves with his left hand"),
+    None when they say neither ("waves") or both ways."""
+    t = str(prompt).lower()
+    both, one = bool(V.BOTH_HANDS.search(t)), bool(V.ONE_HAND.search(t)) or named_side(t) is not None
+    return "both" if both and not one else "one" if one and not both else None
 
 
 def arms_held(prompt: str) -> bool:
@@ -287,7 +291,7 @@ def without_numbers(prompt: str) -> str:
 _TAKEN = (V.COUNT_TIMES, V.FAST, V.SLOW, V.STOP, V.STEPS, V.STEPS_ALONE, V.STILL, V.SPOKEN_DISTANCE, V.CLOCKWISE,
           V.COUNTER_CLOCKWISE, V.BACK_AND_FORTH, V.ZIGZAG, V.DIAGONAL, V.COURSE_WORDS, V.COURSE_WAY, V.TURN_WHOLE,
           V.TURN_HALF, V.TURN_QUARTER, V.FORWARD, V.BACKWARD, V.IN_PLACE, V.TRAVEL_SIDE, V.SIDEWAYS, V.SIDE,
-          V.DIRECTION, V.SUBJECT, V.TURN_TWICE, V.ARMS_HELD, V.BOTH_HANDS, V.DURATION, V.ASIDE, V.CONNECTOR, V.THEN)
+          V.DIRECTION, V.SUBJECT, V.TURN_TWICE, V.ARMS_HELD, V.BOTH_HANDS, V.ONE_HAND, V.DURATION, V.ASIDE, V.CONNECTOR, V.THEN)
 
 
 def unused_words(text: str, body_words=(), idle=()) -> list[str]:

@@ -61,8 +61,8 @@ def said(reading: dict) -> str:
         bits.append(f"side: {reading['side']}")
     if reading.get("arms_held"):
         bits.append("arms held raised")
-    if reading.get("both_hands"):
-        bits.append("both hands")
+    if reading.get("hands"):
+        bits.append("both hands" if reading["hands"] == "both" else "one hand")
     said = "; ".join(bits) if bits else "no word the readers act on (the model reads the prompt whole)"
     if reading.get("unused"):   # named, never dropped in silence
         said += "; not used: " + ", ".join(repr(w) for w in reading["unused"])

@@ -153,9 +153,11 @@ TRAVEL_SIDE = re.compile(_GOING + r"(?:\W+\w+){0,3}?\W+(?:to|towards?|over to) (
 SIDEWAYS = re.compile(_GOING + r"(?:\W+\w+){0,3}?\W+(sideways|sidewards)\b", re.I)
 
 # -- arms held raised: a state ("with both arms raised", "keeps his hand up"), not the act of raising --------
-# both hands or arms: a gesture with both ("waves with both hands", "raises her hands", "waves his arms"); one otherwise
+# the hands a gesture is made with: both ("waves with both hands", "raises her hands", "waves his arms") or
+# one ("raises a hand", "lifts one hand high", "with his arm up"); a named side is one too
 BOTH_HANDS = re.compile(r"\b(?:both|two)\s+(?:of\s+(?:his|her|their|the)\s+)?(?:hands|arms)\b|"
                         r"\b(?:his|her|their|the|its|your|one's)\s+(?:hands|arms)\b")
+ONE_HAND = re.compile(r"\b(?:a|one|his|her|their|the|its|your|one's)\s+(?:hand|arm)\b")
 ARMS_HELD = re.compile(r"\b(?:with|keeps?|keeping|holds?|holding)\s+(?:[\w-]+\s+){0,2}?(?:arms?|hands?)\s+(?:held\s+)?"
                        r"(?:raised|lifted|up|high|aloft|above(?:\s+(?:his|her|their|the)\s+heads?)?|overhead|in the air)\b|"
                        r"\b(?:arms?|hands?)\s+(?:held\s+)?(?:raised|lifted|aloft|up high)\b")

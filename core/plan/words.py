@@ -45,7 +45,7 @@ class Words:
     slow_flight: bool = False                  # slow of a gait with flights (a jog, a run): shorter strides
     gestures_only: bool = False                # every action named is an arms action ("he waves")
     arms_held: bool = False                    # the arms kept raised ("with both arms raised")
-    both_hands: bool = False                   # a gesture of both hands ("waves with both hands"); else one
+    hands: str | None = None                   # a gesture's hands: "both" ("waves with both hands"), "one" ("a hand")
     seconds: float | None = None               # the length the words ask ("for ten seconds")
     unused: tuple[str, ...] = ()               # words no class took ("nervously")
 
@@ -97,8 +97,8 @@ class Words:
             out["side"] = f"{self.side[0]} {self.side[1]}"
         if self.arms_held:
             out["arms_held"] = True
-        if self.both_hands:
-            out["both_hands"] = True
+        if self.hands is not None:
+            out["hands"] = self.hands
         if self.seconds is not None:
             out["seconds"] = self.seconds
         if self.unused:
@@ -124,7 +124,7 @@ def read_words(text: str) -> Words:
         gait_text=None if stop is None else stop[0],
         stand_still=stop is None and R.asks_stand_still(low), count=R.asked_count(low), pace=pace,
         slow_flight=pace == "slow" and R.asks_slow_flight(low), gestures_only=R.gestures_only(low),
-        arms_held=R.arms_held(low), both_hands=R.asks_both_hands(low), seconds=R.asked_seconds(low),
+        arms_held=R.arms_held(low), hands=R.hands_asked(low), seconds=R.asked_seconds(low),
         unused=tuple(R.unused_words(low, _body_words(low), () if pace else (V.FAST, V.SLOW))))
 
 
