@@ -11,8 +11,8 @@ made that way are offered when any is (the takes nearest by caption,
 competes: the judges read the library's one-hand waves as raised hands (blind paraphrases: waves
 60 -> 20 % by the TMA judge when one hand was made the default; docs/design-notes.md). A take is
 made with both when its less active hand travels at least ``BOTH_SHARE`` of the more active one's
-path (``part_judge.side_activity``, wrist and elbow relative to the pelvis): Bandai's both-hands
-waves and raises 0.81-1.00, its one-hand ones 0.02-0.40.
+path (``part_compose.side_activity``, wrist and elbow relative to the pelvis): Bandai's both-hands
+waves and raises 0.78-1.00, its one-hand ones 0.05-0.33 (whole takes).
 """
 from __future__ import annotations
 
@@ -26,7 +26,7 @@ HAND_GESTURES = frozenset(a for a in ARMS_ACTIONS if a in ACTIONS and ACTIONS[a]
 
 def made_with_both(joints) -> bool:
     """Whether (T, 22, 3) ``joints`` make their gesture with both hands (module docstring)."""
-    from ..eval.part_judge import side_activity
+    from .part_compose import side_activity
 
     left, right = side_activity(joints, "hand")
     return min(left, right) >= BOTH_SHARE * max(left, right, 1e-6)
