@@ -94,15 +94,19 @@ def test_a_sit_keeps_the_head_up_and_a_lie_down_puts_it_down():
 
 def test_a_lie_down_starts_standing_only_when_it_starts_at_its_start(openbody):
     """HDM05's captured lie-downs start standing (root at 1.0-1.1 of the leg's length); their last
-    3 s start in a crouch, as the codes' last seconds a 3 s "sits down" was made of. A sit or a
-    lie-down keeps the candidates that start standing when any does."""
+    3 s start in a crouch, as the codes' last seconds a 3 s "sits down" was made of. A sit keeps
+    the candidates that start standing when any does; a lie-down the ones that end lying, however
+    they start."""
     from shapemove.core.generation.generate import Generator
-    from shapemove.core.generation.posture_change import posture_kept, starts_standing
+    from shapemove.core.generation.posture_change import HEAD_Y, posture_kept, starts_standing
 
     pool = Generator(None, body=openbody).pool
     i = pool.ids.index("HDM_bd_lieDownFloor_001_120")
     whole = pool.window(i, len(pool.take(i)["rotations"]), 0).features
-    last = pool.window(i, 60, 0).features
+    last = pool.window(i, 80, 0).features    # its last 4 s: from kneeling to lying
     assert starts_standing(whole) and not starts_standing(last)
-    keep = posture_kept("lie down", [last, whole], np.ones(2, bool))
-    assert keep.tolist() == [False, True]
+    assert posture_kept("lie down", [last, whole], np.ones(2, bool)).tolist() == [True, True]   # both end lying
+    sit = [np.asarray(f).copy() for f in (last, whole)]    # the two, made to keep the head up: sits
+    for f in sit:
+        f[:, HEAD_Y] = np.maximum(f[:, HEAD_Y], 0.5 * f[:, HEAD_Y].max())
+    assert posture_kept("sit", sit, np.ones(2, bool)).tolist() == [False, True]

@@ -17,9 +17,11 @@ for a sit the candidates whose head stays up compete, and for a lie-down those w
 down: the head's low height (its ``LOW_QUANTILE``) under ``LYING`` of its highest lies (the built
 data's lie-downs 0.08-0.09, get-ups from the floor 0.09-0.28, squats 0.54-0.73, bends 0.52); a sit
 with none whose head stays up keeps a candidate that does not lie rather than one that does ("no
-sit is better than a body lying on the floor"). Of those, the ones that start standing are kept
+sit is better than a body lying on the floor"). Of a sit's, the ones that start standing are kept
 when any does (``starts_standing``): a 3 s segment "sits down" chose the last 3 s of a lie-down's
-codes, which start in a crouch.
+codes, which start in a crouch. Not of a lie-down's: asked for 4 s, the captured lie-downs' last
+4 s start kneeling and end lying flat (the head 0.13 m high), while the samples that start standing
+end half-way, the head 0.35-0.48 m high; a lie-down must end lying.
 
     keep = posture_kept("get up", feats, keep)     # (N,) bool among (T, 263) candidates
 """
@@ -65,7 +67,7 @@ def posture_kept(action: str | None, feats: list, keep: np.ndarray) -> np.ndarra
     makes = np.array([way * posture_change(f) >= MIN_CHANGE for f in feats]) & keep
     if action in HEAD_DOWN:
         head = np.array([lies(f) for f in feats]) == HEAD_DOWN[action]
-        up = np.array([starts_standing(f) for f in feats])
+        up = np.array([starts_standing(f) for f in feats]) if action == "sit" else np.ones(len(feats), bool)
         for narrowed in (makes & head & up, makes & head, keep & head):
             if narrowed.any():
                 return narrowed
