@@ -189,7 +189,8 @@ class TakePool:
             from .hands_asked import made_with_both
 
             t = self.take(i)
-            self._both[i] = made_with_both(self.proc.pose_on(t["rotations"], t["root"], t["betas"], 1.0, t["contacts"]))
+            joints = self.proc.pose_on(t["rotations"], t["root"], t["betas"], 1.0, t["contacts"])
+            self._both[i] = made_with_both(joints)
         return self._both[i]
 
     def nearest(self, text: np.ndarray, action: str | None, seed: int, count: int = TAKES,

@@ -201,7 +201,7 @@ class Generator:
         down = self.vae.cfg.downsample
         text = self._embed_texts([r.prompt])[0]
         words = r.words if r.words is not None else read_words(r.prompt)
-        straight, hands = straight_asked(words), hands_wanted(words, action)   # one hand unless both are said
+        straight, hands = straight_asked(words), hands_wanted(words, action)   # a gesture's hands as said
         if r.seconds is None:   # the model's length: a take plays whole, at least UNASKED_SECONDS
             return pool.windows(text, action, r.seed, self._length(UNASKED_SECONDS)[0] * down, side, hi * down,
                                 times=times, straight=straight, hands=hands)
