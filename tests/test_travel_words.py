@@ -91,3 +91,24 @@ def test_the_picker_sets_aside_the_tmas_favourite_when_it_walks_backward():
     assert int(np.argmax(scores)) < 4, "the TMA alone should prefer a walk backward here"
     best = gen.picker.pick(prompt, feats)
     assert best >= 4 and best == 4 + int(np.argmax(scores[4:]))
+
+
+def test_a_gait_asked_backwards_is_a_walk_backward_with_a_note():
+    """No capture runs, jogs or marches backwards, and every take and sample goes forward: "a woman
+    runs backwards" ran 7.5 m forward, "a man jogs backwards" stood about. The walk backward's takes
+    are offered for them (seed 0, 4 s), and the motion says so; a walk backward is itself."""
+    from shapemove.core.generation.generate import Generator, Request
+    from shapemove.core.generation.travel_words import backward_taken
+    from shapemove.core.plan.words import read_words
+
+    assert backward_taken(read_words("a woman runs backwards"), "run") == "walk backward"
+    assert backward_taken(read_words("a man marches backwards"), "march") == "walk backward"
+    assert backward_taken(read_words("a man walks backwards"), "walk backward") is None
+    assert backward_taken(read_words("a woman runs forward"), "run") is None
+    assert backward_taken(read_words("she kicks backwards"), "kick") is None          # no gait
+    gen = Generator(None)
+    for prompt, verb in (("a woman runs backwards", "runs"), ("a man jogs backwards", "jogs")):
+        m = gen.generate_batch([Request(prompt, seed=0, seconds=4)])[0]
+        z = m.joints[:, 0, 2]
+        assert z[-1] - z[0] < -2.0, (prompt, z[-1] - z[0])      # it goes backwards (it faces +Z at the start)
+        assert f"no capture {verb} backwards: a walk backward is played" in m.notes, m.notes

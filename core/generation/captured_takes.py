@@ -77,6 +77,7 @@ class Window:
     mirrored: bool = False
     looped: int = 0         # frames of the take's own cycle played again (take_loop.py)
     cut: int = 0            # frames of the repetitions asked that the length asked leaves out
+    note: str = ""          # why this take stands in for what was asked (travel_words.backward_taken)
 
     @property
     def arrays(self) -> dict:
@@ -339,6 +340,8 @@ def captured_motion(w: Window, body, betas, ik_refine_iters: int = 10, prompt: s
     out = planted_retarget(w.arrays, body, betas, ik_refine_iters)
     out.prompt = prompt
     out.provenance = w.provenance
+    if w.note:
+        out.notes.append(w.note)
     if w.looped:
         out.notes.append(f"the captured take plays {(len(w.rotations) - w.looped) / FPS:.1f} s: its own cycle "
                          f"repeats for the remaining {w.looped / FPS:.1f} s")

@@ -55,6 +55,7 @@ from .sampling_params import (DEFAULT_GUIDANCE, check_candidates, check_guidance
 from .request import Request
 from .slow_steps import slow_motion
 from .still_take import still_take
+from .travel_words import backward_taken, backward_verb
 from .hands_asked import hands_wanted
 from .typical_pace import leg_ratio, load_typical_speeds, slow_take, typical_paced, unplain_take
 from .straight_gait import straight_asked
@@ -251,12 +252,16 @@ class Generator:
             found = self._action_clips(r, lo, hi)
             asked = self._taken(self._asked(r))   # a take of another action than the words ask does not compete
             words = r.words if r.words is not None else read_words(r.prompt)
+            backward = backward_taken(words, asked)   # "runs backwards": the data's backward gait is a walk
+            asked = backward or asked
             times = words.count[1] if words.count is not None else None          # "three jumping jacks"
             windows = [w for w in (self._windows(r, asked, lo, hi, side, times) if captured else [])   # of the asked action,
                        if action_credit(asked, w.action) is not None                    # at a plain gait's pace
                        and not slow_take(w, words, self.typical_speeds, self.body)
                        and not unplain_take(w, words)
                        and not still_take(w, asked, words)]
+            for w in windows if backward else []:
+                w.note = f"no capture {backward_verb(self._asked(r))} backwards: a walk backward is played"
             cands, sources, beta = (self._from_action_clips(r, found) if found    # the user's clips: as captured
                                     else self._sampled(r, lo, hi, g, library=not windows))   # takes, or as codes
             best = 0

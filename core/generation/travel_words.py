@@ -11,6 +11,8 @@ in the root frame, +Z forward, +X the body's left), summed over the clip, so a w
 still counts as forward. A word only rules out what goes against it by more than ``SLACK``
 metres: "punches forward" does not ask a punch to travel, it refuses one that walks backward.
 The words are read by the plan (``plan/reader.travel_of``). Both ways named ("forward and back", "left and right") is no direction at all.
+A gait other than a walk asked backwards ("runs backwards") has the walk backward's captured takes
+offered (``backward_taken``): the data hold no other gait going backwards.
 """
 from __future__ import annotations
 
@@ -46,3 +48,25 @@ def allowed(travel: Travel, feats: list) -> np.ndarray:
     where none does (the words are then no help in choosing) or it names no travel."""
     ok = np.array([obeys(travel, f) for f in feats], dtype=bool) if travel.named else np.ones(len(feats), bool)
     return ok if ok.any() else np.ones(len(feats), bool)
+
+
+BACKWARD_GAIT = "walk backward"   # the data's one gait that goes backwards
+
+
+def backward_taken(words, asked: str | None) -> str | None:
+    """The action whose captured takes compete for a gait the words (``plan.words.Words``) send
+    backwards: the walk backward for any other gait of ``vocabulary.GAITS`` ("runs backwards",
+    "jogs backwards": no capture does either, and every take and sample goes forward, so the run
+    went 7.5 m forward and the jog stood about); None otherwise."""
+    from ..plan.vocabulary import GAITS
+
+    if asked is None or asked == BACKWARD_GAIT or asked not in GAITS or words.travel.forward >= 0:
+        return None
+    return BACKWARD_GAIT
+
+
+def backward_verb(gait: str) -> str:
+    """How the vocabulary says a gait ("marches", "sneaks"), for the note that a walk backward stands in."""
+    from ..data.actions import ACTIONS
+
+    return ACTIONS[gait].phrases[0].split()[0] if gait in ACTIONS else gait
