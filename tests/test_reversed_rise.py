@@ -31,7 +31,7 @@ def test_the_sit_played_backwards_starts_seated_and_ends_standing():
     sit = Motion(_body(root, root + 0.6), np.zeros(10), np.zeros((60, 24, 3)), np.zeros((60, 3)), 20.0, "openbody",
                  contacts=np.ones((60, 4), np.uint8), provenance="generated")
     for frames in (60, 30, 90):
-        up = sit_reversed(sit, frames, 1)
+        up = sit_reversed(sit, sit.contacts, frames, 1)
         y = up.joints[:, 0, 1]
         assert len(up.joints) == len(up.contacts) == frames and up.provenance == "segment 1 played backwards"
         # from LEAD frames before the root is 3 cm up (sit frame 27), the sit's way down backwards, then standing
@@ -46,10 +46,10 @@ def test_a_squat_before_a_stand_up_is_held_at_its_lowest():
     squat = Motion(_body(root, root + 0.6), np.zeros(10), np.zeros((40, 24, 3)), np.zeros((40, 3)), 20.0, "openbody",
                    contacts=np.ones((40, 4), np.uint8), notes=["the captured take lasts 1.2 s: its last pose is held "
                                                                "for the remaining 0.8 s"])
-    low = held_low(squat)
+    low = held_low(squat, squat.contacts)
     assert len(low.joints) == 40 and np.allclose(low.joints[14:, 0, 1], 0.4) and np.array_equal(low.joints[:15], squat.joints[:15])
     assert low.notes == ["held at its lowest from 0.7 s: the next segment stands up"] and ends_seated(low.joints)
-    assert held_low(low) is low                                  # lowest at its end already
+    assert held_low(low, low.contacts) is low                                  # lowest at its end already
 
 
 def test_sitting_down_then_standing_up_rises_from_the_seat(openbody):

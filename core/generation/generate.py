@@ -250,10 +250,11 @@ class Generator:
             g = torch.Generator().manual_seed(int(r.seed))
             lo, hi = self._length(r.seconds)
             found = self._action_clips(r, lo, hi)
-            asked = self._taken(self._asked(r))   # a take of another action than the words ask does not compete
+            requested = self._asked(r)
+            wanted = self._taken(requested)   # a take of another action than the words ask does not compete
             words = r.words if r.words is not None else read_words(r.prompt)
-            backward = backward_taken(words, asked)   # "runs backwards": the data's backward gait is a walk
-            asked = backward or asked
+            backward = backward_taken(words, wanted)   # "runs backwards": the data's backward gait is a walk
+            asked = backward or wanted
             times = words.count[1] if words.count is not None else None          # "three jumping jacks"
             windows = [w for w in (self._windows(r, asked, lo, hi, side, times) if captured else [])   # of the asked action,
                        if action_credit(asked, w.action) is not None                    # at a plain gait's pace
@@ -261,7 +262,7 @@ class Generator:
                        and not unplain_take(w, words)
                        and not still_take(w, asked, words)]
             for w in windows if backward else []:
-                w.note = f"no capture {backward_verb(self._asked(r))} backwards: a walk backward is played"
+                w.note = f"no capture {backward_verb(requested)} backwards: a walk backward is played"
             cands, sources, beta = (self._from_action_clips(r, found) if found    # the user's clips: as captured
                                     else self._sampled(r, lo, hi, g, library=not windows))   # takes, or as codes
             best = 0

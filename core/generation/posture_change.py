@@ -46,7 +46,12 @@ STANDING = 0.95    # a root this share of the leg's length high stands (standing
 def posture_change(features) -> float:
     """The root's height at the end minus at the start of a (T, 263) candidate, as a share of its
     highest root."""
-    y = np.asarray(features, dtype=np.float64)[:, 3]
+    return height_change(np.asarray(features, dtype=np.float64)[:, 3])
+
+
+def height_change(y) -> float:
+    """A (T,) height at the end (its last ``ENDS`` frames) minus at the start, as a share of its highest."""
+    y = np.asarray(y, dtype=np.float64)
     return float((y[-ENDS:].mean() - y[:ENDS].mean()) / max(y.max(), 1e-6))
 
 

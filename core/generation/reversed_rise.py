@@ -14,7 +14,7 @@ up again as captured, so it is held from its lowest frame on (``held_low``) and 
 from there the same way. The segment says so (its provenance: "segment 1 played backwards").
 
     if rises_from_seat(before_words, words, before_motion):
-        motion = sit_reversed(before_motion, frames, 1)
+        motion = sit_reversed(before_motion, contacts, frames, 1)
 """
 from __future__ import annotations
 
@@ -23,7 +23,7 @@ import dataclasses
 import numpy as np
 
 from ..plan.vocabulary import RISEN_FROM
-from .posture_change import ENDS, LYING, MIN_CHANGE
+from .posture_change import ENDS, LYING, MIN_CHANGE, height_change
 
 HEAD = 15
 LOWERED = frozenset({"sit"}) | RISEN_FROM   # a seat, a squat, a bend: what a stand-up after it rises from
@@ -38,9 +38,8 @@ def ends_seated(joints) -> bool:
     j = np.asarray(joints, np.float64)
     if len(j) < 2 * ENDS:
         return False
-    root, head = j[:, 0, 1], j[:, HEAD, 1]
-    down = (root[:ENDS].mean() - root[-ENDS:].mean()) / max(root.max(), 1e-6)
-    return bool(down >= MIN_CHANGE and head[-ENDS:].mean() > LYING * max(head.max(), 1e-6))
+    head = j[:, HEAD, 1]
+    return bool(-height_change(j[:, 0, 1]) >= MIN_CHANGE and head[-ENDS:].mean() > LYING * max(head.max(), 1e-6))
 
 
 def stands_up(words) -> bool:
@@ -59,18 +58,16 @@ def rises_from_seat(before, words, before_motion) -> bool:
     return stands_up(words) and lowers(before) and ends_seated(before_motion.joints)
 
 
-def held_low(motion):
-    """A finished segment that goes down held from its lowest frame on (the root's lowest), so the
-    segment after it can stand up from there: "squats, holds it, then stands up" (a captured squat
-    goes down and up again). The Motion itself when it is lowest at its end already."""
+def held_low(motion, contacts):
+    """A finished segment that goes down (its (T, 4) foot ``contacts``) held from its lowest frame on
+    (the root's lowest), so the segment after it can stand up from there: "squats, holds it, then
+    stands up" (a captured squat goes down and up again). The Motion itself when it is lowest at its
+    end already."""
     j = np.asarray(motion.joints)
     low = int(np.argmin(j[:, 0, 1]))
     if (j[low:, 0, 1] - j[low, 0, 1]).max() < SETTLED:   # it stays down to its end already
         return motion
-    from ..motion.contacts import detect_contacts
-
-    c = np.asarray(motion.contacts if motion.contacts is not None and len(motion.contacts) == len(j)
-                   else detect_contacts(j, motion.fps), np.uint8)
+    c = np.asarray(contacts, np.uint8)
     held = len(j) - low - 1
     return dataclasses.replace(
         motion, joints=np.concatenate([j[:low + 1], np.repeat(j[low:low + 1], held, 0)]),
@@ -79,15 +76,12 @@ def held_low(motion):
         + [f"held at its lowest from {low / motion.fps:.1f} s: the next segment stands up"])
 
 
-def sit_reversed(sit, frames: int, index: int):
-    """The finished ``sit`` Motion played backwards over ``frames`` frames (module docstring), as a
-    segment's Motion (joints and contacts: what a stitched timeline joins); ``index``: the sit's
-    segment, 1-based, for its provenance."""
-    from ..motion.contacts import detect_contacts
-
+def sit_reversed(sit, contacts, frames: int, index: int):
+    """The finished ``sit`` Motion (its (T, 4) foot ``contacts``) played backwards over ``frames``
+    frames (module docstring), as a segment's Motion (joints and contacts: what a stitched timeline
+    joins); ``index``: the sit's segment, 1-based, for its provenance."""
     j = np.asarray(sit.joints)[::-1]
-    c = np.asarray(sit.contacts if sit.contacts is not None and len(sit.contacts) == len(sit.joints)
-                   else detect_contacts(sit.joints, sit.fps), np.uint8)[::-1]
+    c = np.asarray(contacts, np.uint8)[::-1]
     seated = j[0, 0, 1]
     rise = int(np.argmax(j[:, 0, 1] > seated + SETTLED)) if (j[:, 0, 1] > seated + SETTLED).any() else 0
     lo = max(0, rise - LEAD)   # the seated stretch left out but LEAD frames: the rise comes first

@@ -158,12 +158,12 @@ def stitched_sequence(gen, segments: list[tuple[str, float]], body: np.ndarray, 
         if cancel is not None and cancel():
             raise ShapeMoveError("cancelled")
         if i and rises_from_seat(said[i - 1], said[i], motions[-1]):   # standing up from the seat just sat on
-            motions.append(sit_reversed(motions[-1], max(2, int(round(sec * FPS))), i))
+            motions.append(sit_reversed(motions[-1], _contacts(motions[-1]), max(2, int(round(sec * FPS))), i))
         else:
             seg = segment_request(base, text, sec, body, base.seed + i, None if readings is None else readings[i])
             motions.append(gen.generate_batch([seg])[0])
             if i + 1 < len(segments) and lowers(said[i]) and stands_up(said[i + 1]):   # down, held, then up
-                motions[-1] = held_low(motions[-1])
+                motions[-1] = held_low(motions[-1], _contacts(motions[-1]))
         if progress is not None:
             progress((i + 1) / (len(segments) + 1), f"segment {i + 1}/{len(segments)}: {text}")
     return assembled(gen, motions, [t for t, _ in segments], body)
