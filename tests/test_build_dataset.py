@@ -163,3 +163,22 @@ def test_ik_is_calibrated_per_clip(tiny_dataset):
         assert 0 < m["ik_offset_max_cm"] <= 6.0 + 1e-6, m["id"]
         marker.append(m["ik_marker_error_cm"])
     assert len(marker) >= 12 and np.mean(marker) <= 1.5
+
+
+def test_a_take_too_short_to_train_on_is_built_for_the_library_only(mocap_root, tmp_path):
+    """A single hop (14 frames at 20 fps, under ``MIN_FRAMES``) of a training subject is built whole
+    into the ``library`` split: no split list holds it, so nothing trains or is judged on it, and
+    the motion library takes it; the same of a held-out subject (HDM05 dg) is not built at all."""
+    from shapemove.core.data.build import LIBRARY_SPLIT, MIN_FRAMES, TAKE_MIN_FRAMES
+    from shapemove.core.data.library_build import library_metas
+
+    kept, held_out = "HDM_bd_hopBothLegs1hops_001_120", "HDM_dg_hopBothLegs1hops_026_120"
+    out = tmp_path / "out"
+    report = build_dataset([mocap_root], out, only=[kept, held_out], verbose=False, ik_refine_iters=0)
+    assert report.built == 1 and report.splits == {"train": 0, "val": 0, "test": 0, LIBRARY_SPLIT: 1}
+    meta = json.loads((out / "meta" / f"{kept}.json").read_text())
+    assert meta["split"] == LIBRARY_SPLIT and TAKE_MIN_FRAMES <= meta["frames"] < MIN_FRAMES
+    assert np.load(out / "poses" / f"{kept}.npy").shape == (meta["frames"], 24, 3)
+    assert all(not _ids(out, s) for s in ("train", "val", "test"))
+    assert [cid for cid, _ in report.failures] == [held_out] and "held-out subject" in report.failures[0][1]
+    assert [m["id"] for m in library_metas(out)] == [kept]

@@ -201,21 +201,24 @@ def test_two_things_at_once_puts_captured_parts_together(openbody):
 
 
 def test_an_action_without_takes_draws_on_the_takes_of_its_general_action(openbody):
-    """No take of the library is a hop; a hop is a jump (``actions.GENERIC_OF``): "hops" plays a
-    captured jump, both feet leaving the floor, where the samples alone stand nearly still."""
+    """No take of the library is mainly ballet; ballet is a dance (``actions.GENERIC_OF``): the
+    dance takes compete for it. A hop has takes of its own, the single hops of HDM05 too short to
+    train on (``build.LIBRARY_SPLIT``): "hops forward on both feet" plays one, both feet leaving
+    the floor, where the samples alone stand nearly still."""
     from shapemove.core.generation.generate import Generator, Request
 
     gen = Generator(None, body=openbody)
-    assert "hop" not in gen.pool.actions and gen._taken("hop") == "jump" and gen._taken("kick") == "kick"
+    assert "ballet" not in gen.pool.actions and gen._taken("ballet") == "dance" and gen._taken("kick") == "kick"
     assert gen._taken("sit") == "sit"                     # nothing more general: no take competes
+    assert gen.pool.actions.count("hop") >= 20 and gen._taken("hop") == "hop"
     m = gen.generate_batch([Request("a man hops forward on both feet", seconds=4, seed=0)])[0]
     assert m.provenance.startswith("captured: ")
     kept = gen.pool.actions[gen.pool.ids.index(m.retrieved_clips[0])]
-    assert kept in ("jump", "jump forward", "spin jump")
+    assert kept in ("hop", "jump", "jump forward", "spin jump")
     feet = np.minimum(m.joints[:, 10, 1], m.joints[:, 11, 1])
     assert feet.max() - feet.min() > 0.15                 # in the air
     gen.set_captured(False)
-    assert gen._taken("hop") == "hop"
+    assert gen._taken("ballet") == "ballet"
 
 
 def test_a_short_gait_take_goes_on_instead_of_standing(openbody):

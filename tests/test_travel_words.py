@@ -30,6 +30,9 @@ def allowed(prompt, feats):
     ("waves to his left", Travel()),                               # a side, but no going
     ("A golfer swings to the left", Travel()),
     ("a person jumps and waves", Travel()),
+    ("a woman circles her arms backwards", Travel()),              # the way the arms go, not the body
+    ("he swings his arms forward", Travel()),
+    ("she walks backwards, circling her arms", Travel(forward=-1)),
 ])
 def test_travel_of_reads_the_words(prompt, expected):
     assert travel_of(prompt) == expected

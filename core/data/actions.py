@@ -194,7 +194,7 @@ _LIST = [
     _a("elbow to knee", "exercise", ["touches each elbow to the opposite knee"],
        [r"\belbow\w* to (the )?(opposite )?knees?"]),
     _a("arm circles", "exercise", ["rotates both arms", "makes circles with the arms"],
-       [r"\brotat\w* (both )?arms", r"\barm circles", r"\bcircl\w* (both |the )?arms", r"\bcircles with the arms"]),
+       [r"\brotat\w* (both )?arms", r"\barm circles", r"\bcircl\w* (both |the |his |her |their |your )?arms", r"\bcircles with the arms"]),
     _a("balance", "exercise", ["balances on one leg"], [r"\bbalanc"]),
     # gestures
     _a("wave", "gesture", ["waves", "waves a hand"], [r"\bwav(e|es|ing)\b"]),
@@ -251,6 +251,7 @@ GENERIC_OF = {"walk in a figure eight": ("walk",), "walk in a circle": ("walk",)
 # (``generation.take_loop.looped_repetition``); a kick or a throw done once is held instead (a
 # gait's one-cycle take too: docs/design-notes.md)
 REPEATED = frozenset({"arm circles", "jumping jacks", "dribble", "elbow to knee", "side twist"})
+MOVES_ON = frozenset({"dribble"})   # of those, the one that may go somewhere as it repeats
 
 
 def specific(acts: list[str]) -> list[str]:

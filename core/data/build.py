@@ -9,7 +9,10 @@ For each clip (see ``sources.discover``):
      leg length) and put back on the ground,
   5. HumanML3D features of both, captions, shape texts from the mesh measurements.
 Bandai clips (one shared skeleton) additionally get retargeted copies on bodies sampled from the
-shape space (``AUGMENT_SHARE``). Each clip is written atomically and marked done by its
+shape space (``AUGMENT_SHARE``). A clip under ``MIN_FRAMES`` but at least ``TAKE_MIN_FRAMES`` long
+(a single hop, one arm circle: 0.5 to 1.2 s) trains nothing: it is built whole, without an
+augmented copy, into the split ``LIBRARY_SPLIT``, which only the motion library reads
+(``library_build.py``); one of a held-out subject is not built at all. Each clip is written atomically and marked done by its
 ``meta/ID.json``, so an interrupted build resumes where it stopped.
 """
 from __future__ import annotations
@@ -35,6 +38,8 @@ from .sources import ClipSource, discover, open_source
 from .splits import split_of
 
 MIN_FRAMES = 24          # 1.2 s; the SA-VAE trains on the clips of >= 64 frames, the T5 on all
+TAKE_MIN_FRAMES = 10     # 0.5 s; a shorter clip is no take the motion library can play
+LIBRARY_SPLIT = "library"  # clips too short to train on, kept as captured takes only
 AUGMENT_SHARE = 0.5      # fraction of Bandai clips that get one copy on a sampled body
 AUGMENT_BETA_CLIP = 2.5  # sampled betas ~ N(0,1) clipped to +-2.5
 
@@ -83,8 +88,8 @@ class ClipProcessor:
     def load(self, clip: ClipSource):
         motion = load_smpl22(clip.path, fps=FPS)
         joints = np.asarray(motion.joints, dtype=np.float32)
-        if joints.shape[0] < MIN_FRAMES:
-            raise ShapeMoveError(f"too short: {joints.shape[0]} frames at {FPS} fps (need {MIN_FRAMES})")
+        if joints.shape[0] < TAKE_MIN_FRAMES:
+            raise ShapeMoveError(f"too short: {joints.shape[0]} frames at {FPS} fps (need {TAKE_MIN_FRAMES})")
         if not np.isfinite(joints).all():
             raise ShapeMoveError("non-finite joint positions")
         return joints
@@ -290,6 +295,11 @@ def build_dataset(sources: list[Path], out: Path, body=None, augment_share: floa
             continue
         try:
             joints = proc.load(clip)
+            if len(joints) < MIN_FRAMES:   # a take for the library only, never of a held-out subject
+                if split == "test":
+                    raise ShapeMoveError(f"too short: {len(joints)} frames at {FPS} fps (need {MIN_FRAMES}; "
+                                         "a shorter take of a held-out subject is not kept)")
+                split, todo = LIBRARY_SPLIT, [(cid, b) for cid, b in todo if b is None]
             for cid, b in todo:
                 arrays = proc.process(joints, b)
                 extra = {"augmented_from": clip.id} if b is not None else {}
@@ -308,17 +318,17 @@ def build_dataset(sources: list[Path], out: Path, body=None, augment_share: floa
                 traceback.print_exc()
         if progress is not None:
             progress((i + 1) / len(clips), clip.id)
-    finalize(out)
+    report.splits = finalize(out)
     report.seconds = time.time() - t0
-    report.splits = {s: len((out / f"{s}.txt").read_text().split()) for s in ("train", "val", "test")}
     path = out / ("build_report.txt" if count == 1 else f"build_report.shard-{index}-of-{count}.txt")
     earlier = path.read_text() if path.is_file() else ""   # every run's report is kept, newest last
     atomic_write_text(path, earlier + report.summary() + "\n")
     return report
 
 
-def finalize(out: Path) -> None:
-    """meta.jsonl, split lists and Mean/Std (over the training split) from the per-clip files."""
+def finalize(out: Path) -> dict[str, int]:
+    """meta.jsonl, split lists and Mean/Std (over the training split) from the per-clip files;
+    returns the clips of each split (train, val, test and ``LIBRARY_SPLIT``, which has no list)."""
     from ..motion.features import mean_std
 
     metas = [json.loads(p.read_text()) for p in sorted((out / "meta").glob("*.json"))]
@@ -332,3 +342,4 @@ def finalize(out: Path) -> None:
         mean, std = mean_std(feats)
         atomic_save_npy(out / "Mean.npy", np.asarray(mean, np.float32))
         atomic_save_npy(out / "Std.npy", np.asarray(std, np.float32))
+    return {s: sum(m["split"] == s for m in metas) for s in ("train", "val", "test", LIBRARY_SPLIT)}

@@ -2,8 +2,9 @@
 
     python -m shapemove data library --data data/built --out weights/default/library.npz
 
-The takes are the dataset's captured clips of the training and validation splits as performed:
-no shape-augmented copies, composed clips or mirror images (generation mirrors a take itself when
+The takes are the dataset's captured clips of the training and validation splits as performed,
+and those too short to train on (``build.LIBRARY_SPLIT``: a single hop, one arm circle): no
+shape-augmented copies, composed clips or mirror images (generation mirrors a take itself when
 the words name the other side), never the test split (held out for evaluation). Each keeps its
 rotations, root path, measured contacts, fitted betas, captions, main action, performer and
 licence. The frequent actions (``FREQUENT``: walks, runs, jogs, raised hands, waves) keep
@@ -21,9 +22,10 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ShapeMoveError
+from .build import LIBRARY_SPLIT
 from .motion_library import MotionLibrary, mean_caption_vectors, source_name
 
-SPLITS = ("train", "val")
+SPLITS = ("train", "val", LIBRARY_SPLIT)
 FREQUENT = ("walk", "run", "jog", "raise hand", "wave")
 FREQUENT_TAKES = 96
 

@@ -45,7 +45,7 @@ import numpy as np
 from ..constants import FPS
 from ..errors import ShapeMoveError
 from ..scene.motion_file import Motion
-from ..data.actions import REPEATED
+from ..data.actions import MOVES_ON, REPEATED
 from ..plan.vocabulary import GAITS, POSTURE_CHANGES
 from .repeated_takes import cut_for, repeated_stretch
 from .straight_gait import STRAIGHTENED, straightened
@@ -274,7 +274,8 @@ class TakePool:
                         again = looped_gait(rot, root, con, posed_joints, want) or \
                             looped_steps(rot, root, con, posed_joints, want, mirrored)   # and the step's mirror image
                 if again is None and (self.actions[i] in REPEATED or self.actions[i] in GAITS):
-                    again = looped_repetition(rot, root, con, posed_joints, want)   # one arm circle, one gait cycle
+                    again = looped_repetition(rot, root, con, posed_joints, want,   # one arm circle, one gait
+                                              self.actions[i] in GAITS or self.actions[i] in MOVES_ON)   # cycle
             if again is not None:
                 rot, root, con, first = again
                 looped = want - first

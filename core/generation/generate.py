@@ -42,6 +42,7 @@ from .prompts import check_prompt
 from .rerank import CandidatePicker
 from .retrieval_seeds import seed_prefixes, seeded_count
 from .held_arms import held_motion
+from .held_repetition import performed
 from .on_the_spot import on_the_spot
 from ..plan.plan import plan_text, read_plan
 from ..plan.reader import without_numbers
@@ -261,6 +262,7 @@ class Generator:
                        and not slow_take(w, words, self.typical_speeds, self.body)
                        and not unplain_take(w, words)
                        and not still_take(w, asked, words)]
+            windows = performed(windows, asked, times)   # arm circles that stop half way: not when others go on
             for w in windows if backward else []:
                 w.note = f"no capture {backward_verb(requested)} backwards: a walk backward is played"
             cands, sources, beta = (self._from_action_clips(r, found) if found    # the user's clips: as captured

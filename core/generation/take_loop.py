@@ -22,7 +22,9 @@ window (``retarget.planted_retarget``) plants the repeats as the take's own step
 A take of one repetition of an action done over and over by its nature (``actions.REPEATED``: a
 single arm circle of 1.9 s) has no second cycle to find; ``looped_repetition`` plays its busy
 stretch again when the stretch ends where it began (the same seam and heading conditions): on the
-spot, or moved on by the stretch's advance when its root travels faster than ``TRAVELS``.
+spot, or moved on by the stretch's advance when its root travels faster than ``TRAVELS`` and the
+action may go somewhere as it repeats (a dribble, a gait's cycle; an arm circle whose performer
+stepped back once is not looped into a walk backwards: it is held).
 
 A take of a gait (four jogging steps from standing) is looped on its steps (``looped_gait``): its
 last stride, from one foot's touching down to the same foot's next, the latest such stride of either
@@ -79,11 +81,11 @@ def looped_take(rotations, root, contacts, joints, frames: int):
     return _played_on(rotations, root, contacts, J, steps, headings(J), a, b, b, frames)
 
 
-def looped_repetition(rotations, root, contacts, joints, frames: int):
+def looped_repetition(rotations, root, contacts, joints, frames: int, travels: bool = True):
     """As ``looped_take`` for a take of one repetition (``actions.REPEATED``): its busy stretch a..b-1
     (the standing start and end left out) is the cycle, played again while its last frame steps into
     its first no farther than the take's own steps; None when it does not, or the take is long
-    enough."""
+    enough. ``travels`` False: the action is done on the spot, the cycle's advance is never added."""
     from .track import headings
 
     if len(rotations) >= frames:
@@ -94,7 +96,7 @@ def looped_repetition(rotations, root, contacts, joints, frames: int):
         return None
     steps, a, b = busy
     r = np.asarray(root, np.float64)
-    moves = np.linalg.norm((r[b - 1] - r[a])[[0, 2]]) > TRAVELS * (b - 1 - a) / FPS   # moving on as it repeats
+    moves = travels and np.linalg.norm((r[b - 1] - r[a])[[0, 2]]) > TRAVELS * (b - 1 - a) / FPS   # moving on
     return _played_on(rotations, root, contacts, J, steps, headings(J), a, b, b - 1, frames, travel=moves)
 
 

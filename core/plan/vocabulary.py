@@ -141,8 +141,11 @@ TURN_NEGATED = re.compile(r"\b(?:without|not|no|never|don't|doesn't|do not|does 
 # "walks back" / "comes back" / "heads back": a return, walked facing the way (not "walks backwards", "steps back")
 RETURN = re.compile(r"\b(?:walk|stroll|jog|run|sprint|head|com|go|hurr|wander|march)\w* back(?! and forth| and back)\b(?!-)",
                     re.I)
-FORWARD = re.compile(r"\b(?:forwards?|ahead|onwards?|toward(?:s)? (?:the )?(?:camera|viewer))\b|" + RETURN.pattern, re.I)
-BACKWARD = re.compile(r"\b(backwards?|in reverse|backs? (?:up|away)|backing (?:up|away)|retreat\w*|"
+# "circles her arms backwards", "swings his arms forward": the way the arms go, not the body
+_ARMS_WAY = r"(?<!arms )(?<!arm )"
+FORWARD = re.compile(r"\b(?:" + _ARMS_WAY + r"forwards?|ahead|onwards?|toward(?:s)? (?:the )?(?:camera|viewer))\b|"
+                     + RETURN.pattern, re.I)
+BACKWARD = re.compile(r"\b(" + _ARMS_WAY + r"backwards?|in reverse|backs? (?:up|away)|backing (?:up|away)|retreat\w*|"
                       r"(?:steps?|stepping) back(?! and forth))\b", re.I)
 IN_PLACE = re.compile(r"\b(in place|on the spot)\b", re.I)
 # a side named for travel: a verb of going, then within three words "to the left" / "to his right"
