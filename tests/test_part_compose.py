@@ -197,8 +197,10 @@ def test_clauses_the_patterns_miss_are_named_by_the_nearest_caption(gen):
     assert (plan.legs_prompt, plan.arms_prompt) == ("a man marches", "a man swinging his right arm overhead")
     assert (plan.legs_action, plan.arms_action) == ("march", "raise hand") and side is None
     assert plan.arms_side == ("right", "hand")
+    both = plan_of("a man tiptoes and circles his arms", gen)[0]   # the arms' circles named: two things
+    assert (both.legs_action, both.arms_action) == ("sneak", "arm circles")
     # single actions stay whole: no part named by the patterns, a subject alone, "as fast as"
-    for single in ("a man tiptoes and circles his arms", "A person walking with a hurt right leg",
+    for single in ("A person walking with a hurt right leg",
                    "A man running as fast as he can", "he walks to the door and opens it",
                    "A zombie shambling toward the camera, arms out",
                    "A person raises the left hand slowly, like an elderly person.",   # a style, not a walk
