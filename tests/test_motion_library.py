@@ -92,3 +92,18 @@ def test_load_refuses_pickles_and_bad_shapes(tmp_path):
         MotionLibrary.load(tmp_path / "ok.npz", max_bytes=1000)
     with pytest.raises(ShapeMoveError, match="not found"):
         MotionLibrary.load(tmp_path / "none.npz")
+
+
+def test_a_take_too_short_to_train_on_is_kept_unless_it_is_a_stride_of_a_gait(tmp_path):
+    """Of the clips built for the library only, a single hop is a take; a 0.65 s sprint is one
+    stride, not a take to walk on from."""
+    import json
+
+    from shapemove.core.data.build import LIBRARY_SPLIT
+
+    (tmp_path / "meta").mkdir()
+    for cid, action, split in (("hop", "hop", LIBRARY_SPLIT), ("dash", "sprint", LIBRARY_SPLIT),
+                               ("run", "sprint", "train"), ("held", "hop", "test")):
+        (tmp_path / "meta" / f"{cid}.json").write_text(json.dumps({"id": cid, "split": split,
+                                                                    "labels": {"actions": [action]}}))
+    assert [m["id"] for m in library_metas(tmp_path)] == ["hop", "run"]

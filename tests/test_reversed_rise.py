@@ -79,3 +79,27 @@ def test_a_held_squat_then_standing_up_rises_from_the_crouch(openbody):
     y = m.joints[:, 0, 1]
     assert y[b - 10:b].max() < 0.6 * y[:5].mean()                        # still down at the end of the squat
     assert y[-5:].mean() == pytest.approx(y[:5].mean(), abs=0.05)         # up again
+
+
+def test_regenerating_keeps_the_stand_up_on_its_seat(openbody):
+    """Regenerate on a timeline's stand-up made it anew as a single prompt: a get-up from lying (the
+    body went down on the floor to rise). Made again, it is the sit before it played backwards
+    again; and the sit made again (another seed) has the stand-up rise from the new seat."""
+    from shapemove.core.generation.generate import Generator, Request
+    from shapemove.core.generation.sequence import regenerate_segment
+
+    gen = Generator(None, body=openbody)
+    m = gen.generate_batch([Request("a man sits down, then stands up", seed=0)])[0]
+    up = regenerate_segment(gen, m, 1, seed=7)
+    assert up.provenance.endswith("segment 2: segment 1 played backwards"), up.provenance
+    (_, b), (c, _) = up.segment_bounds
+    y = up.joints[:, 0, 1]
+    assert y[c:].min() > y[b - 5:b].min() - 0.05                         # never lower than the seat: no floor
+    assert y[-5:].mean() == pytest.approx(y[:5].mean(), abs=0.08)
+
+    sat = regenerate_segment(gen, m, 0, seed=3)                          # the sit again: a new seat
+    assert sat.provenance.endswith("segment 2: segment 1 played backwards"), sat.provenance
+    (_, b), (c, _) = sat.segment_bounds
+    j = sat.joints
+    assert np.abs(j[c] - j[c - 1]).max() < 0.05                          # the rise starts where the new sit ends
+    assert j[c:c + 5, 0, 1].mean() < j[:5, 0, 1].mean() - 0.3

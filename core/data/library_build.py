@@ -3,7 +3,8 @@
     python -m shapemove data library --data data/built --out weights/default/library.npz
 
 The takes are the dataset's captured clips of the training and validation splits as performed,
-and those too short to train on (``build.LIBRARY_SPLIT``: a single hop, one arm circle): no
+and those too short to train on (``build.LIBRARY_SPLIT``: a single hop, one arm circle; not a
+stride of a gait): no
 shape-augmented copies, composed clips or mirror images (generation mirrors a take itself when
 the words name the other side), never the test split (held out for evaluation). Each keeps its
 rotations, root path, measured contacts, fitted betas, captions, main action, performer and
@@ -31,7 +32,11 @@ FREQUENT_TAKES = 96
 
 
 def library_metas(data) -> list[dict]:
-    """The metas of the captured takes a library holds (see the module docstring), sorted by id."""
+    """The metas of the captured takes a library holds (see the module docstring), sorted by id: of
+    the clips too short to train on, not those of a gait (a 0.65 s sprint is a stride, not a take to
+    walk on from)."""
+    from ..plan.vocabulary import GAITS
+
     data = Path(data)
     if not (data / "meta").is_dir():
         raise ShapeMoveError(f"{data} is not a built dataset (no meta/ folder): run `python -m shapemove data build`")
@@ -39,7 +44,8 @@ def library_metas(data) -> list[dict]:
     for p in sorted((data / "meta").glob("*.json")):
         m = json.loads(p.read_text(encoding="utf-8"))
         if m.get("split") in SPLITS and not (m.get("augmented_from") or m.get("composed_from") or m.get("mirror_of")):
-            out.append(m)
+            if not (m["split"] == LIBRARY_SPLIT and main_action(m) in GAITS):
+                out.append(m)
     return out
 
 

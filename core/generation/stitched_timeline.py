@@ -178,9 +178,16 @@ def regenerate_stitched(gen, motion: Motion, index: int, seed: int, prompt: str 
                         seconds: float | None = None, request=None) -> Motion:
     """Segment ``index`` of a stitched timeline made again (new ``seed``, optionally a new ``prompt``
     or ``seconds``) as a single prompt on the timeline's body; the other segments keep their frames
-    and are joined again around it."""
+    and are joined again around it. The standing up from a seat keeps to its seat
+    (``reversed_rise.py``): a segment that rises from the one before is that segment played
+    backwards again, and the rise after a segment made again is played backwards from the new one
+    (a sit or a squat before a stand-up held at its lowest, as ``stitched_sequence`` makes them)."""
+    import dataclasses
+
     from ..constants import FPS
+    from ..plan.words import read_words
     from .request import Request
+    from .reversed_rise import held_low, lowers, rises_from_seat, sit_reversed, stands_up
 
     bounds = np.asarray(motion.segment_bounds)
     prompts = list(motion.segment_prompts)
@@ -188,16 +195,33 @@ def regenerate_stitched(gen, motion: Motion, index: int, seed: int, prompt: str 
         raise ShapeMoveError(f"segment {index + 1} does not exist: this timeline has {len(bounds)}")
     text = prompt or prompts[index]
     sec = float(seconds) if seconds is not None else (bounds[index, 1] - bounds[index, 0]) / FPS
-    base = request if request is not None else Request(text)
-    new = gen.generate_batch([segment_request(base, text, sec, motion.betas, seed)])[0]
     joints = [np.asarray(motion.joints[s:e]) for s, e in bounds]
     whole = _contacts(motion)
     contacts = [whole[s:e] for s, e in bounds]
+    sources = segment_sources(motion) or [None] * len(prompts)
+    from .sequence import plan_readings
+
+    readings = plan_readings(motion) or [None] * len(prompts)   # an edited plan's actions, where it has them
+    said = [read_words(t) if i == index and t != prompts[index] or readings[i] is None else readings[i]
+            for i, t in enumerate(prompts[:index] + [text] + prompts[index + 1:])]
+    segment = lambda i: dataclasses.replace(motion, joints=joints[i], contacts=contacts[i])  # noqa: E731
+    frames = max(2, int(round(sec * FPS)))
+    if index and rises_from_seat(said[index - 1], said[index], segment(index - 1)):
+        new = sit_reversed(segment(index - 1), contacts[index - 1], frames, index)
+    else:
+        base = request if request is not None else Request(text)
+        new = gen.generate_batch([segment_request(base, text, sec, motion.betas, seed)])[0]
+        if index + 1 < len(prompts) and lowers(said[index]) and stands_up(said[index + 1]):   # down, held, up
+            new = held_low(new, _contacts(new))
     joints[index], contacts[index] = np.asarray(new.joints), _contacts(new)
     prompts[index] = text
-    out = planted(gen, joints, contacts, prompts, motion.betas, motion.prompt)
-    sources = segment_sources(motion) or [None] * len(prompts)
     sources[index] = new.provenance
+    after = index + 1
+    if after < len(prompts) and sources[after] == f"segment {after} played backwards":   # the rise from it, again
+        if rises_from_seat(said[index], said[after], segment(index)):
+            rise = sit_reversed(segment(index), contacts[index], len(joints[after]), after)
+            joints[after], contacts[after] = np.asarray(rise.joints), _contacts(rise)
+    out = planted(gen, joints, contacts, prompts, motion.betas, motion.prompt)
     out.provenance, out.shape_source = segment_provenance(sources), "given"
     out.plan = motion.plan if text == motion.segment_prompts[index] else None
     return out
