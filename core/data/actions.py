@@ -62,7 +62,7 @@ _EVERYDAY = {
     "crawl": (
         r"\bon all fours\b", r"\bcreep\w* (\w+ )?on all fours\b", r"\bon (his |her |their |your )?hands and knees\b",
     ),
-    "jump": (r"\bsprings? (up|into the air)\b", r"\bvault(s|ed|ing)?\b",),
+    "jump": (r"\bsprings? (up|into the air)\b", r"\bvault(s|ed|ing)?\b", r"\bskip\w* (a |the )?rope\b",),
     "jump forward": (r"\b(broad|standing long) jumps?\b", r"\bleap\w* as far\b",),
     "spin jump": (r"\b(jump|leap)\w* (up )?and (twirl|spin|turn|rotat)\w*",),
     "hop": (r"\bskip\w* (along )?on one (leg|foot)\b", r"\bbounc\w* on (both|two) feet\b",
