@@ -94,6 +94,26 @@ def test_the_shipped_library_is_what_the_builder_makes_now(tiny_dataset):
         np.testing.assert_array_equal(take.contacts, np.load(tiny_dataset / "contacts" / f"{cid}.npy"))
 
 
+def test_the_shipped_retrieval_memory_is_what_the_builder_makes_now(tiny_dataset):
+    """The default model's retrieval memory holds, for each tiny-dataset training clip it keeps, the
+    codes the model's SA-VAE gives that clip as the builder makes it today
+    (``tools/build_motion_memory.py``; the memory of 2026-11-26 came from an older build)."""
+    import torch
+
+    from shapemove.core.generation.model_bundle import DEFAULT_MODEL_DIR
+    from shapemove.core.models.motion_memory import MotionMemory
+    from shapemove.core.models.savae import load_savae
+    from shapemove.core.train.t5_dataset import tokenize_clips
+
+    mem = MotionMemory.load(DEFAULT_MODEL_DIR / "t5")
+    shared = [m["id"] for m in library_metas(tiny_dataset) if m["split"] == "train" and m["id"] in mem.clip_ids]
+    assert len(shared) >= 4, shared
+    with torch.no_grad():
+        made = tokenize_clips(load_savae(DEFAULT_MODEL_DIR / "savae.pt"), tiny_dataset, shared)
+    for cid in shared:
+        np.testing.assert_array_equal(mem.clip_tokens[mem.clip_ids.index(cid)], made[cid], err_msg=cid)
+
+
 def _write(path, **arrays):
     with open(path, "wb") as f:
         np.savez(f, **arrays)
