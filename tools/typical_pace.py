@@ -39,7 +39,8 @@ def gait_speeds(data: Path, split: str = "train") -> dict[str, dict[str, list[fl
         labels, cid = meta.get("labels") or {}, meta.get("id")
         actions = labels.get("actions") or []
         style = labels.get("style")
-        if cid not in ids or meta.get("augmented_from") or not actions or actions[0] not in GAITS:
+        if (cid not in ids or meta.get("augmented_from") or meta.get("mirror_of") or meta.get("composed_from")
+                or not actions or actions[0] not in GAITS):   # each capture once, as performed
             continue
         if style not in ("normal", None):
             continue
