@@ -42,6 +42,7 @@ from .seam_pace import paced_seams, seam_steps
 from ..plan.words import read_words
 from .stop_words import distance_cut, distance_keeps, from_start, standing_after, stop_cut
 from .token_sampling import body_for, sample_codes
+from .timeline_plan import plan_readings
 from .track import Track, decoded_track, plant, rotate_y, smoothstep
 
 PREFIX_CODES = 4          # codes (0.8 s at 4 frames a code) a segment continues from
@@ -242,22 +243,6 @@ def _assemble(gen, codes_per_segment, prompts, betas, arms_per_segment=None, wor
               readings=None) -> Motion:
     track, feats, extra = _timeline_track(gen, codes_per_segment, betas, arms_per_segment)
     return _planted(gen, track, feats, extra, codes_per_segment, prompts, betas, words, readings)
-
-
-def plan_readings(motion: Motion) -> list | None:
-    """The readings of a timeline's segments in the plan it was made from (``Motion.plan``, an edited
-    plan's fields kept), None without one or when it does not match the segments."""
-    if not motion.plan or motion.segment_prompts is None:
-        return None
-    from ..plan.plan import plan_from_json
-
-    try:
-        plan = plan_from_json(motion.plan)
-    except ShapeMoveError:
-        return None
-    if [s.text for s in plan.segments] != list(motion.segment_prompts):
-        return None
-    return [s.words for s in plan.segments]
 
 
 def redecode_timeline(gen, motion: Motion, betas) -> Motion:

@@ -199,7 +199,7 @@ def regenerate_stitched(gen, motion: Motion, index: int, seed: int, prompt: str 
     whole = _contacts(motion)
     contacts = [whole[s:e] for s, e in bounds]
     sources = segment_sources(motion) or [None] * len(prompts)
-    from .sequence import plan_readings
+    from .timeline_plan import plan_readings
 
     readings = plan_readings(motion) or [None] * len(prompts)   # an edited plan's actions, where it has them
     said = [read_words(t) if i == index and t != prompts[index] or readings[i] is None else readings[i]

@@ -16,7 +16,7 @@ action's words in the text the model reads), ``side`` ("left hand"), ``course`` 
 up), ``hands`` (a gesture's hands: "both" or "one"); a segment's ``text`` and ``seconds``
 (its length, which wins) too. A field left out asks nothing. The
 motion keeps the plan (``Motion.plan``), so a timeline re-decoded for a new body or a strip
-regenerated acts on its edited segments again (``generation/sequence.plan_readings``).
+regenerated acts on its edited segments again (``generation/timeline_plan.plan_readings``).
 """
 from __future__ import annotations
 
