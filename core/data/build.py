@@ -12,8 +12,8 @@ Bandai clips (one shared skeleton) additionally get retargeted copies on bodies 
 shape space (``AUGMENT_SHARE``). A clip under ``MIN_FRAMES`` but at least ``TAKE_MIN_FRAMES`` long
 (a single hop, one arm circle: 0.5 to 1.2 s) trains nothing: it is built whole, without an
 augmented copy, into the split ``LIBRARY_SPLIT``, which only the motion library reads
-(``library_build.py``); one of a held-out subject is not built at all. Each clip is written atomically and marked done by its
-``meta/ID.json``, so an interrupted build resumes where it stopped.
+(``library_build.py``); one of a held-out subject is not built at all. Each clip is written
+atomically and marked done by its ``meta/ID.json``, so an interrupted build resumes where it stopped.
 """
 from __future__ import annotations
 

@@ -4,9 +4,8 @@
 
 The takes are the dataset's captured clips of the training and validation splits as performed,
 and those too short to train on (``build.LIBRARY_SPLIT``: a single hop, one arm circle; not a
-stride of a gait): no
-shape-augmented copies, composed clips or mirror images (generation mirrors a take itself when
-the words name the other side), never the test split (held out for evaluation). Each keeps its
+stride of a gait): no shape-augmented copies, composed clips or mirror images (generation mirrors
+a take itself when the words name the other side), never the test split (held out for evaluation). Each keeps its
 rotations, root path, measured contacts, fitted betas, captions, main action, performer and
 licence. The frequent actions (``FREQUENT``: walks, runs, jogs, raised hands, waves) keep
 ``FREQUENT_TAKES`` takes each, drawn round-robin over their (source, label) groups so that the

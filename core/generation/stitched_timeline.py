@@ -188,6 +188,7 @@ def regenerate_stitched(gen, motion: Motion, index: int, seed: int, prompt: str 
     from ..plan.words import read_words
     from .request import Request
     from .reversed_rise import held_low, lowers, rises_from_seat, sit_reversed, stands_up
+    from .timeline_plan import plan_readings
 
     bounds = np.asarray(motion.segment_bounds)
     prompts = list(motion.segment_prompts)
@@ -199,10 +200,8 @@ def regenerate_stitched(gen, motion: Motion, index: int, seed: int, prompt: str 
     whole = _contacts(motion)
     contacts = [whole[s:e] for s, e in bounds]
     sources = segment_sources(motion) or [None] * len(prompts)
-    from .timeline_plan import plan_readings
-
     readings = plan_readings(motion) or [None] * len(prompts)   # an edited plan's actions, where it has them
-    said = [read_words(t) if i == index and t != prompts[index] or readings[i] is None else readings[i]
+    said = [read_words(t) if (i == index and t != prompts[index]) or readings[i] is None else readings[i]
             for i, t in enumerate(prompts[:index] + [text] + prompts[index + 1:])]
     segment = lambda i: dataclasses.replace(motion, joints=joints[i], contacts=contacts[i])  # noqa: E731
     frames = max(2, int(round(sec * FPS)))
