@@ -63,7 +63,8 @@ def test_a_word_rules_out_only_travel_against_it_beyond_the_slack():
     sideways = Travel(sideways=True)
     assert obeys(sideways, _clip(0.01, -0.02)) and not obeys(sideways, _clip(0.03, 0.02))
     in_place = Travel(in_place=True)
-    assert obeys(in_place, _clip(0.02, 0.0)) and not obeys(in_place, _clip(0.02, 0.02))  # 0.8 m; 1.13 m
+    assert obeys(in_place, _clip(0.012, 0.0)) and not obeys(in_place, _clip(0.02, 0.0))  # 0.48 m; 0.8 m
+    assert not obeys(in_place, _clip(0.0, -0.013))          # 0.52 m to the side (a hop of HDM05: 1 m)
 
 
 def test_allowed_sets_aside_the_contrary_and_keeps_all_when_none_obey():
@@ -115,3 +116,16 @@ def test_a_gait_asked_backwards_is_a_walk_backward_with_a_note():
         z = m.joints[:, 0, 2]
         assert z[-1] - z[0] < -2.0, (prompt, z[-1] - z[0])      # it goes backwards (it faces +Z at the start)
         assert f"no capture {verb} backwards: a walk backward is played" in m.notes, m.notes
+
+
+def test_hopping_on_the_spot_stays_on_the_spot(openbody):
+    """With the default model: HDM05's hops on both feet go about a metre forward each; "a person
+    hops on the spot" (4 s, seed 0) played one (0.9 m forward, then standing) while the in-place
+    tolerance was 1 m; now the motion leaves the floor and stays within 0.5 m."""
+    from shapemove.core.generation.generate import Generator, Request
+
+    m = Generator(None, body=openbody).generate_batch([Request("a person hops on the spot", seconds=4, seed=0)])[0]
+    root = m.joints[:, 0]
+    assert np.ptp(root[:, [0, 2]], axis=0).max() < 0.5
+    feet = m.joints[:, [7, 8, 10, 11], 1].min(1)
+    assert feet.max() > 0.15                                        # off the floor: a hop, not a stand

@@ -9,7 +9,9 @@ contradicts the travel words is therefore set aside before choosing, unless ever
 The root travel is read from the features' own root velocities (``features.py``: metres per frame
 in the root frame, +Z forward, +X the body's left), summed over the clip, so a walk that curves
 still counts as forward. A word only rules out what goes against it by more than ``SLACK``
-metres: "punches forward" does not ask a punch to travel, it refuses one that walks backward.
+metres: "punches forward" does not ask a punch to travel, it refuses one that walks backward; "in
+place" refuses more than ``SLACK`` metres of travel any way (a hop of a metre forward for "hops on
+the spot").
 The words are read by the plan (``plan/reader.travel_of``). Both ways named ("forward and back", "left and right") is no direction at all.
 A gait other than a walk asked backwards ("runs backwards") has the walk backward's captured takes
 offered (``backward_taken``): the data hold no other gait going backwards.
@@ -38,7 +40,7 @@ def obeys(travel: Travel, features: np.ndarray, slack: float = SLACK) -> bool:
         return False
     if travel.sideways and (abs(left) < slack or abs(left) < abs(fwd)):
         return False
-    if travel.in_place and np.hypot(fwd, left) > 2 * slack:
+    if travel.in_place and np.hypot(fwd, left) > slack:
         return False
     return True
 
