@@ -173,3 +173,36 @@ def test_the_table_counts_each_capture_once(tiny_dataset, tmp_path):
     assert sum(len(v) for g in before.values() for v in g.values()) >= 2, before
     assert mirror_dataset(data, verbose=False)                       # mirror images written into train
     assert tool.gait_speeds(data) == before
+
+
+def test_a_jog_asked_fast_stays_a_jog():
+    """"a man jogs quickly" was chosen at 2.7-3.6 m/s, a run's pace: a jog asked fast is brought
+    down to no faster than halfway between the jog's and the run's typical speeds; a run or a walk
+    asked fast, and a plain jog, keep their own rule."""
+    from shapemove.core.generation.typical_pace import fast_gait, paced_speed
+    from shapemove.core.plan.words import read_words
+
+    speeds = {"walk": 1.19, "jog": 1.56, "run": 2.87}
+    assert fast_gait(read_words("a man jogs quickly")) == "jog"
+    assert paced_speed(read_words("a man jogs quickly"), speeds) == pytest.approx(2.215)
+    assert paced_speed(read_words("the boy does a quick jog"), speeds) == pytest.approx(2.215)
+    assert paced_speed(read_words("a man jogs"), speeds) == 1.56                  # typical
+    for other in ("a man runs quickly", "a person walks quickly", "a man jogs quickly in a circle",
+                  "a man jogs quickly to the left"):
+        assert paced_speed(read_words(other), speeds) is None, other
+    assert paced_speed(read_words("a man jogs quickly"), {"jog": 1.56}) is None   # no run in the table
+
+
+def test_a_quick_jog_goes_faster_than_a_jog_and_slower_than_a_run(openbody):
+    """With the default model (seed 0): between the typical jog and the typical run on its body."""
+    from shapemove.core.generation.generate import Generator, Request
+    from shapemove.core.generation.typical_pace import TOLERANCE, body_speed, load_typical_speeds
+    from shapemove.core.generation.model_bundle import DEFAULT_MODEL_DIR
+    from shapemove.core.motion.root_speed import mean_speed
+
+    gen = Generator(None, body=openbody)
+    m = gen.generate_batch([Request("a man jogs quickly", seconds=4, seed=0)])[0]
+    speeds = load_typical_speeds(DEFAULT_MODEL_DIR)
+    speed = mean_speed(m.joints, m.fps)
+    cap = body_speed((speeds["jog"] + speeds["run"]) / 2, openbody, m.betas)
+    assert body_speed(speeds["jog"], openbody, m.betas) < speed <= cap * (1 + TOLERANCE)

@@ -18,7 +18,10 @@ chose for "a man walks" as readily as plain walks (median 0.93x typical with the
 Nor does a take that stops or circles (``unplain_take``: held on its last pose for more than
 ``MOST_HELD`` of the window, or its root's path not ``straight``, the typical speeds' own test of a
 straight capture): a 1.9 s jog around a bend, then standing, was "a person jogs" at 0.48x.
-The feet are planted again (``track.replanted``). Nothing is retimed when the words ask a pace ("quickly"),
+A jog asked fast ("a quick jog", "jogs quickly") was chosen at 2.7-3.6 m/s, a run's pace (2.87):
+it is brought down to no faster than halfway between the jog's and the run's typical speeds
+(``FAST_UP_TO``), so it stays a jog. The feet are planted again (``track.replanted``). Nothing
+else is retimed when the words ask a pace ("quickly"),
 a distance, a number of steps, a stop, a course, a turn, a direction other than forward, a count,
 two things at once or a side (``plan.words.Words``); the user's ``--speed`` applies after.
 
@@ -48,6 +51,7 @@ MAX_BYTES = 64 << 10
 GAITS = ("walk", "jog", "run")
 FLIGHT = ("jog", "run")     # keep their cadence; shorter strides instead
 TOLERANCE = 0.03            # a motion within this share of its typical speed is left as it is
+FAST_UP_TO = {"jog": "run"}   # a gait asked fast goes at most halfway to the next gait's typical speed
 MAX_CHANGE = 1.5            # the most a motion's speed is changed by (either way)
 MOVING = 0.2                # m/s: a motion slower than this is not a gait going anywhere: left as it is
 SLOW_TAKE = 0.95            # a captured take under this share of its typical speed does not compete
@@ -136,10 +140,33 @@ def paced_gait(words, course: bool = True) -> str | None:
     return gait
 
 
+def fast_gait(words) -> str | None:
+    """The gait of ``FAST_UP_TO`` the words ask fast along a line and nothing else of ("a man jogs
+    quickly"); None otherwise."""
+    gait = lined_gait(words)
+    if gait not in FAST_UP_TO or words.pace != "fast" or any(a not in (None, False) for a in (words.count, words.side)):
+        return None
+    return gait
+
+
+def paced_speed(words, speeds: dict, course: bool = True) -> float | None:
+    """The speed (m/s, average body) a motion of the words is brought down to: its plain gait's typical
+    speed (``paced_gait``), or, for a gait asked fast (``fast_gait``), halfway from its typical speed
+    to the next gait's; None when none applies or the table lacks the gaits."""
+    gait = paced_gait(words, course)
+    if gait is not None:
+        return speeds.get(gait)
+    fast = fast_gait(words) if words is not None else None
+    if fast is None or fast not in speeds or FAST_UP_TO[fast] not in speeds:
+        return None
+    return (speeds[fast] + speeds[FAST_UP_TO[fast]]) / 2
+
+
 def typical_paced(motion, body, words, speeds: dict, ik_refine_iters: int = 10, course: bool = True):
-    """``motion`` brought down to its plain gait's typical speed on its body (module doc); the
-    motion itself when the words ask more than a plain gait (or a slow one: ``plain_gait``), the table
-    lacks the gait, or it is no more than ``TOLERANCE`` above typical. A gait asked slowly is
+    """``motion`` brought down to its plain gait's typical speed on its body, a jog asked fast to
+    ``paced_speed``'s (module doc); the motion itself when the words ask more than a plain gait
+    (or a slow or a fast one: ``plain_gait``, ``fast_gait``), the table lacks the gait, or it is no
+    more than ``TOLERANCE`` above that speed. A gait asked slowly is
     brought down here before ``slow_steps`` slows it: "jogs slowly" goes slower than "jogs" whichever
     take or sample was chosen (a 2.5 m/s DeepMimic jog slowed by a fifth would outrun a plain jog). So is
     a course's gait, before it is bent onto the course (``paced_gait``; ``course`` False: not)."""
@@ -147,10 +174,11 @@ def typical_paced(motion, body, words, speeds: dict, ik_refine_iters: int = 10, 
     from .stride_scale import scaled_strides
     from .track import Track, replanted, resample, track_of
 
-    gait = paced_gait(words, course)
-    if gait is None or gait not in speeds or motion.num_frames < 4 or motion.network_joints is None:
+    typical = paced_speed(words, speeds, course)
+    if typical is None or motion.num_frames < 4 or motion.network_joints is None:
         return motion
-    want = body_speed(speeds[gait], body, motion.betas)
+    gait = paced_gait(words, course) or fast_gait(words)
+    want = body_speed(typical, body, motion.betas)
     speed = mean_speed(motion.joints, motion.fps)
     if speed < MOVING or speed <= want * (1 + TOLERANCE):
         return motion
