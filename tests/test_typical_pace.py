@@ -179,18 +179,18 @@ def test_a_jog_asked_fast_stays_a_jog():
     """"a man jogs quickly" was chosen at 2.7-3.6 m/s, a run's pace: a jog asked fast is brought
     down to no faster than halfway between the jog's and the run's typical speeds; a run or a walk
     asked fast, and a plain jog, keep their own rule."""
-    from shapemove.core.generation.typical_pace import fast_gait, paced_speed
+    from shapemove.core.generation.typical_pace import fast_gait, paced_target
     from shapemove.core.plan.words import read_words
 
     speeds = {"walk": 1.19, "jog": 1.56, "run": 2.87}
     assert fast_gait(read_words("a man jogs quickly")) == "jog"
-    assert paced_speed(read_words("a man jogs quickly"), speeds) == pytest.approx(2.215)
-    assert paced_speed(read_words("the boy does a quick jog"), speeds) == pytest.approx(2.215)
-    assert paced_speed(read_words("a man jogs"), speeds) == 1.56                  # typical
+    assert paced_target(read_words("a man jogs quickly"), speeds) == ("jog", pytest.approx(2.215))
+    assert paced_target(read_words("the boy does a quick jog"), speeds) == ("jog", pytest.approx(2.215))
+    assert paced_target(read_words("a man jogs"), speeds) == ("jog", 1.56)        # typical
     for other in ("a man runs quickly", "a person walks quickly", "a man jogs quickly in a circle",
                   "a man jogs quickly to the left"):
-        assert paced_speed(read_words(other), speeds) is None, other
-    assert paced_speed(read_words("a man jogs quickly"), {"jog": 1.56}) is None   # no run in the table
+        assert paced_target(read_words(other), speeds) is None, other
+    assert paced_target(read_words("a man jogs quickly"), {"jog": 1.56}) is None   # no run in the table
 
 
 def test_a_quick_jog_goes_faster_than_a_jog_and_slower_than_a_run(openbody):

@@ -22,10 +22,11 @@ import dataclasses
 
 import numpy as np
 
+from ..body.skeleton import JOINT_NAMES
 from ..plan.vocabulary import RISEN_FROM
 from .posture_change import ENDS, LYING, MIN_CHANGE, height_change
 
-HEAD = 15
+HEAD = JOINT_NAMES.index("head")
 LOWERED = frozenset({"sit"}) | RISEN_FROM   # a seat, a squat, a bend: what a stand-up after it rises from
 SETTLED = 0.03   # m: the root within this of its seated height is still sitting
 LEAD = 5         # frames of sitting kept before the rise
@@ -76,6 +77,11 @@ def held_low(motion, contacts):
         + [f"held at its lowest from {low / motion.fps:.1f} s: the next segment stands up"])
 
 
+def played_backwards(index: int) -> str:
+    """The provenance of a segment that is segment ``index`` (1-based) played backwards."""
+    return f"segment {index} played backwards"
+
+
 def sit_reversed(sit, contacts, frames: int, index: int):
     """The finished ``sit`` Motion (its (T, 4) foot ``contacts``) played backwards over ``frames``
     frames (module docstring), as a segment's Motion (joints and contacts: what a stitched timeline
@@ -91,5 +97,5 @@ def sit_reversed(sit, contacts, frames: int, index: int):
         j = np.concatenate([j, np.repeat(j[-1:], extra, 0)])
         c = np.concatenate([c, np.repeat(np.ones((1, c.shape[1]), np.uint8), extra, 0)])
     return dataclasses.replace(sit, joints=np.ascontiguousarray(j), contacts=np.ascontiguousarray(c), tokens=None,
-                               features=None, provenance=f"segment {index} played backwards",
+                               features=None, provenance=played_backwards(index),
                                retrieved_clips=[], notes=[], warnings=[])

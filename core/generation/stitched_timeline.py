@@ -147,9 +147,7 @@ def stitched_sequence(gen, segments: list[tuple[str, float]], body: np.ndarray, 
     ``base.seed + 1``, ...; a segment standing up from the seat of the one before, that sit played
     backwards (``reversed_rise.py``); ``readings``: the plan's reading of each segment (None: its
     text's own)."""
-    from ..constants import FPS
     from ..plan.words import read_words
-    from .reversed_rise import held_low, lowers, rises_from_seat, sit_reversed, stands_up
 
     said = [readings[i] if readings is not None and readings[i] is not None else read_words(text)
             for i, (text, _) in enumerate(segments)]
@@ -157,16 +155,26 @@ def stitched_sequence(gen, segments: list[tuple[str, float]], body: np.ndarray, 
     for i, (text, sec) in enumerate(segments):
         if cancel is not None and cancel():
             raise ShapeMoveError("cancelled")
-        if i and rises_from_seat(said[i - 1], said[i], motions[-1]):   # standing up from the seat just sat on
-            motions.append(sit_reversed(motions[-1], _contacts(motions[-1]), max(2, int(round(sec * FPS))), i))
-        else:
-            seg = segment_request(base, text, sec, body, base.seed + i, None if readings is None else readings[i])
-            motions.append(gen.generate_batch([seg])[0])
-            if i + 1 < len(segments) and lowers(said[i]) and stands_up(said[i + 1]):   # down, held, then up
-                motions[-1] = held_low(motions[-1], _contacts(motions[-1]))
+        asked = segment_request(base, text, sec, body, base.seed + i, None if readings is None else readings[i])
+        motions.append(_segment_made(i, said, motions[-1] if i else None, sec, lambda: gen.generate_batch([asked])[0]))
         if progress is not None:
             progress((i + 1) / (len(segments) + 1), f"segment {i + 1}/{len(segments)}: {text}")
     return assembled(gen, motions, [t for t, _ in segments], body)
+
+
+def _segment_made(i: int, said: list, before: Motion | None, seconds: float, make) -> Motion:
+    """Segment ``i`` of a timeline whose segments' readings are ``said``: the segment ``before`` it
+    played backwards when it stands up from the seat that one ends on (``reversed_rise.py``), else
+    ``make()``, held at its lowest when the next segment stands up from it."""
+    from ..constants import FPS
+    from .reversed_rise import held_low, lowers, rises_from_seat, sit_reversed, stands_up
+
+    if i and rises_from_seat(said[i - 1], said[i], before):   # standing up from the seat just sat on
+        return sit_reversed(before, _contacts(before), max(2, int(round(seconds * FPS))), i)
+    made = make()
+    if i + 1 < len(said) and lowers(said[i]) and stands_up(said[i + 1]):   # down, held, then up
+        made = held_low(made, _contacts(made))
+    return made
 
 
 def is_stitched(motion: Motion) -> bool:
@@ -187,7 +195,7 @@ def regenerate_stitched(gen, motion: Motion, index: int, seed: int, prompt: str 
     from ..constants import FPS
     from ..plan.words import read_words
     from .request import Request
-    from .reversed_rise import held_low, lowers, rises_from_seat, sit_reversed, stands_up
+    from .reversed_rise import played_backwards, rises_from_seat, sit_reversed
     from .timeline_plan import plan_readings
 
     bounds = np.asarray(motion.segment_bounds)
@@ -204,19 +212,14 @@ def regenerate_stitched(gen, motion: Motion, index: int, seed: int, prompt: str 
     said = [read_words(t) if (i == index and t != prompts[index]) or readings[i] is None else readings[i]
             for i, t in enumerate(prompts[:index] + [text] + prompts[index + 1:])]
     segment = lambda i: dataclasses.replace(motion, joints=joints[i], contacts=contacts[i])  # noqa: E731
-    frames = max(2, int(round(sec * FPS)))
-    if index and rises_from_seat(said[index - 1], said[index], segment(index - 1)):
-        new = sit_reversed(segment(index - 1), contacts[index - 1], frames, index)
-    else:
-        base = request if request is not None else Request(text)
-        new = gen.generate_batch([segment_request(base, text, sec, motion.betas, seed)])[0]
-        if index + 1 < len(prompts) and lowers(said[index]) and stands_up(said[index + 1]):   # down, held, up
-            new = held_low(new, _contacts(new))
+    base = request if request is not None else Request(text)
+    new = _segment_made(index, said, segment(index - 1) if index else None, sec,
+                        lambda: gen.generate_batch([segment_request(base, text, sec, motion.betas, seed)])[0])
     joints[index], contacts[index] = np.asarray(new.joints), _contacts(new)
     prompts[index] = text
     sources[index] = new.provenance
     after = index + 1
-    if after < len(prompts) and sources[after] == f"segment {after} played backwards":   # the rise from it, again
+    if after < len(prompts) and sources[after] == played_backwards(after):   # the rise from it, again
         if rises_from_seat(said[index], said[after], segment(index)):
             rise = sit_reversed(segment(index), contacts[index], len(joints[after]), after)
             joints[after], contacts[after] = np.asarray(rise.joints), _contacts(rise)

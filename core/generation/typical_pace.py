@@ -149,22 +149,22 @@ def fast_gait(words) -> str | None:
     return gait
 
 
-def paced_speed(words, speeds: dict, course: bool = True) -> float | None:
-    """The speed (m/s, average body) a motion of the words is brought down to: its plain gait's typical
-    speed (``paced_gait``), or, for a gait asked fast (``fast_gait``), halfway from its typical speed
-    to the next gait's; None when none applies or the table lacks the gaits."""
+def paced_target(words, speeds: dict, course: bool = True) -> tuple[str, float] | None:
+    """(gait, speed in m/s on the average body) a motion of the words is brought down to: its plain
+    gait's typical speed (``paced_gait``), or, for a gait asked fast (``fast_gait``), halfway from its
+    typical speed to the next gait's; None when none applies or the table lacks the gaits."""
     gait = paced_gait(words, course)
     if gait is not None:
-        return speeds.get(gait)
-    fast = fast_gait(words) if words is not None else None
+        return (gait, speeds[gait]) if gait in speeds else None
+    fast = fast_gait(words)
     if fast is None or fast not in speeds or FAST_UP_TO[fast] not in speeds:
         return None
-    return (speeds[fast] + speeds[FAST_UP_TO[fast]]) / 2
+    return fast, (speeds[fast] + speeds[FAST_UP_TO[fast]]) / 2
 
 
 def typical_paced(motion, body, words, speeds: dict, ik_refine_iters: int = 10, course: bool = True):
     """``motion`` brought down to its plain gait's typical speed on its body, a jog asked fast to
-    ``paced_speed``'s (module doc); the motion itself when the words ask more than a plain gait
+    ``paced_target``'s (module doc); the motion itself when the words ask more than a plain gait
     (or a slow or a fast one: ``plain_gait``, ``fast_gait``), the table lacks the gait, or it is no
     more than ``TOLERANCE`` above that speed. A gait asked slowly is
     brought down here before ``slow_steps`` slows it: "jogs slowly" goes slower than "jogs" whichever
@@ -174,10 +174,10 @@ def typical_paced(motion, body, words, speeds: dict, ik_refine_iters: int = 10, 
     from .stride_scale import scaled_strides
     from .track import Track, replanted, resample, track_of
 
-    typical = paced_speed(words, speeds, course)
-    if typical is None or motion.num_frames < 4 or motion.network_joints is None:
+    target = paced_target(words, speeds, course)
+    if target is None or motion.num_frames < 4 or motion.network_joints is None:
         return motion
-    gait = paced_gait(words, course) or fast_gait(words)
+    gait, typical = target
     want = body_speed(typical, body, motion.betas)
     speed = mean_speed(motion.joints, motion.fps)
     if speed < MOVING or speed <= want * (1 + TOLERANCE):
