@@ -49,6 +49,9 @@ def test_vocabulary():
     ("a person does sit ups", []),
     ("a child skips happily", ["hop"]),
     ("she skips rope", ["jump"]),                     # jumps over a rope, not a skip along
+    ("a boy bounces up and down on the spot", ["hop"]),   # small hops on both feet
+    ("she keeps bouncing in place", ["hop"]),
+    ("a ball bounces off the wall", []),
     ("a drunk man staggers", ["walk"]),
     ("a tired man drags his feet", ["walk"]),
     ("a man crouches and looks around", ["squat"]),

@@ -54,6 +54,22 @@ def test_edited_fields_are_what_the_plan_holds():
     assert not plan_from_json(edited).segments[0].words.travel.named   # a field removed asks nothing
 
 
+def test_actions_taken_out_of_a_plan_lose_their_words_and_actions_put_in_are_said():
+    edited = plan_json("a woman stands up and waves")          # two segments: the stand-up, then the wave
+    assert [s["understood"]["actions"] for s in edited["segments"]] == [["get up"], ["wave"]]
+    one = {"segments": [{"text": "a woman stands up and waves", "understood": {"actions": ["wave"]}}]}
+    seg = plan_from_json(one).segments[0]
+    assert (seg.text, seg.words.actions) == ("a woman waves", ("wave",))
+    one["segments"][0]["understood"]["actions"] = ["get up"]
+    assert plan_from_json(one).segments[0].words.actions == ("get up",)
+    seg = plan_from_json({"segments": [{"text": "a man kicks and punches", "understood": {"actions": ["punch"]}}]}).segments[0]
+    assert (seg.text, seg.words.actions) == ("a man punches", ("punch",))
+    seg = plan_from_json({"segments": [{"text": "a person walks forward",
+                                        "understood": {"actions": ["walk", "wave"]}}]}).segments[0]
+    assert (seg.text, seg.words.actions, seg.words.parts.arms_action) == \
+        ("a person walks forward and waves", ("walk", "wave"), "wave")
+
+
 @pytest.mark.parametrize("plan, field", [
     ({"segments": [{"text": "a man walks", "understood": {"course": "square"}}]}, "segments[0].understood.course"),
     ({"segments": [{"text": "a man walks", "seconds": 0.1}]}, "segments[0].seconds"),

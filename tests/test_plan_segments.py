@@ -61,14 +61,17 @@ from shapemove.core.plan.segments import SEGMENT_SECONDS, split_segments
     ("she walks to the chair and sits down", ["she walks to the chair", "she sits down"]),
     ("he lies down and rolls over", ["he lies down", "he rolls over"]),
     ("a man crawls, then stands up and runs", ["a man crawls", "a man stands up", "a man runs"]),
-    ("a woman squats, then stands up and waves", ["a woman squats", "a woman stands up and waves"]),  # the squat's end
+    # standing up after a squat or a bend is its own end: the segment after it is what follows the stand-up
+    ("a woman squats, then stands up and waves", ["a woman squats", "a woman waves"]),
+    ("she bends over, then stands up and walks away", ["she bends over", "she walks away"]),
+    ("a man sits down, then stands up and waves", ["a man sits down", "a man stands up", "a man waves"]),
     # "and" between two actions one body does not do at once orders, and so do the commas of a list before it
     ("she runs to the car and jumps in", ["she runs to the car", "she jumps in"]),
     ("a person walks up to a table and puts down a cup", ["a person walks up to a table", "a person puts down a cup"]),
     ("a man kicks and punches", ["a man kicks", "a man punches"]),
     ("she jumps, squats and waves", ["she jumps", "she squats", "she waves"]),
     ("a woman walks forward, turns around and walks back", ["a woman walks forward, turns around", "a woman walks back"]),
-    ("a person squats down, subsequently stands up and runs", ["a person squats down", "a person stands up and runs"]),
+    ("a person squats down, subsequently stands up and runs", ["a person squats down", "a person runs"]),
     # a turn after a gait that counts its steps or a distance comes after them
     ("the man walks 10 steps and turns left", ["the man walks 10 steps", "the man turns left"]),
     ("a man walks 3 metres and turns around", ["a man walks 3 metres", "a man turns around"]),

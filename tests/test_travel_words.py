@@ -129,3 +129,17 @@ def test_hopping_on_the_spot_stays_on_the_spot(openbody):
     assert np.ptp(root[:, [0, 2]], axis=0).max() < 0.5
     feet = m.joints[:, [7, 8, 10, 11], 1].min(1)
     assert feet.max() > 0.15                                        # off the floor: a hop, not a stand
+
+
+def test_a_hop_asked_on_the_spot_at_the_models_length_is_brought_back_to_the_spot(openbody):
+    """At the model's own length the candidates are as long as each sample or take, and none of
+    "a person hops on the spot" (seed 0) stays within 0.5 m: every one competes and an HDM05 hop that
+    lands 1.0 m forward was played. The words keep the body on the spot as they keep a gait
+    (``on_the_spot.py``): its stride is shortened to 0.5 m of travel."""
+    from shapemove.core.generation.generate import Generator, Request
+    from shapemove.core.generation.track import travel
+
+    m = Generator(None, body=openbody).generate_batch([Request("a person hops on the spot", seed=0)])[0]
+    assert float(travel(m.joints)[-1]) <= 0.55
+    assert np.ptp(m.joints[:, 0, [0, 2]], axis=0).max() < 0.7
+    assert m.joints[:, [7, 8, 10, 11], 1].min(1).max() > 0.15     # it still leaves the floor

@@ -66,6 +66,7 @@ _EVERYDAY = {
     "jump forward": (r"\b(broad|standing long) jumps?\b", r"\bleap\w* as far\b",),
     "spin jump": (r"\b(jump|leap)\w* (up )?and (twirl|spin|turn|rotat)\w*",),
     "hop": (r"\bskip\w* (along )?on one (leg|foot)\b", r"\bbounc\w* on (both|two) feet\b",
+            r"\bbounc(e|es|ed|ing) (up and down|in place|on the spot)\b",
             r"\bskip(s|ping|ped)?\b(?!\s+(rope|over|the|a|an)\b)",),
     "jumping jacks": (r"\bstar[- ]?jumps?\b",),
     "backflip": (r"\bsomersault\w* backwards?\b", r"\bback tuck\b", r"\bflip\w* over backwards?\b",),

@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 from dataclasses import dataclass, replace
 
 from ..errors import ShapeMoveError
@@ -192,9 +193,25 @@ def _swap_action(text: str, old: str | None, new: str) -> str:
     return (low[:a] + phrase.split()[0] + low[b:]) if " " not in phrase.strip() else (low[:a] + phrase + low[b:])
 
 
+def _drop_action(text: str, action: str) -> str:
+    """``text`` without the words of its ``action`` and the "and" that joined them ("a woman stands
+    up and waves", get up -> "a woman waves")."""
+    from ..data.actions import action_spans, split_words
+
+    low = split_words(text)
+    for a, b, name in action_spans(low):
+        if name == action:
+            left, right = low[:a].rstrip(), low[b:].lstrip()
+            right = re.sub(r"^(?:and|,|then|while)\s+", "", right)
+            left = re.sub(r"(?:\s+and|,)$", "", left) if not right or right[0] in ",.;" else left
+            low = f"{left} {right}".strip()
+            break
+    return low
+
+
 def _edited_words(seg: dict, where: str, text: str) -> tuple[str, Words]:
     """(the text the model reads, the reading) of one edited segment (module doc)."""
-    from ..data.actions import ACTIONS
+    from ..data.actions import ACTIONS, find_actions
     from .part_prompts import PartPlan, named_side, plan_parts
     from .reader import TRAVEL_WAYS
     from .vocabulary import COUNTED, COURSE_NAMES, MAX_METRES, MAX_STEPS, MAX_COUNT
@@ -217,6 +234,16 @@ def _edited_words(seg: dict, where: str, text: str) -> tuple[str, Words]:
     if actions and actions[0] not in read.actions:   # a new action: its words replace the old one's
         text = _swap_action(text, read.actions[0] if read.actions else None, actions[0])
         read = read_words(text)
+    reworded = False
+    if actions:   # actions taken out lose their words, actions put in are said
+        before = text
+        for gone in [a for a in read.actions if a not in actions]:
+            text = _drop_action(text, gone)
+        text = " and ".join([text] + [ACTIONS[a].phrases[0] for a in actions[1:] if a not in find_actions(text)])
+        read, reworded = read_words(text), text != before
+        if read.actions and set(read.actions) != set(actions):
+            raise _bad(f"{where}.understood.actions", f"{actions!r} cannot be said in one segment (its text reads "
+                       f"{list(read.actions)!r}: {text!r}); edit the segment's text")
     parts = read.parts
     if "legs" in said or "arms" in said:
         legs = _text(said.get("legs"), f"{where}.understood.legs")
@@ -227,7 +254,7 @@ def _edited_words(seg: dict, where: str, text: str) -> tuple[str, Words]:
         side = named_side(arms)
         parts = PartPlan(legs, arms, found.legs_action, found.arms_action,
                          side if side is not None and side[1] == "hand" else None)
-    elif "legs" not in said:
+    elif not reworded:   # the printed plan names them: taken out, nothing is made by part
         parts = None
     side = None
     if "side" in said:

@@ -116,13 +116,16 @@ def _and_steps(piece: str, before: str = "") -> list[str]:
     cuts, at the commas of a
     list of steps before it ("jumps, squats and waves": three); the piece itself otherwise. Standing
     up after a squat or a bend (``before``: what precedes the piece) is that action's own end, no
-    action of its own ("squats, then stands up and waves" is two)."""
+    action of its own: "squats, then stands up and waves" is two, the squat (which stands up again)
+    and "waves"."""
     whole = find_actions(piece)
     for m in AND.finditer(piece):
         a, b = piece[:m.start()], piece[m.end():]
         first, then = find_actions(a), find_actions(b)
         if not (first and then and _has_verb(b)):
             continue
+        if first == ["get up"] and not _changes_posture("get up", find_actions(before)):
+            return _and_steps(b, before)   # the squat's own standing up: "squats, then stands up and waves"
         posture = first[0] != then[0] and (_changes_posture(first[0], find_actions(before))
                                            or _changes_posture(then[0], first))
         counted = then[0] == "turn" and stop_request(a) is not None   # "walks 10 steps and turns left"
