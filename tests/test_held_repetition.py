@@ -47,3 +47,25 @@ def test_arm_circles_go_on_to_the_end_on_the_spot(openbody):
     assert np.ptp(wrists, axis=0).min() > 0.3                        # both arms still circling
     root = m.joints[:, 0]
     assert np.linalg.norm(root[-1, [0, 2]] - root[0, [0, 2]]) < 0.2   # on the spot
+
+
+def _flights(joints) -> int:
+    low = np.asarray(joints)[:, [7, 8, 10, 11], 1].min(1)
+    up = (low > 0.08).astype(int)
+    return int((np.diff(up) == 1).sum())
+
+
+def test_hops_go_on_hopping_along_or_on_the_spot(openbody):
+    """With the default model: HDM05's hops on both feet are single hops (0.7-0.8 s, a metre forward
+    each). "a girl skips along happily" played one and stood for 3.3 s; a hop is now done over and
+    over (``actions.REPEATED``) and goes on as it repeats (``MOVES_ON``): it hops along. On the spot,
+    the repeated hops are brought back to 0.5 m (``on_the_spot.py``)."""
+    from shapemove.core.generation.generate import Generator, Request
+
+    gen = Generator(None, body=openbody)
+    m = gen.generate_batch([Request("a girl skips along happily", seed=0)])[0]
+    root = m.joints[:, 0, [0, 2]]
+    assert "hopBothLegs" in m.provenance and _flights(m.joints) >= 4
+    assert np.linalg.norm(root[-1] - root[0]) > 2.0                              # along
+    m = gen.generate_batch([Request("a person hops on the spot", seed=0)])[0]
+    assert _flights(m.joints) >= 4 and np.ptp(m.joints[:, 0, [0, 2]], axis=0).max() < 0.7

@@ -251,8 +251,8 @@ GENERIC_OF = {"walk in a figure eight": ("walk",), "walk in a circle": ("walk",)
 # actions done over and over by their nature: a take of one repetition plays on as a loop of it
 # (``generation.take_loop.looped_repetition``); a kick or a throw done once is held instead (a
 # gait's one-cycle take too: docs/design-notes.md)
-REPEATED = frozenset({"arm circles", "jumping jacks", "dribble", "elbow to knee", "side twist"})
-MOVES_ON = frozenset({"dribble"})   # of those, the one that may go somewhere as it repeats
+REPEATED = frozenset({"arm circles", "jumping jacks", "dribble", "elbow to knee", "side twist", "hop"})
+MOVES_ON = frozenset({"dribble", "hop"})   # of those, the ones that may go somewhere as they repeat
 
 
 def specific(acts: list[str]) -> list[str]:

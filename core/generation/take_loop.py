@@ -23,7 +23,7 @@ A take of one repetition of an action done over and over by its nature (``action
 single arm circle of 1.9 s) has no second cycle to find; ``looped_repetition`` plays its busy
 stretch again when the stretch ends where it began (the same seam and heading conditions): on the
 spot, or moved on by the stretch's advance when its root travels faster than ``TRAVELS`` and the
-action may go somewhere as it repeats (a dribble, a gait's cycle; an arm circle whose performer
+action may go somewhere as it repeats (a dribble, a hop, a gait's cycle; an arm circle whose performer
 stepped back once is not looped into a walk backwards: it is held).
 
 A take of a gait (four jogging steps from standing) is looped on its steps (``looped_gait``): its
