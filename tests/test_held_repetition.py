@@ -69,3 +69,18 @@ def test_hops_go_on_hopping_along_or_on_the_spot(openbody):
     assert np.linalg.norm(root[-1] - root[0]) > 2.0                              # along
     m = gen.generate_batch([Request("a person hops on the spot", seed=0)])[0]
     assert _flights(m.joints) >= 4 and np.ptp(m.joints[:, 0, [0, 2]], axis=0).max() < 0.7
+
+
+
+def test_a_hop_loops_only_when_the_words_ask_for_a_hop(openbody):
+    """A take of an action that goes on as it repeats (``actions.MOVES_ON``) loops only for its own
+    action: drawn by caption for other words ("a child toddles forward" in ``eval paraphrase``,
+    seed 1), six looped hops were chosen over the walks; not asked for, it is held."""
+    from shapemove.core.generation.generate import Generator
+
+    pool = Generator(None, body=openbody).pool
+    i = pool.ids.index("HDM_bd_hopBothLegs1hops_002_120")
+    asked = pool.window(i, 80, 0, asked="hop")
+    other = pool.window(i, 80, 0, asked=None)
+    assert asked.looped > 40 and asked.held < 10
+    assert other.looped == 0 and other.held > 40

@@ -227,7 +227,7 @@ class TakePool:
         return chosen
 
     def window(self, i: int, frames: int, seed: int, side=None, longest: int | None = None,
-               times: int | None = None, straight: bool = False) -> Window:
+               times: int | None = None, straight: bool = False, asked: str | None = None) -> Window:
         """Take ``i`` cut to ``frames`` (the seed picks the start), or held to it when shorter;
         ``longest``: the length is the model's (``frames`` the least), the take plays whole up to
         ``longest`` frames. ``side``: ("left" | "right", "hand" | "foot") mirrors a take whose
@@ -238,7 +238,10 @@ class TakePool:
         and, shorter than asked, loops on its last stride (``take_loop.looped_gait``); a take of any
         other gait (``vocabulary.GAITS``: two sneaking steps) shorter than asked and without two
         cycles of its own loops on its last stride too, else on its last step and the step's mirror
-        image, else (a cycle whose contacts do not show its steps) whole, as one repetition."""
+        image, else (a cycle whose contacts do not show its steps) whole, as one repetition. A take of
+        an action that goes somewhere as it repeats (``actions.MOVES_ON``: a hop) loops only when it
+        is the action ``asked``: "a child toddles forward" chose six looped hops among the takes nearest
+        by caption."""
         from .part_compose import needs_mirror
 
         t = self.take(i)
@@ -273,7 +276,8 @@ class TakePool:
                     if again is None and self.actions[i] in GAITS:   # on its last stride, else its last step
                         again = looped_gait(rot, root, con, posed_joints, want) or \
                             looped_steps(rot, root, con, posed_joints, want, mirrored)   # and the step's mirror image
-                if again is None and (self.actions[i] in REPEATED or self.actions[i] in GAITS):
+                goes_on = self.actions[i] not in MOVES_ON or self.actions[i] == asked   # a hop loops for "hops" only
+                if again is None and (self.actions[i] in REPEATED and goes_on or self.actions[i] in GAITS):
                     again = looped_repetition(rot, root, con, posed_joints, want,   # one arm circle, one gait
                                               self.actions[i] in GAITS or self.actions[i] in MOVES_ON)   # cycle
             if again is not None:
@@ -295,7 +299,7 @@ class TakePool:
                 straight: bool = False, hands: bool | None = None) -> list[Window]:
         """One window of each take offered (``nearest``, ``hands`` as there); ``times``: the repetitions
         the words ask; ``straight``: the words ask a plain gait (``window``)."""
-        return [self.window(i, frames, seed, side, longest, times, straight)
+        return [self.window(i, frames, seed, side, longest, times, straight, action)
                 for i in self.nearest(text, action, seed, count, hands)]
 
 
