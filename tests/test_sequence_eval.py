@@ -70,7 +70,8 @@ def test_a_specific_form_counts_only_when_lenient():
 def judges(tiny_dataset):
     from shapemove.core.data.actions import ACTIONS
     from shapemove.core.eval.action_classifier import ActionClassifier
-    from shapemove.core.eval.part_judge import PartJudge, is_real
+    from shapemove.core.data.built_meta import is_real
+    from shapemove.core.eval.part_judge import PartJudge
 
     metas = [json.loads(ln) for ln in (tiny_dataset / "meta.jsonl").read_text().splitlines() if ln.strip()]
     judge = PartJudge.from_metas(tiny_dataset, [m for m in metas if is_real(m)], progress=False)

@@ -28,7 +28,7 @@ GAITS = ("walk", "jog", "run")
 
 def gait_speeds(data: Path, split: str = "train") -> dict[str, dict[str, list[float]]]:
     """{gait: {"normal" | "unstyled": speeds (m/s) of its straight captures of ``split``}}."""
-    from shapemove.core.data.built_meta import iter_meta
+    from shapemove.core.data.built_meta import is_real, iter_meta
     from shapemove.core.eval.gait import mean_speed
     from shapemove.core.generation.track import root_centre
     from shapemove.core.generation.typical_pace import straight
@@ -39,8 +39,7 @@ def gait_speeds(data: Path, split: str = "train") -> dict[str, dict[str, list[fl
         labels, cid = meta.get("labels") or {}, meta.get("id")
         actions = labels.get("actions") or []
         style = labels.get("style")
-        if (cid not in ids or meta.get("augmented_from") or meta.get("mirror_of") or meta.get("composed_from")
-                or not actions or actions[0] not in GAITS):   # each capture once, as performed
+        if cid not in ids or not is_real(meta) or not actions or actions[0] not in GAITS:   # each capture once
             continue
         if style not in ("normal", None):
             continue

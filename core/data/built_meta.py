@@ -5,6 +5,7 @@ written as each clip is built).
     for m in iter_meta(data): ...      # every clip's meta: meta.jsonl, else meta/*.json
     metas = read_meta(data, ids)       # {id: meta} of those clips, a missing one from meta/ID.json ({} if none)
     clip_meta(data, cid)               # one clip's meta/ID.json ({} when it has none)
+    is_real(meta)                      # a captured clip as performed, not a copy made from one
 
 Sizes are bounded before and while reading (``core/io/limits``): meta.jsonl at ``MAX_META_BYTES``,
 read line by line (a line that is not a JSON object is refused, naming the line); one meta/ID.json
@@ -108,3 +109,9 @@ def _note(path: Path, text: str) -> None:
     if key not in _noted:
         _noted.add(key)
         print(f"note: {text}; the clip is used without its meta (actions, labels)", file=sys.stderr)
+
+
+def is_real(meta: dict) -> bool:
+    """A captured clip, not a shape-augmented, mirrored or composed copy."""
+    return not any(meta.get(k) for k in ("augmented_from", "mirror_of", "composed_from")) and \
+        not str(meta.get("id", "")).endswith("_aug")

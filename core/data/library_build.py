@@ -23,6 +23,7 @@ import numpy as np
 
 from ..errors import ShapeMoveError
 from .build import LIBRARY_SPLIT
+from .built_meta import is_real
 from .motion_library import MotionLibrary, mean_caption_vectors, source_name
 
 SPLITS = ("train", "val", LIBRARY_SPLIT)
@@ -42,7 +43,7 @@ def library_metas(data) -> list[dict]:
     out = []
     for p in sorted((data / "meta").glob("*.json")):
         m = json.loads(p.read_text(encoding="utf-8"))
-        if m.get("split") in SPLITS and not (m.get("augmented_from") or m.get("composed_from") or m.get("mirror_of")):
+        if m.get("split") in SPLITS and is_real(m):
             if not (m["split"] == LIBRARY_SPLIT and main_action(m) in GAITS):
                 out.append(m)
     return out

@@ -44,6 +44,7 @@ import numpy as np
 from ..body.skeleton import FACE_JOINTS
 from ..constants import FPS
 from ..data.actions import ACTIONS
+from ..data.built_meta import is_real
 from ..data.compose_parts import ARMS_ACTIONS, LEGS_ACTIONS
 from ..data.mirror import mirror_joints
 from ..errors import ShapeMoveError
@@ -302,12 +303,6 @@ def arms_label(acts: list[str]) -> str | None:
 def path_label(acts: list[str]) -> str | None:
     g = legs_label(acts)
     return None if g is None or g == STAND else (CIRCLE if CIRCLE in acts else STRAIGHT)
-
-
-def is_real(meta: dict) -> bool:
-    """A captured clip, not a shape-augmented, mirrored or composed copy."""
-    return not any(meta.get(k) for k in ("augmented_from", "mirror_of", "composed_from")) and \
-        not str(meta.get("id", "")).endswith("_aug")
 
 
 def real_clips(data, split: str) -> list[dict]:

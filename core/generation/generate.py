@@ -604,8 +604,7 @@ class Generator:
             if words is not None and words.arms_held and words.gestures_only and words.parts is None:
                 motion = held_motion(motion, self.body, self.ik_refine_iters)   # "stands with her arms raised"
             if words is not None:   # "jogs in place", "hops on the spot": the data's gaits and hops travel
-                on_spot = words.in_place or words.travel.in_place
-                motion = on_the_spot(motion, self.body, on_spot, self.ik_refine_iters)   # on_the_spot.py
+                motion = on_the_spot(motion, self.body, words.travel.in_place, self.ik_refine_iters)   # on_the_spot.py
             motion.plan = plan_text(plan) if plan is not None else None
             motion.provenance = motion.provenance or came_from or "generated"
             motion.warnings = [check.warning] if check is not None and check.warning else []

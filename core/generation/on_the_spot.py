@@ -4,7 +4,8 @@ it stands.
 The training data holds one caption of stepping in place, so every sample and retrieved clip of
 "a person jogs in place" travels (the default model: 7.5-9.5 m in 4 s; `travel_words` can only set
 aside candidates, and none stays). When the plan keeps a gait in place (``plan.words.Words.in_place``:
-a gait and "in place" or "on the spot"), and the chosen motion's root still travels more than
+a gait and "in place" or "on the spot"; for a single prompt any action the words keep in place,
+``Words.travel.in_place``: "hops on the spot"), and the chosen motion's root still travels more than
 ``travel_words.SLACK`` (half a metre), its strides are scaled to travel that far
 (``stride_scale.scaled_strides``: the root's path and the feet's reach shortened together, so a
 planted foot stays planted and lands under the hip; the knees placed again, so a lifted foot still
