@@ -35,6 +35,7 @@ def test_hold_mirror_and_busiest_window():
     assert (c[10:] == [0, 1, 0, 0]).all()                         # the last frame's contacts held
     con[-1] = 0
     assert (hold(rot, root, con, 12)[2][10:] == 1).all()           # none at the end: both feet down
+    assert (hold(rot, root, con, 12, stands=False)[2][10:] == 0).all()   # a sit's feet stay where they are
     m = mirrored(*mirrored(rot, root, con))
     assert np.allclose(m[0], rot, atol=1e-5) and np.allclose(m[1], root) and np.array_equal(m[2], con)
     assert np.allclose(mirrored(rot, root, con)[1][:, 0], -root[:, 0])
@@ -79,16 +80,23 @@ def test_a_take_of_another_action_than_the_words_name_does_not_compete():
     assert action_credit("walk backward", "walk backward") == ACTION_BONUS   # a backward walk only asked by name
 
 
-def test_sitting_down_is_never_a_lying_down_take():
-    """The default model has no take of sitting: "an old man sits down slowly" is generated, not
-    played as the lying-down take nearest its words (flat on the floor)."""
+def test_sitting_down_plays_a_lie_down_to_where_it_sits():
+    """No take of the data sits down; every lie-down sits on the floor on its way down. "an old man
+    sits down slowly" walked 9 m (a retrieved elderly walk) and "he sits" bobbed into a crouch and
+    stood up again: now a lie-down take plays to its sit and holds it, the pelvis on the floor and the
+    trunk up, the feet where the take has them (planting them on the floor pulled the legs 12 cm)."""
     from shapemove.core.generation.generate import Generator, Request
 
     gen = Generator(None)
-    for seed in (0, 1):
-        m = gen.generate_batch([Request("an old man sits down slowly", seconds=4, seed=seed)])[0]
-        assert "lieDown" not in (m.provenance or "") and not (m.provenance or "").startswith("captured")
-        assert m.joints[:, 15, 1].min() > 0.5                            # the head never on the floor
+    for prompt, seed in (("an old man sits down slowly", 0), ("he sits", 1)):
+        m = gen.generate_batch([Request(prompt, seconds=4, seed=seed)])[0]
+        assert "lieDownFloor" in m.provenance and m.provenance.endswith("its sit on the floor"), m.provenance
+        root, head = m.joints[:, 0, 1], m.joints[:, 15, 1]
+        assert root[-1] < 0.35 * root[0]                                # down on the floor
+        assert head.min() > 0.5 and head[-1] - root[-1] > 0.4           # sitting up, never lying
+        assert np.ptp(m.joints[-5:], axis=0).max() < 1e-3                # the sit held
+        assert m.ik_error_cm < 3.0
+        assert np.linalg.norm(m.joints[-1, 0, [0, 2]] - m.joints[0, 0, [0, 2]]) < 1.0   # where it stood
 
 
 @pytest.fixture(scope="module")

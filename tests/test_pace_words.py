@@ -69,6 +69,8 @@ def test_an_exercise_or_a_gesture_asked_with_no_travel_does_not_walk_off():
     assert staying(read_words("a man swings his arms in circles"), speeds, everyone).tolist() == [False, True, False, True]
     assert staying(read_words("someone waves"), speeds, everyone).tolist() == [False, True, False, True]
     assert staying(read_words("a man waves"), np.full(4, 1.0), everyone).tolist() == [True] * 4   # none slower
+    for prompt in ("an old man sits down slowly", "a woman lies down", "he gets up"):   # a change of posture
+        assert staying(read_words(prompt), speeds, everyone).tolist() == [False, True, False, True], prompt
     for prompt in ("a man walks and waves", "she waves while walking forward", "a woman dances",
                    "the player kicks the ball", "a man does arm circles while jogging", "someone jumps forward"):
         assert staying(read_words(prompt), speeds, everyone).tolist() == [True] * 4, prompt

@@ -117,6 +117,29 @@ def test_generation_keeps_a_retrieved_clip_only_when_it_wins(gen, memory):
         gen.generate_batch([Request("a man throws punches", retrieval_first=1.5)])
 
 
+def test_a_retrieved_clip_of_another_action_than_the_words_ask_does_not_compete(gen, memory):
+    """"an old man sits down slowly" found an elderly walk by its caption and walked 9 m: a clip
+    labelled with another action than the one asked is not offered, as a captured take of it is not
+    (``captured_takes.action_credit``); with nothing asked, or the action asked, it is."""
+    from shapemove.core.generation.generate import Request
+
+    assert memory.main_action("walk_1") == "walk" and memory.main_action("punch_1") == "punch"
+    assert memory.main_action("no such clip") is None
+    old = gen.t5.memory
+    gen.t5.memory = memory
+    try:   # retrieval first from similarity 0: the retrieved windows alone, when any is offered
+        m = gen.generate_batch([Request("a person sits down", seconds=4, seed=0, retrieval_first=0.0)])[0]
+        assert m.retrieved_clips == []                      # neither a walk nor a punch sits: the samples
+        m = gen.generate_batch([Request("a person walks forward", seconds=4, seed=0, retrieval_first=0.0)])[0]
+        assert m.retrieved_clips == ["walk_1"]
+        m = gen.generate_batch([Request("somebody is here", seconds=4, seed=0, retrieval_first=0.0)])[0]
+        assert m.retrieved_clips in (["walk_1"], ["punch_1"])   # no action asked: any clip competes
+    finally:
+        gen.t5.memory = old
+    real = gen.t5.memory
+    assert real.main_action("dataset-2_walk_elderly_014") == "walk"   # the shipped memory's labels
+
+
 def test_a_judge_does_not_find_the_retrieved_take_itself():
     from shapemove.core.eval.action_classifier import ActionClassifier
     from shapemove.core.models.motion_memory import family, take_of

@@ -20,8 +20,9 @@ in one ``TakePool``. For a prompt:
 - each window's features, on the performer's own body (``ClipProcessor.pose_on``), join the
   samples' decoded features, and the TMA chooses among them all (``rerank.CandidatePicker``), a
   take of the asked action credited ``ACTION_BONUS``; when the words name an action, a take of
-  another one does not compete (``action_credit``: with no take of sitting, "sits down" is
-  generated, not played as the nearest lying-down take; docs/design-notes.md).
+  another one does not compete (``action_credit``: "sits down" is not played as the lying-down take
+  nearest its words); with no take of sitting, a lie-down competes for a sit played to where it
+  sits on the floor (``floor_sit.py``).
 
 A window kept is moved onto the requested body by its own rotations with its feet planted
 (``retarget.planted_retarget``), never through the codes, and says where it came from
@@ -47,6 +48,7 @@ from ..errors import ShapeMoveError
 from ..scene.motion_file import Motion
 from ..data.actions import MOVES_ON, REPEATED
 from ..plan.vocabulary import GAITS, POSTURE_CHANGES
+from .floor_sit import SIT, SIT_FROM, sit_end
 from .repeated_takes import cut_for, repeated_stretch
 from .straight_gait import STRAIGHTENED, straightened
 from .take_loop import looped_gait, looped_repetition, looped_steps, looped_take
@@ -85,13 +87,14 @@ class Window:
         return {"rotations": self.rotations, "root": self.root, "rest": self.rest, "contacts": self.contacts}
 
 
-def hold(rotations, root, contacts, frames: int):
-    """A take shorter than ``frames`` held on its last pose (its contacts, or both feet down when
-    the last frame has none) for the rest."""
+def hold(rotations, root, contacts, frames: int, stands: bool = True):
+    """A take shorter than ``frames`` held on its last pose (its contacts, or, where it ``stands``,
+    both feet down when the last frame has none) for the rest. A sit on the floor does not stand:
+    its feet may be off the floor, and planting them there pulled the legs 12 cm off the pose."""
     extra = frames - len(rotations)
     if extra <= 0:
         return rotations, root, contacts
-    last = contacts[-1] if contacts[-1].any() else np.ones(4, np.uint8)
+    last = contacts[-1] if contacts[-1].any() or not stands else np.ones(4, np.uint8)
     return (np.concatenate([rotations, np.repeat(rotations[-1:], extra, 0)]),
             np.concatenate([root, np.repeat(root[-1:], extra, 0)]),
             np.concatenate([contacts, np.repeat(last[None], extra, 0)]).astype(np.uint8))
@@ -222,6 +225,8 @@ class TakePool:
             if mine:
                 chosen.append(max(mine, key=lambda i: sims[i]))
         named = [i for i in range(len(self)) if action and self.actions[i] == action]
+        if action == SIT and not named:   # no take sits down: the lie-downs do on their way (floor_sit.py)
+            named = [i for i in range(len(self)) if self.actions[i] == SIT_FROM]
         draw(named, max(0, count - len(chosen) - NEAREST) if named else 0)
         draw(range(len(self)), max(0, count - len(chosen)))
         return chosen
@@ -246,12 +251,18 @@ class TakePool:
 
         t = self.take(i)
         rot, root, con, exact = t["rotations"], t["root"], t["contacts"], False
-        if cut_for(self.actions[i], times):
+        action, provenance = self.actions[i], t["provenance"]
+        if asked == SIT and action == SIT_FROM:   # a lie-down played to where it sits (floor_sit.py)
+            end = sit_end(self.proc.pose_on(rot, root, t["betas"], 1.0, con))
+            if end is not None:
+                rot, root, con, action = rot[:end], root[:end], con[:end], SIT
+                provenance += ", its sit on the floor"
+        if cut_for(action, times):
             def posed(r, rt, c):
                 j = self.proc.pose_on(r, rt, t["betas"], 1.0, c)
                 return j, self.proc.features(j, r, c)
 
-            rot, root, con, exact = repeated_stretch(rot, root, con, posed, self.actions[i], times, seed)
+            rot, root, con, exact = repeated_stretch(rot, root, con, posed, action, times, seed)
         n = len(rot)
         want = min(max(frames, n), longest) if longest is not None else frames
         if exact and longest is not None:   # the length is the model's: every repetition asked plays
@@ -259,9 +270,9 @@ class TakePool:
         if n <= want:
             lo = 0
         else:   # a change of posture ends where the take does (up, or lying): its busiest stretch may not
-            lo = n - want if self.actions[i] in POSTURE_CHANGES else busiest_start(rot, want, seed)
+            lo = n - want if action in POSTURE_CHANGES else busiest_start(rot, want, seed)
         rot, root, con = (np.asarray(a[lo:lo + want]) for a in (rot, root, con))
-        gait = straight and self.actions[i] in STRAIGHTENED
+        gait = straight and action in STRAIGHTENED
         if gait:
             rot, root = straightened(rot, root, self.proc.pose_on(rot, root, t["betas"], 1.0, con))
         held = looped = 0
@@ -273,25 +284,25 @@ class TakePool:
                     again = looped_gait(rot, root, con, posed_joints, want)
                 else:
                     again = looped_take(rot, root, con, posed_joints, want)
-                    if again is None and self.actions[i] in GAITS:   # on its last stride, else its last step
+                    if again is None and action in GAITS:   # on its last stride, else its last step
                         again = looped_gait(rot, root, con, posed_joints, want) or \
                             looped_steps(rot, root, con, posed_joints, want, mirrored)   # and the step's mirror image
-                goes_on = self.actions[i] not in MOVES_ON or self.actions[i] == asked   # a hop loops for "hops" only
-                if again is None and (self.actions[i] in REPEATED and goes_on or self.actions[i] in GAITS):
+                goes_on = action not in MOVES_ON or action == asked   # a hop loops for "hops" only
+                if again is None and (action in REPEATED and goes_on or action in GAITS):
                     again = looped_repetition(rot, root, con, posed_joints, want,   # one arm circle, one gait
-                                              self.actions[i] in GAITS or self.actions[i] in MOVES_ON)   # cycle
+                                              action in GAITS or action in MOVES_ON)   # cycle
             if again is not None:
                 rot, root, con, first = again
                 looped = want - first
             held = want - len(rot)
-            rot, root, con = hold(rot, root, con, want)
+            rot, root, con = hold(rot, root, con, want, stands=action != SIT)
         joints = self.proc.pose_on(rot, root, t["betas"], 1.0, con)
         flip = side is not None and needs_mirror(joints, *side)
         if flip:
             rot, root, con = mirrored(rot, root, con)
             joints = self.proc.pose_on(rot, root, t["betas"], 1.0, con)
-        return Window(rot, root, con, t["rest"], self.proc.features(joints, rot, con), self.actions[i], self.ids[i],
-                      t["provenance"] + (", mirrored" if flip else ""), held, flip, looped,
+        return Window(rot, root, con, t["rest"], self.proc.features(joints, rot, con), action, self.ids[i],
+                      provenance + (", mirrored" if flip else ""), held, flip, looped,
                       max(0, n - want) if exact else 0)
 
     def windows(self, text: np.ndarray, action: str | None, seed: int, frames: int, side=None,

@@ -266,7 +266,7 @@ class Generator:
             for w in windows if backward else []:
                 w.note = f"no capture {backward_verb(requested)} backwards: a walk backward is played"
             cands, sources, beta = (self._from_action_clips(r, found) if found    # the user's clips: as captured
-                                    else self._sampled(r, lo, hi, g, library=not windows))   # takes, or as codes
+                                    else self._sampled(r, lo, hi, g, library=not windows, asked=asked))   # takes, or as codes
             best = 0
             body, body_source = self.body_shape(body_of or r, beta.numpy())
             if reach is not None:   # the distance on the T5's body, which the samples are decoded on
@@ -303,10 +303,14 @@ class Generator:
             return action
         return next((g for g in GENERIC_OF.get(action, ()) if g in pool.actions), action)
 
-    def _sampled(self, r: Request, lo: int, hi: int, g: torch.Generator, library: bool = True):
+    def _sampled(self, r: Request, lo: int, hi: int, g: torch.Generator, library: bool = True,
+                 asked: str | None = None):
         """(candidate codes, their memory clip or None, betas): best-of-N's T5 samples (some seeded
         by retrieved clips) and the retrieved clips nearest by caption (``library``: the user's
-        library clips' codes among them)."""
+        library clips' codes among them); when the words ask for an action (``asked``), a retrieved
+        clip labelled with another one does not compete, as a captured take of it would not
+        (``captured_takes.action_credit``: "an old man sits down slowly" finds an elderly walk by
+        its caption)."""
         n = r.candidates if r.temperature > 0 and self.picker is not None else 1
         seeds = self._retrieval_seeds(r, n)
         s = self.default_guidance if r.guidance is None else r.guidance
@@ -322,7 +326,8 @@ class Generator:
             beta = out.betas[0] if beta is None else beta  # [BETA] precedes the codes: one body for all
         sources = [None] * len(cands)
         if n > 1:  # real clips nearest by caption compete with the samples, or replace them
-            found = self._retrieved(r, lo, hi, library)
+            found = [f for f in self._retrieved(r, lo, hi, library)
+                     if action_credit(asked, self.t5.memory.main_action(f[0])) is not None]
             if found and r.retrieval_first is not None and found[0][1] >= r.retrieval_first:
                 cands, sources = [], []
             for cid, _, c in found:

@@ -13,7 +13,9 @@ nearest caption's similarity reaches ``retrieval_first`` (a prompt the data desc
 for word), only the retrieved windows compete: the TMA rates a generated fallback (a raised hand)
 about as close to "throws punches" as a captured punch, so best-of-N alone would keep it. Either way the
 tokens are decoded by the SA-VAE for the requested body, so the motion has that body's proportions
-and its feet are planted as for any sample. A clip shorter than the requested length is skipped.
+and its feet are planted as for any sample. A clip shorter than the requested length is skipped,
+and so is one labelled with another action than the words ask (``Generator._sampled``, by
+``captured_takes.action_credit``: "an old man sits down slowly" found an elderly walk).
 A user's library (``Generator.add_library``) is in the same memory, where thousands of training
 captions can be nearer to a prompt than the user's own: ``library_codes`` offers the library's
 nearest clip beside them when its caption is nearly as near, and its nearest clip of an action the

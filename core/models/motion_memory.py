@@ -154,6 +154,14 @@ class MotionMemory:
                 out[c].append(t)
         return out
 
+    def main_action(self, clip_id: str) -> str | None:
+        """The main labelled action of the clip ``clip_id`` (its first, ``clip_actions``); None for a
+        clip with no label or not in the memory."""
+        if getattr(self, "_clip_index", None) is None or len(self._clip_index) != len(self.clip_ids):
+            self._clip_index = {c: i for i, c in enumerate(self.clip_ids)}
+        i = self._clip_index.get(clip_id)
+        return self.clip_actions[i][0] if i is not None and self.clip_actions[i] else None
+
     def clips_of_action(self, action: str) -> list[tuple[int, list[int]]]:
         """(clip index, its caption indices) of the clips whose main labelled action is ``action``;
         when none is, those labelled with it at all ("walk in a circle" is a walk's second label)."""
