@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from shapemove.core.errors import ShapeMoveError
-from shapemove.core.eval.sequence_eval import (ACTION, ARMS, LEGS, expected_actions, in_order, judge_prompt,
-                                               load_sequences, motion_order, shows, split_right, tally)
+from shapemove.core.eval.sequence_eval import (ACTION, ARMS, LEGS, SIGNATURE, expected_actions, in_order, judge_of,
+                                               judge_prompt, load_sequences, motion_order, shows, split_right, tally)
 from tiny_models import tiny_bundle  # noqa: F401  (session fixture)
 
 WALK, WAVE, KICK = "dataset-1_walk_feminine_001", "dataset-2_wave-left-hand_elderly_001", "dataset-1_kick_normal_001"
@@ -91,8 +91,11 @@ def test_a_hand_made_motion_is_judged_segment_by_segment(judges, tiny_dataset):
     item = {"text": "a woman walks, then waves, then kicks", "words": ["walk", "wave", "kick"]}
     plan = ["a woman walks", "a woman waves", "a woman kicks"]
     row = judge_prompt(item, plan, feats, bounds, judge, clf)
-    assert row["actions"] == ["walk", "wave", "kick"] and row["judges"] == [LEGS, ARMS, ACTION]
+    assert row["actions"] == ["walk", "wave", "kick"] and row["judges"] == [LEGS, SIGNATURE, SIGNATURE]
     assert row["right"] == [True, True, True] and row["split_right"] and row["order_right"] is True
+    assert row["readings"][2]["signatures"]["kick"] and not row["readings"][0]["signatures"]["kick"]
+    assert row["right_vote"] == [True, True, True] and row["order_right_vote"] is True   # the wave by the arms
+    assert [judge_of(a, judge, clf, signatures=False) for a in row["actions"]] == [LEGS, ARMS, ACTION]
     assert [r["frames"] for r in row["readings"]] == [len(c) for c in clips]
     # the same motion asked in the other order: every segment wrong and the order swapped
     back = {"text": "a woman kicks, then waves, then walks", "words": ["kick", "wave", "walk"]}
@@ -107,6 +110,8 @@ def test_a_hand_made_motion_is_judged_segment_by_segment(judges, tiny_dataset):
     assert (res["order"]["right"], res["order"]["judged"]) == (1, 3)
     assert (res["all_right"]["right"], res["all_right"]["prompts"]) == (1, 3)
     assert (res["split"]["right"], res["split"]["prompts"]) == (2, 3)
+    assert (res["segments_vote"]["right"], res["segments_vote"]["judged"]) == (4, 9)
+    assert (res["order_vote"]["right"], res["order_vote"]["judged"]) == (1, 3)
 
 
 def test_eval_sequences_command_on_a_tiny_model(tiny_bundle, tmp_path, capsys):  # noqa: F811

@@ -15,8 +15,17 @@ TMA the generator picks its samples with (``generation/rerank.py``):
 - a gait of ``compose_parts.LEGS_ACTIONS`` by the part judge's legs (``part_judge.legs_right``:
   "walk in a circle" must circle), a gesture (of ``ARMS_ACTIONS``, in the vocabulary's "gesture"
   group: a wave, a raised hand) by its arms (``arms_right``);
+- an action with a physical signature (``action_signatures.py``: a jump and its forms, a squat,
+  lying down, getting up, a spin, a kick, jumping jacks, a wave) by it, on the piece's joints, before
+  either judge above: the vote below names real captured jumps, get-ups and spins 0 % of the time,
+  the arms read 3 s of a captured two-handed wave as a raised hand; the signatures pass 71-100 % of
+  the real clips of their action and 0-1.2 % of the others' (``signature_accuracy.py``,
+  ``tools/signature_check.py``, 3 s windows);
 - any other action by the 5-NN vote among the training clips on pooled raw features
   (``ActionClassifier.from_features``, as ``paraphrase_eval`` reads ``motion_features``).
+
+The figures without the signatures (each such action by the judge above that reads it otherwise: a
+wave by the arms, a jump by the vote) are reported beside them (``segments_vote``, ``order_vote``).
 
 A segment's expected action is the data's action vocabulary (``core/data/actions.action_spans``)
 at the segment's word in the prompt ('strolls' -> walk, 'takes a bow' -> bow, 'stands up' -> get
@@ -47,7 +56,7 @@ from ..errors import ShapeMoveError
 DEFAULT_PROMPTS = Path(__file__).resolve().parents[2] / "configs" / "heldout_sequences.json"
 MAX_PROMPTS_BYTES = 1 << 20
 TARGETS = {"segments": 0.80, "order": 0.95}
-LEGS, ARMS, ACTION = "legs", "arms", "action"   # which judge reads an action
+LEGS, ARMS, SIGNATURE, ACTION = "legs", "arms", "signature", "action"   # which judge reads an action
 
 
 def load_sequences(path=None) -> list[dict]:
@@ -102,17 +111,21 @@ def split_right(segments: list[str], words: list[str]) -> bool:
     return len(segments) == len(words) and all(w in s.lower() for w, s in zip(words, segments))
 
 
-def judge_of(action: str | None, judge, classifier) -> str | None:
+def judge_of(action: str | None, judge, classifier, signatures: bool = True) -> str | None:
     """Which judge reads ``action``: ``LEGS`` (a gait of ``LEGS_ACTIONS`` the part judge knows),
     ``ARMS`` (a gesture: an action of ``ARMS_ACTIONS`` in the vocabulary's "gesture" group that it
     knows; a punch or a throw moves the whole body), ``ACTION`` (the raw-feature classifier has
-    clips of it), None (none can name it)."""
+    clips of it), None (none can name it); before them all ``SIGNATURE``, an action with a physical
+    signature (``action_signatures.signed``: a wave too), unless ``signatures`` is False."""
     from ..data.actions import ACTIONS
     from ..data.compose_parts import ARMS_ACTIONS, LEGS_ACTIONS
+    from .action_signatures import signed
     from .part_judge import CIRCLE, SAME_MOTION
 
     if action is None:
         return None
+    if signatures and signed(action) is not None:
+        return SIGNATURE
     if action in LEGS_ACTIONS and ("walk" if action == CIRCLE else action) in judge.legs.classes:
         return LEGS
     if action in ARMS_ACTIONS and ACTIONS[action].group == "gesture" and \
@@ -122,23 +135,30 @@ def judge_of(action: str | None, judge, classifier) -> str | None:
 
 
 def shows(action: str, kind: str | None, reading: dict | None, lenient: bool = False) -> bool | None:
-    """Whether a segment's ``reading`` ({"legs", "path", "arms", "action"}) shows ``action`` by the
-    judge ``kind`` (``judge_of``); None when it cannot be told. ``lenient``: a specific form of the
-    action counts too (``actions.GENERIC_OF``: a jump forward for a jump, a sneak for a walk)."""
+    """Whether a segment's ``reading`` ({"legs", "path", "arms", "action", "signatures"}) shows
+    ``action`` by the judge ``kind`` (``judge_of``); None when it cannot be told. ``lenient``: a
+    specific form of the action counts too (``actions.GENERIC_OF``: a jump forward for a jump, a
+    sneak for a walk; a signature reads a jump's forms alike)."""
     from ..data.actions import GENERIC_OF
+    from .action_signatures import signed
     from .part_judge import arms_right, legs_right
 
     if kind is None or reading is None:
         return None
+    if kind == SIGNATURE:
+        return bool(reading["signatures"][signed(action)])
     right = legs_right(action, reading) if kind == LEGS else \
         arms_right(action, reading) if kind == ARMS else reading["action"] == action
     return right or (lenient and action in GENERIC_OF.get(reading[kind], ()))
 
 
 def read_segments(features, bounds, judge, classifier, exclude=None) -> list[dict | None]:
-    """Each segment [start, end) of the played (T-1, 263) ``features`` judged by the part judge and
-    the classifier: {"legs", "path", "arms", "action", "frames"}, None for a piece too short to judge.
-    ``exclude``: training clips the motion was made from (judged without their takes)."""
+    """Each segment [start, end) of the played (T-1, 263) ``features`` judged by the part judge, the
+    classifier and the signatures: {"legs", "path", "arms", "action", "signatures", "frames"}, None
+    for a piece too short to judge. ``exclude``: training clips the motion was made from (judged
+    without their takes)."""
+    from ..motion.features import joints_from_features
+    from .action_signatures import signatures
     from .part_judge import MIN_FRAMES
 
     f = np.asarray(features)
@@ -149,7 +169,9 @@ def read_segments(features, bounds, judge, classifier, exclude=None) -> list[dic
         if ok and classifier is not None else [None] * len(ok)
     out: list[dict | None] = [None] * len(pieces)
     for i, p, a in zip(ok, parts, acts):
-        out[i] = {"legs": p["legs"], "path": p["path"], "arms": p["arms"], "action": a, "frames": len(pieces[i])}
+        out[i] = {"legs": p["legs"], "path": p["path"], "arms": p["arms"], "action": a,
+                  "signatures": signatures(joints_from_features(np.asarray(pieces[i], np.float32))),
+                  "frames": len(pieces[i])}
     return out
 
 
@@ -184,22 +206,29 @@ def judge_prompt(item: dict, segments: list[str], features, bounds, judge, class
     words = item["words"]
     actions = expected_actions(item["text"], words)
     kinds = [judge_of(a, judge, classifier) for a in actions]
+    votes = [judge_of(a, judge, classifier, signatures=False) for a in actions]   # the figures without them
     cut = bounds is not None and len(bounds) == len(words)
     readings = read_segments(features, bounds, judge, classifier, exclude) if cut else [None] * len(words)
-    right = [shows(a, k, r) if cut else (False if k is not None else None)
-             for a, k, r in zip(actions, kinds, readings)]
-    lenient = [shows(a, k, r, lenient=True) if cut else ok for a, k, r, ok in zip(actions, kinds, readings, right)]
     split = split_right(segments, words)
-    pairs = motion_order(actions, kinds, readings) if cut else []
 
-    def order(strict: bool):
-        moved = in_order(pairs, strict)
-        return (split and moved) if moved is not None else (False if not split else None)
+    def judged(ks):
+        right = [shows(a, k, r) if cut else (False if k is not None else None) for a, k, r in zip(actions, ks, readings)]
+        lenient = [shows(a, k, r, lenient=True) if cut else ok for a, k, r, ok in zip(actions, ks, readings, right)]
+        pairs = motion_order(actions, ks, readings) if cut else []
 
+        def order(strict: bool):
+            moved = in_order(pairs, strict)
+            return (split and moved) if moved is not None else (False if not split else None)
+
+        return right, lenient, pairs, order(True), order(False)
+
+    right, lenient, pairs, ordered, not_reversed = judged(kinds)
+    right_vote, lenient_vote, _, ordered_vote, _ = judged(votes)
     return {"text": item["text"], "words": words, "actions": actions, "judges": kinds, "plan": segments,
             "split_right": split, "segment_bounds": None if bounds is None else np.asarray(bounds).tolist(),
             "readings": readings, "right": right, "right_lenient": lenient, "order_pairs": pairs,
-            "order_right": order(True), "order_not_reversed": order(False)}
+            "order_right": ordered, "order_not_reversed": not_reversed,
+            "right_vote": right_vote, "right_lenient_vote": lenient_vote, "order_right_vote": ordered_vote}
 
 
 def _share(flags: list) -> float | None:
@@ -207,12 +236,13 @@ def _share(flags: list) -> float | None:
     return sum(told) / len(told) if told else None
 
 
-def tally(rows: list[dict]) -> dict:
-    """The figures of judged prompts (``judge_prompt`` rows)."""
+def _segment_figures(rows: list[dict], right: str = "right", lenient: str = "right_lenient") -> dict:
+    """Judged segments right (``right``: the rows' key of their flags; ``lenient`` the lenient one),
+    overall and per expected action, and the segments no judge reads."""
     per: dict = {}
     unjudged: dict = {}
     for r in rows:
-        for w, a, ok, near in zip(r["words"], r["actions"], r["right"], r["right_lenient"]):
+        for w, a, ok, near in zip(r["words"], r["actions"], r[right], r[lenient]):
             if ok is None:
                 key = a or f"'{w}' (no action)"
                 unjudged[key] = unjudged.get(key, 0) + 1
@@ -222,28 +252,39 @@ def tally(rows: list[dict]) -> dict:
             p["right"] += bool(ok)
             p["lenient"] += bool(near)
     judged = sum(p["n"] for p in per.values())
+    return {"accuracy": sum(p["right"] for p in per.values()) / judged if judged else None,
+            "accuracy_lenient": sum(p["lenient"] for p in per.values()) / judged if judged else None,
+            "right": sum(p["right"] for p in per.values()),
+            "right_lenient": sum(p["lenient"] for p in per.values()), "judged": judged,
+            "unjudged": sum(unjudged.values()), "unjudged_by_action": dict(sorted(unjudged.items())),
+            "per_action": {a: {**p, "accuracy": p["right"] / p["n"]} for a, p in sorted(per.items())}}
+
+
+def tally(rows: list[dict]) -> dict:
+    """The figures of judged prompts (``judge_prompt`` rows); ``segments_vote`` and ``order_vote``:
+    every signed action read by the raw-feature vote instead of its signature."""
     whole = [all(r["right"]) for r in rows if r["right"] and None not in r["right"]]
 
     def order(key: str) -> dict:
         return {"accuracy": _share([r[key] for r in rows]), "right": sum(bool(r[key]) for r in rows),
                 "judged": sum(r[key] is not None for r in rows)}
 
-    return {"segments": {"accuracy": sum(p["right"] for p in per.values()) / judged if judged else None,
-                         "accuracy_lenient": sum(p["lenient"] for p in per.values()) / judged if judged else None,
-                         "right": sum(p["right"] for p in per.values()),
-                         "right_lenient": sum(p["lenient"] for p in per.values()), "judged": judged,
-                         "unjudged": sum(unjudged.values()), "unjudged_by_action": dict(sorted(unjudged.items())),
-                         "per_action": {a: {**p, "accuracy": p["right"] / p["n"]} for a, p in sorted(per.items())}},
+    return {"segments": _segment_figures(rows),
+            "segments_vote": _segment_figures(rows, "right_vote", "right_lenient_vote"),
             "all_right": {"accuracy": _share(whole), "right": sum(whole), "prompts": len(whole)},
             "order": order("order_right"), "order_not_reversed": order("order_not_reversed"),
+            "order_vote": order("order_right_vote"),
             "split": {"accuracy": _share([r["split_right"] for r in rows]),
                       "right": sum(r["split_right"] for r in rows), "prompts": len(rows)}}
 
 
-def reachable(rows: list[dict], judge, classifier) -> dict:
+def reachable(rows: list[dict], judge, classifier, signed_table: dict | None = None) -> dict:
     """What copying real performances could score: each judged segment's expected action read by its
     judge on real training clips without their own takes (``part_judge_accuracy.leave_one_out``,
-    ``ActionClassifier.reachable``), per action and the mean over the judged segments."""
+    ``ActionClassifier.reachable``; a signature on the real clips' segment-long windows,
+    ``signed_table``: ``signature_accuracy.signature_table``), per action and the mean over the
+    judged segments."""
+    from .action_signatures import signed
     from .part_judge import CIRCLE, SAME_MOTION
     from .part_judge_accuracy import leave_one_out
 
@@ -253,6 +294,9 @@ def reachable(rows: list[dict], judge, classifier) -> dict:
     for r in rows:
         for a, k, ok in zip(r["actions"], r["judges"], r["right"]):
             if ok is None or a in per:
+                continue
+            if k == SIGNATURE:
+                per[a] = float((signed_table or {}).get(signed(a), {}).get(signed(a), 0.0))
                 continue
             cls = {LEGS: "walk" if a == CIRCLE else a, ARMS: SAME_MOTION.get(a, a)}.get(k, a)
             table = parts[k]["per_class"] if k in (LEGS, ARMS) else actions
@@ -305,7 +349,11 @@ def eval_sequences(model_dir=None, data=None, prompts=None, seed: int = 0, secon
                      "made_as": list(m.segment_prompts) if m.segment_prompts else [m.prompt]})
         if progress is not None:
             progress((i + 1) / len(items), it["text"])
-    return {**tally(rows), "reachable": reachable(rows, judge, classifier), "targets": TARGETS,
+    from ..plan.segments import SEGMENT_SECONDS
+    from .signature_accuracy import signature_table
+
+    signed_table = signature_table(data, "train", SEGMENT_SECONDS) if data is not None else None
+    return {**tally(rows), "reachable": reachable(rows, judge, classifier, signed_table), "targets": TARGETS,
             "judge": dict(judge.info),
             "classifier": dict(classifier.info) if classifier is not None else None,
             "settings": {"model": str(getattr(gen, "model_dir", model_dir)), "seed": seed, "seconds": seconds,
@@ -341,9 +389,17 @@ def format_results(res: dict) -> str:
     if s["unjudged"]:
         lines.append(f"unjudged segments ({s['unjudged']}: no action of the vocabulary, or none the judges can name): "
                      + ", ".join(f"{k} {n}" for k, n in s["unjudged_by_action"].items()))
-    lines.append("judges: gaits by the part judge's legs, gestures by its arms, other actions by the 5-NN vote "
-                 "on pooled raw features (no TMA); order: the plan's segments in the expected order and, for every "
-                 "two segments of judged actions, more of them shown in place than swapped (not reversed: no fewer)")
+    v, ov = res.get("segments_vote"), res.get("order_vote")
+    if v and ov:
+        lines.append(f"without the signatures (jumps, squats, lying down, getting up, spins, kicks, jumping jacks by "
+                     f"the vote, waves by the arms): segments right {v['right']} of {v['judged']} {_pct(v['accuracy'])}, order right "
+                     f"{ov['right']} of {ov['judged']} {_pct(ov['accuracy'])}")
+    lines.append("judges: an action with a physical signature by it (a flight, a dip, the head down, a rise, a turn, "
+                 "a foot high ahead, a raised wrist swinging), gaits by the part judge's legs, gestures by its arms, "
+                 "other actions by the "
+                 "5-NN vote on pooled raw features (no TMA); order: the plan's segments in the expected order and, "
+                 "for every two segments of judged actions, more of them shown in place than swapped (not "
+                 "reversed: no fewer)")
     lines.append(f"one motion per prompt (seed {st['seed']} + i, "
                  + (f"{st['seconds']:g} s shared by the segments" if st["seconds"] else "the product's length")
                  + f", best of {st['candidates']} token samples per segment by the TMA)")
