@@ -5,8 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from shapemove.core.eval.action_signatures import (FEET, JUMP_RISE, SIGNED, flights, hip_yaw, leg_length,
+from shapemove.core.eval.action_signatures import (FEET, JUMP_RISE, SIGNED, facing_yaw, flights,
                                                    signatures, signed)
+from shapemove.core.motion.skeleton_ops import leg_length
 
 T = 60
 
@@ -26,7 +27,7 @@ def _only(sig: dict, *names) -> bool:
 
 def test_standing_shows_nothing(stand):
     assert _only(signatures(stand))
-    assert 0.75 < leg_length(stand) < 0.95 and abs(hip_yaw(stand)[0]) < 1e-6   # facing +z
+    assert 0.75 < leg_length(stand) < 0.95 and abs(facing_yaw(stand)[0]) < 1e-6   # facing +z
 
 
 def test_a_jump_flies_with_the_pelvis_up_a_run_does_not(stand):
@@ -65,7 +66,7 @@ def test_a_spin_turns_fast_a_slow_turn_does_not(stand):
         return out
 
     fast = turned(2 * np.pi / 20)                  # once round a second: 2 pi in 2 s > 1.5 pi
-    assert _only(signatures(fast), "spin") and np.ptp(hip_yaw(fast)) > 5 * np.pi
+    assert _only(signatures(fast), "spin") and np.ptp(facing_yaw(fast)) > 5 * np.pi
     assert _only(signatures(turned(np.pi / 60)))   # pi / 3 a second: 2 pi / 3 in 2 s
 
 

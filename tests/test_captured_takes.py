@@ -99,6 +99,24 @@ def test_sitting_down_plays_a_lie_down_to_where_it_sits():
         assert np.linalg.norm(m.joints[-1, 0, [0, 2]] - m.joints[0, 0, [0, 2]]) < 1.0   # where it stood
 
 
+def test_a_gesture_with_a_sit_is_made_seated():
+    """"a man sits down while waving" played the sit alone; "a woman sits down and waves" sat, then
+    stood up again to wave. The sit is the legs of two things at once: a lie-down played to its sit,
+    the wave's arms on its chest, swinging above the shoulders while the pelvis is on the floor."""
+    from shapemove.core.eval.action_signatures import signatures
+    from shapemove.core.generation.generate import Generator, Request
+
+    gen = Generator(None)
+    for prompt in ("a man sits down while waving", "a woman sits down and waves"):
+        m = gen.generate_batch([Request(prompt, seconds=4, seed=0)])[0]
+        legs, arms = m.provenance.split("; ")
+        assert "lieDownFloor" in legs and legs.endswith("its sit on the floor") and "wave" in arms, m.provenance
+        root = m.joints[:, 0, 1]
+        assert root[-1] < 0.35 * root[0] and m.joints[-20:, 15, 1].min() > 0.5   # seated, head up
+        assert signatures(m.joints[-40:])["wave"]                             # waving, seated
+        assert m.part_prompts[0].endswith("sits down") and m.segment_bounds is None
+
+
 @pytest.fixture(scope="module")
 def kick_model(tiny_dataset, tmp_path_factory):
     """The default model with the library of the tiny dataset's takes (train + val)."""

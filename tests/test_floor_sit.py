@@ -2,13 +2,20 @@ from __future__ import annotations
 
 import numpy as np
 
-from shapemove.core.generation.floor_sit import LOW, UPRIGHT, sit_end, sitting
+from shapemove.core.generation.floor_sit import LOW, SETTLED, UPRIGHT, sit_end, sitting
+from shapemove.core.motion.skeleton_ops import leg_length
 
 
 def _lie_down(root_y, head_y):
-    """(T, 22, 3) joints with only the pelvis and head heights set."""
+    """(T, 22, 3) joints: the pelvis and head at those heights, the hips at the pelvis's, the knees
+    0.4 m ahead of them, the ankles and feet on the floor under the knees (a leg 0.4 m + the
+    pelvis's height long)."""
     j = np.zeros((len(root_y), 22, 3))
     j[:, 0, 1], j[:, 15, 1] = root_y, head_y
+    for hip, knee, ankle, foot, x in ((1, 4, 7, 10, 0.1), (2, 5, 8, 11, -0.1)):
+        j[:, hip] = np.stack([np.full(len(j), x), j[:, 0, 1], np.zeros(len(j))], 1)
+        j[:, knee] = j[:, hip] + [0.0, 0.0, 0.4]
+        j[:, ankle] = j[:, foot] = np.stack([np.full(len(j), x), np.zeros(len(j)), np.full(len(j), 0.4)], 1)
     return j
 
 
@@ -23,6 +30,9 @@ def test_a_lie_down_sits_where_the_pelvis_is_low_and_the_trunk_up():
     j = _lie_down(root, head)
     assert np.flatnonzero(sitting(j)).tolist() == [7, 8, 9, 10, 11]
     assert sit_end(j) == 11                      # frames 0..10 played, frame 10 held
+    up = j.copy()
+    up[10, [7, 8, 10, 11], 1] = 0.2                 # the feet 0.2 m up where it sits: not settled
+    assert leg_length(up) < 1.2 and 0.2 > SETTLED * leg_length(up) and sit_end(up) is None
     j[7:12, 15, 1] = 0.4                         # the head never up while low: it never sits
     assert sit_end(j) is None
 

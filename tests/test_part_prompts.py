@@ -24,6 +24,9 @@ from shapemove.core.plan.part_prompts import named_side, plan_parts
     ("marching with high knees, he waves both hands", "a person marching with high knees", "he waves both hands",
      ("march", "wave")),
     ("a woman jogs with her arms raised", "a woman jogs", "a person her arms raised", ("jog", "raise hand")),
+    # a sit carries a gesture as a gait does: the gesture made seated
+    ("a woman sits down and waves", "a woman sits down", "a person waves", ("sit", "wave")),
+    ("a man sits down while waving", "a man sits down", "a person waving", ("sit", "wave")),
 ])
 def test_two_things_split_into_a_legs_and_an_arms_prompt(text, legs, arms, acts):
     plan = plan_parts(text)
@@ -45,6 +48,7 @@ def test_the_arms_clause_carries_its_side():
     "someone waves, after that he runs",
     "a person runs and jumps",            # two locomotions: no arms gesture
     "a person kicks and punches",         # no locomotion
+    "a man sits down and lies down",      # a sit and another change of posture: one after the other
 ])
 def test_not_two_things_at_once(text):
     assert plan_parts(text) is None

@@ -65,6 +65,7 @@ from shapemove.core.plan.segments import SEGMENT_SECONDS, split_segments
     ("a woman squats, then stands up and waves", ["a woman squats", "a woman waves"]),
     ("she bends over, then stands up and walks away", ["she bends over", "she walks away"]),
     ("a man sits down, then stands up and waves", ["a man sits down", "a man stands up", "a man waves"]),
+    ("she sits down and then waves", ["she sits down", "she waves"]),   # an order word: one after the other
     # "and" between two actions one body does not do at once orders, and so do the commas of a list before it
     ("she runs to the car and jumps in", ["she runs to the car", "she jumps in"]),
     ("a person walks up to a table and puts down a cup", ["a person walks up to a table", "a person puts down a cup"]),
@@ -100,6 +101,8 @@ def test_ordering_words_make_segments_in_the_order_they_happen(prompt, segments)
     "after the warm-up the man runs", "a man walks ahead, waves, and nods",
     # a gait and an arm gesture at once, a turn beside its gait
     "a man walks and throws a ball", "a man walks and turns left", "a person turns around and walks away",
+    # a sit and an arm gesture at once: waving seated
+    "a woman sits down and waves", "he sits and raises his hand",
 ])
 def test_and_alone_courses_and_things_at_once_stay_one_segment(prompt):
     assert split_segments(prompt) == [prompt]

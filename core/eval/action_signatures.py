@@ -15,7 +15,7 @@ a plain physical signature is checked for it instead, on the (T, 22, 3) joints (
   its highest (not lying), the feet within ``STAY`` m of where they start;
 - **lie down**: the head ends under ``LYING`` of its highest, having been ``UPRIGHT_HEAD`` L high or more (sitting up: 0.8 L; lying: 0.15 L);
 - **get up**: the pelvis ends at least ``RISE`` L higher than it starts, from under ``LOW_START`` L;
-- **spin**: the hips turn ``SPIN`` radians or more one way within ``SPIN_SECONDS`` (a figure eight
+- **spin**: the body (its hips and shoulders) turns ``SPIN`` radians or more one way within ``SPIN_SECONDS`` (a figure eight
   walked turns 1 rad/s);
 - **kick**: a foot's ankle ``KICK_HIGH`` L or more above the floor, ``KICK_AHEAD`` L or more in front
   of the pelvis (a run's heel kicks up behind it);
@@ -38,6 +38,8 @@ import numpy as np
 
 from ..body.skeleton import JOINT_NAMES
 from ..constants import FPS
+from ..errors import ShapeMoveError
+from ..motion.skeleton_ops import facing_directions, heading_angles, leg_length
 
 _J = {n: JOINT_NAMES.index(n) for n in ("pelvis", "head", "left_hip", "right_hip", "left_knee", "right_knee",
                                          "left_ankle", "right_ankle", "left_foot", "right_foot",
@@ -59,14 +61,6 @@ ENDS = 5   # frames averaged at a segment's start and end
 SIGNED = ("jump", "squat", "lie down", "get up", "spin", "kick", "jumping jacks", "wave")
 WAVES = ("wave", "wave goodbye")                     # the forms of a wave its signature reads
 JUMPS = ("jump", "jump forward", "spin jump", "hop")   # the forms of a jump its signature reads
-
-
-def leg_length(joints) -> float:
-    """Mean hip-knee-ankle length of both legs over the frames (m)."""
-    j = np.asarray(joints, dtype=np.float64)
-    return float(np.mean([np.linalg.norm(j[:, _J[f"{s}_hip"]] - j[:, _J[f"{s}_knee"]], axis=-1)
-                          + np.linalg.norm(j[:, _J[f"{s}_knee"]] - j[:, _J[f"{s}_ankle"]], axis=-1)
-                          for s in ("left", "right")]))
 
 
 def _runs(flags) -> list[tuple[int, int]]:
@@ -112,12 +106,13 @@ def waves(joints) -> bool:
     return False
 
 
-def hip_yaw(joints) -> np.ndarray:
-    """(T,) the way the hips face (radians about y, 0 facing +z, unwrapped): up x (right hip - left
-    hip)."""
-    j = np.asarray(joints, dtype=np.float64)
-    across = j[:, _J["right_hip"]] - j[:, _J["left_hip"]]
-    return np.unwrap(np.arctan2(across[:, 2], -across[:, 0]))
+def facing_yaw(joints) -> np.ndarray:
+    """(T,) the way the body faces (radians about y, 0 facing +z, unwrapped: ``skeleton_ops``'s
+    facing of the hips and shoulders); zeros where it cannot be told (hips and shoulders vertical)."""
+    try:
+        return np.unwrap(heading_angles(facing_directions(np.asarray(joints, dtype=np.float64))))
+    except ShapeMoveError:
+        return np.zeros(len(joints))
 
 
 def signatures(joints, fps: float = FPS) -> dict[str, bool]:
@@ -134,7 +129,7 @@ def signatures(joints, fps: float = FPS) -> dict[str, bool]:
                         and feet_moved <= STAY)
     out["lie down"] = bool(lies and head.max() >= UPRIGHT_HEAD * leg)
     out["get up"] = bool(pelvis[:n].mean() <= LOW_START * leg and pelvis[-n:].mean() - pelvis[:n].mean() >= RISE * leg)
-    yaw = hip_yaw(j)
+    yaw = facing_yaw(j)
     w = max(2, int(round(SPIN_SECONDS * fps)))
     turned = np.abs(yaw[min(w, len(yaw) - 1):] - yaw[:max(1, len(yaw) - w)]) if len(yaw) > 1 else np.zeros(1)
     out["spin"] = bool(max(float(turned.max()), float(abs(yaw[-1] - yaw[0])) if len(yaw) <= w else 0.0) >= SPIN)

@@ -50,7 +50,7 @@ from ..data.mirror import mirror_joints
 from ..errors import ShapeMoveError
 from ..geometry.rotations import yaw_matrix
 from ..motion.features import FEATURE_DIM, joints_from_features
-from ..motion.skeleton_ops import gaussian_smooth, heading_angles, smooth_directions
+from ..motion.skeleton_ops import gaussian_smooth, heading_angles, leg_length, smooth_directions
 
 STAND = "stand"
 NO_GESTURE = "none"
@@ -108,11 +108,6 @@ def body_frame(joints: np.ndarray, theta: np.ndarray) -> np.ndarray:
     rel = joints.copy()
     rel[..., [0, 2]] -= joints[:, :1, [0, 2]]
     return np.einsum("tij,tkj->tki", yaw_matrix(-theta), rel)
-
-
-def leg_length(joints: np.ndarray) -> float:
-    seg = lambda a, b: np.linalg.norm(joints[:, a] - joints[:, b], axis=-1)  # noqa: E731
-    return float(max(np.median((seg(1, 4) + seg(4, 7) + seg(2, 5) + seg(5, 8)) / 2), 1e-3))
 
 
 def arm_length(joints: np.ndarray) -> float:

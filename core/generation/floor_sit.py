@@ -12,8 +12,11 @@ held on that pose. It sits on the floor; there is no chair in the scene to sit o
 A frame sits when its pelvis is low (at most ``LOW`` of the take's highest) and its trunk is up
 (the head at least ``UPRIGHT`` of the standing head-to-pelvis height above the pelvis). The pelvis
 goes on down while the body sits (from 0.3 m to 0.11-0.25 m), so the sit ends where it is lowest
-in the first sitting stretch, settled on the floor, the trunk still at 0.75-0.91 of its standing
-height: measured on the 18 takes, 1.1-3.8 s into the take.
+in the first sitting stretch, the trunk still at 0.75-0.91 of its standing height: measured on the
+18 takes, 1.1-3.8 s into the take. There 12 of them have settled, a heel or toe on the floor (a
+foot joint within ``SETTLED`` leg lengths of it: 0.03-0.12 m); the other six still hold the feet
+up (0.13-0.19 m) and are not offered: held there with the feet free, the legs of a sit played as
+the legs of two things at once were pulled 14 cm by the planting.
 
     end = sit_end(joints)        # frames of the take to play, or None: it never sits
 """
@@ -21,11 +24,14 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..body.skeleton import JOINT_NAMES
+from ..body.skeleton import FOOT_LEFT, FOOT_RIGHT, JOINT_NAMES
+from ..motion.skeleton_ops import leg_length
 
 LOW = 0.35        # a sitting pelvis is at most this share of the take's highest
+SETTLED = 0.15    # ... and a foot joint within this many leg lengths of the floor where it ends
 UPRIGHT = 0.75    # ... with the head this share of the standing head-to-pelvis height above it
 HEAD = JOINT_NAMES.index("head")
+FEET = FOOT_LEFT + FOOT_RIGHT   # ankles and feet
 SIT_FROM = "lie down"   # the action whose takes sit on their way down
 SIT = "sit"
 
@@ -40,12 +46,14 @@ def sitting(joints) -> np.ndarray:
 
 def sit_end(joints) -> int | None:
     """How many frames of a lie-down take to play for a sit: up to the frame of its first sitting
-    stretch where the pelvis is lowest; None when no frame sits."""
+    stretch where the pelvis is lowest; None when no frame sits, or when the body has not settled
+    there (no foot joint within ``SETTLED`` leg lengths of the floor)."""
     s = sitting(joints)
     if not s.any():
         return None
+    j = np.asarray(joints, dtype=np.float64)
     first = int(np.argmax(s))
     after = np.flatnonzero(~s[first:])
     last = first + (int(after[0]) if len(after) else len(s) - first)
-    root = np.asarray(joints, dtype=np.float64)[first:last, 0, 1]
-    return first + int(np.argmin(root)) + 1
+    end = first + int(np.argmin(j[first:last, 0, 1])) + 1
+    return end if j[end - 1, FEET, 1].min() <= SETTLED * leg_length(j) else None

@@ -84,9 +84,7 @@ def starts_standing(features) -> bool:
     the leg's length (hip to knee to ankle, its first frame), where a body already going down (a
     lie-down's last seconds: 0.7 of it) is lower."""
     from ..motion.features import joints_from_features
+    from ..motion.skeleton_ops import leg_length
 
     f = np.asarray(features, dtype=np.float32)[:ENDS]
-    j = joints_from_features(f).astype(np.float64)
-    leg = np.mean([np.linalg.norm(j[:, h] - j[:, k], axis=-1) + np.linalg.norm(j[:, k] - j[:, a], axis=-1)
-                   for h, k, a in ((1, 4, 7), (2, 5, 8))])
-    return bool(f[:, 3].mean() >= STANDING * max(float(leg), 1e-6))
+    return bool(f[:, 3].mean() >= STANDING * leg_length(joints_from_features(f)))

@@ -1,4 +1,4 @@
-"""Whole-clip skeleton operations on 22-joint motions: floor, facing direction, canonical pose.
+"""Whole-clip skeleton operations on 22-joint motions: floor, facing direction, leg length, canonical pose.
 
 Joints are (T, 22, 3) in metres, Y up, SMPL order (``core/body/skeleton.py``). The facing
 direction is HumanML3D's: ``across = (r_hip - l_hip) + (r_shoulder - l_shoulder)`` and
@@ -40,6 +40,14 @@ def facing_directions(joints: np.ndarray) -> np.ndarray:
         raise ShapeMoveError(f"cannot tell which way the body faces at frame {bad} "
                              "(hips and shoulders are vertical or coincide)")
     return forward / norm
+
+
+def leg_length(joints) -> float:
+    """The leg's length of (T, 22, 3) joints: hip to knee to ankle, both legs' mean, the median over
+    the frames (at least 1 mm)."""
+    j = np.asarray(joints, dtype=np.float64)
+    seg = lambda a, b: np.linalg.norm(j[:, a] - j[:, b], axis=-1)  # noqa: E731
+    return float(max(np.median((seg(1, 4) + seg(4, 7) + seg(2, 5) + seg(5, 8)) / 2), 1e-3))
 
 
 def heading_angles(forward: np.ndarray) -> np.ndarray:

@@ -8,9 +8,10 @@
 
 Actions are found by the dataset's own action patterns (``data/actions.py``: one vocabulary for
 captions, labels and prompts). A prompt is **two things at once** when it names a locomotion
-(``LEGS``: walk, jog, run, march, sneak, limp, sidestep, walk backward, in a circle, ...) and an
-arm gesture (``ARMS``: wave, punch, throw, raise a hand, beckon, reach up, arm circles, ...) and
-no order between them ("then", "after", "before": a sequence is the timeline's job,
+(``LEGS``: walk, jog, run, march, sneak, limp, sidestep, walk backward, in a circle, ...) or a sit
+(``SEATED``: "sits down and waves" waves seated, where as two segments the body sat, then stood up
+again to wave) and an arm gesture (``ARMS``: wave, punch, throw, raise a hand, beckon, reach up, arm
+circles, ...) and no order between them ("then", "after", "before": a sequence is the timeline's job,
 ``generation/sequence.py``). The text is cut between the two at the connector that joins them (",", "while",
 "as", "and", ...; "with" only where no other joins them: "waves with his right hand while walking"
 is cut at "while"; else where the second action starts); each clause becomes its own prompt, the
@@ -30,14 +31,17 @@ from ..data.compose_parts import ARMS_ACTIONS, LEGS_ACTIONS
 from .vocabulary import CONNECTOR, DIRECTION, FOOT_WORDS, HAND_WORDS, ORDER_WORDS, SIDE, SUBJECT
 
 LEGS = frozenset(LEGS_ACTIONS) | {"sprint", "walk in a figure eight"}   # not "zombie walk": its arms are the action
+SEATED = frozenset({"sit"})      # a posture the arms' gesture is done in, as a gait's legs carry it
+BODY = LEGS | SEATED             # what the legs part of two things at once may be
 ARMS = frozenset(ARMS_ACTIONS)
 FOOT_ACTIONS = frozenset({"kick", "spin kick", "kick ball", "hop"})
 
 
 def at_once(first: str, second: str) -> bool:
-    """Whether one body does the two actions at once, by part: a locomotion (``LEGS``) and an arm
-    gesture (``ARMS``), either way round ("jogs and waves"); any other two follow one another."""
-    return (first in LEGS and second in ARMS) or (first in ARMS and second in LEGS)
+    """Whether one body does the two actions at once, by part: a locomotion or a sit (``BODY``) and
+    an arm gesture (``ARMS``), either way round ("jogs and waves", "sits down and waves"); any other
+    two follow one another."""
+    return (first in BODY and second in ARMS) or (first in ARMS and second in BODY)
 
 
 @dataclass(frozen=True)
@@ -141,7 +145,7 @@ def plan_parts(text: str, classify=None) -> PartPlan | None:
     if ORDER_WORDS.search(t):
         return None
     spans = action_spans(t)
-    legs = max((sp for sp in spans if sp[2] in LEGS), key=lambda sp: (sp[1] - sp[0], -sp[0]), default=None)
+    legs = max((sp for sp in spans if sp[2] in BODY), key=lambda sp: (sp[1] - sp[0], -sp[0]), default=None)
     arms = None
     if legs is not None:  # a gesture outside the locomotion's span; one a connector parts from it first
         apart = [sp for sp in spans if sp[2] in ARMS and (sp[1] <= legs[0] or sp[0] >= legs[1])]
@@ -158,7 +162,7 @@ def plan_parts(text: str, classify=None) -> PartPlan | None:
     if not a or not b:
         return None
     legs_clause, arms_clause = (a, b) if first is legs else (b, a)
-    legs_action = _part_action(legs_clause, LEGS) or legs[2]
+    legs_action = _part_action(legs_clause, BODY) or legs[2]
     arms_action = _part_action(arms_clause, ARMS) or arms[2]
     return _plan(_with_subject(legs_clause), _with_subject(arms_clause), legs_action, arms_action)
 

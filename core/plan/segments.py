@@ -117,7 +117,8 @@ def _and_steps(piece: str, before: str = "") -> list[str]:
     list of steps before it ("jumps, squats and waves": three); the piece itself otherwise. Standing
     up after a squat or a bend (``before``: what precedes the piece) is that action's own end, no
     action of its own: "squats, then stands up and waves" is two, the squat (which stands up again)
-    and "waves"."""
+    and "waves". A sit and a gesture are done at once ("sits down and waves": waving seated,
+    ``part_prompts.at_once``)."""
     whole = find_actions(piece)
     for m in AND.finditer(piece):
         a, b = piece[:m.start()], piece[m.end():]
@@ -126,8 +127,8 @@ def _and_steps(piece: str, before: str = "") -> list[str]:
             continue
         if first == ["get up"] and not _changes_posture("get up", find_actions(before)):
             return _and_steps(b, before)   # the squat's own standing up: "squats, then stands up and waves"
-        posture = first[0] != then[0] and (_changes_posture(first[0], find_actions(before))
-                                           or _changes_posture(then[0], first))
+        posture = first[0] != then[0] and not at_once(first[-1], then[0]) and \
+            (_changes_posture(first[0], find_actions(before)) or _changes_posture(then[0], first))
         counted = then[0] == "turn" and stop_request(a) is not None   # "walks 10 steps and turns left"
         if posture or counted or _one_after_other(first, then, whole):   # an order: the list of steps before it cuts too
             return _list_steps(a) + _and_steps(b, a)
