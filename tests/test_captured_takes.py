@@ -117,6 +117,28 @@ def test_a_gesture_with_a_sit_is_made_seated():
         assert m.part_prompts[0].endswith("sits down") and m.segment_bounds is None
 
 
+def test_a_lie_down_after_a_sit_goes_on_from_the_seat():
+    """"a man sits on the floor, then lies down": the lie-down segment started standing, so the body
+    rose from the floor between the two. A lie-down after a segment that ends seated plays a
+    captured lie-down from where it sits: the pelvis stays on the floor from the sit to the end,
+    and the head ends down. Regenerating that segment keeps it so."""
+    from shapemove.core.generation.generate import Generator, Request
+    from shapemove.core.generation.stitched_timeline import regenerate_stitched
+
+    gen = Generator(None)
+    m = gen.generate_batch([Request("a man sits on the floor, then lies down", seed=0)])[0]
+    first, second = m.provenance.split("; ")
+    assert first.endswith("its sit on the floor") and second.endswith("from its sit on the floor"), m.provenance
+    (s0, e0), (s1, e1) = m.segment_bounds
+    root, head = m.joints[:, 0, 1], m.joints[:, 15, 1]
+    seated = int(np.argmax(root < 0.35 * root[0]))                 # where the sit reaches the floor
+    assert seated < e0 and root[seated:].max() < 0.5 * root[0]       # never up again
+    assert head[-5:].mean() < 0.35 * head.max()                      # lying at the end
+    again = regenerate_stitched(gen, m, 1, seed=5)
+    assert again.provenance.split("; ")[1].endswith("from its sit on the floor")
+    assert again.joints[seated:, 0, 1].max() < 0.5 * root[0]
+
+
 @pytest.fixture(scope="module")
 def kick_model(tiny_dataset, tmp_path_factory):
     """The default model with the library of the tiny dataset's takes (train + val)."""

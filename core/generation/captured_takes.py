@@ -80,6 +80,7 @@ class Window:
     looped: int = 0         # frames of the take's own cycle played again (take_loop.py)
     cut: int = 0            # frames of the repetitions asked that the length asked leaves out
     note: str = ""          # why this take stands in for what was asked (travel_words.backward_taken)
+    seated: bool = False    # it starts where its take sits on the floor (a lie-down after a sit: floor_sit.py)
 
     @property
     def arrays(self) -> dict:
@@ -232,7 +233,8 @@ class TakePool:
         return chosen
 
     def window(self, i: int, frames: int, seed: int, side=None, longest: int | None = None,
-               times: int | None = None, straight: bool = False, asked: str | None = None) -> Window:
+               times: int | None = None, straight: bool = False, asked: str | None = None,
+               seated: bool = False) -> Window:
         """Take ``i`` cut to ``frames`` (the seed picks the start), or held to it when shorter;
         ``longest``: the length is the model's (``frames`` the least), the take plays whole up to
         ``longest`` frames. ``side``: ("left" | "right", "hand" | "foot") mirrors a take whose
@@ -246,17 +248,22 @@ class TakePool:
         image, else (a cycle whose contacts do not show its steps) whole, as one repetition. A take of
         an action that goes somewhere as it repeats (``actions.MOVES_ON``: a hop) loops only when it
         is the action ``asked``: "a child toddles forward" chose six looped hops among the takes nearest
-        by caption."""
+        by caption. A lie-down asked ``seated`` (after a segment that sat) plays from where its take
+        sits on the floor (``floor_sit.sit_end``) to its end, as a sit asked plays to there."""
         from .part_compose import needs_mirror
 
         t = self.take(i)
         rot, root, con, exact = t["rotations"], t["root"], t["contacts"], False
-        action, provenance = self.actions[i], t["provenance"]
-        if asked == SIT and action == SIT_FROM:   # a lie-down played to where it sits (floor_sit.py)
+        action, provenance, from_seat = self.actions[i], t["provenance"], False
+        if action == SIT_FROM and (asked == SIT or seated):   # a lie-down's sit on the floor (floor_sit.py)
             end = sit_end(self.proc.pose_on(rot, root, t["betas"], 1.0, con))
-            if end is not None:
+            if end is not None and asked == SIT:    # played to where it sits
                 rot, root, con, action = rot[:end], root[:end], con[:end], SIT
                 provenance += ", its sit on the floor"
+            elif end is not None:                   # played on from where it sits
+                rot, root, con = rot[end - 1:], root[end - 1:], con[end - 1:]
+                provenance += ", from its sit on the floor"
+                from_seat = True
         if cut_for(action, times):
             def posed(r, rt, c):
                 j = self.proc.pose_on(r, rt, t["betas"], 1.0, c)
@@ -303,14 +310,14 @@ class TakePool:
             joints = self.proc.pose_on(rot, root, t["betas"], 1.0, con)
         return Window(rot, root, con, t["rest"], self.proc.features(joints, rot, con), action, self.ids[i],
                       provenance + (", mirrored" if flip else ""), held, flip, looped,
-                      max(0, n - want) if exact else 0)
+                      max(0, n - want) if exact else 0, seated=from_seat)
 
     def windows(self, text: np.ndarray, action: str | None, seed: int, frames: int, side=None,
                 longest: int | None = None, count: int = TAKES, times: int | None = None,
-                straight: bool = False, hands: bool | None = None) -> list[Window]:
+                straight: bool = False, hands: bool | None = None, seated: bool = False) -> list[Window]:
         """One window of each take offered (``nearest``, ``hands`` as there); ``times``: the repetitions
-        the words ask; ``straight``: the words ask a plain gait (``window``)."""
-        return [self.window(i, frames, seed, side, longest, times, straight, action)
+        the words ask; ``straight``: the words ask a plain gait; ``seated``: after a sit (``window``)."""
+        return [self.window(i, frames, seed, side, longest, times, straight, action, seated)
                 for i in self.nearest(text, action, seed, count, hands)]
 
 

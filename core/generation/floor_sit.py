@@ -18,6 +18,9 @@ foot joint within ``SETTLED`` leg lengths of it: 0.03-0.12 m); the other six sti
 up (0.13-0.19 m) and are not offered: held there with the feet free, the legs of a sit played as
 the legs of two things at once were pulled 14 cm by the planting.
 
+A lie-down asked right after a segment that ends seated (``Request.seated``) plays such a take from
+where it sits to its end: the body goes on from the seat instead of standing up to lie down.
+
     end = sit_end(joints)        # frames of the take to play, or None: it never sits
 """
 from __future__ import annotations

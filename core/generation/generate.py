@@ -206,8 +206,9 @@ class Generator:
         straight, hands = straight_asked(words), hands_wanted(words, action)   # a gesture's hands as said
         if r.seconds is None:   # the model's length: a take plays whole, at least UNASKED_SECONDS
             return pool.windows(text, action, r.seed, self._length(UNASKED_SECONDS)[0] * down, side, hi * down,
-                                times=times, straight=straight, hands=hands)
-        return pool.windows(text, action, r.seed, lo * down, side, times=times, straight=straight, hands=hands)
+                                times=times, straight=straight, hands=hands, seated=r.seated)
+        return pool.windows(text, action, r.seed, lo * down, side, times=times, straight=straight, hands=hands,
+                            seated=r.seated)
 
     # -- tokens ------------------------------------------------------------------------------
     def _length(self, seconds: float | None) -> tuple[int, int]:
@@ -267,6 +268,8 @@ class Generator:
                 w.note = f"no capture {backward_verb(requested)} backwards: a walk backward is played"
             cands, sources, beta = (self._from_action_clips(r, found) if found    # the user's clips: as captured
                                     else self._sampled(r, lo, hi, g, library=not windows, asked=asked))   # takes, or as codes
+            if r.seated and any(w.seated for w in windows):   # after a sit: the lie-downs from their sits,
+                windows, cands, sources = [w for w in windows if w.seated], [], []   # none that stands up first
             best = 0
             body, body_source = self.body_shape(body_of or r, beta.numpy())
             if reach is not None:   # the distance on the T5's body, which the samples are decoded on

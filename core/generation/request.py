@@ -30,3 +30,4 @@ class Request:
     plan: object | None = None  # an edited plan (``plan.plan.Plan``, ``generate --plan``): acted on instead of the prompt's reading
     words: object | None = None  # the reading the candidates are chosen by (``plan.words.Words``; None: the prompt's)
     whole_course: bool = False  # a timeline's segment: a course walks whole periods fitted to its travel (course_walk.py)
+    seated: bool = False  # a timeline's segment after one that ends seated: a lie-down goes on from a sit (floor_sit.py)

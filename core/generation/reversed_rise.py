@@ -53,6 +53,12 @@ def lowers(words) -> bool:
     return any(a in LOWERED for a in words.actions)
 
 
+def lies_from_seat(before, words, before_motion) -> bool:
+    """Whether a segment whose words only lie down follows one that sits (``before``) and ends seated
+    (its finished ``before_motion``): it goes on from the seat (``Request.seated``)."""
+    return list(words.actions) == ["lie down"] and "sit" in before.actions and ends_seated(before_motion.joints)
+
+
 def rises_from_seat(before, words, before_motion) -> bool:
     """Whether a segment whose words are ``words`` (``plan.words.Words``) stands up from the seat the
     segment before (words ``before``, its finished ``before_motion``) ends on."""

@@ -156,7 +156,8 @@ def stitched_sequence(gen, segments: list[tuple[str, float]], body: np.ndarray, 
         if cancel is not None and cancel():
             raise ShapeMoveError("cancelled")
         asked = segment_request(base, text, sec, body, base.seed + i, None if readings is None else readings[i])
-        motions.append(_segment_made(i, said, motions[-1] if i else None, sec, lambda: gen.generate_batch([asked])[0]))
+        motions.append(_segment_made(i, said, motions[-1] if i else None, sec,
+                                     lambda seated: gen.generate_batch([dataclasses.replace(asked, seated=seated)])[0]))
         if progress is not None:
             progress((i + 1) / (len(segments) + 1), f"segment {i + 1}/{len(segments)}: {text}")
     return assembled(gen, motions, [t for t, _ in segments], body)
@@ -165,13 +166,14 @@ def stitched_sequence(gen, segments: list[tuple[str, float]], body: np.ndarray, 
 def _segment_made(i: int, said: list, before: Motion | None, seconds: float, make) -> Motion:
     """Segment ``i`` of a timeline whose segments' readings are ``said``: the segment ``before`` it
     played backwards when it stands up from the seat that one ends on (``reversed_rise.py``), else
-    ``make()``, held at its lowest when the next segment stands up from it."""
+    ``make(seated)``, ``seated`` when it lies down from that seat (``reversed_rise.lies_from_seat``),
+    held at its lowest when the next segment stands up from it."""
     from ..constants import FPS
-    from .reversed_rise import held_low, lowers, rises_from_seat, sit_reversed, stands_up
+    from .reversed_rise import held_low, lies_from_seat, lowers, rises_from_seat, sit_reversed, stands_up
 
     if i and rises_from_seat(said[i - 1], said[i], before):   # standing up from the seat just sat on
         return sit_reversed(before, _contacts(before), max(2, int(round(seconds * FPS))), i)
-    made = make()
+    made = make(bool(i) and lies_from_seat(said[i - 1], said[i], before))
     if i + 1 < len(said) and lowers(said[i]) and stands_up(said[i + 1]):   # down, held, then up
         made = held_low(made, _contacts(made))
     return made
@@ -213,8 +215,8 @@ def regenerate_stitched(gen, motion: Motion, index: int, seed: int, prompt: str 
             for i, t in enumerate(prompts[:index] + [text] + prompts[index + 1:])]
     segment = lambda i: dataclasses.replace(motion, joints=joints[i], contacts=contacts[i])  # noqa: E731
     base = request if request is not None else Request(text)
-    new = _segment_made(index, said, segment(index - 1) if index else None, sec,
-                        lambda: gen.generate_batch([segment_request(base, text, sec, motion.betas, seed)])[0])
+    new = _segment_made(index, said, segment(index - 1) if index else None, sec, lambda seated: gen.generate_batch(
+        [dataclasses.replace(segment_request(base, text, sec, motion.betas, seed), seated=seated)])[0])
     joints[index], contacts[index] = np.asarray(new.joints), _contacts(new)
     prompts[index] = text
     sources[index] = new.provenance
