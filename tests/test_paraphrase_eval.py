@@ -67,6 +67,15 @@ def test_paraphrase_eval_on_a_tiny_model(tiny_bundle, tmp_path, capsys):  # noqa
             named = sum(n for b, n in row.items() if b == a or frozenset((a, b)) in pairs)
             assert acc[a] == pytest.approx(named / sum(row.values()))
 
+    # the signatures: the kick prompt's row read by the kick's (no other prompt's action has one),
+    # tallied beside the TMA judge's reading of the same prompt
+    sig = res["signature"]
+    assert [r["signature_right"] is not None for r in rows] == [r["action"] == "kick" for r in rows]
+    kicks = [r for r in rows if r["action"] == "kick"]
+    assert sig["prompts"] == len(kicks) and sig["accuracy"] == pytest.approx(
+        sum(r["signature_right"] for r in kicks) / len(kicks))
+    assert set(sig["per_action"]) == {"kick"} and "physical signatures" in out
+
     # two seeds: every prompt generated once per seed, seed 0's generations as in the one-seed run,
     # and the accuracies counted over all the generations
     assert main(["eval", "paraphrase", "--model", str(model), "--prompts", str(tmp_path / "p.json"), "--seconds", "1",
@@ -84,7 +93,8 @@ def test_paraphrase_eval_on_a_tiny_model(tiny_bundle, tmp_path, capsys):  # noqa
         eval_paraphrase(model, tmp_path / "p.json", seed=[1, 1], data=data)
 
     # a user's library (--library): its clips join the memory; with only retrieved clips competing
-    # (--retrieval-first 0) every prompt keeps the library's one clip, and the result counts them
+    # (--retrieval-first 0) every prompt keeps the library's one clip, a walk, but the one that asks
+    # for a run (a clip of another action than the one asked does not compete), and the result counts them
     from shapemove.core.generation.generate import Generator, Request
     from shapemove.core.scene.motion_file import save_motion
 
@@ -96,8 +106,8 @@ def test_paraphrase_eval_on_a_tiny_model(tiny_bundle, tmp_path, capsys):  # noqa
                  "--data", str(data), "--json", str(tmp_path / "r3.json"), "--quiet", "--library", str(lib),
                  "--retrieval-first", "0"]) == 0
     three = json.loads((tmp_path / "r3.json").read_text())
-    assert three["library"] == str(lib) and three["kept_library"] == len(rows)
-    assert all(r["kept_clips"] == ["library:stroll"] for r in three["rows"])
+    assert three["library"] == str(lib) and three["kept_library"] == len(rows) - 1
+    assert [r["kept_clips"] == ["library:stroll"] for r in three["rows"]] == [r["action"] != "run" for r in rows]
 
     # --model-length: each motion as long as the model makes it (the product's default), not --seconds
     assert main(["eval", "paraphrase", "--model", str(model), "--prompts", str(tmp_path / "p.json"), "--seconds", "1",

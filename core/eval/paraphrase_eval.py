@@ -130,6 +130,7 @@ def eval_paraphrase(model_dir=None, prompts=None, tma=None, seed: int | list[int
     from ..motion.features import motion_features
     from ..generation.sampling_params import or_defaults
     from .action_classifier import ActionClassifier, built_dir
+    from .action_signatures import signatures, signed
     from .tma_embed import embed_motions, embed_texts, load_tma
 
     items = load_prompts(prompts)
@@ -174,7 +175,9 @@ def eval_paraphrase(model_dir=None, prompts=None, tma=None, seed: int | list[int
         motion_emb = embed_motions(model, [played], mean, std)[0]
         embs.append(motion_emb)
         feats.append(played)
+        sig = signed(it["action"])   # a third judge where the action has a physical signature
         rows.append({**it, "seed": s, "seconds": round(m.num_frames / m.fps, 2),
+                     "signature_right": None if sig is None else bool(signatures(m.joints)[sig]),
                      "motion_proto_pred": actions[int(np.argmax(A @ motion_emb))],
                      "warned": bool(m.warnings), "kept_clips": list(m.retrieved_clips),
                      "parts": list(m.part_prompts) if m.part_prompts else None,
@@ -204,7 +207,7 @@ def eval_paraphrase(model_dir=None, prompts=None, tma=None, seed: int | list[int
             "motion_vs_text_prototypes": _tally(rows, "motion_proto_pred"),
             **({"motion_features": _tally(rows, "motion_features_pred", pairs.get("motion_features"))}
                if feature_classifier is not None else {}),
-            "reachable": reach, "indistinct": merged,
+            "reachable": reach, "indistinct": merged, "signature": _signature_tally(rows, pairs.get("motion")),
             **({"nearest_caption": _tally(rows, "nearest_caption_pred")} if nearest else {}),
             "frequent": {"min_clips": frequent, "actions": sorted({r["action"] for r in often}),
                          "motion": _tally(often, "motion_pred", pairs.get("motion")),
@@ -227,6 +230,25 @@ def eval_paraphrase(model_dir=None, prompts=None, tma=None, seed: int | list[int
             "unknown_prompts": len(items) - len(known), "warned": sum(r["warned"] for r in rows),
             "prompts_file": str(Path(prompts) if prompts else DEFAULT_PROMPTS),
             "actions": actions, "rows": rows}
+
+
+def _signature_tally(rows: list[dict], pairs: set | None) -> dict:
+    """The prompts whose action has a physical signature (``action_signatures.py``): how often the
+    played motion shows it, per action, beside the TMA judge's merged reading of the same prompts."""
+    from .indistinct_actions import merged_right
+
+    signed_rows = [r for r in rows if r.get("signature_right") is not None]
+    per: dict = {}
+    for r in signed_rows:
+        p = per.setdefault(r["action"], {"n": 0, "right": 0, "motion_merged": 0})
+        p["n"] += 1
+        p["right"] += r["signature_right"]
+        p["motion_merged"] += bool(r.get("motion_pred") and merged_right(r["action"], r["motion_pred"], pairs or set()))
+    n = len(signed_rows)
+    return {"prompts": n, "accuracy": sum(p["right"] for p in per.values()) / n if n else None,
+            "motion_merged": sum(p["motion_merged"] for p in per.values()) / n if n else None,
+            "per_action": {a: {**p, "accuracy": p["right"] / p["n"], "motion_merged": p["motion_merged"] / p["n"]}
+                           for a, p in sorted(per.items())}}
 
 
 def _indistinct(clfs: dict, data, seconds: float | None) -> dict:
@@ -318,6 +340,13 @@ def format_results(res: dict) -> str:
         lines.append(f"without the TMA (5-NN on pooled raw features): motion {_pct(res['motion_features']['accuracy'])} "
                      f"({_pct(res['motion_features']['accuracy_lenient'])} lenient)")
     lines += _merged_lines(res)
+    sig = res.get("signature") or {}
+    if sig.get("prompts"):
+        lines.append(f"physical signatures (a flight, a dip, a raised wrist swinging...: eval/action_signatures.py) "
+                     f"on the {sig['prompts']} prompts of an action that has one: shown {_pct(sig['accuracy'])}, the "
+                     f"TMA judge merged {_pct(sig['motion_merged'])}; "
+                     + ", ".join(f"{a} {_pct(p['accuracy'], 0)} / {_pct(p['motion_merged'], 0)}"
+                                 for a, p in sig["per_action"].items()))
     reach = res.get("reachable") or {}
     if reach:
         lines.append("reachable (a perfect generator, each prompt's action judged by leave-one-take-out on the "
