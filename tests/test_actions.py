@@ -65,6 +65,8 @@ def test_vocabulary():
     ("she moves both arms around in small circles", ["arm circles"]),
     ("a man walks in circles", ["walk in a circle", "walk"]),
     ("someone lifts a heavy box", ["pick up"]),
+    ("a man puts a box down on the floor", ["put down"]),   # the thing put down between the verb and "down"
+    ("she picks the heavy box up", ["pick up"]),
     ("running flat out, she lifts one hand high", ["run", "raise hand"]),
     ("she paces the room", []),                       # a course (back and forth), not an action
     ("a dancer circling his arms", ["dance", "arm circles"]),   # no circle walk (vocabulary.ARM_CIRCLES)

@@ -184,9 +184,9 @@ _LIST = [
     _a("squat", "exercise", ["does a squat", "squats down"], [r"\bsquat"]),
     _a("bend over", "exercise", ["bends over", "bends down"], [r"\bbend(s|ing)? (over|down)\b", r"\bbent over\b"]),
     _a("pick up", "exercise", ["picks something up from the floor"],
-       [r"\bpick\w* (\w+ )?up\b", r"\bscoop"]),
+       [r"\bpick\w* (\w+ ){0,3}up\b", r"\bscoop"]),   # "picks the heavy box up"
     _a("put down", "exercise", ["puts something down on the floor"],
-       [r"\bput\w* (\w+ )?down\b", r"\bdeposit"]),
+       [r"\bput\w* (\w+ ){0,3}down\b", r"\bdeposit"]),   # "puts a box down"
     _a("reach up", "exercise", ["reaches up high", "reaches up and grabs something"],
        [r"\breach(es|ing)? (up|for|high)", r"\bgrab"]),
     _a("stretch", "exercise", ["stretches", "does stretches"], [r"\bstretch(es|ing)?\b"]),
