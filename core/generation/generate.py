@@ -54,6 +54,7 @@ from .stop_words import (DISTANCE_PACE, DISTANCE_SECONDS, OVERSHOOT, STAND_SECON
 from .sampling_params import (DEFAULT_GUIDANCE, check_candidates, check_guidance, check_retrieval_first,
                               check_retrieval_prefix, check_retrieved, check_sampling)
 from .request import Request
+from .slow_action import slowed
 from .slow_steps import slow_motion
 from .still_take import still_take
 from .travel_words import backward_taken, backward_verb
@@ -606,6 +607,9 @@ class Generator:
                     # turning) a course or a turn the words name given back on the paced track
                     motion = typical_paced(motion, self.body, words, self.typical_speeds, self.ik_refine_iters)
                     motion = slow_motion(motion, self.body, words, self.ik_refine_iters)      # slow_steps.py
+                    if words.slowly:   # an action that is no gait, asked slowly (slow_action.py)
+                        motion = slowed(motion, self.body, None if r.seconds is None else motion.num_frames,
+                                        self.ik_refine_iters)
                     motion = (course_motion(motion, self.body, course, words.course_right, self.ik_refine_iters, r.whole_course)
                               if course is not None else                                          # course_walk.py
                               turn_motion(motion, self.body, turn, self.ik_refine_iters))         # turn_words.py

@@ -165,8 +165,8 @@ def _choice(value, where: str, options) -> str:
 
 
 UNDERSTOOD_KEYS = ("actions", "legs", "arms", "course", "course_way", "turn_degrees", "travel", "in_place",
-                   "distance_m", "steps", "stop", "stand_still", "count", "pace", "seconds", "side", "arms_held",
-                   "hands", "unused")
+                   "distance_m", "steps", "stop", "stand_still", "count", "pace", "slowly", "seconds", "side",
+                   "arms_held", "hands", "unused")
 
 
 def _swap_action(text: str, old: str | None, new: str) -> str:
@@ -289,6 +289,7 @@ def _edited_words(seg: dict, where: str, text: str) -> tuple[str, Words]:
                        "the segment names none")
         count = (countable[0], n)
     pace = None if said.get("pace") is None else _choice(said["pace"], f"{where}.understood.pace", ("fast", "slow"))
+    slowly = _flag(said.get("slowly", False), f"{where}.understood.slowly") and pace is None
     length = None if said.get("seconds") is None else _number(said["seconds"], f"{where}.understood.seconds",
                                                               MIN_SEGMENT_SECONDS, MAX_SECONDS)
     gait_text = read.gait_text if read.stop else (text if stop else None)
@@ -296,8 +297,8 @@ def _edited_words(seg: dict, where: str, text: str) -> tuple[str, Words]:
     return text, replace(read, parts=parts, side=None if parts is not None else side, course=course,
                          course_right=way == "right", turn=turn, travel=replace(travel, in_place=in_place),
                          in_place=in_place, stop=stop, steps=steps, distance_m=metres, gait_text=gait_text,
-                         stand_still=stand and not stop, count=count, pace=pace, slow_flight=flight, seconds=length,
-                         hands=hands, arms_held=held)
+                         stand_still=stand and not stop, count=count, pace=pace, slow_flight=flight, slowly=slowly,
+                         seconds=length, hands=hands, arms_held=held)
 
 
 def plan_from_json(data, seconds: float | None = None) -> Plan:

@@ -67,6 +67,14 @@ def asks_slow_flight(prompt: str) -> bool:
     return bool(gaits) and not gaits <= STEPPING
 
 
+def asks_slow_action(prompt: str) -> bool:
+    """Whether the prompt asks an action that is no gait to be done slowly ("an old man sits down
+    slowly", "she waves slowly"): a slow pace named, no fast one, no gait and no travel ("backs up
+    slowly" steps), an action named."""
+    return bool(V.SLOW.search(prompt)) and not V.FAST.search(prompt) and not _gaits(prompt) and \
+        not travel_of(prompt).named and bool(action_spans(prompt))
+
+
 # -- stop, steps, distance, standing ----------------------------------------------------------
 def stop_request(text: str) -> tuple[str, int | None] | None:
     """(the prompt without its stop clause or distance, the steps it counts or None) when ``text``

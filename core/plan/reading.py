@@ -55,6 +55,8 @@ def said(reading: dict) -> str:
         bits.append(f"{reading['count']} times")
     if "pace" in reading:
         bits.append(reading["pace"])
+    if reading.get("slowly"):
+        bits.append("slowly")
     if "seconds" in reading:
         bits.append(f"for {reading['seconds']:g} s")
     if "side" in reading:

@@ -43,6 +43,7 @@ class Words:
     count: tuple[str, int] | None = None       # (countable action, times)
     pace: str | None = None                    # "fast" | "slow"
     slow_flight: bool = False                  # slow of a gait with flights (a jog, a run): shorter strides
+    slowly: bool = False                       # an action that is no gait done slowly ("sits down slowly")
     gestures_only: bool = False                # every action named is an arms action ("he waves")
     arms_held: bool = False                    # the arms kept raised ("with both arms raised")
     hands: str | None = None                   # a gesture's hands: "both" ("waves with both hands"), "one" ("a hand")
@@ -93,6 +94,8 @@ class Words:
             out["count"] = self.count[1]
         if self.pace is not None:
             out["pace"] = self.pace
+        if self.slowly:
+            out["slowly"] = True
         if self.side is not None:
             out["side"] = f"{self.side[0]} {self.side[1]}"
         if self.arms_held:
@@ -114,6 +117,7 @@ def read_words(text: str) -> Words:
     metres = R.asked_distance(low) if stop is not None else None
     course = R.course_named(low)
     pace = "fast" if R.asks_fast(low) else "slow" if (R.asks_slow_steps(low) or R.asks_slow_flight(low)) else None
+    slowly = pace is None and R.asks_slow_action(low)
     if stop is not None:   # the words without the stop, in the prompt's own case
         stop = R.stop_request(str(text))
     return Words(
@@ -123,9 +127,9 @@ def read_words(text: str) -> Words:
         steps=None if stop is None else stop[1], distance_m=None if metres is None else float(metres),
         gait_text=None if stop is None else stop[0],
         stand_still=stop is None and R.asks_stand_still(low), count=R.asked_count(low), pace=pace,
-        slow_flight=pace == "slow" and R.asks_slow_flight(low), gestures_only=R.gestures_only(low),
+        slow_flight=pace == "slow" and R.asks_slow_flight(low), slowly=slowly, gestures_only=R.gestures_only(low),
         arms_held=R.arms_held(low), hands=R.hands_asked(low), seconds=R.asked_seconds(low),
-        unused=tuple(R.unused_words(low, _body_words(low), () if pace else (V.FAST, V.SLOW))))
+        unused=tuple(R.unused_words(low, _body_words(low), () if pace or slowly else (V.FAST, V.SLOW))))
 
 
 def _body_words(low: str) -> list[str]:

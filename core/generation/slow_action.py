@@ -1,0 +1,56 @@
+"""An action that is no gait, asked slowly ("an old man sits down slowly", "she waves slowly"):
+played at ``SLOW_ACTION`` of its speed.
+
+A gait asked slowly goes slower (``slow_steps.py``); any other action was played at its captured
+or generated speed and "slowly" named as not used. Here the motion's moving part (up to where it
+holds still: a captured sit or kick held on its last pose) is resampled longer (``track.resample``)
+and planted again (``track.replanted``):
+
+- the model's length (no length asked): the moving part lasts ``1 / SLOW_ACTION`` as long and the
+  motion with it (a 3.7 s sit becomes 5.5 s), the still end kept;
+- a length asked: the motion keeps it, the moving part taking up its still end, as far as
+  ``1 / SLOW_ACTION`` (a 1.1 s sit held 2.9 s in 4 s is played over 1.6 s); a motion that moves to
+  its last frame keeps its speed (slowed, its end would be cut).
+
+    motion = slowed(motion, body, frames=None)      # the model's length: longer
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .track import Track, replanted, resample, track_of
+
+SLOW_ACTION = 0.67   # of its speed: an action asked slowly
+STILL = 1e-3         # m: a frame whose joints all move less than this from the one before holds still
+
+
+def moving_frames(joints) -> int:
+    """The frames of (T, J, 3) ``joints`` before their still end (at least 2)."""
+    j = np.asarray(joints, dtype=np.float64)
+    step = np.abs(np.diff(j, axis=0)).max(axis=(1, 2))
+    moving = np.flatnonzero(step >= STILL)
+    return max(2, int(moving[-1]) + 2) if len(moving) else 2
+
+
+def slowed(motion, body, frames: int | None, ik_refine_iters: int = 10):
+    """``motion`` played at ``SLOW_ACTION`` of its speed (module doc); ``frames``: the length asked
+    (None: the model's, which grows). The motion itself when nothing would change."""
+    track = track_of(motion)
+    n = len(track)
+    active = moving_frames(track.joints)
+    longer = int(round(active / SLOW_ACTION))
+    if frames is None:
+        total = n - active + longer           # the still end kept after it
+    else:
+        total, longer = n, min(longer, n)     # the still end taken up
+    if longer <= active:
+        return motion
+    moved = resample(Track(track.joints[:active], track.contacts[:active]), longer)
+    still = total - longer
+    joints = np.concatenate([moved.joints, np.repeat(track.joints[-1:], still, 0)])
+    contacts = np.concatenate([moved.contacts, np.repeat(track.contacts[-1:], still, 0)])
+    out = replanted(motion, body, Track(joints, contacts), ik_refine_iters, measured=bool(motion.contacts_measured))
+    out.provenance = motion.provenance
+    out.notes = list(motion.notes) + [f"played slowly: the action over {longer / motion.fps:.1f} s "
+                                      f"instead of {active / motion.fps:.1f} s"]
+    return out
