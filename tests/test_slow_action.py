@@ -39,3 +39,5 @@ def test_a_sit_asked_slowly_takes_longer_to_reach_the_floor():
     assert "played slowly" in kept.notes[-1] and kept.provenance == m.provenance
     slow = gen.generate_batch([Request("an old man sits down slowly", seed=0)])[0]   # through the generator
     assert "played slowly" in " ".join(slow.notes)
+    seated = gen.generate_batch([Request("a man sits down slowly while waving", seed=0)])[0]   # by part too
+    assert seated.part_prompts and "played slowly" in " ".join(seated.notes)

@@ -584,6 +584,9 @@ class Generator:
                 legs = read_words(words.parts.legs_prompt)          # "walks slowly, waving": both parts slower
                 motion = typical_paced(motion, self.body, legs, self.typical_speeds, self.ik_refine_iters, course=False)
                 motion = slow_motion(motion, self.body, words, self.ik_refine_iters)   # (slow_steps.py)
+                if words.slowly:   # "sits down slowly, waving": the seated wave too (slow_action.py)
+                    motion = slowed(motion, self.body, None if r.seconds is None else motion.num_frames,
+                                    self.ik_refine_iters)
             course = self.asks_course(words, check, edited) if words is not None else None   # course_walk.py
             if motion is None:  # one action, no side named: the motion as the model writes it
                 sampled = asked if course is None else dataclasses.replace(asked, prompt=read_words(asked.prompt).straight_text)
