@@ -52,6 +52,10 @@ def test_edited_fields_are_what_the_plan_holds():
     assert (w.course, w.course_right, w.distance_m, w.stop) == ("walk in a circle", True, 5.0, True)
     del edited["segments"][0]["understood"]["travel"]
     assert not plan_from_json(edited).segments[0].words.travel.named   # a field removed asks nothing
+    sit = plan_json("an old man sits down slowly")
+    assert sit["segments"][0]["understood"]["slowly"] is True and plan_from_json(sit).segments[0].words.slowly
+    del sit["segments"][0]["understood"]["slowly"]
+    assert not plan_from_json(sit).segments[0].words.slowly            # taken out: played at its own speed
 
 
 def test_actions_taken_out_of_a_plan_lose_their_words_and_actions_put_in_are_said():
@@ -78,6 +82,7 @@ def test_actions_taken_out_of_a_plan_lose_their_words_and_actions_put_in_are_sai
     ({"segments": [{"text": "a man walks", "understood": {"side": "left ear"}}]}, "segments[0].understood.side"),
     ({"segments": [{"text": "a man walks", "understood": {"actions": ["levitate"]}}]}, "segments[0].understood.actions[0]"),
     ({"segments": [{"text": "a man walks", "understood": {"steps": 3, "stop": False}}]}, "segments[0].understood.stop"),
+    ({"segments": [{"text": "a man sits", "understood": {"slowly": "yes"}}]}, "segments[0].understood.slowly"),
     ({"segments": [{"text": ""}]}, "segments[0].text"),
     ({"segments": []}, "segments"),
     ({"segments": [{"text": "a man walks"}, {"text": "a man jumps", "understood": {"count": 20}}]},
