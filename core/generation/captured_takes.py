@@ -21,8 +21,8 @@ in one ``TakePool``. For a prompt:
   samples' decoded features, and the TMA chooses among them all (``rerank.CandidatePicker``), a
   take of the asked action credited ``ACTION_BONUS``; when the words name an action, a take of
   another one does not compete (``action_credit``: "sits down" is not played as the lying-down take
-  nearest its words); with no take of sitting, a lie-down competes for a sit played to where it
-  sits on the floor (``floor_sit.py``).
+  nearest its words); for an action no take is of, the takes that stand in for it compete, made
+  into it (``stand_in_takes.py``: a lie-down played to where it sits, a put-down backwards).
 
 A window kept is moved onto the requested body by its own rotations with its feet planted
 (``retarget.planted_retarget``), never through the codes, and says where it came from
@@ -49,6 +49,7 @@ from ..scene.motion_file import Motion
 from ..data.actions import MOVES_ON, REPEATED
 from ..plan.vocabulary import GAITS, POSTURE_CHANGES
 from .floor_sit import SIT, SIT_FROM, sit_end
+from .stand_in_takes import STAND_IN, stand_in
 from .repeated_takes import cut_for, repeated_stretch
 from .straight_gait import STRAIGHTENED, straightened
 from .take_loop import looped_gait, looped_repetition, looped_steps, looped_take
@@ -226,8 +227,8 @@ class TakePool:
             if mine:
                 chosen.append(max(mine, key=lambda i: sims[i]))
         named = [i for i in range(len(self)) if action and self.actions[i] == action]
-        if action == SIT and not named:   # no take sits down: the lie-downs do on their way (floor_sit.py)
-            named = [i for i in range(len(self)) if self.actions[i] == SIT_FROM]
+        if action in STAND_IN and not named:   # no take of it: another's stand in (stand_in_takes.py)
+            named = [i for i in range(len(self)) if self.actions[i] == STAND_IN[action]]
         draw(named, max(0, count - len(chosen) - NEAREST) if named else 0)
         draw(range(len(self)), max(0, count - len(chosen)))
         return chosen
@@ -248,19 +249,23 @@ class TakePool:
         image, else (a cycle whose contacts do not show its steps) whole, as one repetition. A take of
         an action that goes somewhere as it repeats (``actions.MOVES_ON``: a hop) loops only when it
         is the action ``asked``: "a child toddles forward" chose six looped hops among the takes nearest
-        by caption. A lie-down asked ``seated`` (after a segment that sat) plays from where its take
-        sits on the floor (``floor_sit.sit_end``) to its end, as a sit asked plays to there."""
+        by caption. A take standing in for an action no take is of (``stand_in_takes.py``) is made
+        into it first: a lie-down played to where it sits, a put-down backwards. A lie-down asked
+        ``seated`` (after a segment that sat) plays from where its take sits on the floor
+        (``floor_sit.sit_end``) to its end."""
         from .part_compose import needs_mirror
 
         t = self.take(i)
         rot, root, con, exact = t["rotations"], t["root"], t["contacts"], False
         action, provenance, from_seat = self.actions[i], t["provenance"], False
-        if action == SIT_FROM and (asked == SIT or seated):   # a lie-down's sit on the floor (floor_sit.py)
-            end = sit_end(self.proc.pose_on(rot, root, t["betas"], 1.0, con))
-            if end is not None and asked == SIT:    # played to where it sits
-                rot, root, con, action = rot[:end], root[:end], con[:end], SIT
-                provenance += ", its sit on the floor"
-            elif end is not None:                   # played on from where it sits
+        pose = lambda r, rt, c: self.proc.pose_on(r, rt, t["betas"], 1.0, c)  # noqa: E731
+        made = stand_in(asked, action, rot, root, con, pose)   # a sit, a pick-up (stand_in_takes.py)
+        if made is not None:
+            rot, root, con, action, said = made
+            provenance += f", {said}"
+        elif action == SIT_FROM and seated:   # a lie-down after a sit: on from where it sits (floor_sit.py)
+            end = sit_end(pose(rot, root, con))
+            if end is not None:
                 rot, root, con = rot[end - 1:], root[end - 1:], con[end - 1:]
                 provenance += ", from its sit on the floor"
                 from_seat = True
