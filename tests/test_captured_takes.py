@@ -257,7 +257,8 @@ def test_an_action_without_takes_draws_on_the_takes_of_its_general_action(openbo
 
     gen = Generator(None, body=openbody)
     assert "ballet" not in gen.pool.actions and gen._taken("ballet") == "dance" and gen._taken("kick") == "kick"
-    assert gen._taken("sit") == "sit"                     # nothing more general: no take competes
+    assert gen._taken("sit") == "sit"                     # nothing more general (the lie-downs stand in)
+    assert gen._taken("shoot") == "throw"                 # a shot at the basket is a throw: HDM05's throwBasketball
     assert gen.pool.actions.count("hop") >= 20 and gen._taken("hop") == "hop"
     m = gen.generate_batch([Request("a man hops forward on both feet", seconds=4, seed=0)])[0]
     assert m.provenance.startswith("captured: ")

@@ -245,7 +245,7 @@ GENERIC_OF = {"walk in a figure eight": ("walk",), "walk in a circle": ("walk",)
               "limp": ("walk",), "sneak": ("walk",), "walk backward": ("walk",), "jump forward": ("jump",),
               "spin jump": ("jump", "spin"), "kick ball": ("kick",), "spin kick": ("kick", "spin"),
               "ballet": ("dance",), "wave goodbye": ("wave",), "cartwheel": ("turn",), "slash": ("swing",),
-              "hop": ("jump",)}
+              "hop": ("jump",), "shoot": ("throw",)}   # a shot at the basket is thrown
 
 
 # actions done over and over by their nature: a take of one repetition plays on as a loop of it
