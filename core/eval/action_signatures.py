@@ -39,6 +39,7 @@ import numpy as np
 from ..body.skeleton import JOINT_NAMES
 from ..constants import FPS
 from ..errors import ShapeMoveError
+from ..motion.contacts import runs
 from ..motion.skeleton_ops import facing_directions, heading_angles, leg_length
 
 _J = {n: JOINT_NAMES.index(n) for n in ("pelvis", "head", "left_hip", "right_hip", "left_knee", "right_knee",
@@ -63,19 +64,12 @@ WAVES = ("wave", "wave goodbye")                     # the forms of a wave its s
 JUMPS = ("jump", "jump forward", "spin jump", "hop")   # the forms of a jump its signature reads
 
 
-def _runs(flags) -> list[tuple[int, int]]:
-    """[start, end) of each run of True."""
-    f = np.concatenate([[False], np.asarray(flags, bool), [False]])
-    d = np.flatnonzero(np.diff(f.astype(np.int8)))
-    return list(zip(d[::2], d[1::2]))
-
-
 def flights(joints, leg: float) -> list[tuple[int, int]]:
     """The flights of a jump: runs of at least ``FLIGHT_FRAMES`` frames with every foot joint
     ``FLIGHT`` x ``leg`` off the floor and the pelvis ``JUMP_RISE`` x ``leg`` above its median."""
     j = np.asarray(joints, dtype=np.float64)
     up = (j[:, FEET, 1].min(axis=1) >= FLIGHT * leg) & (j[:, 0, 1] >= np.median(j[:, 0, 1]) + JUMP_RISE * leg)
-    return [(a, b) for a, b in _runs(up) if b - a >= FLIGHT_FRAMES]
+    return [(a, b) for a, b in runs(up) if b - a >= FLIGHT_FRAMES]
 
 
 def turns(x, swing: float) -> int:
@@ -130,9 +124,8 @@ def signatures(joints, fps: float = FPS) -> dict[str, bool]:
     out["lie down"] = bool(lies and head.max() >= UPRIGHT_HEAD * leg)
     out["get up"] = bool(pelvis[:n].mean() <= LOW_START * leg and pelvis[-n:].mean() - pelvis[:n].mean() >= RISE * leg)
     yaw = facing_yaw(j)
-    w = max(2, int(round(SPIN_SECONDS * fps)))
-    turned = np.abs(yaw[min(w, len(yaw) - 1):] - yaw[:max(1, len(yaw) - w)]) if len(yaw) > 1 else np.zeros(1)
-    out["spin"] = bool(max(float(turned.max()), float(abs(yaw[-1] - yaw[0])) if len(yaw) <= w else 0.0) >= SPIN)
+    w = min(max(2, int(round(SPIN_SECONDS * fps))), len(yaw) - 1)   # the turn over SPIN_SECONDS (or all of it)
+    out["spin"] = bool(w > 0 and np.abs(yaw[w:] - yaw[:-w]).max() >= SPIN)
     forward = np.stack([np.sin(yaw), np.cos(yaw)], axis=1)
     kick = False
     for a in (_J["left_ankle"], _J["right_ankle"]):
@@ -144,7 +137,7 @@ def signatures(joints, fps: float = FPS) -> dict[str, bool]:
               >= JACKS_SPREAD * leg).any()
     off = j[:, FEET, 1].min(axis=1) >= FLIGHT * leg
     speed = np.concatenate([[0.0], np.linalg.norm(np.diff(j[:, 0][:, [0, 2]], axis=0), axis=1) * fps])
-    hops = [(a, b) for a, b in _runs(off) if b - a >= FLIGHT_FRAMES and speed[a:b].mean() < IN_PLACE]
+    hops = [(a, b) for a, b in runs(off) if b - a >= FLIGHT_FRAMES and speed[a:b].mean() < IN_PLACE]
     out["jumping jacks"] = bool(len(hops) >= 2 and hands_up and spread)
     out["wave"] = waves(j)
     return out

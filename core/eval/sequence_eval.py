@@ -262,7 +262,8 @@ def _segment_figures(rows: list[dict], right: str = "right", lenient: str = "rig
 
 def tally(rows: list[dict]) -> dict:
     """The figures of judged prompts (``judge_prompt`` rows); ``segments_vote`` and ``order_vote``:
-    every signed action read by the raw-feature vote instead of its signature."""
+    every signed action read by the judge that reads it without its signature (a wave by the arms,
+    the rest by the raw-feature vote)."""
     whole = [all(r["right"]) for r in rows if r["right"] and None not in r["right"]]
 
     def order(key: str) -> dict:

@@ -271,7 +271,7 @@ class TakePool:
                 from_seat = True
         if cut_for(action, times):
             def posed(r, rt, c):
-                j = self.proc.pose_on(r, rt, t["betas"], 1.0, c)
+                j = pose(r, rt, c)
                 return j, self.proc.features(j, r, c)
 
             rot, root, con, exact = repeated_stretch(rot, root, con, posed, action, times, seed)
@@ -286,12 +286,12 @@ class TakePool:
         rot, root, con = (np.asarray(a[lo:lo + want]) for a in (rot, root, con))
         gait = straight and action in STRAIGHTENED
         if gait:
-            rot, root = straightened(rot, root, self.proc.pose_on(rot, root, t["betas"], 1.0, con))
+            rot, root = straightened(rot, root, pose(rot, root, con))
         held = looped = 0
         if len(rot) < want:   # a take that repeats plays on as a loop, another is held on its last pose
             again = None      # (a take cut to the repetitions asked is held: a loop would add more)
             if not exact:
-                posed_joints = self.proc.pose_on(rot, root, t["betas"], 1.0, con)
+                posed_joints = pose(rot, root, con)
                 if gait:   # on its last stride
                     again = looped_gait(rot, root, con, posed_joints, want)
                 else:
@@ -308,11 +308,11 @@ class TakePool:
                 looped = want - first
             held = want - len(rot)
             rot, root, con = hold(rot, root, con, want, stands=action != SIT)
-        joints = self.proc.pose_on(rot, root, t["betas"], 1.0, con)
+        joints = pose(rot, root, con)
         flip = side is not None and needs_mirror(joints, *side)
         if flip:
             rot, root, con = mirrored(rot, root, con)
-            joints = self.proc.pose_on(rot, root, t["betas"], 1.0, con)
+            joints = pose(rot, root, con)
         return Window(rot, root, con, t["rest"], self.proc.features(joints, rot, con), action, self.ids[i],
                       provenance + (", mirrored" if flip else ""), held, flip, looped,
                       max(0, n - want) if exact else 0, seated=from_seat)

@@ -32,7 +32,6 @@ SLOW_SPEED = 0.8    # a stepping gait asked slowly is played at this speed
 STANDING_SPEED = 0.25   # m/s: a candidate of a gait asked to go on slower than this stands about
 WANDER_SPEED = 0.5      # m/s: a candidate of an action done where one stands this fast walks off
 STAYING_GROUPS = ("exercise", "gesture")   # the vocabulary's groups of actions done where one stands
-STAYING_FLOOR = ("sit", "lie down", "get up")   # and the changes of posture, done where one is
 
 def path_length(features: np.ndarray) -> float:
     """Metres the root travels along its path over a (T, 263) feature clip (its horizontal
@@ -73,15 +72,16 @@ def going(words, speeds: np.ndarray, among: np.ndarray) -> np.ndarray:
 def staying(words, speeds: np.ndarray, among: np.ndarray) -> np.ndarray:
     """(N,) bool: where the words (``plan.words.Words``) ask only actions done where one stands (the
     vocabulary's ``STAYING_GROUPS``: an exercise, a gesture: arm circles, a side twist, a wave; and
-    ``STAYING_FLOOR``: sitting down, lying down, getting up) and no travel, the candidates ``among``
+    its ``POSTURE_CHANGES``: sitting down, lying down, getting up) and no travel, the candidates ``among``
     slower than ``WANDER_SPEED``; ``among`` itself otherwise, or when none is. "A woman twists her
     torso side to side" chose a sample that walked sideways 4.8 m (retrieved for "side to side"),
     "a man swings his arms in circles" a take walking 5 m, "an old man sits down slowly" a sample
     walking 2 m that never sat."""
     from ..data.actions import ACTIONS
+    from ..plan.vocabulary import POSTURE_CHANGES
 
     if not among.any() or not words.actions or words.travel.named or words.course is not None or \
-            not all(a in STAYING_FLOOR or a in ACTIONS and ACTIONS[a].group in STAYING_GROUPS for a in words.actions):
+            not all(a in POSTURE_CHANGES or a in ACTIONS and ACTIONS[a].group in STAYING_GROUPS for a in words.actions):
         return among
     keep = among & (np.asarray(speeds, dtype=np.float64) < WANDER_SPEED)
     return keep if keep.any() else among

@@ -79,6 +79,7 @@ class MotionMemory:
         self.texts, self.vectors = list(texts), vectors.float()
         self.text_clips = [list(c) for c in text_clips]
         self.clip_ids, self.clip_tokens = list(clip_ids), [np.asarray(t, dtype=np.int64) for t in clip_tokens]
+        self._clip_index = {c: i for i, c in enumerate(self.clip_ids)}   # clip id -> index (``main_action``)
         self.clip_family = clip_family or [frozenset([c]) for c in clip_ids]
         self._index = {t: i for i, t in enumerate(self.texts)}
         if clip_actions is None or len(clip_actions) != len(self.clip_ids):
@@ -130,6 +131,7 @@ class MotionMemory:
         for cid, caps, toks in zip(clip_ids, captions, clip_tokens):
             c = len(self.clip_ids)
             self.clip_ids.append(str(cid))
+            self._clip_index[str(cid)] = c
             self.clip_tokens.append(np.asarray(toks, dtype=np.int64))
             for t in dict.fromkeys(caps):
                 i = self._index.get(t)
@@ -157,8 +159,6 @@ class MotionMemory:
     def main_action(self, clip_id: str) -> str | None:
         """The main labelled action of the clip ``clip_id`` (its first, ``clip_actions``); None for a
         clip with no label or not in the memory."""
-        if getattr(self, "_clip_index", None) is None or len(self._clip_index) != len(self.clip_ids):
-            self._clip_index = {c: i for i, c in enumerate(self.clip_ids)}
         i = self._clip_index.get(clip_id)
         return self.clip_actions[i][0] if i is not None and self.clip_actions[i] else None
 
