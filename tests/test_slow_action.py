@@ -25,16 +25,19 @@ def test_a_sit_asked_slowly_takes_longer_to_reach_the_floor():
     length, the sit lasts 1 / SLOW_ACTION as long and the motion with it; at 4 s the sit takes up
     its held end, reaching the floor later and keeping the length."""
     from shapemove.core.generation.generate import Generator, Request
+    from shapemove.core.plan.words import read_words
 
     gen = Generator(None)
     m = gen.generate_batch([Request("an old man sits down", seconds=4, seed=0)])[0]
     down = lambda x: int(np.argmax(x.joints[:, 0, 1] < 0.35 * x.joints[0, 0, 1]))  # noqa: E731
     active = moving_frames(m.network_joints)
-    long = slowed(m, gen.body, None)
+    asked = read_words("an old man sits down slowly")
+    assert slowed(m, gen.body, read_words("an old man sits down"), False) is m   # not asked slowly
+    long = slowed(m, gen.body, asked, keep_length=False)
     assert long.num_frames == m.num_frames - active + round(active / SLOW_ACTION)
     assert down(long) == pytest.approx(down(m) / SLOW_ACTION, abs=3)
     assert np.abs(long.joints[-1] - m.joints[-1]).max() < 0.03             # it ends as it did, seated
-    kept = slowed(m, gen.body, m.num_frames)
+    kept = slowed(m, gen.body, asked, keep_length=True)
     assert kept.num_frames == m.num_frames and down(m) < down(kept) <= down(long) + 1
     assert "played slowly" in kept.notes[-1] and kept.provenance == m.provenance
     slow = gen.generate_batch([Request("an old man sits down slowly", seed=0)])[0]   # through the generator

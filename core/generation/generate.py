@@ -584,9 +584,7 @@ class Generator:
                 legs = read_words(words.parts.legs_prompt)          # "walks slowly, waving": both parts slower
                 motion = typical_paced(motion, self.body, legs, self.typical_speeds, self.ik_refine_iters, course=False)
                 motion = slow_motion(motion, self.body, words, self.ik_refine_iters)   # (slow_steps.py)
-                if words.slowly:   # "sits down slowly, waving": the seated wave too (slow_action.py)
-                    motion = slowed(motion, self.body, None if r.seconds is None else motion.num_frames,
-                                    self.ik_refine_iters)
+                motion = slowed(motion, self.body, words, r.seconds is not None, self.ik_refine_iters)   # slow_action.py
             course = self.asks_course(words, check, edited) if words is not None else None   # course_walk.py
             if motion is None:  # one action, no side named: the motion as the model writes it
                 sampled = asked if course is None else dataclasses.replace(asked, prompt=read_words(asked.prompt).straight_text)
@@ -610,9 +608,7 @@ class Generator:
                     # turning) a course or a turn the words name given back on the paced track
                     motion = typical_paced(motion, self.body, words, self.typical_speeds, self.ik_refine_iters)
                     motion = slow_motion(motion, self.body, words, self.ik_refine_iters)      # slow_steps.py
-                    if words.slowly:   # an action that is no gait, asked slowly (slow_action.py)
-                        motion = slowed(motion, self.body, None if r.seconds is None else motion.num_frames,
-                                        self.ik_refine_iters)
+                    motion = slowed(motion, self.body, words, r.seconds is not None, self.ik_refine_iters)   # slow_action.py
                     motion = (course_motion(motion, self.body, course, words.course_right, self.ik_refine_iters, r.whole_course)
                               if course is not None else                                          # course_walk.py
                               turn_motion(motion, self.body, turn, self.ik_refine_iters))         # turn_words.py

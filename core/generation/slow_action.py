@@ -12,7 +12,7 @@ and planted again (``track.replanted``):
   ``1 / SLOW_ACTION`` (a 1.1 s sit held 2.9 s in 4 s is played over 1.6 s); a motion that moves to
   its last frame keeps its speed (slowed, its end would be cut).
 
-    motion = slowed(motion, body, frames=None)      # the model's length: longer
+    motion = slowed(motion, body, read_words("an old man sits down slowly"), keep_length=False)   # longer
 """
 from __future__ import annotations
 
@@ -32,17 +32,21 @@ def moving_frames(joints) -> int:
     return max(2, int(moving[-1]) + 2) if len(moving) else 2
 
 
-def slowed(motion, body, frames: int | None, ik_refine_iters: int = 10):
-    """``motion`` played at ``SLOW_ACTION`` of its speed (module doc); ``frames``: the length asked
-    (None: the model's, which grows). The motion itself when nothing would change."""
+def slowed(motion, body, words, keep_length: bool, ik_refine_iters: int = 10):
+    """``motion`` played at ``SLOW_ACTION`` of its speed when the plan's ``words``
+    (``plan.words.Words``) ask its action slowly (module doc); ``keep_length``: a length was asked,
+    which it keeps (else the model's, which grows). The motion itself otherwise, or when nothing would
+    change."""
+    if not words.slowly:
+        return motion
     track = track_of(motion)
     n = len(track)
     active = moving_frames(track.joints)
     longer = int(round(active / SLOW_ACTION))
-    if frames is None:
-        total = n - active + longer           # the still end kept after it
-    else:
+    if keep_length:
         total, longer = n, min(longer, n)     # the still end taken up
+    else:
+        total = n - active + longer           # the still end kept after it
     if longer <= active:
         return motion
     moved = resample(Track(track.joints[:active], track.contacts[:active]), longer)
