@@ -69,8 +69,17 @@ def test_vocabulary():
     ("she picks the heavy box up", ["pick up"]),
     ("running flat out, she lifts one hand high", ["run", "raise hand"]),
     ("she paces the room", []),                       # a course (back and forth), not an action
-    ("a dancer circling his arms", ["dance", "arm circles"]),   # no circle walk (vocabulary.ARM_CIRCLES)
+    ("a dancer circling his arms", ["arm circles"]),   # no circle walk (vocabulary.ARM_CIRCLES); a dancer does it
     ("a woman circles her arms backwards", ["arm circles"]),
+    # a person named by what they do names it only when nothing else is named
+    ("a dancer performs on stage", ["dance"]),
+    ("the dancer bows to the crowd", ["bow"]),
+    ("a climber waves from the top", ["wave"]),
+    ("a man in sneakers walks", ["walk"]), ("a creepy figure waves", ["wave"]),
+    # past tenses
+    ("she waved", ["wave"]), ("he threw the ball", ["throw"]), ("she stood up", ["get up"]),
+    ("he got up", ["get up"]), ("the soldier marched", ["march"]), ("they danced", ["dance"]),
+    ("she stretched", ["stretch"]), ("he spun around", ["spin"]),
 ])
 def test_find_actions(text, expected):
     assert find_actions(text) == expected

@@ -76,6 +76,15 @@ from shapemove.core.plan.segments import SEGMENT_SECONDS, split_segments
     # a turn after a gait that counts its steps or a distance comes after them
     ("the man walks 10 steps and turns left", ["the man walks 10 steps", "the man turns left"]),
     ("a man walks 3 metres and turns around", ["a man walks 3 metres", "a man turns around"]),
+    # "once" opening a clause and "having" with its comma come first; a past tense names its action
+    ("once she has waved, she runs off", ["she has waved", "she runs off"]),
+    ("having bowed, the actor walks away", ["the actor bowed", "the actor walks away"]),
+    ("having finished his run, the man waves", ["the man finished his run", "the man waves"]),
+    ("the woman bows and, after that, walks off", ["the woman bows", "the woman walks off"]),
+    # a person of any noun the body words know, or a role, is the subject of every segment
+    ("the boxer punches, then kicks and then bows", ["the boxer punches", "the boxer kicks", "the boxer bows"]),
+    ("a grandmother sits down slowly, then lies down", ["a grandmother sits down slowly", "a grandmother lies down"]),
+    ("a dancer spins around, then bows", ["a dancer spins around", "a dancer bows"]),
 ])
 def test_ordering_words_make_segments_in_the_order_they_happen(prompt, segments):
     assert split_segments(prompt) == segments
@@ -91,6 +100,7 @@ def test_ordering_words_make_segments_in_the_order_they_happen(prompt, segments)
     "a person walks forward and then stops.", "she jogs, then comes to a stop", "a man walks 4 steps then halts",
     "a woman walks forward waving, then stops", "he runs, then he stops", "a person walks, then he",
     "a person walks then 123", "Leap up and rotate a full 360 before landing.",
+    "having a good time, she dances", "once upon a time a man walked", "a man waves once while walking",
     "Sink down by bending both knees, then straighten.", "Turn sideways head over heels, hands then feet.",
     "Favoring one leg after twisting an ankle.", "Someone stretching their arms overhead after waking up",
     "the man later waves", "after the rain, he jogs", "a man walks to the end of the room",

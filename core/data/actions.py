@@ -152,7 +152,7 @@ _LIST = [
     _a("run", "locomotion", ["runs", "runs forward"], [r"\brun(s|ning)?\b", r"\bran\b"]),
     _a("jog", "locomotion", ["jogs", "jogs forward", "goes for a jog"], [r"\bjog(s|ging|ged)?\b"]),
     _a("sprint", "locomotion", ["sprints", "dashes forward at full speed"], [r"\bsprint", r"\bdash(es|ing)?\b"]),
-    _a("march", "locomotion", ["marches", "marches forward"], [r"\bmarch(es|ing)?\b"]),
+    _a("march", "locomotion", ["marches", "marches forward"], [r"\bmarch(es|ing|ed)?\b"]),
     _a("limp", "locomotion", ["limps", "walks with a limp"], [r"\blimp", r"\bhurt ?leg", r"\bbad ?leg"]),
     _a("sneak", "locomotion", ["sneaks forward", "walks stealthily", "creeps forward"],
        [r"\bsneak", r"\bstealth", r"\bcreep"]),
@@ -173,7 +173,7 @@ _LIST = [
     _a("cartwheel", "acrobatics", ["does a cartwheel", "turns a cartwheel"], [r"\bcartwheel", r"\bturn\w* a cartwheel"]),
     _a("roll", "floor", ["rolls on the ground", "does a forward roll"], [r"\broll(s|ing|ed)?\b(?! de)"]),
     _a("get up", "floor", ["gets up from the ground", "stands up from the floor"],
-       [r"\bget(s|ting)? up\b", r"\bstand(s|ing)? up\b", r"\bgetup\b"]),
+       [r"\b(get(s|ting)?|got) up\b", r"\b(stand(s|ing)?|stood) up\b", r"\bgetup\b"]),
     _a("lie down", "floor", ["lies down on the floor", "lies down"],
        [r"\blie(s)? down", r"\blying down", r"\blays? down"]),
     _a("sit", "floor", ["sits down", "sits"], [r"\bsit(s|ting)?\b(?![- ]?ups?\b)", r"\bsat\b"]),
@@ -189,7 +189,7 @@ _LIST = [
        [r"\bput\w* (\w+ ){0,3}down\b", r"\bdeposit"]),   # "puts a box down"
     _a("reach up", "exercise", ["reaches up high", "reaches up and grabs something"],
        [r"\breach(es|ing)? (up|for|high)", r"\bgrab"]),
-    _a("stretch", "exercise", ["stretches", "does stretches"], [r"\bstretch(es|ing)?\b"]),
+    _a("stretch", "exercise", ["stretches", "does stretches"], [r"\bstretch(es|ing|ed)?\b"]),
     _a("side twist", "exercise", ["does side twists", "twists the upper body from side to side"],
        [r"\bside twists?\b", r"\btwist"]),
     _a("elbow to knee", "exercise", ["touches each elbow to the opposite knee"],
@@ -198,7 +198,7 @@ _LIST = [
        [r"\brotat\w* (both )?arms", r"\barm circles", r"\bcircl\w* (both |the |his |her |their |your )?arms", r"\bcircles with the arms"]),
     _a("balance", "exercise", ["balances on one leg"], [r"\bbalanc"]),
     # gestures
-    _a("wave", "gesture", ["waves", "waves a hand"], [r"\bwav(e|es|ing)\b"]),
+    _a("wave", "gesture", ["waves", "waves a hand"], [r"\bwav(e|es|ed|ing)\b"]),
     _a("wave goodbye", "gesture", ["waves goodbye"], [r"\bwav\w* (good)?-?bye", r"\bbye ?bye\b", r"\bbye\b"]),
     _a("raise hand", "gesture", ["raises a hand", "raises a hand up"],
        [r"\brais\w* (\w+ ){0,2}(hand|hands|arm|arms)\b", r"\blift\w* (\w+ )?arms?\b", r"\bhands? (up|in the air)",
@@ -216,15 +216,15 @@ _LIST = [
     _a("slash", "combat", ["slashes with a sword", "swings a sword"], [r"\bslash", r"\bsword", r"\bswing\w* (a |the )?sword"]),
     # sport
     _a("kick ball", "sport", ["kicks a ball"], [r"\bkick\w* (a |the )?(soccer )?ball", r"\bsoccer"]),
-    _a("throw", "sport", ["throws a ball"], [r"\bthrow\w* (a |the )?(\w+ )?ball", r"\bthrowbasketball"]),
+    _a("throw", "sport", ["throws a ball"], [r"\b(throw\w*|threw) (a |the )?(\w+ )?ball", r"\bthrowbasketball"]),
     _a("dribble", "sport", ["dribbles a basketball"], [r"\bdribbl"]),
     _a("shoot", "sport", ["shoots a basketball"], [r"\bshoot(s|ing)?\b"]),
     # dance
     _a("dance", "dance", ["dances", "does a dance"],
-       [r"\bdanc(e|es|ing|er)\b", r"\bsalsa", r"\blambada", r"\blindy ?hop"]),
+       [r"\bdanc(e|es|ed|ing|er)\b", r"\bsalsa", r"\blambada", r"\blindy ?hop"]),
     _a("ballet", "dance", ["does ballet moves", "dances ballet"],
        [r"\bballet", r"\barabesque", r"\bjetes?\b", r"\bglissade", r"\bplie\b", r"\bpirouettes?\b"]),
-    _a("spin", "dance", ["spins around", "turns on the spot"], [r"\bspin(s|ning)?\b", r"\bwhirl", r"\bpirouettes?\b", r"\bturns? on the spot"]),
+    _a("spin", "dance", ["spins around", "turns on the spot"], [r"\bspin(s|ning)?\b", r"\bspun\b", r"\bwhirl", r"\bpirouettes?\b", r"\bturns? on the spot"]),
     _a("pose", "dance", ["holds a pose", "strikes a pose"], [r"\bposes?\b", r"\byoga"]),
     _a("wash", "gesture", ["washes", "takes a shower"], [r"\bwash", r"\bshower"]),
 ]
@@ -261,9 +261,24 @@ def specific(acts: list[str]) -> list[str]:
     return [a for a in acts if a not in drop]
 
 
+# words an action's pattern finds that name a person by what they do: the action only when the text
+# names no other ("a dancer performs": dance; "a dancer spins": a spin)
+DOER_WORDS = frozenset({"dancer", "dancers", "climber", "climbers", "sprinter", "sprinters", "crawler", "crawlers"})
+# words an action's pattern finds that name no action ("a man in sneakers walks", "a creepy figure waves")
+NOT_ACTION_WORDS = frozenset({"sneaker", "sneakers", "creepy", "creepily"})
+
+
+def _word_at(text: str, i: int) -> str:
+    """The whole word of ``text`` holding position ``i``."""
+    before = re.search(r"[a-z'-]*$", text[:i]).group(0)
+    return before + re.match(r"[a-z'-]*", text[i:]).group(0)
+
+
 def action_spans(text: str) -> list[tuple[int, int, str]]:
     """(start, end, action) of every action named in ``split_words(text)``, in order of appearance;
-    where two patterns overlap, the longer match wins ("jumping jacks" over "jump")."""
+    where two patterns overlap, the longer match wins ("jumping jacks" over "jump"). A match in a
+    word of ``NOT_ACTION_WORDS`` names nothing, one in a word of ``DOER_WORDS`` only when nothing
+    else is named."""
     text = split_words(text)
     hits = []  # (start, -length, name, end)
     for name, rx in _COMPILED:
@@ -273,7 +288,9 @@ def action_spans(text: str) -> list[tuple[int, int, str]]:
     for start, neg, name, end in sorted(hits, key=lambda h: (h[1], h[0])):  # longest first
         if not any(start < e and end > s for s, e, _ in taken):
             taken.append((start, end, name))
-    return sorted(taken)
+    taken = [sp for sp in taken if _word_at(text, sp[0]) not in NOT_ACTION_WORDS]
+    doing = [sp for sp in taken if _word_at(text, sp[0]) not in DOER_WORDS]
+    return sorted(doing or taken)
 
 
 def find_actions(text: str) -> list[str]:

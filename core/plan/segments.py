@@ -9,7 +9,8 @@ that", "afterwards", "after which", "next", "finally", "(a minute) later", "even
 "subsequently", "followed by", "finishes / ends with", "follows it with", "first ... then", and
 "before" / "after" in front of a clause ("after waving, she jogs", "she jogs after waving", "before
 sitting down he waves": the wave first; at the start also in front of a noun and its comma, or a
-noun and the main clause's subject: "after a bow, ...", "after a long walk she sits down"). Where
+noun and the main clause's subject: "after a bow, ...", "after a long walk she sits down"; "once"
+in front of a clause and "having" with its comma are an "after": "once she has waved, she runs off"). Where
 an order word cuts, the commas of a list of steps before it cut too ("walks ahead, spins around,
 then waves": three; ``vocabulary.LIST_STEP``), but not before a participle ("jogs, waving": two
 things at once) nor before a turn (the turn ends its gait). A way alone after an order word goes
@@ -48,6 +49,7 @@ MIN_SEGMENT_SECONDS = 0.4   # the shortest segment a timeline takes (``generatio
 
 def _tidy(piece: str) -> str:
     piece = re.sub(r"\s+", " ", piece).strip(" ,;.:!")
+    piece = re.sub(r"\s*,?\s*\band$", "", piece)   # "bows and, after that, walks off"
     return re.sub(r"^(?:and|then|so)\b\s*", "", piece).strip(" ,;.")
 
 
@@ -75,7 +77,7 @@ def _ordered(piece: str) -> list[str]:
         cut = comma if comma >= 0 else _main_clause_start(rest)
         if cut is not None and _both_act(rest[:cut], rest[cut:]):
             sub, main = rest[:cut], rest[cut:]
-            pair = [sub, main] if lead.group(1) == "after" else [main, sub]
+            pair = [main, sub] if lead.group(1) == "before" else [sub, main]   # "after", "once"
             return [p for part in pair for p in _ordered(_tidy(part))]
     mid = MIDDLE.search(piece)
     if mid and mid.start() > 0 and _both_act(piece[:mid.start()], piece[mid.end():]):

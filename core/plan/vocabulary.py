@@ -14,6 +14,8 @@ from __future__ import annotations
 import re
 from typing import NamedTuple
 
+from ..text.shape_words import CHILD_WORDS, FEMALE_WORDS, MALE_WORDS
+
 # -- numbers ------------------------------------------------------------------------------------
 NUMBERS = {"a": 1, "one": 1, "a single": 1, "two": 2, "a couple of": 2, "a couple": 2, "three": 3, "a few": 3,
            "four": 4, "five": 5, "six": 6, "seven": 7, "eight": 8, "nine": 9, "ten": 10}   # "three steps" too
@@ -169,9 +171,17 @@ ARMS_HELD = re.compile(r"\b(?:with|keeps?|keeping|holds?|holding)\s+(?:[\w-]+\s+
 # "and" joins two clauses, not the pairs "back and forth", "to and fro", "up and down", "round and round"
 CONNECTOR = re.compile(r",|;|\b(?:while|whilst|as|and(?!\s+(?:forth|fro|forwards|down|round)\b)|with|at the same time|"
                        r"all the while|meanwhile|simultaneously)\b")
+# who does it: a pronoun, or a noun of a person (the body words' nouns of either sex and of an age,
+# and the roles prompts name) after up to three words ("a short, heavy grandmother")
+_OBJECT_PRONOUNS = frozenset({"him", "his", "himself", "her", "hers", "herself"})
+PERSON_NOUNS = tuple(dict.fromkeys(
+    [w for w in MALE_WORDS + FEMALE_WORDS if w not in _OBJECT_PRONOUNS] + list(CHILD_WORDS) +
+    ["person", "someone", "somebody", "they", "people", "teenager", "teen", "adolescent", "pensioner", "soldier",
+     "dancer", "athlete", "figure", "character", "actor", "actress", "player", "runner", "walker", "human", "boxer",
+     "fighter", "coach", "student", "teacher", "jogger", "hiker", "gymnast", "skater", "climber", "swimmer",
+     "worker", "performer", "robot", "zombie", "ninja", "toddler", "i", "you", "we"]))
 SUBJECT = re.compile(r"^(?:(?:a|an|the|this|that|one|some|my|our|his|her|their|your)\s+(?:[\w-]+,?\s+){0,3}?)?"
-                     r"(?:person|man|woman|boy|girl|guy|lady|kid|child|someone|somebody|he|she|they|people|"
-                     r"soldier|dancer|athlete|figure|character|actor|player|runner|walker|human|i|you|we)\b")
+                     r"(?:" + "|".join(sorted(PERSON_NOUNS, key=len, reverse=True)) + r")\b")
 HAND_WORDS = r"hand|hands|arm|arms|fist|fists|palm|elbow|shoulder|wrist|finger|fingers"
 FOOT_WORDS = r"foot|feet|leg|legs|knee|knees|heel|toe|toes|shin|ankle|thigh"
 SIDE = re.compile(r"\b(left|right)\b(?:(?:-|\s+)(?:(?:hand(?:ed)?|arm(?:ed)?|foot(?:ed)?|leg(?:ged)?)\b|"
@@ -180,7 +190,8 @@ DIRECTION = re.compile(r"\b(?:to|towards?|on) (?:the|his|her|their|your|its) (?:
                        r"\b(?:turn|turns|turning|turned|veer|veers|steer|steers|bear|bears|head|heads|go|goes|"
                        r"walk|walks|step|steps|move|moves|look|looks|curve|curves|spin|spins|rotate|rotates)"
                        r"\s+(?:to\s+)?(?:left|right)\b")
-ORDER_WORDS = re.compile(r"\b(then|after|afterwards|before|followed by|next|finally|later)\b")   # no two at once
+ORDER_WORDS = re.compile(r"\b(then|after|afterwards|before|followed by|next|finally|later)\b|"
+                         r"^\s*once\s+(?:he|she|they|someone|somebody|i|we|you)\b|^\s*having\s+[^,]{2,40},")   # no two at once
 
 # -- order: segments ----------------------------------------------------------------------------
 # words that put what follows after what precedes ("then"): a cut with that order
@@ -196,9 +207,11 @@ _CLAUSE_AHEAD = r"(?=[a-z'-]+ing\b|(?:he|she|they|someone|somebody|i|we|you)\b)"
 BEFORE_AFTER = re.compile(r"\s*,?\s*\b(before|after)\s+" + _CLAUSE_AHEAD)
 # ... and at the start, before a noun phrase and its comma, or a noun phrase and the main clause's subject
 # ("after a bow, the actor walks away", "after a long walk she sits down")
-LEADING_BEFORE_AFTER = re.compile(r"^\s*(before|after)\s+(?:" + _CLAUSE_AHEAD + r"|(?=(?:a|an|the|his|her|their)\s[^,]{1,30},)|"
+# ("once" opening a clause, and "having" with its comma, are an "after": "once she has waved, she runs off",
+# "having bowed, the actor walks away")
+LEADING_BEFORE_AFTER = re.compile(r"^\s*(?:(before|after)\s+(?:" + _CLAUSE_AHEAD + r"|(?=(?:a|an|the|his|her|their)\s[^,]{1,30},)|"
                                   r"(?=(?:a|an|the|his|her|their)\s(?:[a-z'-]+\s){1,3}(?:he|she|they|someone|somebody|"
-                                  r"(?:a|an|the)\s)))")
+                                  r"(?:a|an|the)\s)))|(once)\s+(?=(?:he|she|they|someone|somebody|i|we|you)\b)|(having)\s+(?=[^,]{2,40},))")
 # a way to go alone after an order word: the gait before it goes on that way ("runs to the left, then to the
 # right" -> "runs to the right")
 WAY_ALONE = re.compile(r"^(?:(?:back\s+)?to\s+(?:the|his|her|their|its)\s+(?:left|right)|(?:back|for)wards?|ahead|sideways|"
