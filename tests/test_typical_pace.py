@@ -90,6 +90,36 @@ def test_a_slow_captured_take_does_not_compete_for_a_plain_gait():
     assert not slow_take(take(1.0, rest), plain, {}, body)
 
 
+def test_a_jog_take_at_a_runs_pace_does_not_compete_for_a_plain_jog():
+    """DeepMimic's jog goes at 2.8 m/s: for "a man jogs" a take faster than halfway from the jog's
+    typical speed to the run's (on its performer's leg) is left out; one at a jog's pace, a walk or a
+    jog asked fast is not."""
+    from shapemove.core.body.load import load_body_model
+    from shapemove.core.constants import FPS
+    from shapemove.core.generation.captured_takes import Window
+    from shapemove.core.generation.typical_pace import fast_take
+    from shapemove.core.plan.words import read_words
+
+    body = load_body_model(None)
+    rest = body.rest_joints(__import__("torch").zeros(1, body.num_betas))[0, :24].numpy()
+
+    def take(speed, performer):
+        feats = np.zeros((59, 263), np.float32)
+        feats[:, 1] = speed / FPS
+        return Window(rotations=np.zeros((60, 24, 3, 3)), root=np.zeros((60, 3)), contacts=np.zeros((60, 4)),
+                      rest=performer, features=feats, action="jog", clip_id="x", provenance="captured")
+
+    speeds = {"walk": 1.2, "jog": 1.6, "run": 2.8}          # halfway from the jog to the run: 2.2 m/s
+    jogs = read_words("a man jogs")
+    assert fast_take(take(2.8, rest), jogs, speeds, body)
+    assert fast_take(take(2.25, rest), jogs, speeds, body) and not fast_take(take(2.15, rest), jogs, speeds, body)
+    assert not fast_take(take(2.5, rest * 1.2), jogs, speeds, body)     # 2.5 m/s on a 1.2x leg: 2.08 on the average's
+    assert not fast_take(take(1.6, rest), jogs, speeds, body)
+    assert not fast_take(take(2.8, rest), read_words("a man jogs quickly"), speeds, body)
+    assert not fast_take(take(2.8, rest), read_words("a man walks"), speeds, body)   # no gait after the walk's
+    assert not fast_take(take(2.8, rest), jogs, {"jog": 1.6}, body)
+
+
 def test_a_take_that_stops_or_circles_is_no_plain_gait():
     """For "a person jogs", a take that stops (1.9 s of jogging held on its last pose for the rest
     of 4 s) or runs around a circle does not compete; one that goes straight does, and a course

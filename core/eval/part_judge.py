@@ -9,10 +9,12 @@ HumanML3D features, 20 fps) and the nearest real clips, so the generator's TMA, 
 its samples (``generation/rerank.py``), cannot flatter it (as ``action_classifier.FeatureEmbedder``).
 
 - **legs** (legs and root only): root velocity in the body's own frame (forward, sideways, up
-  and down) and its direction, turning rate, pelvis height, the hips, knees, ankles and feet relative to
+  and down) and its direction, pelvis height, the hips, knees, ankles and feet relative to
   the pelvis in the body's frame (mean and spread over time), foot speeds, the share of frames with
   both feet off the floor and the stride frequency; every length in leg lengths, so bodies of any
-  size compare. Classes: the gaits of ``compose_parts.LEGS_ACTIONS`` ("walk in a circle" is a
+  size compare. Nothing of the path: a gait reads the same circling or straight (the captured jogs
+  at a jog's pace are HDM05's, all circling left; by their turning, as a straightened take plays for
+  "jogs forward", they read as walks or runs). Classes: the gaits of ``compose_parts.LEGS_ACTIONS`` ("walk in a circle" is a
   walk: its gait) and ``STAND`` (the real standing gesture clips). ``path`` is read apart from the
   gait: ``CIRCLE`` when the body keeps turning one way while it moves (each quarter of the clip
   turns >= ``CIRCLE_DEG_PER_S`` the same way), else "straight".
@@ -138,7 +140,6 @@ def legs_descriptor(joints) -> dict[str, np.ndarray]:
     local = body_frame(j, theta) / L
     step = np.einsum("tij,tj->ti", yaw_matrix(-theta[:-1]), j[1:, 0] - j[:-1, 0]) * FPS / L   # root velocity, body frame
     hspeed = np.linalg.norm(step[:, [0, 2]], axis=-1)
-    omega = np.diff(theta) * FPS
     legs = local[:, LEG_JOINTS] - local[:, :1] * np.array([0, 1, 0])                       # relative to the pelvis
     feet_speed = np.linalg.norm(np.diff(legs[:, 4:], axis=0), axis=-1).mean(0) * FPS          # ankles, feet
     feet_h = j[:, [7, 8, 10, 11], 1] / L
@@ -148,7 +149,6 @@ def legs_descriptor(joints) -> dict[str, np.ndarray]:
     return {
         "root": np.array([step[:, 2].mean(), step[:, 0].mean(), hspeed.mean(), hspeed.std(), step[:, 1].std()]),
         "direction": np.array([step[:, 2].mean(), step[:, 0].mean()]) / (np.hypot(step[:, 2].mean(), step[:, 0].mean()) + 0.3),
-        "turn": np.array([abs(omega.mean()), np.abs(omega).mean()]),
         "height": np.array([local[:, 0, 1].mean(), local[:, 0, 1].std()]),
         "pose": legs.mean(0).ravel(),
         "spread": legs.std(0).ravel(),

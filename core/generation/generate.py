@@ -59,7 +59,7 @@ from .slow_steps import slow_motion
 from .still_take import still_take
 from .travel_words import backward_taken, backward_verb
 from .hands_asked import hands_wanted
-from .typical_pace import leg_ratio, load_typical_speeds, slow_take, typical_paced, unplain_take
+from .typical_pace import fast_take, leg_ratio, load_typical_speeds, slow_take, typical_paced, unplain_take
 from .straight_gait import straight_asked
 from .turn_words import turn_motion
 
@@ -262,6 +262,7 @@ class Generator:
             windows = [w for w in (self._windows(r, asked, lo, hi, side, times) if captured else [])   # of the asked action,
                        if action_credit(asked, w.action) is not None                    # at a plain gait's pace
                        and not slow_take(w, words, self.typical_speeds, self.body)
+                       and not fast_take(w, words, self.typical_speeds, self.body)
                        and not unplain_take(w, words)
                        and not still_take(w, asked, words)]
             windows = performed(windows, asked, times)   # arm circles that stop half way: not when others go on
