@@ -92,8 +92,8 @@ def test_a_slow_captured_take_does_not_compete_for_a_plain_gait():
 
 def test_a_jog_take_at_a_runs_pace_does_not_compete_for_a_plain_jog():
     """DeepMimic's jog goes at 2.8 m/s: for "a man jogs" a take faster than halfway from the jog's
-    typical speed to the run's (on its performer's leg) is left out; one at a jog's pace, a walk or a
-    jog asked fast is not."""
+    typical speed to the run's (on its performer's leg) is left out, and for "a man jogs slowly"; one
+    at a jog's pace, a walk or a jog asked fast is not."""
     from shapemove.core.body.load import load_body_model
     from shapemove.core.constants import FPS
     from shapemove.core.generation.captured_takes import Window
@@ -116,6 +116,7 @@ def test_a_jog_take_at_a_runs_pace_does_not_compete_for_a_plain_jog():
     assert not fast_take(take(2.5, rest * 1.2), jogs, speeds, body)     # 2.5 m/s on a 1.2x leg: 2.08 on the average's
     assert not fast_take(take(1.6, rest), jogs, speeds, body)
     assert not fast_take(take(2.8, rest), read_words("a man jogs quickly"), speeds, body)
+    assert fast_take(take(2.8, rest), read_words("a man jogs slowly"), speeds, body)   # slowed from a jog's pace
     assert not fast_take(take(2.8, rest), read_words("a man walks"), speeds, body)   # no gait after the walk's
     assert not fast_take(take(2.8, rest), jogs, {"jog": 1.6}, body)
 

@@ -15,8 +15,8 @@ followed 0.75 m off, a walk at 2x sliding 0.77 mm a frame), so a slow chosen wal
 Instead a captured take slower than ``SLOW_TAKE`` of the typical speed (on its performer's body)
 does not compete for a plain gait (``slow_take``): the data's walks include strolls, which the TMA
 chose for "a man walks" as readily as plain walks (median 0.93x typical with them, 0.97x without).
-A take of a jog faster than halfway to the run's typical speed does not compete either (``fast_take``):
-it runs.
+A take of a jog faster than halfway to the run's typical speed does not compete either, for a plain
+jog or one asked slowly (``fast_take``): it runs.
 Nor does a take that stops or circles (``unplain_take``: held on its last pose for more than
 ``MOST_HELD`` of the window, or its root's path not ``straight``, the typical speeds' own test of a
 straight capture): a 1.9 s jog around a bend, then standing, was "a person jogs" at 0.48x.
@@ -240,8 +240,10 @@ def fast_take(window, words, speeds: dict, body) -> bool:
     from its typical speed to the next gait's, on the performer's body: the next gait's pace
     (DeepMimic's jog, 2.8 m/s with both feet off the floor 36 % of the time, against the data's jogs
     at 1.3-2.0 m/s and 8 %; brought down by shorter strides it still ran). Like a slow take, it does
-    not compete; False when the words ask more than a plain gait or the table lacks the gaits."""
-    gait = plain_gait(words)
+    not compete, for the plain gait or the gait asked slowly (slowed from a run's pace, "jogs slowly,
+    waving" went as fast as "jogs along, waving"); False when the words ask more than that or the
+    table lacks the gaits."""
+    gait = plain_gait(words, slow=True)
     if gait not in FAST_UP_TO or gait not in speeds or FAST_UP_TO[gait] not in speeds:
         return False
     speed = gait_speed(np.asarray(window.features)[: max(1, len(window.features) - window.held)])
