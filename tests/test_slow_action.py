@@ -4,7 +4,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from shapemove.core.generation.slow_action import SLOW_ACTION, STILL, moving_frames, slowed
+from shapemove.core.generation.slow_action import MIN_GAIN, SLOW_ACTION, STILL, moving_frames, slowed
 
 pytestmark = pytest.mark.usefixtures("one_thread")
 
@@ -40,6 +40,11 @@ def test_a_sit_asked_slowly_takes_longer_to_reach_the_floor():
     kept = slowed(m, gen.body, asked, keep_length=True)
     assert kept.num_frames == m.num_frames and down(m) < down(kept) <= down(long) + 1
     assert "played slowly" in kept.notes[-1] and kept.provenance == m.provenance
+    short = gen.generate_batch([Request("an old man sits down", seconds=1.5, seed=0)])[0]   # the sit fills 1.5 s
+    assert moving_frames(short.network_joints) * MIN_GAIN > short.num_frames
+    same = slowed(short, gen.body, asked, keep_length=True)
+    assert same is short and same.notes[-1] == (f"not played slowly: the action fills the {short.num_frames / 20:.1f} s "
+                                                "asked (a longer length leaves it room)")
     slow = gen.generate_batch([Request("an old man sits down slowly", seed=0)])[0]   # through the generator
     assert "played slowly" in " ".join(slow.notes)
     seated = gen.generate_batch([Request("a man sits down slowly while waving", seed=0)])[0]   # by part too

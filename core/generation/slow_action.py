@@ -10,7 +10,8 @@ and planted again (``track.replanted``):
   motion with it (a 3.7 s sit becomes 5.5 s), the still end kept;
 - a length asked: the motion keeps it, the moving part taking up its still end, as far as
   ``1 / SLOW_ACTION`` (a 1.1 s sit held 2.9 s in 4 s is played over 1.6 s); a motion that moves to
-  its last frame keeps its speed (slowed, its end would be cut).
+  its last frame, or holds still too briefly to be played ``MIN_GAIN`` longer, keeps its speed
+  (slowed, its end would be cut), and says so.
 
     motion = slowed(motion, body, read_words("an old man sits down slowly"), keep_length=False)   # longer
 """
@@ -21,6 +22,7 @@ import numpy as np
 from .track import Track, replanted, resample, track_of
 
 SLOW_ACTION = 0.67   # of its speed: an action asked slowly
+MIN_GAIN = 1.05      # a moving part made less than this much longer is left as it is (said when a length is asked)
 STILL = 1e-3         # m: a frame whose joints all move less than this from the one before holds still
 
 
@@ -47,7 +49,10 @@ def slowed(motion, body, words, keep_length: bool, ik_refine_iters: int = 10):
         total, longer = n, min(longer, n)     # the still end taken up
     else:
         total = n - active + longer           # the still end kept after it
-    if longer <= active:
+    if longer < MIN_GAIN * active:   # a length asked that the action fills: nothing to take up
+        if keep_length:
+            motion.notes = list(motion.notes) + [f"not played slowly: the action fills the {n / motion.fps:.1f} s "
+                                                 "asked (a longer length leaves it room)"]
         return motion
     moved = resample(Track(track.joints[:active], track.contacts[:active]), longer)
     still = total - longer
@@ -55,6 +60,6 @@ def slowed(motion, body, words, keep_length: bool, ik_refine_iters: int = 10):
     contacts = np.concatenate([moved.contacts, np.repeat(track.contacts[-1:], still, 0)])
     out = replanted(motion, body, Track(joints, contacts), ik_refine_iters, measured=bool(motion.contacts_measured))
     out.provenance = motion.provenance
-    out.notes = list(motion.notes) + [f"played slowly: the action over {longer / motion.fps:.1f} s "
-                                      f"instead of {active / motion.fps:.1f} s"]
+    out.notes = list(motion.notes) + [f"played slowly: the action over {longer / motion.fps:.2f} s "
+                                      f"instead of {active / motion.fps:.2f} s"]
     return out
