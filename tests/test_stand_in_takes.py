@@ -5,18 +5,41 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from shapemove.core.generation.stand_in_takes import STAND_IN, stand_in
+from shapemove.core.generation.stand_in_takes import STAND_IN, bend_span, stand_in
 
 pytestmark = pytest.mark.usefixtures("one_thread")
 
 
+def put_down_joints(foot_moves_low: bool = False) -> np.ndarray:
+    """A put-down's joints at 20 fps: steps in (frames 0-9, the feet at 1 m/s), the right wrist down
+    to 0.2 m and back to 1.0 m over frames 12-28 with the feet still, steps away (frames 31-39);
+    ``foot_moves_low``: a foot shuffles while the hand is at the floor."""
+    T = 40
+    j = np.zeros((T, 24, 3))
+    x = np.concatenate([np.arange(10) * 0.05, np.full(21, 0.45), 0.45 + np.arange(1, 10) * 0.05])
+    j[:, [7, 8, 10, 11], 0] = x[:, None]
+    if foot_moves_low:
+        j[19:22, 10, 2] = [0.0, 0.1, 0.2]
+    wrist = np.ones(T)
+    wrist[12:29] = 0.6 + 0.4 * np.cos(np.linspace(0, 2 * np.pi, 17))
+    j[:, 21, 1] = wrist
+    return j
+
+
 def test_a_put_down_backwards_is_a_pick_up():
-    rot = np.arange(5 * 24 * 9, dtype=np.float32).reshape(5, 24, 3, 3)
-    root = np.arange(15, dtype=np.float32).reshape(5, 3)
-    con = np.array([[1, 1, 0, 0], [1, 0, 0, 0], [0, 0, 0, 0], [0, 1, 0, 1], [1, 1, 1, 1]], np.uint8)
-    r, t, c, action, said = stand_in("pick up", "put down", rot, root, con, pose=None)
-    assert action == "pick up" and said == "played backwards"
-    assert np.array_equal(r, rot[::-1]) and np.array_equal(t, root[::-1]) and np.array_equal(c, con[::-1])
+    """Its bend alone, where the feet hold still through it; a take that steps while its hand is low
+    does not stand in."""
+    rot = np.arange(40 * 24 * 9, dtype=np.float32).reshape(40, 24, 3, 3)
+    root = np.arange(120, dtype=np.float32).reshape(40, 3)
+    con = np.tile(np.array([[1, 1, 0, 0], [0, 0, 1, 1]], np.uint8), (20, 1))
+    start, end = bend_span(put_down_joints())
+    assert 9 <= start <= 12 and 29 <= end <= 32                  # from standing, down, up, to standing
+    r, t, c, action, said = stand_in("pick up", "put down", rot, root, con, lambda *a: put_down_joints())
+    assert action == "pick up" and said == "its bend played backwards"
+    assert np.array_equal(r, rot[start:end][::-1]) and np.array_equal(t, root[start:end][::-1])
+    assert np.array_equal(c, con[start:end][::-1])
+    assert bend_span(put_down_joints(foot_moves_low=True)) is None   # a step while the hand is low
+    assert stand_in("pick up", "put down", rot, root, con, lambda *a: put_down_joints(True)) is None   # no stand-in
     assert stand_in("pick up", "walk", rot, root, con, None) is None     # only the action that stands in
     assert stand_in("put down", "put down", rot, root, con, None) is None  # a take of the action itself
     assert stand_in(None, "put down", rot, root, con, None) is None
@@ -25,7 +48,8 @@ def test_a_put_down_backwards_is_a_pick_up():
 
 def test_picking_something_up_plays_a_captured_put_down_backwards():
     """No take picks something up; HDM05's put-downs bend, set something on the floor with the right
-    hand and stand up: played backwards the right hand goes down to the floor and comes back up."""
+    hand and stand up: played backwards the right hand goes down to the floor and comes back up, the
+    body where it stood."""
     from shapemove.core.generation.generate import Generator, Request
 
     gen = Generator(None)
@@ -35,3 +59,5 @@ def test_picking_something_up_plays_a_captured_put_down_backwards():
     low = int(np.argmin(wrist))
     assert wrist[low] < 0.35 and wrist[0] > 0.8 and wrist[-1] > 0.8 and 0 < low < len(wrist) - 1
     assert m.joints[0, 0, 1] > 0.85 and m.joints[-1, 0, 1] > 0.85          # standing before and after
+    travel = np.linalg.norm(m.joints[:, 0, [0, 2]] - m.joints[0, 0, [0, 2]], axis=1).max()
+    assert travel < 0.4, travel            # no steps back: the put-down's walk up and away left out

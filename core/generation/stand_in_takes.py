@@ -5,9 +5,14 @@ The archives hold no capture of sitting down nor of picking something up, and th
 neither reliably. HDM05's 20 ``depositFloorR`` takes bend down, set something on the floor with the
 right hand and stand up again; played backwards they bend down, take it from the floor and stand
 up: a pick-up, every contact of the feet where it was (time reversed, a planted foot stays
-planted). So when the words ask one of these actions and no take is of it, the takes of
+planted). A put-down walks up to the spot and away again, which backwards steps back twice; so
+where its feet hold still through the whole bend (``bend_span``: no foot moves faster than
+``STEPPING`` from before the hand goes down to after it comes back up, the right wrist at both ends
+of that stretch higher than halfway from its lowest to its highest), that stretch plays backwards,
+and a take without one does not stand in (as a lie-down that never settles on the floor does not
+sit). So when the words ask one of these actions and no take is of it, the takes of
 ``STAND_IN`` compete for it, made into it by ``stand_in``, each saying how ("captured: HDM05 bd
-depositFloorR 004 (CC BY-SA 3.0), played backwards").
+depositFloorR 004 (CC BY-SA 3.0), its bend played backwards").
 
     rot, root, con, action, said = stand_in("pick up", "put down", rot, root, con, pose)
 """
@@ -15,16 +20,38 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..constants import FPS
+from ..motion.skeleton_ops import gaussian_smooth
 from .floor_sit import SIT, SIT_FROM, sit_end
 
 PICK_UP, PUT_DOWN = "pick up", "put down"
 STAND_IN = {SIT: SIT_FROM, PICK_UP: PUT_DOWN}   # an action no take is of: the action whose takes play it
+STEPPING = 0.5     # m/s: a foot joint moving faster than this (lightly smoothed) takes a step
+RIGHT_WRIST, FOOT_JOINTS = 21, [7, 8, 10, 11]
+
+
+def bend_span(joints, fps: float = FPS) -> tuple[int, int] | None:
+    """(start, end) frames of a put-down's (T, J, 3) ``joints`` (y up) through which the feet hold
+    still around its lowest right wrist, the bend and the rise whole (module doc); None when there is
+    no such stretch (a foot shifts while the hand is low)."""
+    j = gaussian_smooth(np.asarray(joints, np.float64), 1.0)
+    if len(j) < 3:
+        return None
+    feet = np.linalg.norm(np.diff(j[:, FOOT_JOINTS][:, :, [0, 2]], axis=0), axis=-1).max(1) * fps
+    low = int(np.argmin(j[:, RIGHT_WRIST, 1]))
+    before, after = np.flatnonzero(feet[:low] > STEPPING), np.flatnonzero(feet[low:] > STEPPING)
+    start = int(before[-1]) + 1 if len(before) else 0
+    end = low + int(after[0]) + 1 if len(after) else len(j)
+    wrist = j[:, RIGHT_WRIST, 1]
+    half = wrist[low] + 0.5 * (wrist.max() - wrist[low])
+    return (start, end) if wrist[start] > half and wrist[end - 1] > half else None
 
 
 def stand_in(asked: str | None, action: str, rotations, root, contacts, pose):
     """(rotations, root, contacts, action, what it says) of a take of ``action`` made into the
-    ``asked`` action it stands in for (``STAND_IN``), or None when it does not stand in for it (or,
-    a lie-down, never sits); ``pose(rot, root, con) -> (T, J, 3)`` joints on the performer's body."""
+    ``asked`` action it stands in for (``STAND_IN``), or None when it does not stand in for it (a
+    lie-down that never sits, a put-down that steps while its hand is low); ``pose(rot, root, con) ->
+    (T, J, 3)`` joints on the performer's body."""
     if asked is None or STAND_IN.get(asked) != action:
         return None
     if asked == SIT:
@@ -32,5 +59,9 @@ def stand_in(asked: str | None, action: str, rotations, root, contacts, pose):
         if end is None:
             return None
         return rotations[:end], root[:end], contacts[:end], SIT, "its sit on the floor"
-    return (np.ascontiguousarray(rotations[::-1]), np.ascontiguousarray(root[::-1]),
-            np.ascontiguousarray(contacts[::-1]), asked, "played backwards")
+    span = bend_span(pose(rotations, root, contacts))
+    if span is None:
+        return None
+    start, end = span
+    return (np.ascontiguousarray(rotations[start:end][::-1]), np.ascontiguousarray(root[start:end][::-1]),
+            np.ascontiguousarray(contacts[start:end][::-1]), asked, "its bend played backwards")
