@@ -1,6 +1,7 @@
 """`python -m shapemove demo [--prompt TEXT] [--shape-text TEXT] [--out DIR]`: the one-command demo.
 
-Generates the prompt with the embedded default model on OpenBody, builds the scene headless and
+Generates the prompt with the embedded default model on OpenBody (the body of the shape text, else
+of the prompt's person words, else "a tall, heavy-set man"), builds the scene headless and
 writes ``DIR/shapemove.blend``, ``DIR/preview.png`` (a strip of frames) and ``DIR/motion.npz``,
 then prints where they are and the predicted body measurements.
 """
@@ -19,12 +20,24 @@ DEFAULT_SHAPE = "a tall, heavy-set man"
 
 def add_arguments(p):
     p.add_argument("--prompt", default=DEFAULT_PROMPT)
-    p.add_argument("--shape-text", default=DEFAULT_SHAPE)
+    p.add_argument("--shape-text", default=None,
+                   help=f"the body (default: the prompt's person words, \"{DEFAULT_SHAPE}\" when it names none)")
     p.add_argument("--seconds", type=float, default=None)
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--model", type=Path, default=None, help="model folder (default: the embedded default model)")
     p.add_argument("--out", type=Path, default=Path("out/demo"))
     p.add_argument("--frames", type=int, default=5, help="frames in the preview strip")
+
+
+def demo_shape(body, prompt: str, shape_text: str | None) -> str | None:
+    """The shape text the demo generates with: the one given; none when the prompt's person words
+    say who ("a short, stocky woman picks up a box": the body from them, as ``generate`` does);
+    else ``DEFAULT_SHAPE``."""
+    from ..core.generation.generate import body_from_prompt
+
+    if shape_text and shape_text.strip():
+        return shape_text
+    return None if body_from_prompt(body, prompt)[1] == "prompt words" else DEFAULT_SHAPE
 
 
 def run(args) -> int:
@@ -35,7 +48,8 @@ def run(args) -> int:
 
     t0 = time.time()
     gen = loaded_generator(args.model)
-    motion = gen.generate(args.prompt, args.shape_text, seconds=args.seconds, seed=args.seed)
+    shape = demo_shape(gen.body, args.prompt, args.shape_text)
+    motion = gen.generate(args.prompt, shape, seconds=args.seconds, seed=args.seed)
     save_motion(args.out / "motion.npz", motion)
     t1 = time.time()
     try:
@@ -45,7 +59,7 @@ def run(args) -> int:
     info = build_scene_file(motion, gen.body, args.out / "shapemove.blend", args.out / "preview.png", frames=args.frames)
     m = measure(gen.body, motion.betas)
     print(f"prompt:      {motion.prompt}")
-    print(f"shape text:  {args.shape_text}  (body from: {motion.shape_source or '[BETA] head'})")
+    print(f"shape text:  {shape or '(none: the prompt says who)'}  (body from: {motion.shape_source or '[BETA] head'})")
     if motion.provenance:   # "captured: HDM05 bd kickLFront 002 (CC BY-SA 3.0)", "generated", per segment
         print(f"source:      {motion.provenance}")
     print(f"motion:      {motion.num_frames} frames at {motion.fps:g} fps ({motion.num_frames / motion.fps:.1f} s), "

@@ -107,3 +107,17 @@ def test_render_with_a_library_plays_a_captured_kick(mocap_root, tmp_path):
         assert "tokens" not in z.files and joints.shape[0] == 80
     lift = max(float(joints[:, a, 1].max() - joints[:, a, 1].min()) for a in (7, 8))
     assert lift > 0.6      # an ankle's kick (the user's right kick or a built-in library's)
+
+
+def test_demo_takes_the_body_from_the_prompt_when_it_says_who():
+    """`demo --prompt "a short, stocky woman picks up a box"` makes her, not the demo's default man;
+    a prompt without person words gets the default; a shape text given wins."""
+    from shapemove.cli.demo import DEFAULT_SHAPE, demo_shape
+    from shapemove.core.body.load import load_body_model
+
+    body = load_body_model(None)
+    assert demo_shape(body, "a short, stocky woman picks up a box", None) is None
+    assert demo_shape(body, "an old man sits down slowly", "") is None
+    assert demo_shape(body, "a person jogs forward and waves", None) == DEFAULT_SHAPE
+    assert demo_shape(body, "someone kicks", "  ") == DEFAULT_SHAPE
+    assert demo_shape(body, "a short woman waves", "a tall man") == "a tall man"
