@@ -43,3 +43,23 @@ def test_a_child_is_the_youngest_and_smallest_body_the_model_makes(openbody):
     assert measure(openbody, tall)["height_cm"] > 180
     adult, src = body_from_prompt(openbody, "an old child walks")   # ages that disagree: no body from them
     assert src == "average adult"
+
+
+def test_a_timeline_and_a_loop_take_their_body_as_one_prompt_does(openbody):
+    """"a short, stocky woman walks forward, then sits down" is short and stocky throughout (the
+    [BETA] head had made her 169 cm, 65 kg): the timeline's body and a loop's come from the same
+    reading as a single prompt's; a shape text or given betas still win."""
+    from shapemove.core.generation.loaded_generator import loaded_generator
+    from shapemove.core.generation.token_sampling import body_for
+
+    gen = loaded_generator(None)
+    want, src = body_from_prompt(gen.body, "a short, stocky woman walks forward")
+    predicted = np.full(gen.body.num_betas, 0.5, np.float32)   # what the [BETA] head said
+    got, source = body_for(gen, "a short, stocky woman walks forward", None, None, predicted)
+    assert src == source == "prompt words" and np.allclose(got, want)
+    avg, source = body_for(gen, "a person walks", None, None, predicted)
+    assert source == "average adult" and not avg.any()
+    given, source = body_for(gen, "a short woman walks", None, np.zeros(gen.body.num_betas), predicted)
+    assert source == "given"
+    m = gen.generate("a short, stocky woman walks forward, then sits down", seconds=4, seed=0)
+    assert m.shape_source == "prompt words" and np.allclose(m.betas, want, atol=1e-5)

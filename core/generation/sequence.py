@@ -5,7 +5,8 @@ Each segment's motion codes are sampled with the T5 continuing from the previous
 the body is and writes the next prompt's motion from there, so the transition is the model's, not
 a cross-fade. Of ``candidates`` samples per segment the TMA keeps the one closest to that
 segment's prompt (``rerank``). All codes are then decoded as one sequence by the SA-VAE for one
-body (the first segment's [BETA] head, or the shape text's measurements, or given betas) and
+body (given betas, else the first segment's as a single prompt's: the shape text's measurements or
+the [BETA] head's reading of it, else the prompt's person words or the average adult) and
 planted once (``track.plant``). The Motion keeps ``segment_bounds`` (frames) and
 ``segment_prompts``; ``regenerate_segment`` samples one segment again (continuing from its
 predecessor) and keeps every other segment's codes and frames: the SA-VAE's decoder reads far
@@ -312,8 +313,8 @@ def generate_sequence(gen, segments, shape_text: str | None = None, betas=None, 
     if shape_text:
         gen.check_text(shape_text, "shape text")
     down = gen.vae.cfg.downsample
-    # one body for the whole timeline: the first segment's (the [BETA] head reads it from the same
-    # state a sample's [BETA] is read from), known before any stop is cut
+    # one body for the whole timeline: the first segment's, as a single prompt's (``body_for``),
+    # known before any stop is cut
     body, source = body_for(gen, segs[0].prompt, shape_text, betas,
                             gen.predicted_betas(segs[0].prompt, shape_text).numpy())
     if by_parts and gen.captured_on and gen.pool is not None and len(gen.pool):   # captured takes compete:

@@ -37,14 +37,13 @@ def sample_codes(gen, prompt: str, shape_text: str | None, n: int, min_codes: in
 
 
 def body_for(gen, prompt: str, shape_text: str | None, betas, predicted) -> tuple[np.ndarray, str]:
-    """(betas, where they came from) of a request: given betas, else ``gen.body_shape`` for a
-    shape text (measurements or the [BETA] head's reading), else the [BETA] head's prediction."""
+    """(betas, where they came from) of a request: given betas, else ``gen.body_shape``, as for a
+    single prompt: a shape text's measurements or the [BETA] head's reading of it; without one, the
+    prompt's person words ("a short, stocky woman walks, then sits down") or the average adult."""
     if betas is not None:
         from .decode import check_betas
 
         return check_betas(betas), "given"
-    if shape_text:
-        from .request import Request
+    from .request import Request
 
-        return gen.body_shape(Request(prompt, shape_text, None), np.asarray(predicted, np.float32))
-    return np.asarray(predicted, np.float32), "[BETA] head"
+    return gen.body_shape(Request(prompt, shape_text, None), np.asarray(predicted, np.float32))
