@@ -68,6 +68,10 @@ TABLE = [   # (prompt, seconds, options)
     ("she walks ahead, spins around, then waves", 2, []), ("a man jumps and follows it with a bow", 2, LOOP),
     ("after a long walk she sits down", 2, []), ("a man walks a loop around the tree, then waves", 2, IN_PLACE),
     ("a thief tiptoes along", 1, LOOP),
+    # "once" and "having" order, a person of any noun says every segment, a pick-up, a body in a timeline
+    ("once she has waved, she runs off", 2, SPEED), ("having bowed, the actor walks away", 2, LOOP),
+    ("the boxer punches, then kicks", 2, []), ("a man picks up a box from the floor", 1, IN_PLACE),
+    ("a short, stocky woman walks forward, then sits down", 2, PATH),
 ]
 
 
