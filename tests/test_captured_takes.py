@@ -81,14 +81,24 @@ def test_a_take_of_another_action_than_the_words_name_does_not_compete():
 
 
 def test_sitting_down_plays_a_lie_down_to_where_it_sits():
-    """No take of the data sits down; every lie-down sits on the floor on its way down. "an old man
+    """No take of the data sits down; every lie-down sits on the floor on its way down, and those
+    that settle there are offered (``TakePool.stands_in``). "an old man
     sits down slowly" walked 9 m (a retrieved elderly walk) and "he sits" bobbed into a crouch and
     stood up again: now a lie-down take plays to its sit and holds it, the pelvis on the floor and the
     trunk up, the feet where the take has them (planting them on the floor pulled the legs 12 cm)."""
     from shapemove.core.generation.generate import Generator, Request
 
     gen = Generator(None)
-    for prompt, seed in (("an old man sits down", 0), ("he sits", 1)):   # (slowly: test_slow_action.py)
+    # every seed offers a take that sits: "a man sits on a chair and crosses his legs" (seed 0) had drawn
+    # only lie-downs that never settle where they sit, and a generated sample bobbed and stood again
+    offered = [i for i in range(len(gen.pool)) if gen.pool.actions[i] == "lie down"]
+    settled = [i for i in offered if gen.pool.stands_in(i, "sit")]
+    assert 0 < len(settled) < len(offered)
+    for seed in range(3):
+        drawn = gen.pool.nearest(gen._embed_texts(["a man sits on a chair and crosses his legs"])[0], "sit", seed)
+        sits = [i for i in drawn if gen.pool.actions[i] == "lie down"]
+        assert sits and set(sits) <= set(settled), (seed, drawn)
+    for prompt, seed in (("an old man sits down", 0), ("he sits", 1), ("a man sits on a chair and crosses his legs", 0)):
         m = gen.generate_batch([Request(prompt, seconds=4, seed=seed)])[0]
         assert "lieDownFloor" in m.provenance and m.provenance.endswith("its sit on the floor"), m.provenance
         root, head = m.joints[:, 0, 1], m.joints[:, 15, 1]

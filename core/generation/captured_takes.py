@@ -21,8 +21,9 @@ in one ``TakePool``. For a prompt:
   samples' decoded features, and the TMA chooses among them all (``rerank.CandidatePicker``), a
   take of the asked action credited ``ACTION_BONUS``; when the words name an action, a take of
   another one does not compete (``action_credit``: "sits down" is not played as the lying-down take
-  nearest its words); for an action no take is of, the takes that stand in for it compete, made
-  into it (``stand_in_takes.py``: a lie-down played to where it sits, a put-down backwards).
+  nearest its words); for an action no take is of, the takes that can stand in for it are drawn and
+  compete, made into it (``stand_in_takes.py``: a lie-down that settles played to where it sits, a
+  put-down's bend backwards; ``stands_in``).
 
 A window kept is moved onto the requested body by its own rotations with its feet planted
 (``retarget.planted_retarget``), never through the codes, and says where it came from
@@ -129,6 +130,7 @@ class TakePool:
         self.vectors = np.zeros((n, 0), np.float32)
         self._cache: OrderedDict = OrderedDict()
         self._both: dict[int, bool] = {}
+        self._stands_in: dict[tuple[int, str], bool] = {}
 
     def __len__(self) -> int:
         return len(self.actions)
@@ -199,6 +201,16 @@ class TakePool:
             self._both[i] = made_with_both(joints)
         return self._both[i]
 
+    def stands_in(self, i: int, asked: str) -> bool:
+        """Whether take ``i`` can be made into the ``asked`` action it stands in for (``stand_in``: a
+        lie-down that settles where it sits, a put-down whose feet hold still through its bend; kept)."""
+        if (i, asked) not in self._stands_in:
+            t = self.take(i)
+            pose = lambda r, rt, c: self.proc.pose_on(r, rt, t["betas"], 1.0, c)  # noqa: E731
+            made = stand_in(asked, self.actions[i], t["rotations"], t["root"], t["contacts"], pose)
+            self._stands_in[(i, asked)] = made is not None
+        return self._stands_in[(i, asked)]
+
     def nearest(self, text: np.ndarray, action: str | None, seed: int, count: int = TAKES,
                 hands: bool | None = None) -> list[int]:
         """Takes offered for a prompt whose TMA text vector is ``text`` (see the module docstring);
@@ -227,8 +239,8 @@ class TakePool:
             if mine:
                 chosen.append(max(mine, key=lambda i: sims[i]))
         named = [i for i in range(len(self)) if action and self.actions[i] == action]
-        if action in STAND_IN and not named:   # no take of it: another's stand in (stand_in_takes.py)
-            named = [i for i in range(len(self)) if self.actions[i] == STAND_IN[action]]
+        if action in STAND_IN and not named:   # no take of it: the takes that can stand in (stand_in_takes.py)
+            named = [i for i in range(len(self)) if self.actions[i] == STAND_IN[action] and self.stands_in(i, action)]
         draw(named, max(0, count - len(chosen) - NEAREST) if named else 0)
         draw(range(len(self)), max(0, count - len(chosen)))
         return chosen
