@@ -80,6 +80,9 @@ def test_vocabulary():
     ("she waved", ["wave"]), ("he threw the ball", ["throw"]), ("she stood up", ["get up"]),
     ("he got up", ["get up"]), ("the soldier marched", ["march"]), ("they danced", ["dance"]),
     ("she stretched", ["stretch"]), ("he spun around", ["spin"]),
+    # lying somewhere is lying down; lying about something is not
+    ("a woman lies on her back", ["lie down"]), ("he lies flat on the floor", ["lie down"]),
+    ("the man lies about his age", []),
 ])
 def test_find_actions(text, expected):
     assert find_actions(text) == expected
