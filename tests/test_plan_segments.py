@@ -143,6 +143,23 @@ def test_a_course_segment_takes_the_time_to_go_once_round_when_the_length_is_the
     assert [s["seconds"] for s in shown["segments"]] == pytest.approx([5.847, 3.0], abs=0.001)
 
 
+def test_a_distance_segment_takes_the_time_to_go_it_when_the_length_is_the_models():
+    """Hand-derived from the default model's typical walk (1.194 m/s) and run (2.87 m/s): "walks 5
+    metres, then turns around" went 4.2 m in the 3 s a segment had; now 5 / (0.9 x 1.194) + 1 s to
+    stand = 5.65 s, run 20 m 8.74 s, slowly at 0.8 of the pace; a short distance keeps the default;
+    a total asked is shared as before."""
+    from shapemove.core.generation.course_shapes import model_course_seconds
+
+    at_pace = model_course_seconds(None)
+    plan = read_plan("a man walks 5 metres, then turns around and walks back")
+    assert plan.lengths(None, at_pace) == pytest.approx([5 / (0.9 * 1.194) + 1.0, SEGMENT_SECONDS], abs=0.01)
+    assert read_plan("she runs 20 metres, then waves").lengths(None, at_pace)[0] == pytest.approx(20 / (0.9 * 2.87) + 1, abs=0.01)
+    slow = read_plan("he walks 3 metres slowly, then sits down").lengths(None, at_pace)[0]
+    assert slow == pytest.approx(3 / (0.9 * 1.194 * 0.8) + 1.0, abs=0.01)
+    assert read_plan("he walks 1 metre, then waves").lengths(None, at_pace)[0] == SEGMENT_SECONDS
+    assert plan.lengths(8.0, at_pace) == pytest.approx([4.0, 4.0])
+
+
 def test_a_counted_segment_takes_as_long_as_its_repetitions_when_the_length_is_the_models():
     """"six jumping jacks, then waves": 7 x 1.1 s for the jacks (one more for the start and the end),
     the default for the wave; a total asked is shared as before; few repetitions keep the default."""

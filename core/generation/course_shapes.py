@@ -32,6 +32,7 @@ STEP = 0.005                        # m: a course's heading integrated at this s
 UNASKED_PACE = 0.9                  # no length asked: once round at this share of the gait's typical pace
 UNASKED_LEAST, UNASKED_MOST = 4.0, 12.0   # s: and within these
 WALK_SPEED = 1.2                    # m/s: a walk's pace where the model folder has no typical pace table
+STOP_SECONDS = 1.0                  # standing after a distance gone (``unasked_seconds``)
 
 
 def radius_for(distance: float) -> float:
@@ -118,17 +119,24 @@ NOTE_BELOW = 0.9   # a course gone round less than this share of once is noted
 
 
 def unasked_seconds(words, speeds: dict[str, float]) -> float | None:
-    """The length a course the words (``plan.words.Words``) name gets when none is asked: once round
-    at the typical pace ``speeds`` (``typical_pace.load_typical_speeds``) of its gait (walk, jog or
-    run; a walk's for another gait, ``WALK_SPEED`` without a table), slowed when asked slowly
-    (``course_seconds``); None for a course with no round."""
+    """The length the way the words (``plan.words.Words``) name gets when none is asked: a course
+    once round (``course_seconds``), or a distance ("walks 5 metres, then turns around") gone at
+    ``UNASKED_PACE`` of the pace and then ``STOP_SECONDS`` standing (at most ``UNASKED_MOST``); at
+    the typical pace ``speeds`` (``typical_pace.load_typical_speeds``) of its gait (walk, jog or
+    run; a walk's for another gait, ``WALK_SPEED`` without a table), slowed when asked slowly. None
+    for no course and no distance, or a course with no round."""
     from .pace_words import SLOW_SPEED
 
-    if words.course is None:
+    if words.course is None and words.distance_m is None:
         return None
-    gait = words.course_gait[1] if words.course_gait else None
-    speed = speeds.get(gait) or speeds.get("walk") or WALK_SPEED
-    return course_seconds(words.course, speed * (SLOW_SPEED if words.pace == "slow" else 1.0))
+    if words.course is not None:
+        gait = words.course_gait[1] if words.course_gait else None
+    else:
+        gait = next((a for a in words.actions if a in speeds), None)
+    speed = (speeds.get(gait) or speeds.get("walk") or WALK_SPEED) * (SLOW_SPEED if words.pace == "slow" else 1.0)
+    if words.course is None:
+        return float(min(words.distance_m / (UNASKED_PACE * speed) + STOP_SECONDS, UNASKED_MOST))
+    return course_seconds(words.course, speed)
 
 
 def model_course_seconds(model_dir=None):

@@ -385,8 +385,9 @@ class Generator:
         return seed_prefixes(self.t5.memory, self.tok, r.prompt, seeded_count(n), r.retrieval_prefix)
 
     def course_seconds(self, words) -> float | None:
-        """The length a course the words name gets when none is asked: once round at the typical
-        pace of its gait (``course_shapes.unasked_seconds`` on the model folder's table)."""
+        """The length a course or a distance the words name gets when none is asked: once round, or
+        the distance gone and a stop, at the typical pace of its gait (``course_shapes.unasked_seconds``
+        on the model folder's table)."""
         return unasked_seconds(words, self.typical_speeds)
 
     @staticmethod

@@ -71,10 +71,14 @@ class Plan:
 def own_seconds(words: Words, course_seconds=None) -> float:
     """A segment's seconds when no length is set: the length its words ask ("for ten seconds"),
     else the time its course takes to go once round (``course_seconds(words)``, when given and the
-    course has a round: "walks a loop around the tree"), else ``counted_seconds``."""
+    course has a round: "walks a loop around the tree") or its distance to be gone and stood
+    ("walks 5 metres, then turns around": at least ``counted_seconds``), else ``counted_seconds``."""
     if words.seconds is not None:
         return float(words.seconds)
-    once = course_seconds(words) if course_seconds is not None and words.course is not None else None
+    way = words.course is not None or words.distance_m is not None
+    once = course_seconds(words) if course_seconds is not None and way else None
+    if once is not None and words.course is None:
+        return max(float(once), counted_seconds(words))
     return float(once) if once is not None else counted_seconds(words)
 
 
