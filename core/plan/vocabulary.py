@@ -225,6 +225,7 @@ FIRST = re.compile(r"\b(?:first(?:ly)?|at first|initially|to begin with|to start
 # any other "and" joins two things at once or one action ("jumps and twirls": a spin jump)
 POSTURE_CHANGES = {"get up": 1.0, "lie down": -1.0, "sit": -1.0}   # the changes of posture: the way the root goes (up, down)
 RISEN_FROM = frozenset({"squat", "bend over", "pick up", "put down"})   # "squats, then stands up": the squat's own end
+TO_THE_FLOOR = frozenset({"pick up", "put down"})   # actions whose hand goes down to the floor
 AND = re.compile(r"\s*,?\s*\band\s+")
 PARTICIPLE = re.compile(r"^(?!(?:spring|bring|swing|sing|string|ring|thing|sling|sting|wing|cling|fling)\b)[a-z'-]{2,}ing\b")
 
