@@ -25,6 +25,16 @@ def test_the_hands_the_words_ask(prompt, asked, wanted):
     assert hands_wanted(read_words(prompt), asked) is wanted
 
 
+def test_a_named_foot_says_nothing_of_the_hands():
+    """"kicks with her right leg" named one hand ("side: right foot; one hand" in what was understood)."""
+    from shapemove.core.plan.reading import said
+
+    assert read_words("a woman kicks with her right leg").hands is None
+    assert said(read_words("a woman kicks with her right leg").understood()) == "kick; side: right foot"
+    assert read_words("he waves with his left hand").hands == "one"
+    assert read_words("first wave with the right hand").hands == "one"
+
+
 def test_the_library_tells_waves_of_one_hand_from_waves_of_both(openbody):
     """Bandai's wave-both-hands takes are made with both hands, its wave-right-hand ones with one;
     the both-hands takes are the nearest by caption to a wave asked with one hand too, which gets one

@@ -273,7 +273,8 @@ def hands_asked(prompt: str) -> str | None:
     hands"), "one" when of one ("raises a hand", "lifts one hand high", "waves with his left hand"),
     None when they say neither ("waves") or both ways."""
     t = str(prompt).lower()
-    both, one = bool(V.BOTH_HANDS.search(t)), bool(V.ONE_HAND.search(t)) or named_side(t) is not None
+    side = named_side(t)   # a named hand is one hand; a named foot says nothing of the hands
+    both, one = bool(V.BOTH_HANDS.search(t)), bool(V.ONE_HAND.search(t)) or side is not None and side[1] == "hand"
     return "both" if both and not one else "one" if one and not both else None
 
 
