@@ -239,3 +239,16 @@ def test_swing_rotations_reproduce_bone_directions(real_clips):
             got = np.einsum("tij,j->ti", world[j], rest_dir)
             bone = joints[:, c] - joints[:, j]
             np.testing.assert_allclose(got, bone / np.linalg.norm(bone, axis=-1, keepdims=True), atol=1e-6)
+
+
+def test_the_height_column_of_a_joint():
+    """The head's height is ric's 15th joint's y (4 + 3 x 14 + 1 = 47); the root's is not in ric."""
+    import pytest
+
+    from shapemove.core.errors import ShapeMoveError
+    from shapemove.core.motion.features import height_column
+
+    assert height_column(15) == 47 and height_column(1) == 5 and height_column(21) == 65
+    for bad in (0, 22):
+        with pytest.raises(ShapeMoveError, match="joints 1..21"):
+            height_column(bad)

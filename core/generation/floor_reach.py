@@ -15,14 +15,12 @@ from __future__ import annotations
 import numpy as np
 
 from ..body.skeleton import JOINT_NAMES
-from ..motion.features import feature_slices
+from ..motion.features import height_column
 from ..plan.vocabulary import TO_THE_FLOOR
 
 LOW_HAND = 0.25   # a wrist this share of the head's highest above the floor reaches it
-# heights in the (T, 263) features: y in ``ric`` (joints 1..21, heights the floor's)
-_Y = lambda name: feature_slices["ric"].start + 3 * (JOINT_NAMES.index(name) - 1) + 1  # noqa: E731
-WRISTS_Y = [_Y("left_wrist"), _Y("right_wrist")]
-HEAD_Y = _Y("head")
+WRISTS_Y = [height_column(JOINT_NAMES.index(n)) for n in ("left_wrist", "right_wrist")]
+HEAD_Y = height_column(JOINT_NAMES.index("head"))
 
 
 def reaches_floor(features) -> bool:

@@ -30,7 +30,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..body.skeleton import JOINT_NAMES
-from ..motion.features import feature_slices
+from ..motion.features import height_column
 from ..plan.vocabulary import POSTURE_CHANGES
 
 MIN_CHANGE = 0.3   # of the candidate's highest root
@@ -38,7 +38,7 @@ ENDS = 5           # frames averaged at the start and at the end
 LYING = 0.35       # a head whose low height is under this share of its highest lies
 LOW_QUANTILE = 0.1
 # the head's height in the (T, 263) features: its y in ``ric`` (joints 1..21, heights the floor's)
-HEAD_Y = feature_slices["ric"].start + 3 * (JOINT_NAMES.index("head") - 1) + 1
+HEAD_Y = height_column(JOINT_NAMES.index("head"))
 HEAD_DOWN = {"lie down": True, "sit": False}   # where the head goes in the change of posture
 STANDING = 0.95    # a root this share of the leg's length high stands (standing: 1.05-1.15)
 

@@ -49,6 +49,16 @@ feature_slices = {
     "contacts": slice(259, 263),
 }
 
+
+
+def height_column(joint: int) -> int:
+    """The column of (T, 263) features holding joint ``joint``'s height above the floor (1..21: its
+    y in ``ric``; the root's is ``root_y``)."""
+    if not 1 <= joint < NUM_JOINTS:
+        raise ShapeMoveError(f"features hold the heights of joints 1..{NUM_JOINTS - 1} in ric, not of joint {joint}")
+    return feature_slices["ric"].start + 3 * (joint - 1) + 1
+
+
 # HumanML3D's paramUtil.t2m_raw_offsets: unit rest direction of the bone ENDING at each joint
 # (arms hanging down, feet and head pointing forward).
 T2M_RAW_OFFSETS = np.array([

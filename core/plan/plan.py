@@ -59,7 +59,8 @@ class Plan:
         """Each segment's seconds of a motion ``total`` seconds long (None: the length its words
         ask, "for ten seconds", else ``own_seconds``); a segment's own seconds (an edited plan's)
         win. ``course_seconds(words) -> seconds | None``: the time a segment's course takes to go
-        once round (the model's typical pace: ``generation.course_shapes.unasked_seconds``)."""
+        once round, or its distance to be gone and stood (the model's typical pace:
+        ``generation.course_shapes.unasked_seconds``)."""
         if all(s.seconds is not None for s in self.segments):
             return [float(s.seconds) for s in self.segments]
         if total is None:   # the words' own length ("for ten seconds"), else the model's
