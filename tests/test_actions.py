@@ -83,6 +83,9 @@ def test_vocabulary():
     # lying somewhere is lying down; lying about something is not
     ("a woman lies on her back", ["lie down"]), ("he lies flat on the floor", ["lie down"]),
     ("the man lies about his age", []),
+    # a twisted ankle is no side twist; favouring a leg is a limp
+    ("favoring one leg after twisting an ankle", ["limp"]), ("she twists her upper body", ["side twist"]),
+    ("favouring his left leg, he walks", ["limp", "walk"]),
 ])
 def test_find_actions(text, expected):
     assert find_actions(text) == expected
