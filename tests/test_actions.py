@@ -86,6 +86,11 @@ def test_vocabulary():
     # a twisted ankle is no side twist; favouring a leg is a limp
     ("favoring one leg after twisting an ankle", ["limp"]), ("she twists her upper body", ["side twist"]),
     ("favouring his left leg, he walks", ["limp", "walk"]),
+    # backing up, shuffling sideways, stretching up, side-stepping
+    ("he backs up slowly", ["walk backward"]), ("he stands back up", ["get up"]),
+    ("shuffling sideways, he waves", ["sidestep", "wave"]), ("a man shuffles the cards", []),
+    ("the kid stretches up on tiptoes", ["reach up"]), ("she walks on tiptoes", ["sneak", "walk"]),
+    ("the goalkeeper side-steps along the line", ["sidestep"]),
 ])
 def test_find_actions(text, expected):
     assert find_actions(text) == expected

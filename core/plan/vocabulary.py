@@ -179,7 +179,9 @@ PERSON_NOUNS = tuple(dict.fromkeys(
     ["person", "someone", "somebody", "they", "people", "teenager", "teen", "adolescent", "pensioner", "soldier",
      "dancer", "athlete", "figure", "character", "actor", "actress", "player", "runner", "walker", "human", "boxer",
      "fighter", "coach", "student", "teacher", "jogger", "hiker", "gymnast", "skater", "climber", "swimmer",
-     "worker", "performer", "robot", "zombie", "ninja", "toddler", "i", "you", "we"]))
+     "worker", "performer", "robot", "zombie", "ninja", "toddler", "thief", "burglar", "spy", "guard", "mailman",
+     "postman", "waiter", "officer", "nurse", "doctor", "chef", "cowboy", "pirate", "knight", "goalkeeper",
+     "footballer", "i", "you", "we"]))
 SUBJECT = re.compile(r"^(?:(?:a|an|the|this|that|one|some|my|our|his|her|their|your)\s+(?:[\w-]+,?\s+){0,3}?)?"
                      r"(?:" + "|".join(sorted(PERSON_NOUNS, key=len, reverse=True)) + r")\b")
 HAND_WORDS = r"hand|hands|arm|arms|fist|fists|palm|elbow|shoulder|wrist|finger|fingers"
