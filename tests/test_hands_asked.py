@@ -51,3 +51,21 @@ def test_the_library_tells_waves_of_one_hand_from_waves_of_both(openbody):
         both = gen.generate_batch([Request("a man waves with both hands", seed=seed, seconds=3)])[0]
         assert "both-hands" not in one.provenance and not made_with_both(one.joints), one.provenance
         assert "both-hands" in both.provenance and made_with_both(both.joints), both.provenance
+
+
+def test_both_arms_asked_of_any_action_keeps_the_candidates_made_with_both():
+    """"someone stretches both arms above the head" (seed 0) chose a sample raising the left arm
+    alone (wrists at 1.46 and 0.85 m, the head at 1.46); now both go above the head. Words that say
+    no hands keep every candidate."""
+    import numpy as np
+
+    from shapemove.core.generation.generate import Generator, Request
+    from shapemove.core.generation.hands_asked import both_kept, made_with_both
+
+    gen = Generator(None)
+    m = gen.generate_batch([Request("someone stretches both arms above the head", "a short, slim woman", seed=0)])[0]
+    head = m.joints[:, 15, 1].max()
+    assert made_with_both(m.joints) and min(m.joints[:, 20, 1].max(), m.joints[:, 21, 1].max()) > head
+    keep = np.array([True, False, True])
+    assert both_kept(read_words("a man waves"), [None] * 3, keep) is keep        # nothing said: untouched
+    assert both_kept(None, [None] * 3, keep) is keep

@@ -12,7 +12,10 @@ competes: the judges read the library's one-hand waves as raised hands (blind pa
 60 -> 20 % by the TMA judge when one hand was made the default; docs/design-notes.md). A take is
 made with both when its less active hand travels at least ``BOTH_SHARE`` of the more active one's
 path (``part_compose.side_activity``, wrist and elbow relative to the pelvis): Bandai's both-hands
-waves and raises 0.78-1.00, its one-hand ones 0.05-0.33 (whole takes).
+waves and raises 0.78-1.00, its one-hand ones 0.05-0.33 (whole takes). Whatever the action, when
+the words say both hands the candidates made with both are the ones that compete, when any is
+(``both_kept``, in ``rerank``): the choice had kept a sample stretching one arm up for "stretches
+both arms above the head".
 """
 from __future__ import annotations
 
@@ -30,6 +33,20 @@ def made_with_both(joints) -> bool:
 
     left, right = side_activity(joints, "hand")
     return min(left, right) >= BOTH_SHARE * max(left, right, 1e-6)
+
+
+def both_kept(words, feats: list, keep):
+    """``keep`` (N,) narrowed to the candidates made with both hands when the words (``plan.words.Words``)
+    say both ("stretches both arms above the head": a sample raising one arm was chosen) and any of
+    them is; ``keep`` itself otherwise. ``feats``: (T, 263) candidates."""
+    import numpy as np
+
+    from ..motion.features import joints_from_features
+
+    if words is None or words.hands != "both":
+        return keep
+    both = np.array([made_with_both(np.asarray(joints_from_features(f))) for f in feats]) & keep
+    return both if both.any() else keep
 
 
 def hands_wanted(words, asked: str | None) -> bool | None:

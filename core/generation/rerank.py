@@ -13,8 +13,8 @@ Travel and pace words come first: a candidate whose root travel goes against "fo
 (``pace_words``), and for "jumps twice" or "three squats" only those that leave the floor or go
 down the number of times nearest the asked one (``count_words``), for "walks 3 metres" those
 whose path gets that far (``stop_words``), for "gets up" or "lies down" those that rise or go
-down (``posture_change``), and for "picks up" or "puts down" those whose hand reaches the floor
-(``floor_reach``), since the TMA reads what the body does, not which way, how fast, how far
+down (``posture_change``), for "picks up" or "puts down" those whose hand reaches the floor
+(``floor_reach``), and for "both arms" those made with both (``hands_asked``), since the TMA reads what the body does, not which way, how fast, how far
 or how many times, and weighs who does it as much as what.
 
 Bias to keep in mind: R-precision and the paraphrase classifier also read TMA embeddings, so
@@ -28,6 +28,7 @@ import numpy as np
 from ..plan.words import read_words
 from .count_words import counter, nearest_count
 from .floor_reach import floor_reached
+from .hands_asked import both_kept
 from .pace_words import fastest, gait_speed, going, staying
 from .posture_change import posture_kept
 from .stop_words import reaching
@@ -67,5 +68,6 @@ class CandidatePicker:
             keep = nearest_count([counter(action)(f) for f in feats], want, keep)
         keep = posture_kept(words.actions[0] if words.actions else None, feats, keep)
         keep = floor_reached(words.actions[0] if words.actions else None, feats, keep)
+        keep = both_kept(words, feats, keep)   # "both arms": not a candidate made with one
         scores = self.scores(prompt, feats) + (0.0 if bonus is None else np.asarray(bonus, np.float64))
         return int(np.argmax(np.where(keep, scores, -np.inf)))
