@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from shapemove.core.generation.stand_in_takes import STAND_IN, bend_span, stand_in
+from shapemove.core.generation.stand_in_takes import STAND_IN, bend_span, played_as, stand_in_span
 
 pytestmark = pytest.mark.usefixtures("one_thread")
 
@@ -34,15 +34,18 @@ def test_a_put_down_backwards_is_a_pick_up():
     con = np.tile(np.array([[1, 1, 0, 0], [0, 0, 1, 1]], np.uint8), (20, 1))
     start, end = bend_span(put_down_joints())
     assert 9 <= start <= 12 and 29 <= end <= 32                  # from standing, down, up, to standing
-    r, t, c, action, said = stand_in("pick up", "put down", rot, root, con, lambda *a: put_down_joints())
+    assert stand_in_span("pick up", "put down", put_down_joints()) == (start, end)
+    r, t, c, action, said = played_as("pick up", rot, root, con, (start, end))
     assert action == "pick up" and said == "its bend played backwards"
     assert np.array_equal(r, rot[start:end][::-1]) and np.array_equal(t, root[start:end][::-1])
     assert np.array_equal(c, con[start:end][::-1])
     assert bend_span(put_down_joints(foot_moves_low=True)) is None   # a step while the hand is low
-    assert stand_in("pick up", "put down", rot, root, con, lambda *a: put_down_joints(True)) is None   # no stand-in
-    assert stand_in("pick up", "walk", rot, root, con, None) is None     # only the action that stands in
-    assert stand_in("put down", "put down", rot, root, con, None) is None  # a take of the action itself
-    assert stand_in(None, "put down", rot, root, con, None) is None
+    assert stand_in_span("pick up", "put down", put_down_joints(True)) is None   # no stand-in
+    assert stand_in_span("pick up", "walk", put_down_joints()) is None     # only the action that stands in
+    assert stand_in_span("put down", "put down", put_down_joints()) is None  # a take of the action itself
+    assert stand_in_span(None, "put down", put_down_joints()) is None
+    r, t, c, action, said = played_as("sit", rot, root, con, (0, 25))   # a sit: as it is, to where it sits
+    assert action == "sit" and said == "its sit on the floor" and np.array_equal(r, rot[:25]) and np.array_equal(c, con[:25])
     assert STAND_IN == {"sit": "lie down", "pick up": "put down"}
 
 

@@ -50,7 +50,7 @@ from ..scene.motion_file import Motion
 from ..data.actions import MOVES_ON, REPEATED
 from ..plan.vocabulary import GAITS, POSTURE_CHANGES
 from .floor_sit import SIT, SIT_FROM, sit_end
-from .stand_in_takes import STAND_IN, stand_in
+from .stand_in_takes import STAND_IN, played_as, stand_in_span
 from .repeated_takes import cut_for, repeated_stretch
 from .straight_gait import STRAIGHTENED, straightened
 from .take_loop import looped_gait, looped_repetition, looped_steps, looped_take
@@ -130,7 +130,7 @@ class TakePool:
         self.vectors = np.zeros((n, 0), np.float32)
         self._cache: OrderedDict = OrderedDict()
         self._both: dict[int, bool] = {}
-        self._stands_in: dict[tuple[int, str], bool] = {}
+        self._spans: dict[tuple[int, str], tuple[int, int] | None] = {}
 
     def __len__(self) -> int:
         return len(self.actions)
@@ -201,15 +201,21 @@ class TakePool:
             self._both[i] = made_with_both(joints)
         return self._both[i]
 
-    def stands_in(self, i: int, asked: str) -> bool:
-        """Whether take ``i`` can be made into the ``asked`` action it stands in for (``stand_in``: a
-        lie-down that settles where it sits, a put-down whose feet hold still through its bend; kept)."""
-        if (i, asked) not in self._stands_in:
+    def stands_in(self, i: int, asked: str | None) -> bool:
+        """Whether take ``i`` can be made into the ``asked`` action it stands in for (a lie-down that
+        settles where it sits, a put-down whose feet hold still through its bend)."""
+        return self.stand_in_span(i, asked) is not None
+
+    def stand_in_span(self, i: int, asked: str | None) -> tuple[int, int] | None:
+        """The frames of take ``i`` that play the ``asked`` action it stands in for, or None
+        (``stand_in_takes.stand_in_span`` on the take posed on its performer; kept)."""
+        if STAND_IN.get(asked or "") != self.actions[i]:
+            return None
+        if (i, asked) not in self._spans:
             t = self.take(i)
-            pose = lambda r, rt, c: self.proc.pose_on(r, rt, t["betas"], 1.0, c)  # noqa: E731
-            made = stand_in(asked, self.actions[i], t["rotations"], t["root"], t["contacts"], pose)
-            self._stands_in[(i, asked)] = made is not None
-        return self._stands_in[(i, asked)]
+            joints = self.proc.pose_on(t["rotations"], t["root"], t["betas"], 1.0, t["contacts"])
+            self._spans[(i, asked)] = stand_in_span(asked, self.actions[i], joints)
+        return self._spans[(i, asked)]
 
     def nearest(self, text: np.ndarray, action: str | None, seed: int, count: int = TAKES,
                 hands: bool | None = None) -> list[int]:
@@ -240,7 +246,7 @@ class TakePool:
                 chosen.append(max(mine, key=lambda i: sims[i]))
         named = [i for i in range(len(self)) if action and self.actions[i] == action]
         if action in STAND_IN and not named:   # no take of it: the takes that can stand in (stand_in_takes.py)
-            named = [i for i in range(len(self)) if self.actions[i] == STAND_IN[action] and self.stands_in(i, action)]
+            named = [i for i in range(len(self)) if self.stands_in(i, action)]
         draw(named, max(0, count - len(chosen) - NEAREST) if named else 0)
         draw(range(len(self)), max(0, count - len(chosen)))
         return chosen
@@ -271,9 +277,9 @@ class TakePool:
         rot, root, con, exact = t["rotations"], t["root"], t["contacts"], False
         action, provenance, from_seat = self.actions[i], t["provenance"], False
         pose = lambda r, rt, c: self.proc.pose_on(r, rt, t["betas"], 1.0, c)  # noqa: E731
-        made = stand_in(asked, action, rot, root, con, pose)   # a sit, a pick-up (stand_in_takes.py)
-        if made is not None:
-            rot, root, con, action, said = made
+        span = self.stand_in_span(i, asked)   # a sit, a pick-up (stand_in_takes.py)
+        if span is not None:
+            rot, root, con, action, said = played_as(asked, rot, root, con, span)
             provenance += f", {said}"
         elif action == SIT_FROM and seated:   # a lie-down after a sit: on from where it sits (floor_sit.py)
             end = sit_end(pose(rot, root, con))

@@ -11,15 +11,17 @@ where its feet hold still through the whole bend (``bend_span``: no foot moves f
 of that stretch higher than halfway from its lowest to its highest), that stretch plays backwards,
 and a take without one does not stand in (as a lie-down that never settles on the floor does not
 sit). So when the words ask one of these actions and no take is of it, the takes of
-``STAND_IN`` compete for it, made into it by ``stand_in``, each saying how ("captured: HDM05 bd
+``STAND_IN`` compete for it, made into it (``stand_in_span``, ``played_as``), each saying how ("captured: HDM05 bd
 depositFloorR 004 (CC BY-SA 3.0), its bend played backwards").
 
-    rot, root, con, action, said = stand_in("pick up", "put down", rot, root, con, pose)
+    span = stand_in_span("pick up", "put down", joints)   # the frames that play it (joints: the take posed), or None
+    rot, root, con, action, said = played_as("pick up", rot, root, con, span)
 """
 from __future__ import annotations
 
 import numpy as np
 
+from ..body.skeleton import FOOT_LEFT, FOOT_RIGHT, JOINT_NAMES
 from ..constants import FPS
 from ..motion.skeleton_ops import gaussian_smooth
 from .floor_sit import SIT, SIT_FROM, sit_end
@@ -27,7 +29,7 @@ from .floor_sit import SIT, SIT_FROM, sit_end
 PICK_UP, PUT_DOWN = "pick up", "put down"
 STAND_IN = {SIT: SIT_FROM, PICK_UP: PUT_DOWN}   # an action no take is of: the action whose takes play it
 STEPPING = 0.5     # m/s: a foot joint moving faster than this (lightly smoothed) takes a step
-RIGHT_WRIST, FOOT_JOINTS = 21, [7, 8, 10, 11]
+RIGHT_WRIST, FOOT_JOINTS = JOINT_NAMES.index("right_wrist"), sorted(FOOT_LEFT + FOOT_RIGHT)
 
 
 def bend_span(joints, fps: float = FPS) -> tuple[int, int] | None:
@@ -47,21 +49,24 @@ def bend_span(joints, fps: float = FPS) -> tuple[int, int] | None:
     return (start, end) if wrist[start] > half and wrist[end - 1] > half else None
 
 
-def stand_in(asked: str | None, action: str, rotations, root, contacts, pose):
-    """(rotations, root, contacts, action, what it says) of a take of ``action`` made into the
-    ``asked`` action it stands in for (``STAND_IN``), or None when it does not stand in for it (a
-    lie-down that never sits, a put-down that steps while its hand is low); ``pose(rot, root, con) ->
-    (T, J, 3)`` joints on the performer's body."""
+def stand_in_span(asked: str | None, action: str, joints) -> tuple[int, int] | None:
+    """(start, end) frames of a take of ``action`` whose (T, J, 3) ``joints`` (on its performer's
+    body) play the ``asked`` action it stands in for (``STAND_IN``): a lie-down from its start to
+    its sit, a put-down's bend; None when it does not stand in for it (a lie-down that never sits, a
+    put-down that steps while its hand is low)."""
     if asked is None or STAND_IN.get(asked) != action:
         return None
     if asked == SIT:
-        end = sit_end(pose(rotations, root, contacts))
-        if end is None:
-            return None
-        return rotations[:end], root[:end], contacts[:end], SIT, "its sit on the floor"
-    span = bend_span(pose(rotations, root, contacts))
-    if span is None:
-        return None
+        end = sit_end(joints)
+        return None if end is None else (0, end)
+    return bend_span(joints)
+
+
+def played_as(asked: str, rotations, root, contacts, span: tuple[int, int]):
+    """(rotations, root, contacts, ``asked``, what it says) of a take's ``span`` (``stand_in_span``)
+    made into the action it stands in for: a sit as it is, a pick-up played backwards."""
     start, end = span
+    if asked == SIT:
+        return rotations[start:end], root[start:end], contacts[start:end], SIT, "its sit on the floor"
     return (np.ascontiguousarray(rotations[start:end][::-1]), np.ascontiguousarray(root[start:end][::-1]),
             np.ascontiguousarray(contacts[start:end][::-1]), asked, "its bend played backwards")

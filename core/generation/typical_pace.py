@@ -161,7 +161,12 @@ def paced_target(words, speeds: dict, course: bool = True) -> tuple[str, float] 
     fast = fast_gait(words)
     if fast is None or fast not in speeds or FAST_UP_TO[fast] not in speeds:
         return None
-    return fast, (speeds[fast] + speeds[FAST_UP_TO[fast]]) / 2
+    return fast, halfway(fast, speeds)
+
+
+def halfway(gait: str, speeds: dict) -> float:
+    """Halfway from ``gait``'s typical speed to the next gait's (``FAST_UP_TO``), m/s on the average body."""
+    return (speeds[gait] + speeds[FAST_UP_TO[gait]]) / 2
 
 
 def typical_paced(motion, body, words, speeds: dict, ik_refine_iters: int = 10, course: bool = True):
@@ -246,9 +251,7 @@ def fast_take(window, words, speeds: dict, body) -> bool:
     gait = plain_gait(words, slow=True)
     if gait not in FAST_UP_TO or gait not in speeds or FAST_UP_TO[gait] not in speeds:
         return False
-    speed = gait_speed(np.asarray(window.features)[: max(1, len(window.features) - window.held)])
-    halfway = (speeds[gait] + speeds[FAST_UP_TO[gait]]) / 2
-    return speed > halfway * leg_length(window.rest) / leg_length(rest_of(body, None))
+    return take_speed(window) > on_performer(halfway(gait, speeds), window, body)
 
 
 def slow_take(window, words, speeds: dict, body) -> bool:
@@ -258,6 +261,16 @@ def slow_take(window, words, speeds: dict, body) -> bool:
     gait = plain_gait(words)
     if gait is None or gait not in speeds:
         return False
-    speed = gait_speed(np.asarray(window.features)[: max(1, len(window.features) - window.held)])
-    want = speeds[gait] * leg_length(window.rest) / leg_length(rest_of(body, None))
-    return speed < SLOW_TAKE * want
+    return take_speed(window) < SLOW_TAKE * on_performer(speeds[gait], window, body)
+
+
+def take_speed(window) -> float:
+    """A captured take's (``captured_takes.Window``) speed along its root's path, m/s, over the frames
+    it plays before any held on its last pose."""
+    return gait_speed(np.asarray(window.features)[: max(1, len(window.features) - window.held)])
+
+
+def on_performer(speed: float, window, body) -> float:
+    """A ``speed`` on the average body (m/s) on the performer of the take ``window``: scaled by its
+    leg's length against the average body's."""
+    return speed * leg_length(window.rest) / leg_length(rest_of(body, None))
