@@ -9,13 +9,19 @@ HumanML3D features, 20 fps) and the nearest real clips, so the generator's TMA, 
 its samples (``generation/rerank.py``), cannot flatter it (as ``action_classifier.FeatureEmbedder``).
 
 - **legs** (legs and root only): root velocity in the body's own frame (forward, sideways, up
-  and down) and its direction, pelvis height, the hips, knees, ankles and feet relative to
-  the pelvis in the body's frame (mean and spread over time), foot speeds, the share of frames with
-  both feet off the floor and the stride frequency; every length in leg lengths, so bodies of any
-  size compare. Nothing of the path: a gait reads the same circling or straight (the captured jogs
-  at a jog's pace are HDM05's, all circling left; by their turning, as a straightened take plays for
-  "jogs forward", they read as walks or runs). Classes: the gaits of ``compose_parts.LEGS_ACTIONS`` ("walk in a circle" is a
-  walk: its gait) and ``STAND`` (the real standing gesture clips). ``path`` is read apart from the
+  and down) and its direction, pelvis height, the knees, ankles and feet relative to the pelvis in
+  the body's frame (mean and spread over time), foot speeds, the share of frames with both feet off
+  the floor and the stride frequency; every length in leg lengths, so bodies of any size compare.
+  Not the hips, whose place is the skeleton's (a take posed on a body with hips 6 % wider, relative
+  to its legs, moved them 6 standard deviations of the references'), and across the body the legs
+  are placed about their own middle: a circling gait leans into its turn, a straight one does not.
+  Nothing of the path: a gait reads the same circling or straight (the captured jogs at a jog's
+  pace are HDM05's, all circling left, played straight for "jogs forward"). Classes: the gaits of
+  ``compose_parts.LEGS_ACTIONS`` ("walk in a circle" is a walk: its gait) and ``STAND`` (the real
+  standing gesture clips). A locomotion reference is also matched by its steady stretch
+  (``steady_span``: the pelvis at its cruising speed, without the start from standing or the
+  stop), as a gait played on from a loop is steady: HDM05's jogs are 4 steps from standing.
+  ``part_judge_check.py`` in ``tools/`` measures what each of these does on real clips. ``path`` is read apart from the
   gait: ``CIRCLE`` when the body keeps turning one way while it moves (each quarter of the clip
   turns >= ``CIRCLE_DEG_PER_S`` the same way), else "straight".
 - **arms** (``ARMS``): collars, shoulders, elbows and wrists relative to the chest (spine3) in the
@@ -63,8 +69,13 @@ GAITS = tuple(a for a in LEGS_ACTIONS if a != CIRCLE) + (STAND,)
 GESTURES = tuple(dict.fromkeys(SAME_MOTION.get(a, a) for a in ARMS_ACTIONS)) + (NO_GESTURE,)
 CIRCLE_DEG_PER_S = 15.0      # each quarter of a circling clip turns at least this fast, one way
 MOVING_LEGS_PER_S = 0.3      # ... while the pelvis moves at least this many leg lengths per second
+CRUISING = 0.8               # a steady stretch keeps the pelvis at >= this share of its cruising speed
+STEADY_MIN_FRAMES = 20       # ... for at least this long (1 s)
+STEADY_MAX_SHARE = 0.8       # ... and leaves out at least a fifth of the clip (else the clip is steady)
 MIN_FRAMES = 10
-LEG_JOINTS = [1, 2, 4, 5, 7, 8, 10, 11]
+LEG_JOINTS = [1, 2, 4, 5, 7, 8, 10, 11]   # hips, knees, ankles, feet (left, right)
+POSE_JOINTS = [4, 5, 7, 8, 10, 11]         # knees, ankles, feet: the hips' place is the skeleton's
+STRIDE_PAD = 256                           # samples the stride's spectrum is padded to: 0.08 Hz apart
 ARM_JOINTS = [13, 14, 16, 17, 18, 19, 20, 21]
 CHEST = 9
 SIDE_JOINTS = {"hand": ([18, 20], [19, 21]), "foot": ([7, 10], [8, 11])}   # (left, right)
@@ -112,15 +123,30 @@ def body_frame(joints: np.ndarray, theta: np.ndarray) -> np.ndarray:
     return np.einsum("tij,tkj->tki", yaw_matrix(-theta), rel)
 
 
+def straight_joints(joints) -> np.ndarray:
+    """The joints played off their path: each frame's pose as the body faces it, the pelvis moved by
+    the same steps, taken along one heading (a circling take as a straight one)."""
+    j = check_joints(joints)
+    theta = headings(j)
+    local = body_frame(j, theta)
+    step = np.einsum("tij,tj->ti", yaw_matrix(-theta[:-1]), j[1:, 0] - j[:-1, 0])
+    root = np.concatenate([np.zeros((1, 3)), np.cumsum(step, 0)])
+    local[..., 0] += root[:, None, 0]
+    local[..., 2] += root[:, None, 2]
+    return local
+
+
 def arm_length(joints: np.ndarray) -> float:
     seg = lambda a, b: np.linalg.norm(joints[:, a] - joints[:, b], axis=-1)  # noqa: E731
     return float(max(np.median((seg(16, 18) + seg(18, 20) + seg(17, 19) + seg(19, 21)) / 2), 1e-3))
 
 
-def dominant_frequency(x: np.ndarray) -> tuple[float, float]:
-    """(Hz, share of the power) of the strongest frequency in 0.3..5 Hz of a (T,) signal (0, 0 if flat)."""
+def dominant_frequency(x: np.ndarray, pad: int = 64) -> tuple[float, float]:
+    """(Hz, share of the power) of the strongest frequency in 0.3..5 Hz of a (T,) signal (0, 0 if
+    flat), its spectrum zero-padded to at least ``pad`` samples. The share falls with the signal's
+    length (a real walk's stride: 0.21, 0.39, 0.58 over 1, 2, 4 s), so the legs use the frequency only."""
     x = np.asarray(x, np.float64) - np.mean(x)
-    n = max(len(x), 64)
+    n = max(len(x), pad)
     power = np.abs(np.fft.rfft(x * np.hanning(len(x)), n)) ** 2
     freq = np.fft.rfftfreq(n, 1.0 / FPS)
     band = (freq >= 0.3) & (freq <= 5.0)
@@ -145,15 +171,17 @@ def legs_descriptor(joints) -> dict[str, np.ndarray]:
     feet_h = j[:, [7, 8, 10, 11], 1] / L
     low = feet_h.min(1)
     airborne = float((low > np.quantile(low, 0.05) + 0.06).mean())
-    stride, stride_share = dominant_frequency(legs[:, 4, 2] - legs[:, 5, 2])
+    stride = dominant_frequency(legs[:, 4, 2] - legs[:, 5, 2], STRIDE_PAD)[0]
+    pose = local[:, POSE_JOINTS] - local[:, :1] * np.array([0, 1, 0])
+    pose[..., 0] -= pose[..., 0].mean(1, keepdims=True)    # across the body: about the legs' own middle
     return {
         "root": np.array([step[:, 2].mean(), step[:, 0].mean(), hspeed.mean(), hspeed.std(), step[:, 1].std()]),
         "direction": np.array([step[:, 2].mean(), step[:, 0].mean()]) / (np.hypot(step[:, 2].mean(), step[:, 0].mean()) + 0.3),
         "height": np.array([local[:, 0, 1].mean(), local[:, 0, 1].std()]),
-        "pose": legs.mean(0).ravel(),
-        "spread": legs.std(0).ravel(),
+        "pose": pose.mean(0).ravel(),
+        "spread": pose.std(0).ravel(),
         "feet": np.concatenate([feet_speed, [airborne, low.mean()]]),
-        "stride": np.array([stride, stride_share]),
+        "stride": np.array([stride]),
     }
 
 
@@ -195,6 +223,26 @@ def side_of(joints, part: str) -> str:
     return "left" if left > right else "right"
 
 
+def steady_span(joints) -> tuple[int, int] | None:
+    """(start, end) frames of the longest stretch whose pelvis moves at >= ``CRUISING`` of its
+    cruising speed (the 90th percentile of its horizontal speed, 0.25 s smoothed), when it lasts
+    >= ``STEADY_MIN_FRAMES`` and leaves out >= 1 - ``STEADY_MAX_SHARE`` of the clip; else None."""
+    j = check_joints(joints)
+    speed = np.linalg.norm(np.diff(j[:, 0, [0, 2]], axis=0), axis=1) * FPS
+    speed = np.convolve(speed, np.ones(5) / 5, "same")
+    fast = np.concatenate([[False], speed >= CRUISING * np.quantile(speed, 0.9), [False]])
+    edges = np.flatnonzero(np.diff(fast.astype(np.int8)))
+    starts, ends = edges[::2], edges[1::2]
+    if not len(starts):
+        return None
+    i = int(np.argmax(ends - starts))
+    a, b = int(starts[i]), int(ends[i]) + 1   # speed[t] is frames t..t+1
+    b = min(b, len(j))
+    if b - a < STEADY_MIN_FRAMES or b - a > STEADY_MAX_SHARE * len(j):
+        return None
+    return a, b
+
+
 def path_of(joints) -> str:
     """``CIRCLE`` when the body keeps turning one way while it moves, in every quarter; else ``STRAIGHT``."""
     j = check_joints(joints)
@@ -218,10 +266,11 @@ def path_of(joints) -> str:
 class PartKNN:
     """Class-balanced k-NN on one descriptor: a class's score is the mean distance to its ``k``
     nearest references; the lowest wins. Groups are z-scored by the references' spread and weighted
-    so each counts equally."""
+    so each counts equally. ``stretches[i]``: reference i is a stretch of its source clip (its
+    steady part), not the whole clip."""
 
     def __init__(self, descriptors: list[dict], labels: list[str], sources: list[str], describe: Callable, k: int = 5,
-                 weights: dict[str, float] | None = None):
+                 weights: dict[str, float] | None = None, stretches: list[bool] | None = None):
         if not descriptors or len(descriptors) != len(labels) or len(labels) != len(sources):
             raise ShapeMoveError(f"part judge: {len(descriptors)} reference descriptors for {len(labels)} labels; "
                                  "need at least one of each, equal")
@@ -234,6 +283,7 @@ class PartKNN:
         self.weights = np.concatenate([np.full(n, w.get(g, 1.0) / np.sqrt(n)) for g, n in zip(self.groups, self.sizes)])
         self.X = self._norm(X)
         self.labels, self.sources = np.asarray(labels), np.asarray(sources)
+        self.stretches = np.zeros(len(labels), bool) if stretches is None else np.asarray(stretches, bool)  # a part of its source
         self.classes = sorted(set(labels))
         self.describe, self.k = describe, int(k)
 
@@ -372,21 +422,24 @@ class PartJudge:
                 joints[m["id"]] = load_joints(data, m["id"])
         knns = []
         for refs, describe, weights in ((legs_refs, legs_descriptor, LEGS_WEIGHTS), (arms_refs, arms_descriptor, None)):
-            descs, labels, sources = [], [], []
+            descs, labels, sources, stretches = [], [], [], []
             for m, lab in refs:
                 j = joints[m["id"]]
                 if j is None:
                     continue
-                for jj in (j, mirror_joints(j)):
-                    descs.append(describe(jj))
-                    labels.append(lab)
-                    sources.append(m["id"])
+                span = steady_span(j) if describe is legs_descriptor and lab != STAND else None
+                for jj, stretch in [(j, False)] + ([(j[span[0]:span[1]], True)] if span else []):
+                    for kk in (jj, mirror_joints(jj)):
+                        descs.append(describe(kk))
+                        labels.append(lab)
+                        sources.append(m["id"])
+                        stretches.append(stretch)
             if not descs:
                 raise ShapeMoveError(f"{data}: no real {split or 'reference'} clip of a "
                                      f"{'locomotion or standing gesture' if describe is legs_descriptor else 'gesture'} "
                                      "with usable features; the part judge needs them")
-            knns.append(PartKNN(descs, labels, sources, describe, k, weights))
-        count = lambda knn: {c: int((knn.labels == c).sum() // 2) for c in knn.classes}  # noqa: E731
+            knns.append(PartKNN(descs, labels, sources, describe, k, weights, stretches))
+        count = lambda knn: {c: int(((knn.labels == c) & ~knn.stretches).sum() // 2) for c in knn.classes}  # noqa: E731
         info = {"data": str(data), "split": split, "k": k, "max_per_class": max_per_class,
                 "legs_references": count(knns[0]), "arms_references": count(knns[1])}
         return cls(knns[0], knns[1], info)

@@ -12,7 +12,9 @@
   mirror image of each (``data/mirror.py``, the other side), judged by ``side_of`` on the named part.
 
 Each as {"accuracy", "n", "per_class": {label: {"n", "accuracy"}}, "confusion": {label: {pred: n}}}.
-``leave_one_out(judge)`` is the same on the judge's own references, each without its own take.
+``leave_one_out(judge)`` is the same on the judge's own references, each without its own take;
+``steady_accuracy(judge, data)`` on the steady stretches of real locomotion clips
+(``part_judge.steady_span``), each without its own take: a gait as a looped take plays it.
 """
 from __future__ import annotations
 
@@ -89,6 +91,28 @@ def real_accuracy(judge, data, split: str = "test", max_clips: int | None = None
             "references": dict(judge.info)}
 
 
+def steady_accuracy(judge, data, splits: tuple[str, ...] = ("train", "test"), progress: bool = True) -> dict:
+    """The legs judge on the steady stretch of each real locomotion clip of ``splits`` that has one
+    (``steady_span``), each without its own take (its stretch is a reference too): ``tally``."""
+    from tqdm import tqdm
+
+    from ..models.motion_memory import take_of
+    from .part_judge import STAND, steady_span
+
+    knn = judge.legs
+    takes = np.asarray([take_of(str(s)) for s in knn.sources])
+    metas = [m for split in splits for m in real_clips(data, split) if legs_label(actions_of(m)) not in (None, STAND)]
+    pairs = []
+    for m in tqdm(metas, desc="part judge on steady stretches", unit="clip", disable=not progress):
+        j = load_joints(data, m["id"])
+        span = steady_span(j) if j is not None else None
+        if span is None:
+            continue
+        away = sorted(set(knn.sources[takes == take_of(m["id"])]))
+        pairs.append((legs_label(actions_of(m)), knn.classify(j[span[0]:span[1]], away)))
+    return tally(pairs)
+
+
 def leave_one_out(judge) -> dict:
     """Each reference clip classified among the others without its captured take
     (``motion_memory.take_of``: the clip, its mirror image, a source's own mirrored take such as
@@ -101,7 +125,7 @@ def leave_one_out(judge) -> dict:
     for name, knn in (("legs", judge.legs), ("arms", judge.arms)):
         takes = np.asarray([take_of(str(s)) for s in knn.sources])
         pairs = []
-        for i in range(0, len(knn.labels), 2):  # the clip itself; its mirror follows it
+        for i in np.flatnonzero(~knn.stretches)[::2]:  # the clip itself (its mirror follows it), not its steady stretch
             away = sorted(set(knn.sources[takes == takes[i]]))
             pairs.append((str(knn.labels[i]), best(knn.scores_of(knn.X[i], away))))
         out[name] = tally(pairs)
