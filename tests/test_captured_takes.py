@@ -70,6 +70,31 @@ def test_the_pool_offers_takes_of_the_asked_action_and_the_nearest_captions(open
     assert pool.take(3)["provenance"] == "captured: take 3 (CC0)"
 
 
+def test_a_take_that_would_not_compete_gives_its_place_to_another(openbody):
+    """The same pool: with every take competing the draw is the one without the test; kicks 0-3
+    out (a plain jog's slow takes), the seed's three kicks are all from 4-7, drawn in the places
+    of those left out, and the nearest captions' places too are given to waves that compete; with
+    only one kick competing, only it is offered of the kicks (none beyond the takes of the action)."""
+    actions = ["kick"] * 8 + ["walk"] * 8 + ["wave"] * 4
+    lib = MotionLibrary.from_takes([_take(i, a) for i, a in enumerate(actions)])
+    unit = lambda v: np.asarray(v, np.float32) / np.linalg.norm(v)  # noqa: E731
+    by_action = {"kick": unit([0.6, 0.8, 0, 0]), "walk": unit([0, 0, 1, 0]), "wave": unit([0.95, 0.31, 0, 0])}
+    pool = TakePool(openbody, lib)
+    vectors = np.stack([by_action[a] for a in actions])
+    vectors[:8] += np.linspace(0, 0.01, 8)[:, None]   # kicks 7, 6, ... nearest first
+    pool.set_vectors(vectors)
+    text = np.array([1.0, 0, 0, 0], np.float32)
+    for seed in range(6):
+        assert pool.nearest(text, "kick", seed, competes=lambda i: True) == pool.nearest(text, "kick", seed)
+        tested = []
+        drawn = pool.nearest(text, "kick", seed, competes=lambda i: tested.append(i) or i >= 4)
+        kicks = [i for i in drawn if actions[i] == "kick"]
+        assert len(drawn) == 5 and len(kicks) == 3 and all(i >= 4 for i in kicks), (seed, drawn)
+        assert len(tested) == len(set(tested))                     # each take tested once
+        one = pool.nearest(text, "kick", seed, competes=lambda i: i == 5 or actions[i] == "wave")
+        assert [i for i in one if actions[i] == "kick"] == [5] and all(actions[i] in ("kick", "wave") for i in one)
+
+
 def test_a_take_of_another_action_than_the_words_name_does_not_compete():
     assert action_credit("kick", "kick") == ACTION_BONUS
     assert action_credit("jump", "jump forward") == ACTION_BONUS        # a specific form of the asked action

@@ -58,6 +58,7 @@ from ..data.mirror import mirror_joints
 from ..errors import ShapeMoveError
 from ..geometry.rotations import yaw_matrix
 from ..motion.features import FEATURE_DIM, joints_from_features
+from ..motion.root_speed import steady_span
 from ..motion.skeleton_ops import gaussian_smooth, heading_angles, leg_length, smooth_directions
 
 STAND = "stand"
@@ -69,9 +70,6 @@ GAITS = tuple(a for a in LEGS_ACTIONS if a != CIRCLE) + (STAND,)
 GESTURES = tuple(dict.fromkeys(SAME_MOTION.get(a, a) for a in ARMS_ACTIONS)) + (NO_GESTURE,)
 CIRCLE_DEG_PER_S = 15.0      # each quarter of a circling clip turns at least this fast, one way
 MOVING_LEGS_PER_S = 0.3      # ... while the pelvis moves at least this many leg lengths per second
-CRUISING = 0.8               # a steady stretch keeps the pelvis at >= this share of its cruising speed
-STEADY_MIN_FRAMES = 20       # ... for at least this long (1 s)
-STEADY_MAX_SHARE = 0.8       # ... and leaves out at least a fifth of the clip (else the clip is steady)
 MIN_FRAMES = 10
 LEG_JOINTS = [1, 2, 4, 5, 7, 8, 10, 11]   # hips, knees, ankles, feet (left, right)
 POSE_JOINTS = [4, 5, 7, 8, 10, 11]         # knees, ankles, feet: the hips' place is the skeleton's
@@ -221,26 +219,6 @@ def side_of(joints, part: str) -> str:
     """"left" or "right": the side whose hand (or foot) moves most relative to the pelvis."""
     left, right = side_activity(joints, part)
     return "left" if left > right else "right"
-
-
-def steady_span(joints) -> tuple[int, int] | None:
-    """(start, end) frames of the longest stretch whose pelvis moves at >= ``CRUISING`` of its
-    cruising speed (the 90th percentile of its horizontal speed, 0.25 s smoothed), when it lasts
-    >= ``STEADY_MIN_FRAMES`` and leaves out >= 1 - ``STEADY_MAX_SHARE`` of the clip; else None."""
-    j = check_joints(joints)
-    speed = np.linalg.norm(np.diff(j[:, 0, [0, 2]], axis=0), axis=1) * FPS
-    speed = np.convolve(speed, np.ones(5) / 5, "same")
-    fast = np.concatenate([[False], speed >= CRUISING * np.quantile(speed, 0.9), [False]])
-    edges = np.flatnonzero(np.diff(fast.astype(np.int8)))
-    starts, ends = edges[::2], edges[1::2]
-    if not len(starts):
-        return None
-    i = int(np.argmax(ends - starts))
-    a, b = int(starts[i]), int(ends[i]) + 1   # speed[t] is frames t..t+1
-    b = min(b, len(j))
-    if b - a < STEADY_MIN_FRAMES or b - a > STEADY_MAX_SHARE * len(j):
-        return None
-    return a, b
 
 
 def path_of(joints) -> str:

@@ -10,6 +10,10 @@ in one ``TakePool``. For a prompt:
   part) nearest the prompt by caption (the TMA text embedding of the prompt against
   each take's captions), and the takes nearest by caption whatever their action, ``TAKES`` in
   all, drawn by the request's seed from the ``POOL`` x as many nearest (another seed, other takes);
+  a drawn take whose window would not compete (below, and a plain gait's takes too slow, too fast,
+  stopping or turning: ``typical_pace.py``) gives its place to another, drawn the same way, then
+  to the next nearest of the asked action: "she jogs for a while" (seed 0) drew three jogs too slow
+  for a plain jog and was left with the T5's samples;
   the user's own clips come first: their nearest by caption and their nearest of the asked action;
 - each gives one window of the requested length (one of its busiest, ``busiest_start``); a take shorter
   than asked plays on as a loop of its own cycle where it repeats (``take_loop.py``: jumping jacks,
@@ -38,6 +42,7 @@ from __future__ import annotations
 
 import random
 from collections import OrderedDict
+from collections.abc import Callable
 from itertools import islice
 from dataclasses import dataclass
 from pathlib import Path
@@ -218,37 +223,57 @@ class TakePool:
         return self._spans[(i, asked)]
 
     def nearest(self, text: np.ndarray, action: str | None, seed: int, count: int = TAKES,
-                hands: bool | None = None) -> list[int]:
+                hands: bool | None = None, competes: Callable[[int], bool] | None = None) -> list[int]:
         """Takes offered for a prompt whose TMA text vector is ``text`` (see the module docstring);
         ``hands``: a gesture of both hands (True) or one (False): the takes made so, where any is
-        (``hands_asked.py``)."""
+        (``hands_asked.py``); ``competes(i)``: whether take ``i`` would compete, when given: a drawn
+        take that would not gives its place to another drawn the same way, then, among the takes of
+        the asked action, to the next nearest (a plain jog's slow takes do not use up the places of
+        those at a jog's pace)."""
         if not len(self) or not len(self.vectors):
             return []
         sims = self.vectors @ np.asarray(text, np.float32)
         rng = random.Random(int(seed))
         chosen: list[int] = []
+        passed: dict[int, bool] = {}
 
-        def draw(ids, k):
+        def ok(i: int) -> bool:
+            if competes is None:
+                return True
+            if i not in passed:
+                passed[i] = bool(competes(i))
+            return passed[i]
+
+        def draw(ids, k, further: bool):
             ids = [i for i in sorted(ids, key=lambda i: -sims[i]) if i not in chosen]
             if hands is not None:   # the nearest made with the hands asked, looked at in order until enough
                 made = list(islice((i for i in ids if self.two_handed(i) == hands), POOL * k))
                 ids = made or ids
-            ids = ids[:POOL * k]
-            chosen.extend(ids[j] for j in sorted(rng.sample(range(len(ids)), min(k, len(ids)))))
+            near, rest = ids[:POOL * k], ids[POOL * k:]
+            picked = sorted(rng.sample(range(len(near)), min(k, len(near))))
+            kept = [near[j] for j in picked if ok(near[j])]
+            left = [j for j in range(len(near)) if j not in picked]
+            while len(kept) < k and left:   # in place of those that would not compete: drawn the same way
+                j = left.pop(rng.randrange(len(left)))
+                if ok(near[j]):
+                    kept.append(near[j])
+            if further:   # then the next nearest
+                kept += list(islice((i for i in rest if ok(i)), k - len(kept)))
+            chosen.extend(kept)
 
         user = [i for i in range(len(self)) if self.is_user(i)]
         if user:   # the user's own: the nearest by caption, and the nearest of the asked action
             best = max(user, key=lambda i: sims[i])
-            if sims[best] >= USER_FLOOR:
+            if sims[best] >= USER_FLOOR and ok(best):
                 chosen.append(best)
-            mine = [i for i in user if action and self.actions[i] == action and i not in chosen]
+            mine = [i for i in user if action and self.actions[i] == action and i not in chosen and ok(i)]
             if mine:
                 chosen.append(max(mine, key=lambda i: sims[i]))
         named = [i for i in range(len(self)) if action and self.actions[i] == action]
         if action in STAND_IN and not named:   # no take of it: the takes that can stand in (stand_in_takes.py)
             named = [i for i in range(len(self)) if self.stands_in(i, action)]
-        draw(named, max(0, count - len(chosen) - NEAREST) if named else 0)
-        draw(range(len(self)), max(0, count - len(chosen)))
+        draw(named, max(0, count - len(chosen) - NEAREST) if named else 0, True)
+        draw(range(len(self)), max(0, count - len(chosen)), False)
         return chosen
 
     def window(self, i: int, frames: int, seed: int, side=None, longest: int | None = None,
@@ -337,11 +362,21 @@ class TakePool:
 
     def windows(self, text: np.ndarray, action: str | None, seed: int, frames: int, side=None,
                 longest: int | None = None, count: int = TAKES, times: int | None = None,
-                straight: bool = False, hands: bool | None = None, seated: bool = False) -> list[Window]:
+                straight: bool = False, hands: bool | None = None, seated: bool = False,
+                competes: Callable[[Window], bool] | None = None) -> list[Window]:
         """One window of each take offered (``nearest``, ``hands`` as there); ``times``: the repetitions
-        the words ask; ``straight``: the words ask a plain gait; ``seated``: after a sit (``window``)."""
-        return [self.window(i, frames, seed, side, longest, times, straight, action, seated)
-                for i in self.nearest(text, action, seed, count, hands)]
+        the words ask; ``straight``: the words ask a plain gait; ``seated``: after a sit (``window``);
+        ``competes(window)``: whether a take's window competes, when given: only those are offered,
+        up to ``count``, the others' places drawn again (``nearest``)."""
+        cut: dict[int, Window] = {}
+
+        def of(i: int) -> Window:
+            if i not in cut:
+                cut[i] = self.window(i, frames, seed, side, longest, times, straight, action, seated)
+            return cut[i]
+
+        test = (lambda i: competes(of(i))) if competes is not None else None  # noqa: E731
+        return [of(i) for i in self.nearest(text, action, seed, count, hands, test)]
 
 
 def action_credit(asked: str | None, action: str) -> float | None:

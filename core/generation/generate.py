@@ -195,9 +195,10 @@ class Generator:
         self.captured_on = bool(on)
 
     def _windows(self, r: Request, action: str | None, lo: int, hi: int, side=None,
-                 times: int | None = None) -> list[Window]:
+                 times: int | None = None, competes=None) -> list[Window]:
         """Windows of the captured takes of ``action`` (and the nearest captions) offered for ``r``
-        (``captured_takes.TakePool``), cut to the ``times`` repetitions its words count."""
+        (``captured_takes.TakePool``), cut to the ``times`` repetitions its words count; only those
+        that ``competes(window)``, when given."""
         pool = self.pool if self.captured_on else None
         if pool is None or not len(pool):
             return []
@@ -207,9 +208,9 @@ class Generator:
         straight, hands = straight_asked(words), hands_wanted(words, action)   # a gesture's hands as said
         if r.seconds is None:   # the model's length: a take plays whole, at least UNASKED_SECONDS
             return pool.windows(text, action, r.seed, self._length(UNASKED_SECONDS)[0] * down, side, hi * down,
-                                times=times, straight=straight, hands=hands, seated=r.seated)
+                                times=times, straight=straight, hands=hands, seated=r.seated, competes=competes)
         return pool.windows(text, action, r.seed, lo * down, side, times=times, straight=straight, hands=hands,
-                            seated=r.seated)
+                            seated=r.seated, competes=competes)
 
     # -- tokens ------------------------------------------------------------------------------
     def _length(self, seconds: float | None) -> tuple[int, int]:
@@ -259,12 +260,14 @@ class Generator:
             backward = backward_taken(words, wanted)   # "runs backwards": the data's backward gait is a walk
             asked = backward or wanted
             times = words.count[1] if words.count is not None else None          # "three jumping jacks"
-            windows = [w for w in (self._windows(r, asked, lo, hi, side, times) if captured else [])   # of the asked action,
-                       if action_credit(asked, w.action) is not None                    # at a plain gait's pace
-                       and not slow_take(w, words, self.typical_speeds, self.body)
-                       and not fast_take(w, words, self.typical_speeds, self.body)
-                       and not unplain_take(w, words)
-                       and not still_take(w, asked, words)]
+            def competes(w: Window) -> bool:   # of the asked action, at a plain gait's pace
+                return (action_credit(asked, w.action) is not None
+                        and not slow_take(w, words, self.typical_speeds, self.body)
+                        and not fast_take(w, words, self.typical_speeds, self.body)
+                        and not unplain_take(w, words)
+                        and not still_take(w, asked, words))
+
+            windows = self._windows(r, asked, lo, hi, side, times, competes) if captured else []
             windows = performed(windows, asked, times)   # arm circles that stop half way: not when others go on
             for w in windows if backward else []:
                 w.note = f"no capture {backward_verb(requested)} backwards: a walk backward is played"

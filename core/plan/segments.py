@@ -22,7 +22,9 @@ and walks back"); two things at once ("jogs and waves": a gait and an arm gestur
 made by body part (``generation/parts.py``), "jumps and twirls" one action, a turn beside its gait
 one segment ("walks and turns left"), and "back and forth", "to and fro", "up and down" are courses.
 "After" / "before" cut only before a participle or a pronoun ("runs after the ball" is one thing).
-Both sides of a "before" / "after" must name an action ("jumps and turns before landing" is one),
+A "before" / "after" clause must name an action and the clause it orders name one or say what
+someone does ("jumps and turns before landing" is one; "before crouching down, she glances around"
+two: a motion no take is of, then the crouch),
 and what follows "then" must say what someone does ("bends the knees, then straightens" is one
 squat; ``part_prompts._has_verb``). A stop after "then" is the gait's own ("walks forward, then
 stops": one segment that stops, ``vocabulary.STOP``). "Followed by a jump": "a person does
@@ -62,10 +64,13 @@ def _main_clause_start(t: str) -> int | None:
     return None
 
 
-def _both_act(a: str, b: str) -> bool:
-    """Whether both sides of a "before" / "after" name an action of the vocabulary: "jumps, turning
-    before landing" and "favouring one leg after twisting an ankle" are one motion."""
-    return bool(find_actions(a)) and bool(find_actions(b))
+def _both_act(main: str, sub: str) -> bool:
+    """Whether a "before" / "after" clause ``sub`` and the clause it orders, ``main``, are two
+    motions: ``sub`` names an action of the vocabulary and ``main`` names one too or says what
+    someone does ("before crouching down, she glances around": a motion no take is of, then the
+    crouch). "Jumps, turning before landing" and "favouring one leg after twisting an ankle" are
+    one motion."""
+    return bool(find_actions(sub)) and (bool(find_actions(main)) or _has_verb(_tidy(main)))
 
 
 def _ordered(piece: str) -> list[str]:
@@ -75,7 +80,7 @@ def _ordered(piece: str) -> list[str]:
         rest = piece[lead.end():]
         comma = rest.find(",")
         cut = comma if comma >= 0 else _main_clause_start(rest)
-        if cut is not None and _both_act(rest[:cut], rest[cut:]):
+        if cut is not None and _both_act(rest[cut:], rest[:cut]):
             sub, main = rest[:cut], rest[cut:]
             pair = [main, sub] if lead.group(1) == "before" else [sub, main]   # "after", "once"
             return [p for part in pair for p in _ordered(_tidy(part))]
