@@ -18,6 +18,7 @@ def show_plan(s, plan: dict, prompt: str) -> None:
         item.course = f["course"] or "NONE"
         item.course_way = f["course_way"]
         item.distance, item.count, item.seconds = f["distance"], f["count"], f["seconds"]
+        item.manner = f["manner"] or "NONE"
     s.plan_base = json.dumps(plan)
     s.plan_prompt = prompt
 
@@ -25,7 +26,8 @@ def show_plan(s, plan: dict, prompt: str) -> None:
 def _fields(s) -> list[dict]:
     return [{"text": i.text.strip(), "action": i.action.strip(), "side": "" if i.side == "NONE" else i.side,
              "course": "" if i.course == "NONE" else i.course, "course_way": i.course_way,
-             "distance": round(float(i.distance), 3), "count": int(i.count), "seconds": round(float(i.seconds), 3)}
+             "distance": round(float(i.distance), 3), "count": int(i.count), "seconds": round(float(i.seconds), 3),
+             "manner": "" if i.manner == "NONE" else i.manner}
             for i in s.plan_segments]
 
 

@@ -42,6 +42,7 @@ def draw_plan(layout, s) -> None:
         row = box.row(align=True)
         row.prop(item, "distance")
         row.prop(item, "count")
+        box.prop(item, "manner", text="")
 
 
 class SHAPEMOVE_OT_read_plan(ReportingOperator, bpy.types.Operator):

@@ -12,6 +12,7 @@ from bpy.props import (BoolProperty, CollectionProperty, EnumProperty, FloatProp
                        IntProperty, PointerProperty, StringProperty)
 
 from ..core.constants import NUM_BETAS
+from ..core.plan.vocabulary import MANNER_SAID
 from . import semantic_shape, shape_sync
 from .rig_state import current_betas, rig_of
 
@@ -90,6 +91,8 @@ _COURSES = [("NONE", "No course", "Straight, as the words go"), ("walk in a circ
             ("walk in a figure eight", "Figure eight", ""), ("back and forth", "Back and forth", ""),
             ("zigzag", "Zigzag", ""), ("diagonal", "Diagonal", ""),
             ("aside", "To the side", "")]
+_MANNERS = [("NONE", "No manner", "As the captures do it plainly")] + [
+    (m, m.replace("_", " ").capitalize(), said) for m, said in MANNER_SAID.items()]
 
 
 class ShapeMovePlanSegment(bpy.types.PropertyGroup):
@@ -103,6 +106,8 @@ class ShapeMovePlanSegment(bpy.types.PropertyGroup):
     distance: FloatProperty(name="Distance", default=0.0, min=0.0, max=100.0, precision=1, subtype="DISTANCE",
                             description="Metres the gait goes, then stands (0: no distance)")
     count: IntProperty(name="Count", default=0, min=0, max=12, description="Jumps, hops or squats (0: no count)")
+    manner: EnumProperty(name="Manner", items=_MANNERS, default="NONE",
+                         description="How it is done: the captured takes done so compete")
     seconds: FloatProperty(name="Seconds", default=0.0, min=0.0, max=60.0, precision=1,
                            description="This segment's length (0: its share of the motion's length)")
 

@@ -100,3 +100,24 @@ def test_a_course_segment_shows_the_time_to_go_once_round(addon):
             "print(round(model_course_seconds()(read_words('a man walks in a circle')), 2))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert out.returncode == 0 and out.stdout.strip() == "5.85", out.stderr
+
+
+def test_the_manner_is_a_field_and_generating_plays_the_takes_done_so(addon, tmp_path, monkeypatch):
+    """"a man walks proudly, then bows": the first segment's manner is shown (proud), the user
+    makes the bow a happy one and the walk plain; the job plays Bandai's happy bow and a plain walk."""
+    from shapemove.shapemove_addon import job_submit, panels, paths
+
+    s = bpy.context.scene.shapemove
+    s.prompt = "a man walks proudly, then bows"
+    assert bpy.ops.shapemove.read_plan() == {"FINISHED"}
+    assert [(i.action, i.manner) for i in s.plan_segments] == [("walk", "proud"), ("bow", "NONE")]
+    assert drawn(panels.SHAPEMOVE_PT_generate, bpy.context).count("prop:manner") == 2
+    s.plan_segments[0].manner, s.plan_segments[1].manner = "NONE", "happy"
+    sent = []
+    monkeypatch.setattr(job_submit, "submit_job", lambda op, params, **kw: sent.append((params, kw["on_result"])))
+    monkeypatch.setattr(paths, "new_motion_path", lambda label: tmp_path / f"{len(sent)}.npz")
+    assert bpy.ops.shapemove.generate() == {"FINISHED"}
+    plan = json.loads(sent[-1][0]["plan"])
+    assert "manner" not in plan["segments"][0]["understood"] and plan["segments"][1]["understood"]["manner"] == "happy"
+    result = _run_job({**sent[-1][0], "candidates": 1})
+    assert "bow_happy" in result["provenance"] and "walk_proud" not in result["provenance"], result["provenance"]

@@ -71,7 +71,8 @@ def test_each_word_class_reads_its_example(word_class):
 
 
 def test_words_no_class_takes_are_named():
-    assert read_words("a man paces nervously").unused == ("nervously",)
+    assert read_words("a man paces impatiently").unused == ("impatiently",)
+    assert read_words("a man paces nervously").unused == () and read_words("a man paces nervously").manner == "timid"
     assert read_words("a man sits down quickly").unused == ("quickly",)   # no gait: a fast pace is not acted on
     assert read_words("an old man sits down slowly").unused == ()           # an action done slowly
     assert read_words("an old man sits down slowly").slowly and not read_words("a woman walks slowly").slowly

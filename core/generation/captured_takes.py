@@ -88,6 +88,7 @@ class Window:
     cut: int = 0            # frames of the repetitions asked that the length asked leaves out
     note: str = ""          # why this take stands in for what was asked (travel_words.backward_taken)
     seated: bool = False    # it starts where its take sits on the floor (a lie-down after a sit: floor_sit.py)
+    manner: str | None = None   # how its take is done, as its captions say (``take_manner``)
 
     @property
     def arrays(self) -> dict:
@@ -136,6 +137,8 @@ class TakePool:
         self._cache: OrderedDict = OrderedDict()
         self._both: dict[int, bool] = {}
         self._spans: dict[tuple[int, str], tuple[int, int] | None] = {}
+        self._manners: dict[int, str | None] = {}
+        self.user_captions: dict[int, list[str]] = {}
 
     def __len__(self) -> int:
         return len(self.actions)
@@ -164,6 +167,7 @@ class TakePool:
         v = self.embed(list(captions))
         self.vectors = v if not len(self.vectors) else np.concatenate([self.vectors, v])
         self.actions += [(find_actions(c) or [""])[0] for c in captions]
+        self.user_captions.update({len(self.files) + k: [c] for k, c in enumerate(captions)})
         self.files += [Path(p) for p in paths]
         self.ids += list(ids)
 
@@ -195,6 +199,17 @@ class TakePool:
         if len(self._cache) > KEPT:
             self._cache.popitem(last=False)
         return out
+
+    def manner(self, i: int) -> str | None:
+        """The manner take ``i`` is done in, as its captions say it (``take_manner``; kept)."""
+        if i not in self._manners:
+            captions = self.user_captions.get(i) or (self.library.captions(i) if self.files[i] is None else [])
+            self._manners[i] = take_manner(captions)
+        return self._manners[i]
+
+    def manners_of(self, action: str | None) -> set:
+        """The manners of the takes of ``action`` (None among them for a plain take)."""
+        return {self.manner(i) for i in range(len(self)) if action and self.actions[i] == action}
 
     def two_handed(self, i: int) -> bool:
         """Whether take ``i`` makes its gesture with both hands (``hands_asked.made_with_both``; kept)."""
@@ -358,7 +373,7 @@ class TakePool:
             joints = pose(rot, root, con)
         return Window(rot, root, con, t["rest"], self.proc.features(joints, rot, con), action, self.ids[i],
                       provenance + (", mirrored" if flip else ""), held, flip, looped,
-                      max(0, n - want) if exact else 0, seated=from_seat)
+                      max(0, n - want) if exact else 0, seated=from_seat, manner=self.manner(i))
 
     def windows(self, text: np.ndarray, action: str | None, seed: int, frames: int, side=None,
                 longest: int | None = None, count: int = TAKES, times: int | None = None,
@@ -377,6 +392,21 @@ class TakePool:
 
         test = (lambda i: competes(of(i))) if competes is not None else None  # noqa: E731
         return [of(i) for i in self.nearest(text, action, seed, count, hands, test)]
+
+
+def take_manner(captions: list[str]) -> str | None:
+    """The manner a take's ``captions`` give it (``plan.reader.manner_of``, the prompt's reader): the
+    one at least half of them say ("A person bows happily." / "A human takes a bow cheerfully."), else
+    None (a plain take)."""
+    from collections import Counter
+
+    from ..plan.reader import manner_of
+
+    said = Counter(m for m in (manner_of(c) for c in captions) if m is not None)
+    if not said:
+        return None
+    manner, n = said.most_common(1)[0]
+    return manner if 2 * n >= len(captions) else None
 
 
 def action_credit(asked: str | None, action: str) -> float | None:

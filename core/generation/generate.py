@@ -32,6 +32,7 @@ from ..scene.motion_file import Motion
 from ..torch_threads import one_torch_thread
 from .action_clips import ACTION_CLIPS, UNASKED_SECONDS, action_clips
 from .captured_takes import TakePool, Window, action_credit, captured_motion, decoded_provenance
+from .manner_words import ANY, manner_kept, shown, unmet_note
 from .course_shapes import ACTIONS as COURSE_ACTIONS, unasked_seconds
 from .course_walk import course_motion
 from .decode import decode_features, decode_tokens, redecode
@@ -76,6 +77,7 @@ class Choice(NamedTuple):
     window: Window | None         # the captured take kept (captured_takes.py)
     body: np.ndarray              # (10,) the body the motion is made for (``Generator.body_shape``)
     body_source: str              # where that body came from ("[BETA] head", "measurements", ...)
+    note: str = ""                # what the motion says of the choice (a manner asked not shown: manner_words.py)
 
     @property
     def clips(self) -> list[str]:
@@ -260,8 +262,12 @@ class Generator:
             backward = backward_taken(words, wanted)   # "runs backwards": the data's backward gait is a walk
             asked = backward or wanted
             times = words.count[1] if words.count is not None else None          # "three jumping jacks"
-            def competes(w: Window) -> bool:   # of the asked action, at a plain gait's pace
+            manners = self.pool.manners_of(asked) if captured and self.pool is not None else set()
+            manner = manner_kept(words.manner, manners)   # how the takes that compete are done (manner_words.py)
+
+            def competes(w: Window) -> bool:   # of the asked action, at a plain gait's pace, done as asked
                 return (action_credit(asked, w.action) is not None
+                        and (not asked or w.manner == manner or manner is ANY)
                         and not slow_take(w, words, self.typical_speeds, self.body)
                         and not fast_take(w, words, self.typical_speeds, self.body)
                         and not unplain_take(w, words)
@@ -275,6 +281,9 @@ class Generator:
                                     else self._sampled(r, lo, hi, g, library=not windows, asked=asked))   # takes, or as codes
             if r.seated and any(w.seated for w in windows):   # after a sit: the lie-downs from their sits,
                 windows, cands, sources = [w for w in windows if w.seated], [], []   # none that stands up first
+            if shown(words.manner, windows):   # "walks proudly": the takes done so, not the samples
+                cands, sources = [], []
+            note = unmet_note(words.manner, asked, windows) if captured else ""
             best = 0
             body, body_source = self.body_shape(body_of or r, beta.numpy())
             if reach is not None:   # the distance on the T5's body, which the samples are decoded on
@@ -288,8 +297,8 @@ class Generator:
                 bonus = [0.0] * len(cands) + [action_credit(asked, w.action) for w in windows]
                 best = self.picker.pick(r.prompt, feats + [w.features for w in windows], bonus, r.words, reach)
             if best >= len(cands):
-                return Choice(None, beta, None, windows[best - len(cands)], body, body_source)
-            return Choice(cands[best], beta, sources[best], None, body, body_source)
+                return Choice(None, beta, None, windows[best - len(cands)], body, body_source, note)
+            return Choice(cands[best], beta, sources[best], None, body, body_source, note)
 
     @staticmethod
     def _asked(r: Request) -> str | None:
@@ -487,13 +496,16 @@ class Generator:
         codes miss played as captured (``library_take``), or the codes decoded."""
         if c.window is not None:
             with one_torch_thread():
-                return captured_motion(c.window, self.body, betas, self.ik_refine_iters, prompt)
-        m = self.library_take(c.kept, c.codes, betas, prompt)
-        if m is not None:
-            m.provenance = f"captured: {self.library_files[c.kept].name} (your library)"
-            return m
-        m = self.decode_motion(c.codes, betas, prompt=prompt)
-        m.provenance = decoded_provenance(c.kept)
+                m = captured_motion(c.window, self.body, betas, self.ik_refine_iters, prompt)
+        else:
+            m = self.library_take(c.kept, c.codes, betas, prompt)
+            if m is not None:
+                m.provenance = f"captured: {self.library_files[c.kept].name} (your library)"
+            else:
+                m = self.decode_motion(c.codes, betas, prompt=prompt)
+                m.provenance = decoded_provenance(c.kept)
+        if c.note:
+            m.notes.append(c.note)
         return m
 
     def _text_encoder(self):

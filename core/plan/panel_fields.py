@@ -2,10 +2,12 @@
 
     fields = plan_fields(plan_json("a man walks 3 metres forward, then waves", 4))
     -> [{"text": "a man walks 3 metres forward", "action": "walk", "side": "", "course": "",
-         "course_way": "left", "distance": 3.0, "count": 0, "seconds": 2.0}, {... "action": "wave" ...}]
+         "course_way": "left", "distance": 3.0, "count": 0, "seconds": 2.0, "manner": ""},
+        {... "action": "wave" ...}]
     edited_plan(plan, fields)   # the plan's JSON with the fields' values, for ``plan.plan_from_json``
 
-A field's empty value asks nothing: side "" (no side), course "", distance 0, count 0; seconds 0
+A field's empty value asks nothing: side "" (no side), course "", distance 0, count 0, manner ""
+(none: the plain takes); seconds 0
 is the segment's share of the length (a length its words asked, "for ten seconds", included). The other readings of a segment (its travel, a turn, a
 pace, two things at once) are kept as the words gave them.
 """
@@ -25,7 +27,8 @@ def plan_fields(plan: dict) -> list[dict]:
         out.append({"text": seg["text"], "action": actions[0] if actions else "",
                     "side": said.get("side", ""), "course": said.get("course") or "",
                     "course_way": said.get("course_way", "left"), "distance": float(said.get("distance_m") or 0.0),
-                    "count": int(said.get("count") or 0), "seconds": float(seg.get("seconds") or 0.0)})
+                    "count": int(said.get("count") or 0), "seconds": float(seg.get("seconds") or 0.0),
+                    "manner": said.get("manner") or ""})
     return out
 
 
@@ -45,7 +48,7 @@ def edited_plan(plan: dict, fields: list[dict]) -> dict:
             said["actions"] = [f["action"]]
         elif not f["action"]:
             said.pop("actions", None)
-        for key, value in (("side", f["side"]), ("course", f["course"])):
+        for key, value in (("side", f["side"]), ("course", f["course"]), ("manner", f.get("manner", ""))):
             if value:
                 said[key] = value
             else:

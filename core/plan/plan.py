@@ -13,7 +13,8 @@ may change, add or remove: ``actions`` (the first is the segment's action: a new
 action's words in the text the model reads), ``side`` ("left hand"), ``course`` and ``course_way``,
 ``turn_degrees``, ``travel``, ``in_place``, ``distance_m``, ``steps``, ``stop``, ``stand_still``,
 ``count``, ``pace``, ``seconds`` (the length its words ask), ``arms_held`` (the raised arms kept
-up), ``hands`` (a gesture's hands: "both" or "one"); a segment's ``text`` and ``seconds``
+up), ``hands`` (a gesture's hands: "both" or "one"), ``manner`` (how it is done: a name of
+``vocabulary.MANNERS``, "proud"); a segment's ``text`` and ``seconds``
 (its length, which wins) too. A field left out asks nothing. The
 motion keeps the plan (``Motion.plan``), so a timeline re-decoded for a new body or a strip
 regenerated acts on its edited segments again (``generation/timeline_plan.plan_readings``).
@@ -29,7 +30,7 @@ from ..errors import ShapeMoveError
 from .segments import MIN_SEGMENT_SECONDS, SEGMENT_SECONDS, split_segments
 from . import vocabulary as V
 from .part_prompts import LEGS
-from .vocabulary import POSTURE_SECONDS, REPETITION_SECONDS
+from .vocabulary import MANNERS, POSTURE_SECONDS, REPETITION_SECONDS
 from .words import Words, read_words
 
 MAX_SEGMENTS = 32          # as a timeline (``generation/sequence.MAX_SEGMENTS``)
@@ -171,7 +172,7 @@ def _choice(value, where: str, options) -> str:
 
 UNDERSTOOD_KEYS = ("actions", "legs", "arms", "course", "course_way", "turn_degrees", "travel", "in_place",
                    "distance_m", "steps", "stop", "stand_still", "count", "pace", "slowly", "seconds", "side",
-                   "arms_held", "hands", "unused")
+                   "arms_held", "hands", "manner", "unused")
 
 
 def _swap_action(text: str, old: str | None, new: str) -> str:
@@ -297,13 +298,14 @@ def _edited_words(seg: dict, where: str, text: str) -> tuple[str, Words]:
     slowly = _flag(said.get("slowly", False), f"{where}.understood.slowly") and pace is None
     length = None if said.get("seconds") is None else _number(said["seconds"], f"{where}.understood.seconds",
                                                               MIN_SEGMENT_SECONDS, MAX_SECONDS)
+    manner = None if said.get("manner") is None else _choice(said["manner"], f"{where}.understood.manner", tuple(MANNERS))
     gait_text = read.gait_text if read.stop else (text if stop else None)
     flight = pace == "slow" and any(a in ("jog", "run", "sprint") for a in (actions or read.actions))
     return text, replace(read, parts=parts, side=None if parts is not None else side, course=course,
                          course_right=way == "right", turn=turn, travel=replace(travel, in_place=in_place),
                          in_place=in_place, stop=stop, steps=steps, distance_m=metres, gait_text=gait_text,
                          stand_still=stand and not stop, count=count, pace=pace, slow_flight=flight, slowly=slowly,
-                         seconds=length, hands=hands, arms_held=held)
+                         seconds=length, hands=hands, arms_held=held, manner=manner)
 
 
 def plan_from_json(data, seconds: float | None = None) -> Plan:

@@ -76,6 +76,13 @@ def asks_slow_action(prompt: str) -> bool:
 
 
 # -- stop, steps, distance, standing ----------------------------------------------------------
+def manner_of(text: str) -> str | None:
+    """The manner ``text`` says an action is done in (``vocabulary.MANNERS``, the first of its
+    order found), or None: a prompt's ("walks proudly": "proud") or a caption's."""
+    low = str(text).lower()
+    return next((k for k, rx in V.MANNER_PATTERNS.items() if rx.search(low)), None)
+
+
 def stop_request(text: str) -> tuple[str, int | None] | None:
     """(the prompt without its stop clause or distance, the steps it counts or None) when ``text``
     asks a gait to stop, counts the steps of a gait and asks nothing else ("takes three steps
@@ -301,13 +308,13 @@ _TAKEN = (V.COUNT_TIMES, V.FAST, V.SLOW, V.STOP, V.STEPS, V.STEPS_ALONE, V.STILL
           V.COUNTER_CLOCKWISE, V.BACK_AND_FORTH, V.ZIGZAG, V.DIAGONAL, V.COURSE_WORDS, V.COURSE_WAY, V.TURN_WHOLE,
           V.TURN_HALF, V.TURN_QUARTER, V.FORWARD, V.BACKWARD, V.IN_PLACE, V.TRAVEL_SIDE, V.SIDEWAYS, V.SIDE,
           V.DIRECTION, V.SUBJECT, V.TURN_TWICE, V.ARMS_HELD, V.BOTH_HANDS, V.ONE_HAND, V.DURATION, V.ASIDE,
-          V.CONNECTOR, V.THEN)
+          V.CONNECTOR, V.THEN, V.MANNER)
 
 
 def unused_words(text: str, body_words=(), idle=()) -> list[str]:
     """The words of ``text`` that no word class took: not an action, a subject, a body word
-    (``body_words``), a small word or any class of the vocabulary ("nervously" in "a man paces
-    nervously"); ``idle``: classes whose words were said but not acted on (a pace without a gait:
+    (``body_words``), a small word or any class of the vocabulary ("impatiently" in "a man paces
+    impatiently"); ``idle``: classes whose words were said but not acted on (a pace without a gait:
     "sits down slowly"). The model still reads them with the rest of the prompt."""
     from ..data.actions import split_words
 

@@ -49,6 +49,44 @@ FAST = re.compile(r"\b(quick(?:ly)?|fast(?:er)?|brisk(?:ly)?|rapid(?:ly)?|swift(
 SLOW = re.compile(r"\b(slow(?:ly|er)?|leisurely|lazily|sluggish(?:ly)?|unhurried(?:ly)?|"
                   r"(?:easy|gentle|relaxed|snail's|leisurely|slow) pace)\b", re.I)
 
+# -- manner: how an action is done, as the captures say it --------------------------------------------
+# The data's styles (Bandai's style labels and CMU's style words, written into their captions by
+# ``data/captions.py``): the manner a prompt asks ("walks proudly", "a tired man walks") and a captured
+# take's own (``manner_of`` its captions), read by the same patterns. Looked for in this order, the
+# first found wins ("energetically, with youthful vigour": youthful; "stiffly, like an old person": old).
+MANNERS = {
+    "youthful": r"youthful(?:ly)?|with youthful vigou?r",
+    "old": r"like an? (?:old|elderly) (?:person|man|woman|lady|gentleman)|(?:old|elderly|aged) "
+           r"(?:person|man|woman|lady|gentleman|people|men|women)|grand(?:ma|pa|mother|father)|granny",
+    "stiff": r"stiff(?:ly)?|as if aching",
+    "happy": r"happ(?:y|ily)|cheerful(?:ly)?|joyful(?:ly)?|gleeful(?:ly)?",
+    "sad": r"sad(?:ly)?|gloom(?:y|ily)|dejected(?:ly)?|depressed|sorrowful(?:ly)?|mournful(?:ly)?",
+    "angry": r"angr(?:y|ily)|furious(?:ly)?|in anger|enraged",
+    "proud": r"proud(?:ly)?|with pride",
+    "timid": r"timid(?:ly)?|without confidence|unconfident(?:ly)?|shy(?:ly)?|nervous(?:ly)?|hesitant(?:ly)?",
+    "scared": r"fearful(?:ly)?|scared|afraid|frightened",
+    "tired": r"tired(?:ly)?|wear(?:y|ily)|exhausted|with exhaustion",
+    "childish": r"childish(?:ly)?|childlike|like a (?:little )?(?:child|kid)",
+    "masculine": r"masculine|in a (?:manly|masculine) (?:way|manner)|manly|macho",
+    "feminine": r"feminine|in a (?:feminine|girlish|ladylike) (?:way|manner)|girlish(?:ly)?|ladylike",
+    "energetic": r"energetic(?:ally)?|active(?:ly)?|vigorous(?:ly)?|lively",
+    "rhythmic": r"rhythmic(?:al)?(?:ly)?|like in a musical",
+    "giant": r"like a giant|with heavy steps|heavy-footed|lumbering",
+    "swagger": r"(?:with a )?swagger(?:ing|s)?|like a (?:street )?thug|coolly",
+    "exaggerated": r"exaggerated|extravagant(?:ly)?|dramatic(?:ally)?|with (?:large|big|huge) steps",
+    "clumsy": r"clums(?:y|ily)",
+    "careful": r"careful(?:ly)?|cautious(?:ly)?",
+    "seductive": r"seductive(?:ly)?|sexy",
+}
+MANNER_PATTERNS = {k: re.compile(r"\b(?:" + v + r")\b") for k, v in MANNERS.items()}
+MANNER = re.compile(r"\b(?:in an? )?(?:" + "|".join(MANNERS.values()) + r")(?: (?:way|manner|fashion))?\b")   # the words taken
+MANNER_SAID = {"youthful": "youthfully", "old": "like an old person", "stiff": "stiffly", "happy": "happily",
+               "sad": "sadly", "angry": "angrily", "proud": "proudly", "timid": "timidly", "scared": "fearfully",
+               "tired": "wearily", "childish": "childishly", "masculine": "in a masculine way",
+               "feminine": "in a feminine way", "energetic": "energetically", "rhythmic": "rhythmically",
+               "giant": "like a giant", "swagger": "with a swagger", "exaggerated": "with exaggerated strides",
+               "clumsy": "clumsily", "careful": "carefully", "seductive": "seductively"}
+
 # -- stop, steps, distance, standing still ------------------------------------------------------
 STOP = re.compile(r"\s*(?:,\s*)?(?:\b(?:and|then)\s+)*(?:\b(?:he|she|they|it)\s+)?"
                   r"\b(?:stops?(?:\s+(?:walking|running|jogging|moving))?|halts?|comes? to a (?:stop|halt)|"
@@ -286,6 +324,11 @@ WORD_CLASSES = (
     WordClass("pace", "quickly, briskly, fast / slowly, at a leisurely pace (with a gait)",
               "fast: the fastest third of the candidates; slow: played slower or shorter strides",
               "a woman walks slowly", {"pace": "slow"}),
+    WordClass("manner", "proudly, sadly, happily, angrily, timidly, wearily, childishly, like an old person, an old / "
+              "a tired / a proud man, like a giant, with a swagger, rhythmically, energetically, ... (``MANNERS``)",
+              "the captured takes of the action done so compete, alone (the T5's samples too when none is: it is "
+              "said); none asked, the takes done in a manner compete only where no plain one is",
+              "a man walks proudly", {"manner": "proud"}),
     WordClass("slowly", "slowly, at a leisurely pace (with an action that is no gait)",
               "the action played at 0.67 of its speed, its held end taken up first (generation/slow_action.py)",
               "an old man sits down slowly", {"slowly": True}),

@@ -48,7 +48,8 @@ class Words:
     arms_held: bool = False                    # the arms kept raised ("with both arms raised")
     hands: str | None = None                   # a gesture's hands: "both" ("waves with both hands"), "one" ("a hand")
     seconds: float | None = None               # the length the words ask ("for ten seconds")
-    unused: tuple[str, ...] = ()               # words no class took ("nervously")
+    manner: str | None = None                  # how it is done (``vocabulary.MANNERS``: "proud")
+    unused: tuple[str, ...] = ()               # words no class took ("impatiently")
 
     @property
     def slow_steps(self) -> bool:
@@ -104,6 +105,8 @@ class Words:
             out["hands"] = self.hands
         if self.seconds is not None:
             out["seconds"] = self.seconds
+        if self.manner is not None:
+            out["manner"] = self.manner
         if self.unused:
             out["unused"] = list(self.unused)
         return out
@@ -128,7 +131,7 @@ def read_words(text: str) -> Words:
         gait_text=None if stop is None else stop[0],
         stand_still=stop is None and R.asks_stand_still(low), count=R.asked_count(low), pace=pace,
         slow_flight=pace == "slow" and R.asks_slow_flight(low), slowly=slowly, gestures_only=R.gestures_only(low),
-        arms_held=R.arms_held(low), hands=R.hands_asked(low), seconds=R.asked_seconds(low),
+        arms_held=R.arms_held(low), hands=R.hands_asked(low), seconds=R.asked_seconds(low), manner=R.manner_of(low),
         unused=tuple(R.unused_words(low, _body_words(low), () if pace or slowly else (V.FAST, V.SLOW))))
 
 

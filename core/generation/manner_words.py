@@ -1,0 +1,50 @@
+"""How the captured takes that compete are done: the manner the words ask ("walks proudly", "a
+tired man walks": the plan's ``Words.manner``) against the manners of the takes of the action
+(``captured_takes.TakePool.manner``: what their captions say, read by the prompt's own reader).
+
+- A manner asked that some take of the action is done in: those takes alone compete, and the T5's
+  samples do not (the TMA that chooses hardly tells a proud walk from a plain one).
+- A manner asked that no take of the action is done in: every take competes, the samples too, and
+  the motion says the manner was not shown (``unmet_note``).
+- None asked: the plain takes (no manner in their captions) compete where the action has any, else
+  all of them: "a man bows" drew the bow "like in a musical", or "with a swagger, like a street
+  thug", as readily as the plain one; a plain walk, CMU's "walk, exaggerated stride".
+
+    manner = manner_kept(words.manner, pool.manners_of("walk"))
+    competes = window.manner == manner or manner is ANY
+"""
+from __future__ import annotations
+
+from ..plan.vocabulary import MANNER_SAID
+
+
+class _Any:
+    def __repr__(self) -> str:
+        return "ANY"
+
+
+ANY = _Any()   # every take competes, whatever its manner
+
+
+def manner_kept(asked: str | None, manners: set):
+    """The manner of the takes that compete (None: the plain ones), or ``ANY``; ``asked``: the
+    manner the words ask (None: none); ``manners``: those of the action's takes (None for a plain
+    one; empty when the words name no action or it has no take)."""
+    if asked is not None:
+        return asked if asked in manners else ANY
+    return None if None in manners else ANY
+
+
+def shown(asked: str | None, windows) -> bool:
+    """Whether a take done in the ``asked`` manner is among the ``windows`` that compete (the T5's
+    samples then do not)."""
+    return asked is not None and any(w.manner == asked for w in windows)
+
+
+def unmet_note(asked: str | None, action: str | None, windows) -> str:
+    """What the motion says when the manner asked is not shown: no take of ``action`` done so
+    competes ("" when it is, or none was asked)."""
+    if asked is None or shown(asked, windows):
+        return ""
+    what = f"of {action!r} " if action else ""
+    return f"not done {MANNER_SAID.get(asked, asked)}: no captured take {what}is done so (the words are read as a whole)"

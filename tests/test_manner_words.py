@@ -1,0 +1,69 @@
+"""How an action is done: the manner the words ask against the captured takes' own, read from their
+captions by the prompt's reader (plan/vocabulary.MANNERS, generation/manner_words.py)."""
+from __future__ import annotations
+
+import pytest
+
+from shapemove.core.generation.captured_takes import take_manner
+from shapemove.core.generation.manner_words import ANY, manner_kept, unmet_note
+from shapemove.core.plan.words import read_words
+
+pytestmark = pytest.mark.usefixtures("one_thread")
+
+
+@pytest.mark.parametrize("text, manner", [
+    ("a man walks proudly", "proud"), ("a tired woman runs", "tired"), ("an old man walks", "old"),
+    ("she walks in a proud manner", "proud"), ("a person bows in a childish way", "childish"),
+    ("A person walks forward energetically, with youthful vigour.", "youthful"),   # the first of the order
+    ("A person walks forward stiffly, like an old person.", "old"),
+    ("A person walks with exaggerated strides.", "exaggerated"), ("a man paces nervously", "timid"),
+    ("a heavy man walks", None), ("a man walks", None), ("a person walks slowly", None),   # a body word, a pace
+])
+def test_the_manner_the_words_say(text, manner):
+    w = read_words(text)
+    assert w.manner == manner and not set(w.unused) & {"proudly", "tired", "manner", "way", "childish", "nervously"}
+
+
+def test_a_take_s_manner_is_what_half_its_captions_say():
+    assert take_manner(["A person bows happily.", "A human takes a bow cheerfully.", "A person bows."]) == "happy"
+    assert take_manner(["A person walks sadly.", "A person walks.", "A human walks.", "Someone walks."]) is None
+    assert take_manner(["A person walks.", "A person walks sadly."]) == "sad"                  # half
+    assert take_manner([]) is None and take_manner(["A person waves."]) is None
+
+
+def test_which_takes_compete():
+    plain_and_styled = {None, "happy", "proud"}
+    assert manner_kept("proud", plain_and_styled) == "proud"      # asked and offered: those takes
+    assert manner_kept("sad", plain_and_styled) is ANY           # asked, none done so: every take
+    assert manner_kept(None, plain_and_styled) is None           # none asked: the plain takes
+    assert manner_kept(None, {"happy", "sad"}) is ANY            # no plain take: every take
+    assert manner_kept(None, set()) is ANY and manner_kept("sad", set()) is ANY
+
+    class W:
+        def __init__(self, manner):
+            self.manner = manner
+
+    assert unmet_note("proud", "sit", [W(None)]) == (
+        "not done proudly: no captured take of 'sit' is done so (the words are read as a whole)")
+    assert unmet_note("proud", "walk", [W("proud")]) == "" and unmet_note(None, "walk", [W(None)]) == ""
+
+
+def test_generating_plays_the_takes_done_as_asked():
+    """The default model: "a man bows" drew the bow "like in a musical" (seed 0) and a plain walk
+    CMU's "walk, exaggerated stride"; asked a manner, its take plays, and a manner no take of the
+    action has is said."""
+    from shapemove.core.generation.generate import Generator, Request
+
+    gen = Generator(None)
+    for seed in range(3):
+        bow = gen.generate_batch([Request("a man bows", seed=seed, seconds=3)])[0]
+        assert "dataset-1_bow_normal_001" in bow.provenance, bow.provenance
+        walk = gen.generate_batch([Request("a woman walks", seed=seed, seconds=3)])[0]
+        i = gen.pool.ids.index(walk.provenance.split()[2]) if walk.provenance.startswith("captured: CMU") else None
+        assert "exaggerated" not in walk.provenance and (i is None or gen.pool.manner(i) is None), walk.provenance
+    proud = gen.generate_batch([Request("a man walks proudly", seed=0, seconds=3)])[0]
+    assert "walk_proud" in proud.provenance and not proud.notes
+    happy = gen.generate_batch([Request("a man bows happily", seed=1, seconds=3)])[0]
+    assert "bow_happy" in happy.provenance
+    sit = gen.generate_batch([Request("a man sits down proudly", seed=0, seconds=3)])[0]
+    assert "not done proudly: no captured take of 'sit' is done so" in " ".join(sit.notes)
