@@ -9,8 +9,9 @@ from shapemove.core.data.mirror import mirror_joints
 from shapemove.core.errors import ShapeMoveError
 from shapemove.core.eval.part_judge import (CIRCLE, NO_GESTURE, STRAIGHT, PartJudge, actions_of, arms_label,
                                             dominant_frequency, joints_of, legs_descriptor, legs_label, legs_right,
-                                            load_joints, path_of, side_activity, side_of, steady_span, straight_joints)
+                                            load_joints, path_of, side_activity, side_of, straight_joints)
 from shapemove.core.eval.part_judge_accuracy import leave_one_out, named_side, real_accuracy
+from shapemove.core.motion.root_speed import steady_span
 
 WAVE_LEFT = "dataset-2_wave-left-hand_elderly_001"
 KICK_LEFT = "HDM_bd_kickLFront1Reps_001_120"

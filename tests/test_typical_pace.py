@@ -237,3 +237,29 @@ def test_a_quick_jog_goes_faster_than_a_jog_and_slower_than_a_run(openbody):
     speed = mean_speed(m.joints, m.fps)
     cap = body_speed((speeds["jog"] + speeds["run"]) / 2, openbody, m.betas)
     assert body_speed(speeds["jog"], openbody, m.betas) < speed <= cap * (1 + TOLERANCE)
+
+
+def test_the_table_reads_each_capture_once_under_way(tiny_dataset):
+    """A capture's speed in the table is its speed over its steady stretch (``steady_span``: HDM05's
+    jogs are 4 steps from standing), the whole take's where it has none."""
+    import importlib.util
+    from pathlib import Path
+
+    import numpy as np
+
+    from shapemove.core.motion.root_speed import mean_speed, steady_span
+
+    spec = importlib.util.spec_from_file_location("typical_pace_tool", Path(__file__).parents[1] / "tools" / "typical_pace.py")
+    tool = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(tool)
+    found = tool.gait_speeds(tiny_dataset)
+    read = []
+    for cid in (tiny_dataset / "train.txt").read_text().split():
+        path = tiny_dataset / "norm_joints" / f"{cid}.npy"
+        if path.is_file():
+            j = np.load(path)
+            span = steady_span(j) or (0, len(j))
+            read.append((cid, mean_speed(j[span[0]:span[1]]), mean_speed(j), span))
+    in_table = sorted(v for kinds in found.values() for speeds in kinds.values() for v in speeds)
+    assert in_table and all(any(abs(v - r[1]) < 1e-9 for r in read) for v in in_table)
+    assert any(abs(v - r[1]) < 1e-9 and r[1] > 1.05 * r[2] for r in read for v in in_table), (read, found)

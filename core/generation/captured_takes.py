@@ -138,6 +138,7 @@ class TakePool:
         self._both: dict[int, bool] = {}
         self._spans: dict[tuple[int, str], tuple[int, int] | None] = {}
         self._manners: dict[int, str | None] = {}
+        self._sideways: dict[int, bool] = {}
         self.user_captions: dict[int, list[str]] = {}
 
     def __len__(self) -> int:
@@ -207,9 +208,22 @@ class TakePool:
             self._manners[i] = take_manner(captions)
         return self._manners[i]
 
-    def manners_of(self, action: str | None) -> set:
-        """The manners of the takes of ``action`` (None among them for a plain take)."""
-        return {self.manner(i) for i in range(len(self)) if action and self.actions[i] == action}
+    def manners_of(self, action: str | None, keep: Callable[[int], bool] | None = None) -> set:
+        """The manners of the takes of ``action`` (None among them for a plain take); ``keep(i)``:
+        of those it keeps only."""
+        return {self.manner(i) for i in range(len(self))
+                if action and self.actions[i] == action and (keep is None or keep(i))}
+
+    def sideways(self, i: int) -> bool:
+        """Whether take ``i`` goes to the side at least as far as forward, whole, on its performer
+        (``travel_words.goes_sideways``; kept)."""
+        if i not in self._sideways:
+            from .travel_words import goes_sideways
+
+            t = self.take(i)
+            joints = self.proc.pose_on(t["rotations"], t["root"], t["betas"], 1.0, t["contacts"])
+            self._sideways[i] = goes_sideways(self.proc.features(joints, t["rotations"], t["contacts"]))
+        return self._sideways[i]
 
     def two_handed(self, i: int) -> bool:
         """Whether take ``i`` makes its gesture with both hands (``hands_asked.made_with_both``; kept)."""

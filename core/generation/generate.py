@@ -58,7 +58,7 @@ from .request import Request
 from .slow_action import slowed
 from .slow_steps import slow_motion
 from .still_take import still_take
-from .travel_words import backward_taken, backward_verb
+from .travel_words import SIDEWAYS_ACTIONS, backward_taken, backward_verb, goes_sideways
 from .hands_asked import hands_wanted
 from .typical_pace import fast_take, leg_ratio, load_typical_speeds, slow_take, typical_paced, unplain_take
 from .straight_gait import straight_asked
@@ -262,12 +262,16 @@ class Generator:
             backward = backward_taken(words, wanted)   # "runs backwards": the data's backward gait is a walk
             asked = backward or wanted
             times = words.count[1] if words.count is not None else None          # "three jumping jacks"
-            manners = self.pool.manners_of(asked) if captured and self.pool is not None else set()
+            pool = self.pool if captured else None
+            aside = (asked in SIDEWAYS_ACTIONS and pool is not None   # a sidestep that goes to the side
+                     and any(pool.sideways(i) for i in range(len(pool)) if pool.actions[i] == asked))
+            manners = pool.manners_of(asked, pool.sideways if aside else None) if pool is not None else set()
             manner = manner_kept(words.manner, manners)   # how the takes that compete are done (manner_words.py)
 
             def competes(w: Window) -> bool:   # of the asked action, at a plain gait's pace, done as asked
                 return (action_credit(asked, w.action) is not None
                         and (not asked or w.manner == manner or manner is ANY)
+                        and (not aside or goes_sideways(w.features))
                         and not slow_take(w, words, self.typical_speeds, self.body)
                         and not fast_take(w, words, self.typical_speeds, self.body)
                         and not unplain_take(w, words)

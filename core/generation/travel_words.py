@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..plan.reader import Travel
+from ..plan.reader import TRAVEL_WAYS, Travel
 
 SLACK = 0.5  # metres of travel against the words that are tolerated (a sway, a step to balance)
 
@@ -50,6 +50,17 @@ def allowed(travel: Travel, feats: list) -> np.ndarray:
     where none does (the words are then no help in choosing) or it names no travel."""
     ok = np.array([obeys(travel, f) for f in feats], dtype=bool) if travel.named else np.ones(len(feats), bool)
     return ok if ok.any() else np.ones(len(feats), bool)
+
+
+SIDEWAYS_ACTIONS = frozenset({"sidestep"})   # actions that go to the side by what they are
+
+
+def goes_sideways(features: np.ndarray) -> bool:
+    """Whether a clip goes to the side at least as far as forward (and more than ``SLACK``): what
+    "moves sideways" asks (``obeys``), and what a sidestep's captured take must do to compete where
+    any does (the data's are Bandai's walks to the left or right, most going forward two to four
+    times as far as to the side: "a man steps to the side" walked ahead, veering)."""
+    return obeys(TRAVEL_WAYS["sideways"], features)
 
 
 BACKWARD_GAIT = "walk backward"   # the data's one gait that goes backwards
