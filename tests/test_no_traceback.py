@@ -72,6 +72,10 @@ TABLE = [   # (prompt, seconds, options)
     ("once she has waved, she runs off", 2, SPEED), ("having bowed, the actor walks away", 2, LOOP),
     ("the boxer punches, then kicks", 2, []), ("a man picks up a box from the floor", 1, IN_PLACE),
     ("a short, stocky woman walks forward, then sits down", 2, PATH),
+    # manners: a take done so, none done so (said), a manner in a sequence, a sidestep that goes aside
+    ("a man walks proudly", 1, LOOP), ("a tired woman runs", 1, PATH), ("a man sits down proudly", 1, IN_PLACE),
+    ("a man bows happily, then walks away sadly", 2, SPEED), ("before crouching down, she looks around", 2, []),
+    ("a man steps to the side", 1, LOOP),
 ]
 
 
