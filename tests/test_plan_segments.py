@@ -132,8 +132,9 @@ def test_lengths_share_the_seconds_or_take_a_default_each():
 
 def test_a_course_segment_takes_the_time_to_go_once_round_when_the_length_is_the_models():
     """Hand-derived from the default model's typical walk (1.194 m/s) and jog (1.831 m/s): a circle
-    of 1 m walked once round at 0.9 of that pace, 2 pi / (0.9 x 1.194) = 5.85 s, jogged 3.81 s, which the least length makes 4 s (a figure eight, 4 pi m, jogged 7.63 s); a gait
-    to one side has no round; a total asked is shared as before; without the pace, the default."""
+    of 1 m walked once round at 0.9 of that pace, 2 pi / (0.9 x 1.194) = 5.85 s, jogged 3.81 s,
+    which the least length makes 4 s (a figure eight, 4 pi m, jogged 7.63 s); a gait to one side
+    has no round; a total asked is shared as before; without the pace, the default."""
     from shapemove.core.generation.course_shapes import model_course_seconds
 
     once_round = model_course_seconds(None)

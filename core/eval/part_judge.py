@@ -21,9 +21,9 @@ its samples (``generation/rerank.py``), cannot flatter it (as ``action_classifie
   standing gesture clips). A locomotion reference is also matched by its steady stretch
   (``steady_span``: the pelvis at its cruising speed, without the start from standing or the
   stop), as a gait played on from a loop is steady: HDM05's jogs are 4 steps from standing.
-  ``part_judge_check.py`` in ``tools/`` measures what each of these does on real clips. ``path`` is read apart from the
-  gait: ``CIRCLE`` when the body keeps turning one way while it moves (each quarter of the clip
-  turns >= ``CIRCLE_DEG_PER_S`` the same way), else "straight".
+  ``part_judge_check.py`` in ``tools/`` measures what each of these does on real clips. ``path``
+  is read apart from the gait: ``CIRCLE`` when the body keeps turning one way while it moves (each
+  quarter of the clip turns >= ``CIRCLE_DEG_PER_S`` the same way), else "straight".
 - **arms** (``ARMS``): collars, shoulders, elbows and wrists relative to the chest (spine3) in the
   body's frame, in arm lengths: mean, spread and range over time, wrist and elbow speeds, the
   wrists' highest point and their dominant frequency. Classes: the gestures of
@@ -72,7 +72,6 @@ CIRCLE_DEG_PER_S = 15.0      # each quarter of a circling clip turns at least th
 MOVING_LEGS_PER_S = 0.3      # ... while the pelvis moves at least this many leg lengths per second
 MIN_FRAMES = 10
 LEG_JOINTS = [1, 2, 4, 5, 7, 8, 10, 11]   # hips, knees, ankles, feet (left, right)
-POSE_JOINTS = [4, 5, 7, 8, 10, 11]         # knees, ankles, feet: the hips' place is the skeleton's
 STRIDE_PAD = 256                           # samples the stride's spectrum is padded to: 0.08 Hz apart
 ARM_JOINTS = [13, 14, 16, 17, 18, 19, 20, 21]
 CHEST = 9
@@ -170,7 +169,7 @@ def legs_descriptor(joints) -> dict[str, np.ndarray]:
     low = feet_h.min(1)
     airborne = float((low > np.quantile(low, 0.05) + 0.06).mean())
     stride = dominant_frequency(legs[:, 4, 2] - legs[:, 5, 2], STRIDE_PAD)[0]
-    pose = local[:, POSE_JOINTS] - local[:, :1] * np.array([0, 1, 0])
+    pose = legs[:, 2:].copy()   # knees, ankles, feet: the hips' place is the skeleton's
     pose[..., 0] -= pose[..., 0].mean(1, keepdims=True)    # across the body: about the legs' own middle
     return {
         "root": np.array([step[:, 2].mean(), step[:, 0].mean(), hspeed.mean(), hspeed.std(), step[:, 1].std()]),

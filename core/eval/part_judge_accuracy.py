@@ -14,7 +14,7 @@
 Each as {"accuracy", "n", "per_class": {label: {"n", "accuracy"}}, "confusion": {label: {pred: n}}}.
 ``leave_one_out(judge)`` is the same on the judge's own references, each without its own take;
 ``steady_accuracy(judge, data)`` on the steady stretches of real locomotion clips
-(``part_judge.steady_span``), each without its own take: a gait as a looped take plays it.
+(``motion.root_speed.steady_span``), each without its own take: a gait as a looped take plays it.
 """
 from __future__ import annotations
 
@@ -97,7 +97,8 @@ def steady_accuracy(judge, data, splits: tuple[str, ...] = ("train", "test"), pr
     from tqdm import tqdm
 
     from ..models.motion_memory import take_of
-    from .part_judge import STAND, steady_span
+    from ..motion.root_speed import steady_span
+    from .part_judge import STAND
 
     knn = judge.legs
     takes = np.asarray([take_of(str(s)) for s in knn.sources])

@@ -201,6 +201,12 @@ class TakePool:
             self._cache.popitem(last=False)
         return out
 
+    def posed(self, i: int) -> np.ndarray:
+        """Take ``i`` whole, posed on its performer's body: the joints its kept readings are made
+        from (``two_handed``, ``stand_in_span``, ``sideways``)."""
+        t = self.take(i)
+        return self.proc.pose_on(t["rotations"], t["root"], t["betas"], 1.0, t["contacts"])
+
     def manner(self, i: int) -> str | None:
         """The manner take ``i`` is done in, as its captions say it (``take_manner``; kept)."""
         if i not in self._manners:
@@ -221,8 +227,7 @@ class TakePool:
             from .travel_words import goes_sideways
 
             t = self.take(i)
-            joints = self.proc.pose_on(t["rotations"], t["root"], t["betas"], 1.0, t["contacts"])
-            self._sideways[i] = goes_sideways(self.proc.features(joints, t["rotations"], t["contacts"]))
+            self._sideways[i] = goes_sideways(self.proc.features(self.posed(i), t["rotations"], t["contacts"]))
         return self._sideways[i]
 
     def two_handed(self, i: int) -> bool:
@@ -230,9 +235,7 @@ class TakePool:
         if i not in self._both:
             from .hands_asked import made_with_both
 
-            t = self.take(i)
-            joints = self.proc.pose_on(t["rotations"], t["root"], t["betas"], 1.0, t["contacts"])
-            self._both[i] = made_with_both(joints)
+            self._both[i] = made_with_both(self.posed(i))
         return self._both[i]
 
     def stands_in(self, i: int, asked: str | None) -> bool:
@@ -246,9 +249,7 @@ class TakePool:
         if STAND_IN.get(asked or "") != self.actions[i]:
             return None
         if (i, asked) not in self._spans:
-            t = self.take(i)
-            joints = self.proc.pose_on(t["rotations"], t["root"], t["betas"], 1.0, t["contacts"])
-            self._spans[(i, asked)] = stand_in_span(asked, self.actions[i], joints)
+            self._spans[(i, asked)] = stand_in_span(asked, self.actions[i], self.posed(i))
         return self._spans[(i, asked)]
 
     def nearest(self, text: np.ndarray, action: str | None, seed: int, count: int = TAKES,

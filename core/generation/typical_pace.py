@@ -82,8 +82,9 @@ def load_typical_speeds(model_dir) -> dict[str, float]:
 
 def plain_gait(words, slow: bool = False) -> str | None:
     """The one gait of ``GAITS`` the words (``plan.words.Words``) name when they ask nothing else of
-    it (module doc: no pace, count, side or manner: "walks proudly" goes at the proud take's pace); None otherwise. ``slow``: a slow pace asked of it counts as plain (a slow gait
-    is slowed from its typical speed, not from a brisk one's)."""
+    it (module doc: no pace, count, side or manner: "walks proudly" goes at the proud take's pace);
+    None otherwise. ``slow``: a slow pace asked of it counts as plain (a slow gait is slowed from
+    its typical speed, not from a brisk one's)."""
     gait = lined_gait(words)
     if gait is None:
         return None
