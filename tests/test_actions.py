@@ -91,6 +91,27 @@ def test_vocabulary():
     ("shuffling sideways, he waves", ["sidestep", "wave"]), ("a man shuffles the cards", []),
     ("the kid stretches up on tiptoes", ["reach up"]), ("she walks on tiptoes", ["sneak", "walk"]),
     ("the goalkeeper side-steps along the line", ["sidestep"]),
+    # everyday words: a walk taken in steps, struts and toddles; a dance busted; a put-down placed
+    ("she takes a few steps forward", ["walk"]), ("a child toddles forward", ["walk"]),
+    ("a toddler waves her right hand", ["wave"]), ("he struts toward the camera", ["walk"]),
+    ("an old man shuffles forward slowly", ["walk"]), ("she takes two steps to the side", ["sidestep"]),
+    ("someone is stepping backwards carefully", ["walk backward"]), ("a man shuffles to his left", ["sidestep"]),
+    ("the robot busts a move", ["dance"]), ("a teenager doing a hip hop routine", ["dance"]),
+    ("someone places a bag on the ground", ["put down"]), ("she lowers herself onto the floor", ["sit"]),
+    ("someone grabbing a box from the ground", ["pick up"]), ("stoop and lift a box off the floor", ["pick up"]),
+    ("the old man stoops over", ["bend over"]), ("a person does a back somersault", ["backflip"]),
+    ("someone climbing back to their feet after a fall", ["get up"]), ("the soldier goes prone", ["lie down"]),
+    ("jump and do a full turn before landing", ["spin jump"]), ("a pitcher throws a baseball", ["throw"]),
+    ("the child punts a ball across the yard", ["kick ball"]), ("a player kicks a football", ["kick ball"]),
+    ("the fighter hits with a right hook", ["punch"]), ("someone slicing with a katana", ["slash"]),
+    ("a man gestures for someone to come over", ["beckon"]), ("a waiter shows guests the way", ["guide"]),
+    ("the kid dangles from the monkey bars", ["hang"]), ("a model posing for a photo", ["pose"]),
+    ("someone scrubbing their face", ["wash"]), ("a person walking with a hurt right leg", ["limp", "walk"]),
+    ("someone walking an 8 shape on the floor", ["walk in a figure eight", "walk"]),
+    ("a student puts up their hand", ["raise hand"]), ("standing crunches, alternating sides", ["elbow to knee"]),
+    # CMU's descriptions keep their labels: sitting with the legs dangling is no hang, a dancer's lean no bend
+    ("playground - climb, sit, dangle legs, descend", ["climb", "sit"]),
+    ("dance - lean forward, bring back leg forward, arching arms", ["dance"]),
 ])
 def test_find_actions(text, expected):
     assert find_actions(text) == expected
