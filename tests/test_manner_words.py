@@ -34,7 +34,8 @@ def test_a_take_s_manner_is_what_half_its_captions_say():
 def test_which_takes_compete():
     plain_and_styled = {None, "happy", "proud"}
     assert manner_kept("proud", plain_and_styled) == "proud"      # asked and offered: those takes
-    assert manner_kept("sad", plain_and_styled) is ANY           # asked, none done so: every take
+    assert manner_kept("sad", plain_and_styled) is None          # asked, none done so: the plain takes
+    assert manner_kept("sad", {"happy", "proud"}) is ANY         # ... and no plain take: every take
     assert manner_kept(None, plain_and_styled) is None           # none asked: the plain takes
     assert manner_kept(None, {"happy", "sad"}) is ANY            # no plain take: every take
     assert manner_kept(None, set()) is ANY and manner_kept("sad", set()) is ANY
@@ -67,3 +68,8 @@ def test_generating_plays_the_takes_done_as_asked():
     assert "bow_happy" in happy.provenance
     sit = gen.generate_batch([Request("a man sits down proudly", seed=0, seconds=3)])[0]
     assert "not done proudly: no captured take of 'sit' is done so" in " ".join(sit.notes)
+    for seed in range(2):   # no take of a run is done fearfully: a plain one, not the sad run (every seed before)
+        run = gen.generate_batch([Request("a man runs fearfully", seed=seed, seconds=3)])[0]
+        i = gen.pool.ids.index(run.provenance.split()[2]) if run.provenance.startswith("captured: ") else None
+        assert i is None or gen.pool.manner(i) is None, run.provenance
+        assert "not done fearfully" in " ".join(run.notes)

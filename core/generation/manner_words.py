@@ -4,8 +4,10 @@ tired man walks": the plan's ``Words.manner``) against the manners of the takes 
 
 - A manner asked that some take of the action is done in: those takes alone compete, and the T5's
   samples do not (the TMA that chooses hardly tells a proud walk from a plain one).
-- A manner asked that no take of the action is done in: every take competes, the samples too, and
-  the motion says the manner was not shown (``unmet_note``).
+- A manner asked that no take of the action is done in: the plain takes compete, the samples too,
+  and the motion says the manner was not shown (``unmet_note``): "runs away scared" (no scared run)
+  drew Bandai's sad run as readily as a plain one, which a user asking for fear does not expect
+  either. Where the action has no plain take, every take competes.
 - None asked: the plain takes (no manner in their captions) compete where the action has any, else
   all of them: "a man bows" drew the bow "like in a musical", or "with a swagger, like a street
   thug", as readily as the plain one; a plain walk, CMU's "walk, exaggerated stride".
@@ -30,8 +32,8 @@ def manner_kept(asked: str | None, manners: set):
     """The manner of the takes that compete (None: the plain ones), or ``ANY``; ``asked``: the
     manner the words ask (None: none); ``manners``: those of the action's takes (None for a plain
     one; empty when the words name no action or it has no take)."""
-    if asked is not None:
-        return asked if asked in manners else ANY
+    if asked is not None and asked in manners:
+        return asked
     return None if None in manners else ANY
 
 
