@@ -75,15 +75,31 @@ def test_the_clash_check_would_catch_a_generated_sentence(probe):
     assert norm(probe) in _generator_space()
 
 
-def test_blind_set_loads_names_known_actions_and_shares_no_prompt_with_the_first_set():
-    """configs/heldout_paraphrases_blind.json: a second set written blind by another author."""
+@pytest.mark.parametrize("name, earlier", [
+    ("heldout_paraphrases_blind.json", ["heldout_paraphrases.json"]),
+    ("heldout_paraphrases_blind2.json", ["heldout_paraphrases.json", "heldout_paraphrases_blind.json"]),
+])
+def test_blind_sets_load_name_known_actions_and_share_no_prompt_with_the_earlier_sets(name, earlier):
+    """configs/heldout_paraphrases_blind*.json: sets written blind by other authors (the second one
+    seeing only the action names and how many prompts of each)."""
     from shapemove.core.eval.paraphrase_eval import load_prompts
 
-    blind = load_prompts(PATH.with_name("heldout_paraphrases_blind.json"))
+    blind = load_prompts(PATH.with_name(name))
     assert len(blind) >= 150
     unknown = sorted({n for p in blind for n in [p["action"], *p["also"]] if n not in ACTIONS})
     assert not unknown, f"unknown action names: {unknown}"
     assert len({p["action"] for p in blind}) >= 45
-    first = {p["text"].strip().lower() for p in load_prompts(PATH)}
-    shared = sum(p["text"].strip().lower() in first for p in blind)
-    assert shared == 0, f"{shared} blind prompts repeat a prompt of the first held-out set"
+    for other in earlier:
+        seen = {p["text"].strip().lower() for p in load_prompts(PATH.with_name(other))}
+        shared = sum(p["text"].strip().lower() in seen for p in blind)
+        assert shared == 0, f"{shared} prompts of {name} repeat a prompt of {other}"
+
+
+def test_no_second_blind_prompt_is_a_generated_caption(mocap_root):
+    from shapemove.core.eval.paraphrase_eval import load_prompts
+
+    generated = _generator_space()
+    for clip in discover(Path(mocap_root)):
+        generated.update(norm(c) for c in clip.captions)
+    clash = sum(norm(p["text"]) in generated for p in load_prompts(PATH.with_name("heldout_paraphrases_blind2.json")))
+    assert clash == 0, f"{clash} prompts of the second blind set are sentences the captions write"
