@@ -109,6 +109,10 @@ def test_vocabulary():
     ("someone scrubbing their face", ["wash"]), ("a person walking with a hurt right leg", ["limp", "walk"]),
     ("someone walking an 8 shape on the floor", ["walk in a figure eight", "walk"]),
     ("a student puts up their hand", ["raise hand"]), ("standing crunches, alternating sides", ["elbow to knee"]),
+    ("a man rushes to catch a bus", ["run"]), ("she runs at full speed", ["sprint"]),
+    ("he rises from lying down", ["get up"]), ("she puts the box on the floor", ["put down"]),
+    ("someone greets a friend", ["wave"]), ("a butler bends at the waist to greet a guest", ["bow"]),
+    ("a girl moves to the beat", ["dance"]),
     # CMU's descriptions keep their labels: sitting with the legs dangling is no hang, a dancer's lean no bend
     ("playground - climb, sit, dangle legs, descend", ["climb", "sit"]),
     ("dance - lean forward, bring back leg forward, arching arms", ["dance"]),
