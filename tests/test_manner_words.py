@@ -2,6 +2,7 @@
 captions by the prompt's reader (plan/vocabulary.MANNERS, generation/manner_words.py)."""
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
 from shapemove.core.generation.captured_takes import take_manner
@@ -73,3 +74,13 @@ def test_generating_plays_the_takes_done_as_asked():
         i = gen.pool.ids.index(run.provenance.split()[2]) if run.provenance.startswith("captured: ") else None
         assert i is None or gen.pool.manner(i) is None, run.provenance
         assert "not done fearfully" in " ".join(run.notes)
+    old = gen.generate_batch([Request("an old man walks", seed=0, seconds=3)])[0]
+    quick = gen.generate_batch([Request("an old man walks quickly", seed=0, seconds=3)])[0]
+    assert "elderly" in old.provenance and "elderly" not in quick.provenance, quick.provenance
+    assert "not done like an old person: the captured takes of 'walk' done so are slower than asked" in quick.notes
+
+    def speed(m):
+        j = np.asarray(m.joints)
+        return np.linalg.norm(j[-1, 0, [0, 2]] - j[0, 0, [0, 2]]) / (len(j) / 20)
+
+    assert speed(quick) > 1.5 * speed(old)   # 0.75 m/s, quickly or not, before

@@ -8,6 +8,9 @@ tired man walks": the plan's ``Words.manner``) against the manners of the takes 
   and the motion says the manner was not shown (``unmet_note``): "runs away scared" (no scared run)
   drew Bandai's sad run as readily as a plain one, which a user asking for fear does not expect
   either. Where the action has no plain take, every take competes.
+- A manner asked with a fast pace ("an old man walks quickly") whose takes that compete all go
+  slower than the action's typical pace: the plain takes compete, and the motion says why
+  (``slower_note``); the elderly walks went at 0.75 m/s, quickly or not.
 - None asked: the plain takes (no manner in their captions) compete where the action has any, else
   all of them: "a man bows" drew the bow "like in a musical", or "with a swagger, like a street
   thug", as readily as the plain one; a plain walk, CMU's "walk, exaggerated stride".
@@ -50,3 +53,10 @@ def unmet_note(asked: str | None, action: str | None, windows) -> str:
         return ""
     what = f"of {action!r} " if action else ""
     return f"not done {MANNER_SAID.get(asked, asked)}: no captured take {what}is done so (the words are read as a whole)"
+
+
+def slower_note(asked: str, action: str | None) -> str:
+    """What the motion says when a manner is asked with a fast pace and every take done so is slower
+    than the action's typical pace: the plain takes compete instead."""
+    what = f"of {action!r} " if action else ""
+    return f"not done {MANNER_SAID.get(asked, asked)}: the captured takes {what}done so are slower than asked"
