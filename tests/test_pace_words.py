@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from shapemove.core.generation.pace_words import STANDING_SPEED, WANDER_SPEED, fastest, gait_speed, going, staying
+from shapemove.core.generation.pace_words import RUN_OFF_SPEED, STANDING_SPEED, WANDER_SPEED, fastest, gait_speed, going, staying
 from shapemove.core.plan.reader import asks_fast
 from shapemove.core.plan.words import read_words
 
@@ -74,6 +74,11 @@ def test_an_exercise_or_a_gesture_asked_with_no_travel_does_not_walk_off():
     for prompt in ("a man walks and waves", "she waves while walking forward", "a woman dances",
                    "the player kicks the ball", "a man does arm circles while jogging", "someone jumps forward"):
         assert staying(read_words(prompt), speeds, everyone).tolist() == [True] * 4, prompt
+    fast = np.array([3.3, 0.4, RUN_OFF_SPEED, 1.2])   # a dance that runs off 13 m in 4 s is set aside
+    for prompt in ("the robot busts a move", "a woman dances", "the player kicks the ball", "a kid does a cartwheel"):
+        assert staying(read_words(prompt), fast, everyone).tolist() == [False, True, False, True], prompt
+    for prompt in ("a man walks and waves", "a woman runs", "she dances forward", "someone jumps forward"):   # a gait, travel
+        assert staying(read_words(prompt), fast, everyone).tolist() == [True] * 4, prompt
 
 
 def test_the_picker_takes_a_fast_walk_over_the_tmas_favourite():

@@ -19,7 +19,7 @@ paces named ("slowly, then fast") is no pace; a prompt without a gait ("waves qu
 the TMA, since its root speed says nothing of a hand's. Whatever the pace, a gait asked to go
 somewhere is not given a candidate that stands about (``going``: slower than ``STANDING_SPEED``),
 and an exercise or a gesture asked with no travel not one that walks off (``staying``: as fast
-as ``WANDER_SPEED`` or faster).
+as ``WANDER_SPEED`` or faster), nor any other action but a gait one that runs off (``RUN_OFF_SPEED``).
 """
 from __future__ import annotations
 
@@ -31,6 +31,8 @@ FAST_SHARE = 1 / 3  # the fastest third of the candidates compete for a fast pac
 SLOW_SPEED = 0.8    # a stepping gait asked slowly is played at this speed
 STANDING_SPEED = 0.25   # m/s: a candidate of a gait asked to go on slower than this stands about
 WANDER_SPEED = 0.5      # m/s: a candidate of an action done where one stands this fast walks off
+RUN_OFF_SPEED = 1.6     # m/s: a candidate of any other action but a gait this fast runs off (the built-in
+                        # library's fastest take of one: a dribble down the court, 1.44 m/s)
 STAYING_GROUPS = ("exercise", "gesture")   # the vocabulary's groups of actions done where one stands
 
 def path_length(features: np.ndarray) -> float:
@@ -73,15 +75,22 @@ def staying(words, speeds: np.ndarray, among: np.ndarray) -> np.ndarray:
     """(N,) bool: where the words (``plan.words.Words``) ask only actions done where one stands (the
     vocabulary's ``STAYING_GROUPS``: an exercise, a gesture: arm circles, a side twist, a wave; and
     its ``POSTURE_CHANGES``: sitting down, lying down, getting up) and no travel, the candidates ``among``
-    slower than ``WANDER_SPEED``; ``among`` itself otherwise, or when none is. "A woman twists her
-    torso side to side" chose a sample that walked sideways 4.8 m (retrieved for "side to side"),
-    "a man swings his arms in circles" a take walking 5 m, "an old man sits down slowly" a sample
-    walking 2 m that never sat."""
+    slower than ``WANDER_SPEED``; where they ask only actions that are no gait (a dance, a kick, a
+    jump forward, a climb), those slower than ``RUN_OFF_SPEED``; ``among`` itself otherwise, or when
+    none is. "A woman twists her torso side to side" chose a sample that walked sideways 4.8 m
+    (retrieved for "side to side"), "a man swings his arms in circles" a take walking 5 m, "an old
+    man sits down slowly" a sample walking 2 m that never sat, "the robot busts a move" (a dance) a
+    sample running 13 m."""
     from ..data.actions import ACTIONS
     from ..plan.vocabulary import POSTURE_CHANGES
 
-    if not among.any() or not words.actions or words.travel.named or words.course is not None or \
-            not all(a in POSTURE_CHANGES or a in ACTIONS and ACTIONS[a].group in STAYING_GROUPS for a in words.actions):
+    if not among.any() or not words.actions or words.travel.named or words.course is not None:
         return among
-    keep = among & (np.asarray(speeds, dtype=np.float64) < WANDER_SPEED)
+    if all(a in POSTURE_CHANGES or a in ACTIONS and ACTIONS[a].group in STAYING_GROUPS for a in words.actions):
+        limit = WANDER_SPEED
+    elif all(a in ACTIONS and ACTIONS[a].group != "locomotion" for a in words.actions):
+        limit = RUN_OFF_SPEED
+    else:
+        return among
+    keep = among & (np.asarray(speeds, dtype=np.float64) < limit)
     return keep if keep.any() else among
