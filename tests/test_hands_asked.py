@@ -53,6 +53,22 @@ def test_the_library_tells_waves_of_one_hand_from_waves_of_both(openbody):
         assert "both-hands" in both.provenance and made_with_both(both.joints), both.provenance
 
 
+def test_the_plain_takes_made_with_both_hands_are_reached_past_styled_ones(openbody):
+    """"she throws both hands up": the nearest two-handed raised hands by caption are Bandai's styled
+    ones (energetic, elderly, ...), which a prompt with no manner does not let compete; the plain
+    ones after them are offered (none were: the places went to takes of other actions)."""
+    from shapemove.core.generation.generate import Generator
+
+    gen = Generator(None, body=openbody)
+    pool = gen.pool
+    text = gen._embed_texts(["she throws both hands up"])[0]
+    for seed in range(3):
+        got = pool.nearest(text, "raise hand", seed, hands=True, competes=lambda i: pool.manner(i) is None)
+        raised = [i for i in got if pool.actions[i] == "raise hand"]
+        assert len(raised) >= 3, [pool.ids[i] for i in got]
+        assert all(pool.two_handed(i) and pool.manner(i) is None for i in raised)
+
+
 def test_both_arms_asked_of_any_action_keeps_the_candidates_made_with_both():
     """"someone stretches both arms above the head" (seed 0) chose a sample raising the left arm
     alone (wrists at 1.46 and 0.85 m, the head at 1.46); now both go above the head. Words that say

@@ -276,10 +276,12 @@ class TakePool:
 
         def draw(ids, k, further: bool):
             ids = [i for i in sorted(ids, key=lambda i: -sims[i]) if i not in chosen]
+            near, rest = ids[:POOL * k], iter(ids[POOL * k:])
             if hands is not None:   # the nearest made with the hands asked, looked at in order until enough
-                made = list(islice((i for i in ids if self.two_handed(i) == hands), POOL * k))
-                ids = made or ids
-            near, rest = ids[:POOL * k], ids[POOL * k:]
+                made = (i for i in ids if self.two_handed(i) == hands)
+                first = list(islice(made, POOL * k))
+                if first:   # and the next nearest so made after them
+                    near, rest = first, made
             picked = sorted(rng.sample(range(len(near)), min(k, len(near))))
             kept = [near[j] for j in picked if ok(near[j])]
             left = [j for j in range(len(near)) if j not in picked]
