@@ -397,9 +397,10 @@ def test_timeline_segment_of_two_things_is_made_by_part(gen):
     m = generate_sequence(gen, segs, seed=0)
     own = segment_codes(m, arms=True)
     assert own[0] is None and own[2] is None and len(own[1]) == len(segment_codes(m)[1]) == 20
-    # the sitting segment spreads its arms to shoulder height as it gets up again (the decoded
-    # positions just under the shoulders, the decoded rotations just over them for 15 % of it)
-    assert hand_up(m, 1) >= 0.9 and hand_up(m, 0) <= 0.1 and hand_up(m, 2) <= 0.2
+    # the sitting segment (the T5's sample, the codes alone) sits and gets up again, lifting its arms
+    # over the shoulders as it rises for a quarter of it (0.15 before the asked action was read
+    # beside the words when choosing): no wave
+    assert hand_up(m, 1) >= 0.9 and hand_up(m, 0) <= 0.1 and hand_up(m, 2) <= 0.3
     assert boundary_report(m)["jump_ratio"] <= 2.0
     whole = generate_sequence(gen, segs, seed=0, by_parts=False)
     assert whole.arms_tokens is None and hand_up(whole, 1) <= 0.1   # the prompt whole: no wave

@@ -93,8 +93,9 @@ def test_paraphrase_eval_on_a_tiny_model(tiny_bundle, tmp_path, capsys):  # noqa
         eval_paraphrase(model, tmp_path / "p.json", seed=[1, 1], data=data)
 
     # a user's library (--library): its clips join the memory; with only retrieved clips competing
-    # (--retrieval-first 0) every prompt keeps the library's one clip, a walk, but the one that asks
-    # for a run (a clip of another action than the one asked does not compete), and the result counts them
+    # (--retrieval-first 0) the prompt of a walk keeps the library's one clip, a walk, and those that ask
+    # for a kick ("boots the ball away") or a run do not (a clip of another action than the one asked does
+    # not compete), and the result counts them
     from shapemove.core.generation.generate import Generator, Request
     from shapemove.core.scene.motion_file import save_motion
 
@@ -106,8 +107,8 @@ def test_paraphrase_eval_on_a_tiny_model(tiny_bundle, tmp_path, capsys):  # noqa
                  "--data", str(data), "--json", str(tmp_path / "r3.json"), "--quiet", "--library", str(lib),
                  "--retrieval-first", "0"]) == 0
     three = json.loads((tmp_path / "r3.json").read_text())
-    assert three["library"] == str(lib) and three["kept_library"] == len(rows) - 1
-    assert [r["kept_clips"] == ["library:stroll"] for r in three["rows"]] == [r["action"] != "run" for r in rows]
+    assert three["library"] == str(lib) and three["kept_library"] == 1
+    assert [r["kept_clips"] == ["library:stroll"] for r in three["rows"]] == [r["action"] == "walk" for r in rows]
 
     # --model-length: each motion as long as the model makes it (the product's default), not --seconds
     assert main(["eval", "paraphrase", "--model", str(model), "--prompts", str(tmp_path / "p.json"), "--seconds", "1",

@@ -83,11 +83,12 @@ class CandidatePicker:
 
 
 def action_phrase(words) -> str | None:
-    """The action the words ask (the first, its specific form), as the captions say it ("a person
-    raises a hand"); None when they name none. The TMA reads a user's wording as it was trained to:
-    "she throws both hands up" scored the takes raising both hands 0.05-0.07 against 0.5-0.7 for
-    samples with the hands at the chest."""
+    """The action the words ask (its specific form: a limp, not the walk), as the captions say it ("a
+    person raises a hand"); None when they name none or more than one ("turns around and walks away":
+    the words alone, or the turn would pull the choice to the samples that stay). The TMA reads a
+    user's wording as it was trained to: "she throws both hands up" scored the takes raising both
+    hands 0.05-0.07 against 0.5-0.7 for samples with the hands at the chest."""
     from ..data.actions import ACTIONS, specific
 
     acts = specific(list(words.actions))
-    return f"a person {ACTIONS[acts[0]].phrases[0]}" if acts and acts[0] in ACTIONS else None
+    return f"a person {ACTIONS[acts[0]].phrases[0]}" if len(acts) == 1 and acts[0] in ACTIONS else None
