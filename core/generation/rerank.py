@@ -47,10 +47,16 @@ class CandidatePicker:
 
     def scores(self, prompt: str, feats: list) -> np.ndarray:
         """(N,) cosine similarity of each candidate's (T, 263) features to the prompt."""
+        return self.similarities([prompt], feats)[0]
+
+    def similarities(self, texts: list[str], feats: list) -> list[np.ndarray]:
+        """For each text, the (N,) cosine similarity of each candidate's (T, 263) features to it (the
+        candidates embedded once)."""
         from ..models.tma_embed import embed_motions, embed_texts
 
-        text = embed_texts(self.model, self.tok, [prompt])[0]
-        return embed_motions(self.model, feats, self.mean, self.std) @ text
+        vectors = [embed_texts(self.model, self.tok, [t])[0] for t in texts]   # each alone: no padding
+        motions = embed_motions(self.model, feats, self.mean, self.std)
+        return [motions @ v for v in vectors]
 
     def pick(self, prompt: str, feats: list, bonus=None, words=None, reach: float | None = None) -> int:
         """Index of the candidate closest to ``prompt`` among those that obey the travel, pace (a
@@ -74,10 +80,9 @@ class CandidatePicker:
         keep = posture_kept(words.actions[0] if words.actions else None, feats, keep)
         keep = floor_reached(words.actions[0] if words.actions else None, feats, keep)
         keep = both_kept(words, feats, keep)   # "both arms": not a candidate made with one
-        scores = self.scores(prompt, feats)
-        phrase = action_phrase(words)
-        if phrase is not None:   # the action asked, in the captions' words, read beside the user's
-            scores = (scores + self.scores(phrase, feats)) / 2
+        phrase = action_phrase(words)   # the action asked, in the captions' words, read beside the user's
+        sims = self.similarities([prompt] + ([phrase] if phrase is not None else []), feats)
+        scores = sims[0] if phrase is None else (sims[0] + sims[1]) / 2
         scores = scores + (0.0 if bonus is None else np.asarray(bonus, np.float64))
         return int(np.argmax(np.where(keep, scores, -np.inf)))
 
