@@ -32,7 +32,7 @@ from ..scene.motion_file import Motion
 from ..torch_threads import one_torch_thread
 from .action_clips import ACTION_CLIPS, UNASKED_SECONDS, action_clips
 from .captured_takes import TakePool, Window, action_credit, captured_motion, decoded_provenance
-from .manner_words import ANY, manner_kept, shown, slower_note, unmet_note
+from .manner_words import ANY, manner_kept, shown, slower_note, too_slow, unmet_note
 from .course_shapes import ACTIONS as COURSE_ACTIONS, unasked_seconds
 from .course_walk import course_motion
 from .decode import decode_features, decode_tokens, redecode
@@ -60,8 +60,7 @@ from .slow_steps import slow_motion
 from .still_take import still_take
 from .travel_words import SIDEWAYS_ACTIONS, backward_taken, backward_verb, goes_sideways
 from .hands_asked import hands_wanted
-from .typical_pace import (fast_take, leg_ratio, load_typical_speeds, on_performer, slow_take, take_speed,
-                           typical_paced, unplain_take)
+from .typical_pace import fast_take, leg_ratio, load_typical_speeds, slow_take, typical_paced, unplain_take
 from .straight_gait import straight_asked
 from .turn_words import turn_motion
 
@@ -279,7 +278,7 @@ class Generator:
                         and not still_take(w, asked, words))
 
             windows = self._windows(r, asked, lo, hi, side, times, competes) if captured else []
-            slower = self._slower(words, asked, manner, windows)
+            slower = too_slow(words, asked, manner, windows, self.typical_speeds, self.body)
             if slower:   # "an old man walks quickly": no take done so is quick, a quick plain one is
                 manner = manner_kept(None, manners)
                 windows = self._windows(r, asked, lo, hi, side, times, competes)
@@ -309,14 +308,6 @@ class Generator:
             if best >= len(cands):
                 return Choice(None, beta, None, windows[best - len(cands)], body, body_source, note)
             return Choice(cands[best], beta, sources[best], None, body, body_source, note)
-
-    def _slower(self, words, asked: str | None, manner, windows) -> bool:
-        """Whether the words ask a gait fast in a manner whose takes that compete (``windows``) all go
-        slower than the gait's typical pace on their performers ("an old man walks quickly": the
-        elderly walks at 0.75 m/s)."""
-        typical = self.typical_speeds.get(asked) if asked else None
-        return (words.pace == "fast" and typical is not None and manner is not None and manner is not ANY
-                and bool(windows) and all(take_speed(w) < on_performer(typical, w, self.body) for w in windows))
 
     @staticmethod
     def _asked(r: Request) -> str | None:

@@ -10,7 +10,7 @@ tired man walks": the plan's ``Words.manner``) against the manners of the takes 
   either. Where the action has no plain take, every take competes.
 - A manner asked with a fast pace ("an old man walks quickly") whose takes that compete all go
   slower than the action's typical pace: the plain takes compete, and the motion says why
-  (``slower_note``); the elderly walks went at 0.75 m/s, quickly or not.
+  (``too_slow``, ``slower_note``); the elderly walks went at 0.75 m/s, quickly or not.
 - None asked: the plain takes (no manner in their captions) compete where the action has any, else
   all of them: "a man bows" drew the bow "like in a musical", or "with a swagger, like a street
   thug", as readily as the plain one; a plain walk, CMU's "walk, exaggerated stride".
@@ -53,6 +53,17 @@ def unmet_note(asked: str | None, action: str | None, windows) -> str:
         return ""
     what = f"of {action!r} " if action else ""
     return f"not done {MANNER_SAID.get(asked, asked)}: no captured take {what}is done so (the words are read as a whole)"
+
+
+def too_slow(words, asked: str | None, manner, windows, speeds: dict, body) -> bool:
+    """Whether the words (``plan.words.Words``) ask the gait ``asked`` fast in a ``manner`` whose takes
+    that compete (``windows``) all go slower than its typical pace (``speeds``, on the average body
+    ``body``) on their performers ("an old man walks quickly": the elderly walks at 0.75 m/s)."""
+    from .typical_pace import on_performer, take_speed
+
+    typical = speeds.get(asked) if asked else None
+    return (words.pace == "fast" and typical is not None and manner is not None and manner is not ANY
+            and bool(windows) and all(take_speed(w) < on_performer(typical, w, body) for w in windows))
 
 
 def slower_note(asked: str, action: str | None) -> str:
