@@ -132,6 +132,34 @@ def test_ground_shift_caps_flight_of_predicted_contacts():
     np.testing.assert_allclose(h_free[12:28], 0.40)  # measured contacts: heights kept (e.g. climbing)
 
 
+def test_ground_shift_stands_a_long_hover_of_measured_contacts():
+    """Measured contacts (no ``max_flight``) that miss a dancer's feet for 2 s: the body, 4 cm over
+    the floor set by the contacts around, stands on it, and a leap in that stretch keeps its 0.5 m
+    rise over the frames beside it; a climber 0.6 m up most of a stretch stays up; a clip with no
+    contact at all, mostly 5 cm up, stands on its lowest points too. Without ``hover`` (the dataset
+    builder's grounding) the hover stays."""
+    T = 60
+    low = np.full(T, 0.04)
+    low[:10] = low[50:] = 0.0
+    low[27:33] = 0.54                               # the leap: 0.5 m over the hover
+    c = np.zeros((T, 4), np.uint8)
+    c[:10, 2] = c[50:, 3] = 1
+    h = low + ground_shift(np.stack([low, low], 1), low, c, hover=True)
+    np.testing.assert_allclose(h[10:27], 0.0)
+    np.testing.assert_allclose(h[33:50], 0.0)
+    np.testing.assert_allclose(h[27:33], 0.5)
+    climb = np.full(T, 0.6)
+    climb[:10] = climb[50:] = 0.0
+    climb[10:14] = climb[46:50] = 0.05            # stepping up and down: a few low frames
+    h = climb + ground_shift(np.stack([climb, climb], 1), climb, c, hover=True)
+    np.testing.assert_allclose(h, climb)
+    drift = 0.05 + 0.02 * np.sin(np.arange(30) / 3)   # no contact: 3-7 cm up, never on the floor
+    h = drift + ground_shift(np.stack([drift, drift], 1), drift, np.zeros((30, 4)), hover=True)
+    np.testing.assert_allclose(h, 0.0, atol=1e-12)
+    h = low + ground_shift(np.stack([low, low], 1), low, c)   # without: the builder's grounding, held
+    np.testing.assert_allclose(h[10:27], 0.04)
+
+
 def test_ground_shift_keeps_a_jump_longer_than_a_step():
     """A 14-frame flight (0.7 s) rising 0.4 m and falling, between two contacts, is a jump: kept at
     its height (before, every stretch over 10 frames was grounded and a decoded "jumps twice" hopped

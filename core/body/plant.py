@@ -360,6 +360,7 @@ MAX_FLIGHT = 10   # frames (0.5 s at 20 fps, a 30 cm jump): longer flights are m
 MAX_JUMP = 20     # frames (1 s): the longest stretch without contact that can still be a jump
 JUMP_RISE = 0.08  # m: a jump's lowest point rises at least this far over the floor
 GRAVITY = 9.81
+HOVER = 0.10      # m: a stretch without contact longer than a jump whose lowest point is this low stands
 
 
 def _jumps(heights, fps: float = FPS) -> bool:
@@ -374,13 +375,35 @@ def _jumps(heights, fps: float = FPS) -> bool:
             and peak <= GRAVITY * (len(h) / fps) ** 2 / 8)
 
 
-def ground_shift(per_foot, lowest_all, contacts, max_flight: int | None = None) -> np.ndarray:
+def hovering(heights, support) -> np.ndarray:
+    """(T,) bool: the frames of a stretch without contact longer than a jump lasts (``MAX_JUMP``)
+    where the body's lowest point (``heights``, on the floor the contacts around it set) is within
+    ``HOVER`` of the floor, in a stretch that is that low for at least half its frames (a climber on
+    a box is higher most of the time). Nothing stays in the air that long that low: the feet rest on
+    the floor where the contacts missed them (a dancer on the balls of the feet, whose toes' contact
+    the detector never saw; a capture whose floor rises under the last steps), and the body hovered
+    3-6 cm over it for seconds."""
+    h = np.asarray(heights, dtype=np.float64)
+    out = np.zeros(len(h), bool)
+    for s, e in runs(~np.asarray(support, bool)):
+        low = h[s:e] < HOVER
+        if e - s > MAX_JUMP and low.mean() >= 0.5:   # mostly that low: not a climb onto something
+            out[s:e] = low
+    return out
+
+
+def ground_shift(per_foot, lowest_all, contacts, max_flight: int | None = None, hover: bool = False) -> np.ndarray:
     """(T,) vertical shift that grounds a posed body on its mesh.
 
     per_foot (T,2) lowest vertex of the left/right foot, lowest_all (T,) lowest point of the body,
     contacts (T,4) of joints 7, 8, 10, 11. Frames where a foot is in contact: that foot's lowest
     vertex (the lower of two) goes to 0. Other frames: the shift is interpolated between contact
     frames (held at the ends). No contact at all: one shift for the clip, lowest point on 0.
+    ``hover`` (what the rig plays, ``plant_motion``): then, in a stretch without contact longer than
+    a jump lasts, the frames with the lowest point within ``HOVER`` of the floor put it on the floor
+    (``hovering``; the frames higher up, a leap, interpolated between them). The dataset builder
+    grounds without it (``ClipProcessor.pose_on``), so the built clips, and the weights trained on
+    them, stay as they are.
     Finally every frame is lifted where needed so that no point is below the floor.
     ``max_flight`` (frames): a stretch without contact longer than that cannot be a flight phase
     (predicted contacts missed a step): its lowest point goes to the floor instead, unless it rises
@@ -390,12 +413,16 @@ def ground_shift(per_foot, lowest_all, contacts, max_flight: int | None = None) 
     foot_on = np.stack([c[:, 0] | c[:, 2], c[:, 1] | c[:, 3]], axis=1)        # left, right
     support = foot_on.any(1)
     low_all = np.asarray(lowest_all, dtype=np.float64)
+    t = np.arange(len(c))
+    lowest_contact = np.where(foot_on, np.asarray(per_foot, dtype=np.float64), np.inf).min(1)
     if support.any():
-        lowest_contact = np.where(foot_on, np.asarray(per_foot, dtype=np.float64), np.inf).min(1)
-        t = np.arange(len(c))
         shift = np.interp(t, t[support], -lowest_contact[support])
     else:
         shift = np.full(len(c), -low_all.min())
+    near = hovering(low_all + shift, support) if hover else np.zeros(len(c), bool)
+    if near.any():   # a stretch standing over the floor without contact: its lowest point on it
+        known = support | near
+        shift = np.interp(t, t[known], np.where(support, -lowest_contact, -low_all)[known])
     if max_flight is not None:
         for s, e in runs(~support):
             if e - s > max_flight and not (0 < s and e < len(c) and _jumps(low_all[s:e] + shift[s:e])):
@@ -485,7 +512,7 @@ def plant_motion(body, betas, joints, contacts, refine_iters: int = 10, gate: bo
         c = roll.contacts   # the heels the feet rolled off the floor are released
     transl = np.asarray(ik.transl, dtype=np.float64).copy()
     per_foot, _, low = probe.lowest(ik.rotations, transl)
-    shift = ground_shift(per_foot, low, c, max_flight=max_flight)  # predicted contacts can miss steps
+    shift = ground_shift(per_foot, low, c, max_flight=max_flight, hover=True)  # predicted contacts can miss steps
     if smooth > 0:   # the body was smoothed: so is its vertical shift, downward only (no added float,
         # the peaks a per-frame shift puts into the pelvis height shaken off; never under the floor)
         from ..motion.skeleton_ops import gaussian_smooth
