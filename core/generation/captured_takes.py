@@ -15,6 +15,9 @@ in one ``TakePool``. For a prompt:
   to the next nearest of the asked action: "she jogs for a while" (seed 0) drew three jogs too slow
   for a plain jog and was left with the T5's samples;
   the user's own clips come first: their nearest by caption and their nearest of the asked action;
+  where the words name no action the plan knows, only takes whose captions say nearly what the
+  prompt says compete (``NAMELESS_FLOOR``): "a person plays the guitar" (no action read) played a
+  sprint 15 m at 0.69, "a soldier salutes" a limp at 0.62, "a man rows a boat" a spin jump at 0.82;
 - each gives one window of the requested length (one of its busiest, ``busiest_start``); a take shorter
   than asked plays on as a loop of its own cycle where it repeats (``take_loop.py``: jumping jacks,
   arm circles), else it is held on its last pose for the rest (a kick, then standing); with no
@@ -68,6 +71,7 @@ UNASKED_SECONDS = 4.0  # the least a take plays when the length is the model's
 BUSIEST = 2            # a long take's busiest windows, one drawn by the seed
 KEPT = 16              # takes kept read at once (rotations as matrices)
 OTHER_WAY = frozenset({"walk backward"})   # specific forms that compete only when asked by name
+NAMELESS_FLOOR = 0.9   # TMA caption cosine from which a take competes when the words name no action
 USER_FLOOR = 0.5       # TMA caption cosine from which the user's nearest clip is offered whatever its action
 
 
@@ -305,7 +309,8 @@ class TakePool:
         if action in STAND_IN and not named:   # no take of it: the takes that can stand in (stand_in_takes.py)
             named = [i for i in range(len(self)) if self.stands_in(i, action)]
         draw(named, max(0, count - len(chosen) - NEAREST) if named else 0, True)
-        draw(range(len(self)), max(0, count - len(chosen)), False)
+        near = range(len(self)) if action else [i for i in range(len(self)) if sims[i] >= NAMELESS_FLOOR]
+        draw(near, max(0, count - len(chosen)), False)
         return chosen
 
     def window(self, i: int, frames: int, seed: int, side=None, longest: int | None = None,
