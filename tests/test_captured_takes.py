@@ -283,6 +283,22 @@ def test_two_things_at_once_puts_captured_parts_together(openbody):
     assert off.tokens is not None and off.arms_tokens is not None and off.provenance == "generated"
 
 
+def test_a_hop_carries_a_wave_at_once(openbody):
+    """A hop leaves the arms free: "a child hops while waving" hops on a hop take's legs and waves a
+    wave take's arms (the wave was dropped: one prompt, the hop alone)."""
+    from shapemove.core.generation.generate import Generator, Request
+
+    gen = Generator(None, body=openbody)
+    m = gen.generate_batch([Request("a child hops while waving", seconds=4, seed=0)])[0]
+    assert m.part_prompts == ("a child hops", "a person waving")
+    legs, arms = m.provenance.split("; arms: ")
+    assert "hopBothLegs" in legs and "wave" in arms, m.provenance
+    feet = m.joints[:, [7, 8, 10, 11], 1].min(1)
+    assert feet.max() - feet.min() > 0.08                       # both feet leave the floor: hops
+    wrist = m.joints[:, [20, 21], 1].max(1) - m.joints[:, 15, 1]
+    assert (wrist > 0).mean() > 0.5                             # a hand over the head most of the time: waving
+
+
 def test_an_action_without_takes_draws_on_the_takes_of_its_general_action(openbody):
     """No take of the library is mainly ballet; ballet is a dance (``actions.GENERIC_OF``): the
     dance takes compete for it. A hop has takes of its own, the single hops of HDM05 too short to

@@ -27,6 +27,10 @@ from shapemove.core.plan.part_prompts import named_side, plan_parts
     # a sit carries a gesture as a gait does: the gesture made seated
     ("a woman sits down and waves", "a woman sits down", "a person waves", ("sit", "wave")),
     ("a man sits down while waving", "a man sits down", "a person waving", ("sit", "wave")),
+    # a hop, a jump, a squat leave the arms free: "hops while waving" hopped and dropped the wave
+    ("a child hops while waving", "a child hops", "a person waving", ("hop", "wave")),
+    ("a man jumps and waves", "a man jumps", "a person waves", ("jump", "wave")),
+    ("a woman squats while raising both arms", "a woman squats", "a person raising both arms", ("squat", "raise hand")),
 ])
 def test_two_things_split_into_a_legs_and_an_arms_prompt(text, legs, arms, acts):
     plan = plan_parts(text)
@@ -48,6 +52,7 @@ def test_the_arms_clause_carries_its_side():
     "someone waves, after that he runs",
     "a person runs and jumps",            # two locomotions: no arms gesture
     "a person kicks and punches",         # no locomotion
+    "a man jumps, then waves",            # in order: the timeline's
     "a man sits down and lies down",      # a sit and another change of posture: one after the other
 ])
 def test_not_two_things_at_once(text):

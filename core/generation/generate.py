@@ -32,6 +32,7 @@ from ..scene.motion_file import Motion
 from ..torch_threads import one_torch_thread
 from .action_clips import ACTION_CLIPS, UNASKED_SECONDS, action_clips
 from .captured_takes import TakePool, Window, action_credit, captured_motion, decoded_provenance
+from .one_foot import one_foot_note
 from .manner_words import ANY, manner_kept, shown, slower_note, too_slow, unmet_note
 from .course_shapes import ACTIONS as COURSE_ACTIONS, unasked_seconds
 from .course_walk import course_motion
@@ -293,6 +294,7 @@ class Generator:
                 cands, sources = [], []
             note = (slower_note(words.manner, asked) if slower
                     else unmet_note(words.manner, asked, windows) if captured else "")
+            note = "; ".join(n for n in (note, one_foot_note(words, asked)) if n)   # "hops on one foot"
             best = 0
             body, body_source = self.body_shape(body_of or r, beta.numpy())
             if reach is not None:   # the distance on the T5's body, which the samples are decoded on

@@ -177,6 +177,10 @@ def generate_by_parts(gen, r, words=None, captured: bool = True) -> Motion | Non
     if played:   # another body plants it again by its rotations (retarget.replant), as a take
         m.contacts_measured = True
         m.provenance = f"legs: {legs.provenance}; arms: {arms.provenance}"
+    for part, c in (("legs", legs_choice), ("arms", arms_choice)):   # what a part's words asked and it does not do
+        for note in (c.note, c.window.note if c.window is not None else ""):
+            if note:
+                m.notes.append(f"{part}: {note}")
     if kept is not arms.track:
         m.notes.append(held_note(arms.track))
     if course is not None and not r.whole_course and (note := course_note(course, m.joints, m.fps)):

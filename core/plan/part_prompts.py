@@ -8,9 +8,10 @@
 
 Actions are found by the dataset's own action patterns (``data/actions.py``: one vocabulary for
 captions, labels and prompts). A prompt is **two things at once** when it names a locomotion
-(``LEGS``: walk, jog, run, march, sneak, limp, sidestep, walk backward, in a circle, ...) or a sit
+(``LEGS``: walk, jog, run, march, sneak, limp, sidestep, walk backward, in a circle, ...), a sit
 (``SEATED``: "sits down and waves" waves seated, where as two segments the body sat, then stood up
-again to wave) and an arm gesture (``ARMS``: wave, punch, throw, raise a hand, beckon, reach up, arm
+again to wave) or an action of the legs that leaves the arms free (``ARMS_FREE``: hops, jumps,
+squats; "a child hops while waving" hopped and dropped the wave) and an arm gesture (``ARMS``: wave, punch, throw, raise a hand, beckon, reach up, arm
 circles, ...) and no order between them ("then", "after", "before": a sequence is the timeline's job,
 ``generation/sequence.py``). The text is cut between the two at the connector that joins them (",", "while",
 "as", "and", ...; "with" only where no other joins them: "waves with his right hand while walking"
@@ -32,13 +33,15 @@ from .vocabulary import CONNECTOR, DIRECTION, FOOT_WORDS, HAND_WORDS, ORDER_WORD
 
 LEGS = frozenset(LEGS_ACTIONS) | {"sprint", "walk in a figure eight"}   # not "zombie walk": its arms are the action
 SEATED = frozenset({"sit"})      # a posture the arms' gesture is done in, as a gait's legs carry it
-BODY = LEGS | SEATED             # what the legs part of two things at once may be
+ARMS_FREE = frozenset({"hop", "jump", "jump forward", "squat"})   # done by the legs, the arms free for a gesture
+BODY = LEGS | SEATED | ARMS_FREE  # what the legs part of two things at once may be
 ARMS = frozenset(ARMS_ACTIONS)
 FOOT_ACTIONS = frozenset({"kick", "spin kick", "kick ball", "hop"})
 
 
 def at_once(first: str, second: str) -> bool:
-    """Whether one body does the two actions at once, by part: a locomotion or a sit (``BODY``) and
+    """Whether one body does the two actions at once, by part: a locomotion, a sit or a hop, jump or
+    squat (``BODY``) and
     an arm gesture (``ARMS``), either way round ("jogs and waves", "sits down and waves"); any other
     two follow one another."""
     return (first in BODY and second in ARMS) or (first in ARMS and second in BODY)

@@ -285,6 +285,12 @@ def hands_asked(prompt: str) -> str | None:
     return "both" if both and not one else "one" if one and not both else None
 
 
+def one_foot(prompt: str) -> bool:
+    """Whether the words ask a hop or a jump on one foot ("hops on one foot", "a one-legged hop")."""
+    t = str(prompt).lower()
+    return bool(V.ONE_FOOT.search(t)) and bool(V.ONE_FOOT_ACTIONS & set(find_actions(t)))
+
+
 def arms_held(prompt: str) -> bool:
     """Whether the words keep the arms raised ("with both arms raised", "keeps his hand up")."""
     return bool(V.ARMS_HELD.search(str(prompt).lower()))

@@ -188,6 +188,10 @@ FORWARD = re.compile(r"\b(?:" + _ARMS_WAY + r"forwards?|ahead|onwards?|toward(?:
 BACKWARD = re.compile(r"\b(" + _ARMS_WAY + r"backwards?|in reverse|backs? (?:up|away)|backing (?:up|away)|retreat\w*|"
                       r"(?:steps?|stepping) back(?! and forth))\b", re.I)
 IN_PLACE = re.compile(r"\b(in place|on the spot)\b", re.I)
+# a hop or a jump on one foot ("hops on one foot", "on her left leg", "a one-legged hop"): no capture does one
+ONE_FOOT = re.compile(r"\b(?:on|with|using) (?:just |only )?(?:one|a single|(?:his|her|their|the|its) (?:left|right)) "
+                      r"(?:foot|leg)\b|\bone[- ](?:footed|legged)\b")
+ONE_FOOT_ACTIONS = frozenset({"hop", "jump", "jump forward"})
 # a side named for travel: a verb of going, then within three words "to the left" / "to his right"
 _GOING = (r"\b(?:steps?|stepping|shuffl\w*|walk\w*|mov\w*|slid\w*|glid\w*|crab\w*|strafe\w*|side-?step\w*|run\w*|"
           r"jog\w*|hop\w*|go(?:es|ing)?)\b")
@@ -335,6 +339,9 @@ WORD_CLASSES = (
     WordClass("arms held", "with both arms raised, hands raised, keeps a hand up, holding his arms up high",
               "the arms raised once and held there: the raise played to its highest point, that pose kept for the rest",
               "a man walks with both arms raised", {"arms_held": True, "legs": "a man walks"}),
+    WordClass("one foot", "on one foot, on her left leg, one-legged (with a hop or a jump)",
+              "said not to be met: every captured hop and jump lands on both feet (generation/one_foot.py)",
+              "a child hops on one foot", {"one_foot": True, "actions": ["hop"]}),
     WordClass("order", "then, and then, after that, after which, next, finally, (a minute) later, eventually, "
               "subsequently, followed by, finishes / ends with, follows it with, after / before + a clause, "
               "a list of steps before an order word (walks ahead, spins, then waves), "

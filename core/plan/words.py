@@ -47,6 +47,7 @@ class Words:
     gestures_only: bool = False                # every action named is an arms action ("he waves")
     arms_held: bool = False                    # the arms kept raised ("with both arms raised")
     hands: str | None = None                   # a gesture's hands: "both" ("waves with both hands"), "one" ("a hand")
+    one_foot: bool = False                     # a hop or a jump on one foot (no capture does one)
     seconds: float | None = None               # the length the words ask ("for ten seconds")
     manner: str | None = None                  # how it is done (``vocabulary.MANNERS``: "proud")
     unused: tuple[str, ...] = ()               # words no class took ("impatiently")
@@ -103,6 +104,8 @@ class Words:
             out["arms_held"] = True
         if self.hands is not None:
             out["hands"] = self.hands
+        if self.one_foot:
+            out["one_foot"] = True
         if self.seconds is not None:
             out["seconds"] = self.seconds
         if self.manner is not None:
@@ -131,7 +134,7 @@ def read_words(text: str) -> Words:
         gait_text=None if stop is None else stop[0],
         stand_still=stop is None and R.asks_stand_still(low), count=R.asked_count(low), pace=pace,
         slow_flight=pace == "slow" and R.asks_slow_flight(low), slowly=slowly, gestures_only=R.gestures_only(low),
-        arms_held=R.arms_held(low), hands=R.hands_asked(low), seconds=R.asked_seconds(low), manner=R.manner_of(low),
+        arms_held=R.arms_held(low), hands=R.hands_asked(low), one_foot=R.one_foot(low), seconds=R.asked_seconds(low), manner=R.manner_of(low),
         unused=tuple(R.unused_words(low, _body_words(low), () if pace or slowly else (V.FAST, V.SLOW))))
 
 
