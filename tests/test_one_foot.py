@@ -21,6 +21,7 @@ def test_one_foot_is_read_of_a_hop_or_jump_and_said():
     for text in ("a child hops on both feet", "a child hops", "she balances on one leg", "he kicks with one leg",
                  "a man stands on his left foot"):
         assert not read_words(text).one_foot, text                       # a balance or a kick is on one leg
+    assert read_words("hop on one leg").unused == ()                     # the words are taken: not "leg" unused
     assert one_foot_note(read_words("a child hops"), "hop") == ""
     assert one_foot_note(read_words("a child hops on one foot"), None) == ""
 

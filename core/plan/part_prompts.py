@@ -40,11 +40,12 @@ FOOT_ACTIONS = frozenset({"kick", "spin kick", "kick ball", "hop"})
 
 
 def at_once(first: str, second: str) -> bool:
-    """Whether one body does the two actions at once, by part: a locomotion, a sit or a hop, jump or
-    squat (``BODY``) and
-    an arm gesture (``ARMS``), either way round ("jogs and waves", "sits down and waves"); any other
-    two follow one another."""
-    return (first in BODY and second in ARMS) or (first in ARMS and second in BODY)
+    """Whether one body does the two actions joined by "and" at once, by part: a locomotion or a sit
+    and an arm gesture (``ARMS``), either way round ("jogs and waves", "sits down and waves"); any
+    other two follow one another ("jumps and waves", "she jumps, squats and waves": a hop, a jump or
+    a squat carries a gesture only where the words join them so, "hops while waving")."""
+    legs = LEGS | SEATED
+    return (first in legs and second in ARMS) or (first in ARMS and second in legs)
 
 
 @dataclass(frozen=True)
