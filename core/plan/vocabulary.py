@@ -295,8 +295,8 @@ class WordClass(NamedTuple):
 WORD_CLASSES = (
     WordClass("actions", "walk, run, jog, sit down, wave, kick, jump, squat, throw, ... (data/actions.py)",
               "the legs and arms action the model is asked for", "a person sits down", {"actions": ["sit"]}),
-    WordClass("legs + arms", "a gait, a sit, a hop, a jump or a squat and a gesture joined by 'and', 'while', ',', 'as', "
-              "'with'",
+    WordClass("legs + arms", "a gait or a sit and a gesture joined by 'and', 'while', ',', 'as', 'with'; a hop, a jump "
+              "or a squat and a gesture joined by any of them but 'and'",
               "two things at once: the legs and the arms generated each from its own words",
               "a woman jogs while waving", {"legs": "a woman jogs", "arms": "a person waving"}),
     WordClass("side", "left / right with a hand or foot word, or with an action of one part",
