@@ -134,7 +134,8 @@ def read_words(text: str) -> Words:
         gait_text=None if stop is None else stop[0],
         stand_still=stop is None and R.asks_stand_still(low), count=R.asked_count(low), pace=pace,
         slow_flight=pace == "slow" and R.asks_slow_flight(low), slowly=slowly, gestures_only=R.gestures_only(low),
-        arms_held=R.arms_held(low), hands=R.hands_asked(low), one_foot=R.one_foot(low), seconds=R.asked_seconds(low), manner=R.manner_of(low),
+        arms_held=R.arms_held(low), hands=R.hands_asked(low), one_foot=R.one_foot(low), seconds=R.asked_seconds(low),
+        manner=R.manner_of(low),
         unused=tuple(R.unused_words(low, _body_words(low), () if pace or slowly else (V.FAST, V.SLOW))))
 
 
