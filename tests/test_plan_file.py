@@ -29,6 +29,7 @@ def test_every_plan_the_tuning_prompts_print_reads_back():
 
     root = Path(__file__).resolve().parents[1] / "configs"
     prompts = ["a man walks with both arms raised", "a woman waves with both hands", "he raises a hand",
+               "a child hops on one foot", "a boy jumps up and down", "a man jumps in place",
                "a man walks forward, then walks back",
                "a man turns around and walks away", "a person raises the right hand and then the left hand"]
     for name in ("heldout_paraphrases.json", "tuning_two_things.json", "tuning_sequences.json"):

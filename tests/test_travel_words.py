@@ -27,6 +27,10 @@ def allowed(prompt, feats):
     ("a man walks sideways", Travel(sideways=True)),
     ("toy soldier marching in place", Travel(in_place=True)),
     ("twirl around on the spot", Travel(in_place=True)),
+    ("a boy jumps up and down", Travel(in_place=True)),           # a jump that stays: not a long jump
+    ("she jumps straight up", Travel(in_place=True)),
+    ("a big vertical jump", Travel(in_place=True)),
+    ("a man walks up and down the hall", Travel()),                # a walk's up and down is a course
     ("waves to his left", Travel()),                               # a side, but no going
     ("A golfer swings to the left", Travel()),
     ("a person jumps and waves", Travel()),
@@ -130,6 +134,20 @@ def test_hopping_on_the_spot_stays_on_the_spot(openbody):
     assert np.ptp(root[:, [0, 2]], axis=0).max() < 0.5
     feet = m.joints[:, [7, 8, 10, 11], 1].min(1)
     assert feet.max() > 0.15                                        # off the floor: a hop, not a stand
+
+
+def test_jumping_up_and_down_does_not_jump_away(openbody):
+    """With the default model: "a boy jumps up and down" (4 s, seed 0) played CMU's far jump 105_40,
+    1.8 m forward, as "jumps straight up" played a jump 0.6 m forward; read as staying, a jump in
+    place plays and leaves the floor."""
+    from shapemove.core.generation.generate import Generator, Request
+
+    gen = Generator(None, body=openbody)
+    for prompt in ("a boy jumps up and down", "she jumps straight up"):
+        m = gen.generate_batch([Request(prompt, seconds=4, seed=0)])[0]
+        assert np.linalg.norm(m.joints[-1, 0, [0, 2]] - m.joints[0, 0, [0, 2]]) < 0.3, prompt
+        feet = m.joints[:, [7, 8, 10, 11], 1].min(1)
+        assert feet.max() - feet.min() > 0.15, prompt               # off the floor: a jump
 
 
 def test_a_hop_asked_on_the_spot_at_the_models_length_is_brought_back_to_the_spot(openbody):

@@ -305,7 +305,8 @@ def _edited_words(seg: dict, where: str, text: str) -> tuple[str, Words]:
     flight = pace == "slow" and any(a in ("jog", "run", "sprint") for a in (actions or read.actions))
     return text, replace(read, parts=parts, side=None if parts is not None else side, course=course,
                          course_right=way == "right", turn=turn, travel=replace(travel, in_place=in_place),
-                         in_place=in_place, stop=stop, steps=steps, distance_m=metres, gait_text=gait_text,
+                         in_place=in_place and any(a in LEGS for a in (actions or read.actions)),   # a gait's strides
+                         stop=stop, steps=steps, distance_m=metres, gait_text=gait_text,
                          stand_still=stand and not stop, count=count, pace=pace, slow_flight=flight, slowly=slowly,
                          seconds=length, hands=hands, arms_held=held, one_foot=one_foot, manner=manner)
 

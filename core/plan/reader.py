@@ -267,7 +267,7 @@ def travel_of(prompt: str) -> Travel:
     return Travel(forward=(fw and not bw) - (bw and not fw),
                   side=int(sides == {"left"}) - int(sides == {"right"}),
                   sideways=bool(V.SIDEWAYS.search(prompt)) and not sides,
-                  in_place=bool(V.IN_PLACE.search(prompt)))
+                  in_place=bool(V.IN_PLACE.search(prompt) or V.JUMP_IN_PLACE.search(prompt)))
 
 
 def asks_on_the_spot(prompt: str) -> bool:
@@ -314,7 +314,7 @@ _TAKEN = (V.COUNT_TIMES, V.FAST, V.SLOW, V.STOP, V.STEPS, V.STEPS_ALONE, V.STILL
           V.COUNTER_CLOCKWISE, V.BACK_AND_FORTH, V.ZIGZAG, V.DIAGONAL, V.COURSE_WORDS, V.COURSE_WAY, V.TURN_WHOLE,
           V.TURN_HALF, V.TURN_QUARTER, V.FORWARD, V.BACKWARD, V.IN_PLACE, V.TRAVEL_SIDE, V.SIDEWAYS, V.SIDE,
           V.DIRECTION, V.SUBJECT, V.TURN_TWICE, V.ARMS_HELD, V.BOTH_HANDS, V.ONE_HAND, V.DURATION, V.ASIDE,
-          V.CONNECTOR, V.THEN, V.MANNER, V.ONE_FOOT)
+          V.CONNECTOR, V.THEN, V.MANNER, V.ONE_FOOT, V.JUMP_IN_PLACE)
 
 
 def unused_words(text: str, body_words=(), idle=()) -> list[str]:

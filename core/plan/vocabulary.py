@@ -188,6 +188,9 @@ FORWARD = re.compile(r"\b(?:" + _ARMS_WAY + r"forwards?|ahead|onwards?|toward(?:
 BACKWARD = re.compile(r"\b(" + _ARMS_WAY + r"backwards?|in reverse|backs? (?:up|away)|backing (?:up|away)|retreat\w*|"
                       r"(?:steps?|stepping) back(?! and forth))\b", re.I)
 IN_PLACE = re.compile(r"\b(in place|on the spot)\b", re.I)
+# a jump kept where it is: "jumps straight up", "jumps up and down", "a vertical jump" (not "walks up and down")
+JUMP_IN_PLACE = re.compile(r"\b(?:jump|hop|bounc|leap|spring)\w*(?:\s+\w+){0,3}?\s+(?:straight up|up and down|vertically)\b|"
+                           r"\bvertical(?:ly)?\s+(?:jump|leap|hop)\w*", re.I)
 # a hop or a jump on one foot ("hops on one foot", "on her left leg", "a one-legged hop"): no capture does one
 ONE_FOOT = re.compile(r"\b(?:on|with|using) (?:just |only )?(?:one|a single|(?:his|her|their|the|its) (?:left|right)) "
                       r"(?:foot|leg)\b|\bone[- ](?:footed|legged)\b")
@@ -312,6 +315,9 @@ WORD_CLASSES = (
               {"travel": "backward"}),
     WordClass("in place", "in place, on the spot (with a gait)", "the gait's strides shortened to stay on the spot",
               "a person jogs in place", {"in_place": True}),
+    WordClass("jump in place", "in place, on the spot, straight up, up and down, vertically (with a jump or a hop)",
+              "candidates that travel away set aside: a vertical jump, not a long one", "a boy jumps up and down",
+              {"actions": ["jump"], "in_place": True}),
     WordClass("distance", "3 metres, ten meters, 20 feet, 5 yards (with a gait)",
               "the gait cut where it is that far from its start, then standing", "a man walks 3 metres forward",
               {"distance_m": 3.0, "stop": True}),

@@ -82,7 +82,7 @@ class Words:
             out["turn_degrees"] = round(math.degrees(self.turn))
         if self.travel.way is not None:
             out["travel"] = self.travel.way
-        if self.in_place:
+        if self.in_place or self.travel.in_place:   # a gait on the spot, or a jump that stays
             out["in_place"] = True
         if self.stop:
             if self.distance_m is not None:
