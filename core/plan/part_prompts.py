@@ -12,8 +12,8 @@ captions, labels and prompts). A prompt is **two things at once** when it names 
 (``SEATED``: "sits down and waves" waves seated, where as two segments the body sat, then stood up
 again to wave) or an action of the legs that leaves the arms free (``ARMS_FREE``: hops, jumps,
 squats; "a child hops while waving" hopped and dropped the wave) and an arm gesture (``ARMS``: wave,
-punch, throw, raise a hand, beckon, reach up, arm circles, ...) and no order between them ("then", "after", "before": a sequence is the timeline's job,
-``generation/sequence.py``). The text is cut between the two at the connector that joins them (",", "while",
+punch, throw, raise a hand, beckon, reach up, arm circles, ...) and no order between them ("then",
+"after", "before": a sequence is the timeline's job, ``generation/sequence.py``). The text is cut between the two at the connector that joins them (",", "while",
 "as", "and", ...; "with" only where no other joins them: "waves with his right hand while walking"
 is cut at "while"; else where the second action starts); each clause becomes its own prompt, the
 one without a subject getting "a person".
