@@ -114,6 +114,33 @@ def test_the_default_model_plays_captured_jumping_jacks_and_squats_as_many_times
     assert _raises(plain.joints) >= 6   # a jack about every 1.1 s: the take's jacks played on, nothing else
 
 
+def _flights(joints) -> int:   # both feet off the floor by 8 cm: one count per flight
+    feet = joints[:, [7, 8, 10, 11], 1].min(1)
+    return len(runs(feet - feet.min() > 0.08))
+
+
+def test_again_and_again_plays_a_single_repetition_on_for_the_whole_length():
+    """"A boy jumps up and down" (6 s) jumped once and stood 3.6 s (CMU's single jumps, held);
+    said again and again (``Words.again``) the take's jump plays on, in place, as "she squats
+    repeatedly" squats on; a number asked still counts ("jumps twice")."""
+    from shapemove.core.generation.generate import Generator, Request
+    from shapemove.core.plan.words import read_words
+
+    assert read_words("a boy jumps up and down").again and read_words("she squats repeatedly").again
+    assert read_words("a kid keeps jumping").again and read_words("someone kicks over and over").again
+    assert not read_words("a man jumps twice").again and not read_words("a man walks up and down the hall").again
+    assert not read_words("a man waves repeatedly").again                     # no counted action: said unused
+    assert read_words("a man waves repeatedly").unused == ("repeatedly",)
+    gen = Generator(None)
+    jumps = gen.generate_batch([Request("a boy jumps up and down", seed=0, seconds=6)])[0]
+    assert _flights(jumps.joints) >= 3, _flights(jumps.joints)
+    assert np.linalg.norm(jumps.joints[-1, 0, [0, 2]] - jumps.joints[0, 0, [0, 2]]) < 0.3   # in place
+    squats = gen.generate_batch([Request("she squats repeatedly", seed=0, seconds=6)])[0]
+    assert _squats(squats.joints) >= 3, _squats(squats.joints)
+    twice = gen.generate_batch([Request("a man jumps twice", seed=0, seconds=6)])[0]
+    assert _flights(twice.joints) == 2, _flights(twice.joints)
+
+
 def test_every_repetition_asked_plays_when_the_length_is_the_models():
     """"12 squats" need about 14-19 s of captured squats: with no length asked all twelve play (the
     model's own length stops at 10 s, which held 10); a length asked that holds fewer says so."""

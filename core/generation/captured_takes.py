@@ -56,7 +56,7 @@ from ..constants import FPS
 from ..errors import ShapeMoveError
 from ..scene.motion_file import Motion
 from ..data.actions import MOVES_ON, REPEATED
-from ..plan.vocabulary import GAITS, POSTURE_CHANGES
+from ..plan.vocabulary import COUNTED, GAITS, POSTURE_CHANGES
 from .floor_sit import SIT, SIT_FROM, sit_end
 from .stand_in_takes import STAND_IN, played_as, stand_in_span
 from .repeated_takes import cut_for, repeated_stretch
@@ -315,7 +315,7 @@ class TakePool:
 
     def window(self, i: int, frames: int, seed: int, side=None, longest: int | None = None,
                times: int | None = None, straight: bool = False, asked: str | None = None,
-               seated: bool = False) -> Window:
+               seated: bool = False, repeat: bool = False) -> Window:
         """Take ``i`` cut to ``frames`` (the seed picks the start), or held to it when shorter;
         ``longest``: the length is the model's (``frames`` the least), the take plays whole up to
         ``longest`` frames. ``side``: ("left" | "right", "hand" | "foot") mirrors a take whose
@@ -332,7 +332,9 @@ class TakePool:
         by caption. A take standing in for an action no take is of (``stand_in_takes.py``) is made
         into it first: a lie-down played to where it sits, a put-down backwards. A lie-down asked
         ``seated`` (after a segment that sat) plays from where its take sits on the floor
-        (``floor_sit.sit_end``) to its end."""
+        (``floor_sit.sit_end``) to its end. ``repeat``: the words ask a counted action again and again
+        (``plan.words.Words.again``: "jumps up and down"): a take of one repetition of it loops as a
+        take of a repeated action does, moving on where the repetition does (a jump forward)."""
         from .part_compose import needs_mirror
 
         t = self.take(i)
@@ -380,9 +382,10 @@ class TakePool:
                         again = looped_gait(rot, root, con, posed_joints, want) or \
                             looped_steps(rot, root, con, posed_joints, want, mirrored)   # and the step's mirror image
                 goes_on = action not in MOVES_ON or action == asked   # a hop loops for "hops" only
-                if again is None and (action in REPEATED and goes_on or action in GAITS):
+                repeats = action in REPEATED or repeat and action in COUNTED   # "jumps up and down"
+                if again is None and (repeats and goes_on or action in GAITS):
                     again = looped_repetition(rot, root, con, posed_joints, want,   # one arm circle, one gait
-                                              action in GAITS or action in MOVES_ON)   # cycle
+                                              action in GAITS or action in MOVES_ON or repeat)   # cycle
             if again is not None:
                 rot, root, con, first = again
                 looped = want - first
@@ -400,16 +403,17 @@ class TakePool:
     def windows(self, text: np.ndarray, action: str | None, seed: int, frames: int, side=None,
                 longest: int | None = None, count: int = TAKES, times: int | None = None,
                 straight: bool = False, hands: bool | None = None, seated: bool = False,
-                competes: Callable[[Window], bool] | None = None) -> list[Window]:
+                competes: Callable[[Window], bool] | None = None, repeat: bool = False) -> list[Window]:
         """One window of each take offered (``nearest``, ``hands`` as there); ``times``: the repetitions
-        the words ask; ``straight``: the words ask a plain gait; ``seated``: after a sit (``window``);
+        the words ask; ``straight``: the words ask a plain gait; ``seated``: after a sit; ``repeat``: the
+        words ask it again and again (``window``);
         ``competes(window)``: whether a take's window competes, when given: only those are offered,
         up to ``count``, the others' places drawn again (``nearest``)."""
         cut: dict[int, Window] = {}
 
         def of(i: int) -> Window:
             if i not in cut:
-                cut[i] = self.window(i, frames, seed, side, longest, times, straight, action, seated)
+                cut[i] = self.window(i, frames, seed, side, longest, times, straight, action, seated, repeat)
             return cut[i]
 
         test = (lambda i: competes(of(i))) if competes is not None else None  # noqa: E731

@@ -211,9 +211,10 @@ class Generator:
         straight, hands = straight_asked(words), hands_wanted(words, action)   # a gesture's hands as said
         if r.seconds is None:   # the model's length: a take plays whole, at least UNASKED_SECONDS
             return pool.windows(text, action, r.seed, self._length(UNASKED_SECONDS)[0] * down, side, hi * down,
-                                times=times, straight=straight, hands=hands, seated=r.seated, competes=competes)
+                                times=times, straight=straight, hands=hands, seated=r.seated, competes=competes,
+                                repeat=words.again)
         return pool.windows(text, action, r.seed, lo * down, side, times=times, straight=straight, hands=hands,
-                            seated=r.seated, competes=competes)
+                            seated=r.seated, competes=competes, repeat=words.again)
 
     # -- tokens ------------------------------------------------------------------------------
     def _length(self, seconds: float | None) -> tuple[int, int]:
@@ -283,7 +284,7 @@ class Generator:
             if slower:   # "an old man walks quickly": no take done so is quick, a quick plain one is
                 manner = manner_kept(None, manners)
                 windows = self._windows(r, asked, lo, hi, side, times, competes)
-            windows = performed(windows, asked, times)   # arm circles that stop half way: not when others go on
+            windows = performed(windows, asked, times, words.again)   # arm circles that stop half way: not when others go on
             for w in windows if backward else []:
                 w.note = f"no capture {backward_verb(requested)} backwards: a walk backward is played"
             cands, sources, beta = (self._from_action_clips(r, found) if found    # the user's clips: as captured

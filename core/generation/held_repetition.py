@@ -14,12 +14,13 @@ from __future__ import annotations
 MOST_HELD = 0.25   # share of a window's frames held on its last pose, above it a repetition has stopped
 
 
-def performed(windows: list, asked: str | None, times: int | None = None) -> list:
+def performed(windows: list, asked: str | None, times: int | None = None, again: bool = False) -> list:
     """``windows`` (``captured_takes.Window``) without those held too long for the repeated action
-    ``asked`` (module docstring), unless none is left; unchanged for another action or a count."""
+    ``asked`` (module docstring), or one the words ask ``again`` and again, unless none is left;
+    unchanged for another action or a count."""
     from ..data.actions import REPEATED
 
-    if asked not in REPEATED or times is not None:
+    if (asked not in REPEATED and not again) or times is not None:
         return windows
     going = [w for w in windows if w.held <= MOST_HELD * len(w.rotations)]
     return going or windows

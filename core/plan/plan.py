@@ -14,7 +14,8 @@ action's words in the text the model reads), ``side`` ("left hand"), ``course`` 
 ``turn_degrees``, ``travel``, ``in_place``, ``distance_m``, ``steps``, ``stop``, ``stand_still``,
 ``count``, ``pace``, ``seconds`` (the length its words ask), ``arms_held`` (the raised arms kept
 up), ``hands`` (a gesture's hands: "both" or "one"), ``one_foot`` (a hop or jump asked on one foot:
-said not to be met), ``manner`` (how it is done: a name of
+said not to be met), ``again`` (a counted action repeated for the whole length), ``manner`` (how it
+is done: a name of
 ``vocabulary.MANNERS``, "proud"); a segment's ``text`` and ``seconds``
 (its length, which wins) too. A field left out asks nothing. The
 motion keeps the plan (``Motion.plan``), so a timeline re-decoded for a new body or a strip
@@ -173,7 +174,7 @@ def _choice(value, where: str, options) -> str:
 
 UNDERSTOOD_KEYS = ("actions", "legs", "arms", "course", "course_way", "turn_degrees", "travel", "in_place",
                    "distance_m", "steps", "stop", "stand_still", "count", "pace", "slowly", "seconds", "side",
-                   "arms_held", "hands", "one_foot", "manner", "unused")
+                   "arms_held", "hands", "one_foot", "again", "manner", "unused")
 
 
 def _swap_action(text: str, old: str | None, new: str) -> str:
@@ -288,6 +289,7 @@ def _edited_words(seg: dict, where: str, text: str) -> tuple[str, Words]:
     hands = None if said.get("hands") is None else _choice(said["hands"], f"{where}.understood.hands", ("both", "one"))
     held = _flag(said.get("arms_held", False), f"{where}.understood.arms_held")
     one_foot = _flag(said.get("one_foot", False), f"{where}.understood.one_foot")
+    again = _flag(said.get("again", False), f"{where}.understood.again")
     count = None
     if said.get("count") is not None:
         n = _number(said["count"], f"{where}.understood.count", 1, MAX_COUNT, whole=True)
@@ -308,7 +310,8 @@ def _edited_words(seg: dict, where: str, text: str) -> tuple[str, Words]:
                          in_place=in_place and any(a in LEGS for a in (actions or read.actions)),   # a gait's strides
                          stop=stop, steps=steps, distance_m=metres, gait_text=gait_text,
                          stand_still=stand and not stop, count=count, pace=pace, slow_flight=flight, slowly=slowly,
-                         seconds=length, hands=hands, arms_held=held, one_foot=one_foot, manner=manner)
+                         seconds=length, hands=hands, arms_held=held, one_foot=one_foot, again=again,
+                         manner=manner)
 
 
 def plan_from_json(data, seconds: float | None = None) -> Plan:

@@ -285,6 +285,13 @@ def hands_asked(prompt: str) -> str | None:
     return "both" if both and not one else "one" if one and not both else None
 
 
+def again(prompt: str) -> bool:
+    """Whether the words ask a counted action (``vocabulary.COUNTED``) again and again without a
+    number ("jumps up and down", "squats repeatedly", "keeps kicking")."""
+    t = str(prompt).lower()
+    return bool(V.AGAIN.search(t)) and asked_count(t) is None and any(sp[2] in V.COUNTED for sp in action_spans(t))
+
+
 def one_foot(prompt: str) -> bool:
     """Whether the words ask a hop or a jump on one foot ("hops on one foot", "a one-legged hop")."""
     t = str(prompt).lower()
@@ -314,7 +321,7 @@ _TAKEN = (V.COUNT_TIMES, V.FAST, V.SLOW, V.STOP, V.STEPS, V.STEPS_ALONE, V.STILL
           V.COUNTER_CLOCKWISE, V.BACK_AND_FORTH, V.ZIGZAG, V.DIAGONAL, V.COURSE_WORDS, V.COURSE_WAY, V.TURN_WHOLE,
           V.TURN_HALF, V.TURN_QUARTER, V.FORWARD, V.BACKWARD, V.IN_PLACE, V.TRAVEL_SIDE, V.SIDEWAYS, V.SIDE,
           V.DIRECTION, V.SUBJECT, V.TURN_TWICE, V.ARMS_HELD, V.BOTH_HANDS, V.ONE_HAND, V.DURATION, V.ASIDE,
-          V.CONNECTOR, V.THEN, V.MANNER, V.ONE_FOOT, V.JUMP_IN_PLACE)
+          V.CONNECTOR, V.THEN, V.MANNER, V.ONE_FOOT, V.JUMP_IN_PLACE, V.AGAIN)
 
 
 def unused_words(text: str, body_words=(), idle=()) -> list[str]:

@@ -67,6 +67,8 @@ def said(reading: dict) -> str:
         bits.append("both hands" if reading["hands"] == "both" else "one hand")
     if reading.get("one_foot"):
         bits.append("on one foot")
+    if reading.get("again"):
+        bits.append("again and again")
     if reading.get("manner"):
         bits.append(f"manner: {reading['manner']}")
     said = "; ".join(bits) if bits else "no word the readers act on (the model reads the prompt whole)"

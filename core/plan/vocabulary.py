@@ -191,6 +191,9 @@ IN_PLACE = re.compile(r"\b(in place|on the spot)\b", re.I)
 # a jump kept where it is: "jumps straight up", "jumps up and down", "a vertical jump" (not "walks up and down")
 JUMP_IN_PLACE = re.compile(r"\b(?:jump|hop|bounc|leap|spring)\w*(?:\s+\w+){0,3}?\s+(?:straight up|up and down|vertically)\b|"
                            r"\bvertical(?:ly)?\s+(?:jump|leap|hop)\w*", re.I)
+# a counted action done again and again, as long as the motion lasts ("jumps up and down", "squats repeatedly")
+AGAIN = re.compile(r"\b(?:repeatedly|over and over(?: again)?|again and again|several times|many times|continuously|"
+                   r"keeps? (?:on )?\w+ing|up and down)\b", re.I)
 # a hop or a jump on one foot ("hops on one foot", "on her left leg", "a one-legged hop"): no capture does one
 ONE_FOOT = re.compile(r"\b(?:on|with|using) (?:just |only )?(?:one|a single|(?:his|her|their|the|its) (?:left|right)) "
                       r"(?:foot|leg)\b|\bone[- ](?:footed|legged)\b")
@@ -346,6 +349,10 @@ WORD_CLASSES = (
     WordClass("arms held", "with both arms raised, hands raised, keeps a hand up, holding his arms up high",
               "the arms raised once and held there: the raise played to its highest point, that pose kept for the rest",
               "a man walks with both arms raised", {"arms_held": True, "legs": "a man walks"}),
+    WordClass("again", "repeatedly, over and over, again and again, several times, keeps jumping, up and down "
+              "(with a jump, a hop, a squat or a kick; no number)",
+              "a captured take of one repetition plays it again for as long as the motion lasts",
+              "a man squats repeatedly", {"actions": ["squat"], "again": True}),
     WordClass("one foot", "on one foot, on her left leg, one-legged (with a hop or a jump)",
               "said not to be met: every captured hop and jump lands on both feet (generation/one_foot.py)",
               "a child hops on one foot", {"one_foot": True, "actions": ["hop"]}),

@@ -48,6 +48,7 @@ class Words:
     arms_held: bool = False                    # the arms kept raised ("with both arms raised")
     hands: str | None = None                   # a gesture's hands: "both" ("waves with both hands"), "one" ("a hand")
     one_foot: bool = False                     # a hop or a jump on one foot (no capture does one)
+    again: bool = False                        # a counted action again and again, no number ("squats repeatedly")
     seconds: float | None = None               # the length the words ask ("for ten seconds")
     manner: str | None = None                  # how it is done (``vocabulary.MANNERS``: "proud")
     unused: tuple[str, ...] = ()               # words no class took ("impatiently")
@@ -106,6 +107,8 @@ class Words:
             out["hands"] = self.hands
         if self.one_foot:
             out["one_foot"] = True
+        if self.again:
+            out["again"] = True
         if self.seconds is not None:
             out["seconds"] = self.seconds
         if self.manner is not None:
@@ -134,9 +137,11 @@ def read_words(text: str) -> Words:
         gait_text=None if stop is None else stop[0],
         stand_still=stop is None and R.asks_stand_still(low), count=R.asked_count(low), pace=pace,
         slow_flight=pace == "slow" and R.asks_slow_flight(low), slowly=slowly, gestures_only=R.gestures_only(low),
-        arms_held=R.arms_held(low), hands=R.hands_asked(low), one_foot=R.one_foot(low), seconds=R.asked_seconds(low),
+        arms_held=R.arms_held(low), hands=R.hands_asked(low), one_foot=R.one_foot(low), again=R.again(low),
+        seconds=R.asked_seconds(low),
         manner=R.manner_of(low),
-        unused=tuple(R.unused_words(low, _body_words(low), () if pace or slowly else (V.FAST, V.SLOW))))
+        unused=tuple(R.unused_words(low, _body_words(low), (() if pace or slowly else (V.FAST, V.SLOW))
+                                    + (() if R.again(low) else (V.AGAIN,)))))
 
 
 def _body_words(low: str) -> list[str]:
