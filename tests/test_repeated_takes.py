@@ -128,6 +128,8 @@ def test_again_and_again_plays_a_single_repetition_on_for_the_whole_length():
 
     assert read_words("a boy jumps up and down").again and read_words("she squats repeatedly").again
     assert read_words("a kid keeps jumping").again and read_words("someone kicks over and over").again
+    rope = read_words("a girl jumps rope")                                    # "rope" was said unused
+    assert rope.again and rope.travel.in_place and rope.unused == ()
     assert not read_words("a man jumps twice").again and not read_words("a man walks up and down the hall").again
     assert not read_words("a man waves repeatedly").again                     # no counted action: said unused
     assert read_words("a man waves repeatedly").unused == ("repeatedly",)
@@ -135,6 +137,8 @@ def test_again_and_again_plays_a_single_repetition_on_for_the_whole_length():
     jumps = gen.generate_batch([Request("a boy jumps up and down", seed=0, seconds=6)])[0]
     assert _flights(jumps.joints) >= 3, _flights(jumps.joints)
     assert np.linalg.norm(jumps.joints[-1, 0, [0, 2]] - jumps.joints[0, 0, [0, 2]]) < 0.3   # in place
+    rope = gen.generate_batch([Request("a girl jumps rope", seed=0, seconds=6)])[0]   # a far jump, then standing
+    assert _flights(rope.joints) >= 3 and np.linalg.norm(rope.joints[-1, 0, [0, 2]] - rope.joints[0, 0, [0, 2]]) < 0.3
     squats = gen.generate_batch([Request("she squats repeatedly", seed=0, seconds=6)])[0]
     assert _squats(squats.joints) >= 3, _squats(squats.joints)
     twice = gen.generate_batch([Request("a man jumps twice", seed=0, seconds=6)])[0]

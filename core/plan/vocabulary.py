@@ -190,10 +190,10 @@ BACKWARD = re.compile(r"\b(" + _ARMS_WAY + r"backwards?|in reverse|backs? (?:up|
 IN_PLACE = re.compile(r"\b(in place|on the spot)\b", re.I)
 # a jump kept where it is: "jumps straight up", "jumps up and down", "a vertical jump" (not "walks up and down")
 JUMP_IN_PLACE = re.compile(r"\b(?:jump|hop|bounc|leap|spring)\w*(?:\s+\w+){0,3}?\s+(?:straight up|up and down|vertically)\b|"
-                           r"\bvertical(?:ly)?\s+(?:jump|leap|hop)\w*", re.I)
+                           r"\bvertical(?:ly)?\s+(?:jump|leap|hop)\w*|\b(?:jump|skip)\w* (?:a |the )?rope\b", re.I)
 # a counted action done again and again, as long as the motion lasts ("jumps up and down", "squats repeatedly")
 AGAIN = re.compile(r"\b(?:repeatedly|over and over(?: again)?|again and again|several times|many times|continuously|"
-                   r"keeps? (?:on )?\w+ing|up and down)\b", re.I)
+                   r"keeps? (?:on )?\w+ing|up and down|(?:jump|skip)\w* (?:a |the )?rope)\b", re.I)
 # a hop or a jump on one foot ("hops on one foot", "on her left leg", "a one-legged hop"): no capture does one
 ONE_FOOT = re.compile(r"\b(?:on|with|using) (?:just |only )?(?:one|a single|(?:his|her|their|the|its) (?:left|right)) "
                       r"(?:foot|leg)\b|\bone[- ](?:footed|legged)\b")
@@ -318,7 +318,8 @@ WORD_CLASSES = (
               {"travel": "backward"}),
     WordClass("in place", "in place, on the spot (with a gait)", "the gait's strides shortened to stay on the spot",
               "a person jogs in place", {"in_place": True}),
-    WordClass("jump in place", "in place, on the spot, straight up, up and down, vertically (with a jump or a hop)",
+    WordClass("jump in place", "in place, on the spot, straight up, up and down, vertically, jumps rope (with a jump or "
+              "a hop)",
               "candidates that travel away set aside: a vertical jump, not a long one", "a boy jumps up and down",
               {"actions": ["jump"], "in_place": True}),
     WordClass("distance", "3 metres, ten meters, 20 feet, 5 yards (with a gait)",
@@ -349,8 +350,8 @@ WORD_CLASSES = (
     WordClass("arms held", "with both arms raised, hands raised, keeps a hand up, holding his arms up high",
               "the arms raised once and held there: the raise played to its highest point, that pose kept for the rest",
               "a man walks with both arms raised", {"arms_held": True, "legs": "a man walks"}),
-    WordClass("again", "repeatedly, over and over, again and again, several times, keeps jumping, up and down "
-              "(with a jump, a hop, a squat or a kick; no number)",
+    WordClass("again", "repeatedly, over and over, again and again, several times, keeps jumping, up and down, "
+              "jumps rope (with a jump, a hop, a squat or a kick; no number)",
               "a captured take of one repetition plays it again for as long as the motion lasts",
               "a man squats repeatedly", {"actions": ["squat"], "again": True}),
     WordClass("one foot", "on one foot, on her left leg, one-legged (with a hop or a jump)",
