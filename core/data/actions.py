@@ -293,6 +293,12 @@ REPEATED = frozenset({"arm circles", "jumping jacks", "dribble", "elbow to knee"
 MOVES_ON = frozenset({"dribble", "hop"})   # of those, the ones that may go somewhere as they repeat
 
 
+def action_verb(action: str) -> str:
+    """How the vocabulary says an action's verb ("marches", "hops"), for the notes a motion gives;
+    the name itself for an action the vocabulary lacks."""
+    return ACTIONS[action].phrases[0].split()[0] if action in ACTIONS else action
+
+
 def specific(acts: list[str]) -> list[str]:
     """Drop the generic actions of the specific ones also present (["walk", "limp"] -> ["limp"])."""
     drop = {g for a in acts for g in GENERIC_OF.get(a, ())}

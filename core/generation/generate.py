@@ -22,6 +22,7 @@ import torch
 
 from ..body.load import load_body_model
 from ..constants import FPS
+from ..data.actions import action_verb
 from ..errors import ShapeMoveError
 from ..models.constrained_decoding import decode
 from ..models.known_texts import read_known
@@ -59,7 +60,7 @@ from .request import Request
 from .slow_action import slowed
 from .slow_steps import slow_motion
 from .still_take import still_take
-from .travel_words import SIDEWAYS_ACTIONS, backward_taken, backward_verb, goes_sideways
+from .travel_words import SIDEWAYS_ACTIONS, backward_taken, goes_sideways
 from .hands_asked import hands_wanted
 from .typical_pace import fast_take, leg_ratio, load_typical_speeds, slow_take, typical_paced, unplain_take
 from .straight_gait import straight_asked
@@ -286,7 +287,7 @@ class Generator:
                 windows = self._windows(r, asked, lo, hi, side, times, competes)
             windows = performed(windows, asked, times, words.again)   # arm circles that stop half way: not when others go on
             for w in windows if backward else []:
-                w.note = f"no capture {backward_verb(requested)} backwards: a walk backward is played"
+                w.note = f"no capture {action_verb(requested)} backwards: a walk backward is played"
             cands, sources, beta = (self._from_action_clips(r, found) if found    # the user's clips: as captured
                                     else self._sampled(r, lo, hi, g, library=not windows, asked=asked))   # takes, or as codes
             if r.seated and any(w.seated for w in windows):   # after a sit: the lie-downs from their sits,

@@ -11,10 +11,9 @@ from __future__ import annotations
 def one_foot_note(words, asked: str | None) -> str:
     """The note for words (``plan.words.Words``) asking the action ``asked`` on one foot ("" when they
     do not, or ``asked`` is not one of ``vocabulary.ONE_FOOT_ACTIONS``)."""
-    from ..data.actions import ACTIONS
+    from ..data.actions import action_verb
     from ..plan.vocabulary import ONE_FOOT_ACTIONS
 
     if not words.one_foot or asked not in ONE_FOOT_ACTIONS:
         return ""
-    verb = ACTIONS[asked].phrases[0].split()[0] if asked in ACTIONS else asked
-    return f"no capture {verb} on one foot: every take and sample lands on both feet"
+    return f"no capture {action_verb(asked)} on one foot: every take and sample lands on both feet"

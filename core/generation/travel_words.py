@@ -76,10 +76,3 @@ def backward_taken(words, asked: str | None) -> str | None:
     if asked is None or asked == BACKWARD_GAIT or asked not in GAITS or words.travel.forward >= 0:
         return None
     return BACKWARD_GAIT
-
-
-def backward_verb(gait: str) -> str:
-    """How the vocabulary says a gait ("marches", "sneaks"), for the note that a walk backward stands in."""
-    from ..data.actions import ACTIONS
-
-    return ACTIONS[gait].phrases[0].split()[0] if gait in ACTIONS else gait

@@ -127,6 +127,7 @@ def read_words(text: str) -> Words:
     course = R.course_named(low)
     pace = "fast" if R.asks_fast(low) else "slow" if (R.asks_slow_steps(low) or R.asks_slow_flight(low)) else None
     slowly = pace is None and R.asks_slow_action(low)
+    again = R.again(low)
     if stop is not None:   # the words without the stop, in the prompt's own case
         stop = R.stop_request(str(text))
     return Words(
@@ -137,11 +138,11 @@ def read_words(text: str) -> Words:
         gait_text=None if stop is None else stop[0],
         stand_still=stop is None and R.asks_stand_still(low), count=R.asked_count(low), pace=pace,
         slow_flight=pace == "slow" and R.asks_slow_flight(low), slowly=slowly, gestures_only=R.gestures_only(low),
-        arms_held=R.arms_held(low), hands=R.hands_asked(low), one_foot=R.one_foot(low), again=R.again(low),
+        arms_held=R.arms_held(low), hands=R.hands_asked(low), one_foot=R.one_foot(low), again=again,
         seconds=R.asked_seconds(low),
         manner=R.manner_of(low),
         unused=tuple(R.unused_words(low, _body_words(low), (() if pace or slowly else (V.FAST, V.SLOW))
-                                    + (() if R.again(low) else (V.AGAIN,)))))
+                                    + (() if again else (V.AGAIN,)))))
 
 
 def _body_words(low: str) -> list[str]:
