@@ -113,6 +113,11 @@ def test_vocabulary():
     ("he rises from lying down", ["get up"]), ("she puts the box on the floor", ["put down"]),
     ("someone greets a friend", ["wave"]), ("a butler bends at the waist to greet a guest", ["bow"]),
     ("a girl moves to the beat", ["dance"]),
+    # a step to one side is a sidestep, a step back a walk backward; back and forth is neither
+    ("someone steps to the right", ["sidestep"]), ("she takes a step to her left", ["sidestep"]),
+    ("he slides over to the left", ["sidestep"]), ("a woman steps back", ["walk backward"]),
+    ("a man steps back and waves", ["walk backward", "wave"]), ("she steps back and forth", []),
+    ("he steps backward and forward", []), ("a man steps forward", ["walk"]),
     # CMU's descriptions keep their labels: sitting with the legs dangling is no hang, a dancer's lean no bend
     ("playground - climb, sit, dangle legs, descend", ["climb", "sit"]),
     ("dance - lean forward, bring back leg forward, arching arms", ["dance"]),
