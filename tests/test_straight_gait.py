@@ -92,3 +92,53 @@ def test_which_words_ask_a_gait_on_a_line():
                  "a man jogs in place", "someone turns around", "a woman jogs while waving", "a man waves",
                  "a man walks 3 metres and stops"):
         assert not straight_asked(read_words(text)), text
+
+
+def _there_and_back(openbody, frames=120, turn_at=60, turn_frames=10):
+    """A body walking +Z, turning round (180 degrees over ``turn_frames``) and walking back."""
+    rest = openbody.rest_joints(torch.zeros(1, 10))[0, :22].numpy().astype(np.float64)
+    t = np.arange(frames)
+    theta = np.pi * np.clip((t - turn_at) / turn_frames, 0.0, 1.0)
+    step = 1.2 / 20 * np.stack([np.sin(theta), np.zeros(frames), np.cos(theta)], 1)
+    root = np.cumsum(step, 0) + [0.0, 0.9, 0.0]
+    rot = np.repeat(np.eye(3)[None, None], 24, 1).repeat(frames, 0)
+    rot[:, 0] = yaw_matrix(theta)
+    return _posed(rest, rot, root)
+
+
+def test_a_take_that_turns_round_plays_its_longest_way_along_a_line(openbody):
+    from shapemove.core.generation.straight_gait import LINE_BAND, line_stretch
+
+    J = _there_and_back(openbody, frames=150, turn_at=50)
+    lo, hi = line_stretch(J)
+    assert lo > 50 and hi == 150                       # the way back (95+ frames) is longer than the way there
+    assert 150 - lo == pytest.approx(150 - 50 - 10 * (1 - LINE_BAND / np.pi), abs=4)   # from 45 degrees off its end
+    lo, hi = line_stretch(_there_and_back(openbody, frames=150, turn_at=100))
+    assert lo == 0 and 100 <= hi <= 106                # the way there, up to where it has turned by 45 degrees
+    assert line_stretch(_there_and_back(openbody, frames=80, turn_at=200)) == (0, 80)   # never turns: whole
+
+
+def test_a_line_is_asked_of_one_gait_forward():
+    from shapemove.core.generation.straight_gait import line_asked
+    from shapemove.core.plan.words import read_words
+
+    for text in ("a soldier marches forward", "a man limps along", "a zombie shambles", "she marches"):
+        assert line_asked(read_words(text)), text
+    for text in ("a man limps in a circle", "a soldier marches in place", "she marches and waves",
+                 "a man marches to the left", "a man waves", "a man marches, then turns around"):
+        assert not line_asked(read_words(text)), text
+
+
+def test_the_march_goes_forward_and_never_turns_round():
+    """CMU 105_19, the data's one march, goes up the room, turns round at 7 s and comes back: asked
+    "marches forward" it marched 8.4 m and ended 1.6 m from where it started; now it plays the way
+    there (looped on its last stride where asked for longer)."""
+    from shapemove.core.generation.generate import Generator, Request
+
+    gen = Generator(None)
+    for seconds in (None, 12.0):
+        m = gen.generate_batch([Request("a soldier marches forward", seconds=seconds, seed=0)])[0]
+        assert "cmu_105_19" in m.provenance and "along a line" in m.provenance, m.provenance
+        p = m.joints[:, 0, [0, 2]]
+        path = np.linalg.norm(np.diff(p, axis=0), axis=1).sum()
+        assert np.linalg.norm(p[-1] - p[0]) > 0.95 * path > 4.0, (path, p[-1] - p[0])   # straight on

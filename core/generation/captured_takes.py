@@ -60,7 +60,7 @@ from ..plan.vocabulary import COUNTED, GAITS, POSTURE_CHANGES
 from .floor_sit import SIT, SIT_FROM, sit_end
 from .stand_in_takes import STAND_IN, played_as, stand_in_span
 from .repeated_takes import cut_for, repeated_stretch
-from .straight_gait import STRAIGHTENED, straightened
+from .straight_gait import STRAIGHTENED, line_stretch, straightened
 from .take_loop import looped_gait, looped_repetition, looped_steps, looped_take
 
 TAKES = 5              # captured windows offered per prompt
@@ -323,7 +323,8 @@ class TakePool:
         when asked (``repeated_takes.py``), all of them when the length is the model's, however long;
         a take of a change of posture (``plan/vocabulary.POSTURE_CHANGES``: getting up, lying down) is cut to
         its end. ``straight``: a take of a plain gait is played off its bend (``straight_gait.py``)
-        and, shorter than asked, loops on its last stride (``take_loop.looped_gait``); a take of any
+        and, shorter than asked, loops on its last stride (``take_loop.looped_gait``); a take of
+        another gait that turns round plays its longest stretch along a line (``line_stretch``); a take of any
         other gait (``vocabulary.GAITS``: two sneaking steps) shorter than asked and without two
         cycles of its own loops on its last stride too, else on its last step and the step's mirror
         image, else (a cycle whose contacts do not show its steps) whole, as one repetition. A take of
@@ -351,6 +352,11 @@ class TakePool:
                 rot, root, con = rot[end - 1:], root[end - 1:], con[end - 1:]
                 provenance += ", from its sit on the floor"
                 from_seat = True
+        if straight and action in GAITS and action not in STRAIGHTENED:   # along a line: not its turn round
+            lo, hi = line_stretch(pose(rot, root, con))
+            if hi - lo < len(rot):
+                rot, root, con = rot[lo:hi], root[lo:hi], con[lo:hi]
+                provenance += f", {lo / FPS:.1f}-{hi / FPS:.1f} s (its way along a line)"
         if cut_for(action, times):
             def posed(r, rt, c):
                 j = pose(r, rt, c)

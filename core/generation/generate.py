@@ -63,7 +63,7 @@ from .still_take import still_take
 from .travel_words import SIDEWAYS_ACTIONS, backward_taken, goes_sideways
 from .hands_asked import hands_wanted
 from .typical_pace import fast_take, leg_ratio, load_typical_speeds, slow_take, typical_paced, unplain_take
-from .straight_gait import straight_asked
+from .straight_gait import line_asked, straight_asked
 from .turn_words import turn_motion
 
 
@@ -209,7 +209,7 @@ class Generator:
         down = self.vae.cfg.downsample
         text = self._embed_texts([r.prompt])[0]
         words = r.words if r.words is not None else read_words(r.prompt)
-        straight, hands = straight_asked(words), hands_wanted(words, action)   # a gesture's hands as said
+        straight, hands = straight_asked(words) or line_asked(words), hands_wanted(words, action)   # a gesture's hands as said
         if r.seconds is None:   # the model's length: a take plays whole, at least UNASKED_SECONDS
             return pool.windows(text, action, r.seed, self._length(UNASKED_SECONDS)[0] * down, side, hi * down,
                                 times=times, straight=straight, hands=hands, seated=r.seated, competes=competes,

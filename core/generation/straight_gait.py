@@ -18,6 +18,13 @@ line:
 What stays of the bend is where the feet land across the line and, for some takes, a body facing
 up to 12 degrees off it (the performer looked into the turn).
 
+The other gaits' takes (a march, a limp, a zombie walk, a long sneak) are not straightened: CMU's
+and DeepMimic's go up a room, turn round and come back (CMU 105_19, the data's one march, turns by
+200 degrees at 7 s). Asked along a line ("a soldier marches forward"), such a take plays its longest
+stretch whose heading stays within ``LINE_BAND`` (``line_asked``, ``line_stretch``: the march's
+first 7.2 s), looped on its last stride where the length asked is longer, instead of the turn and
+the way back.
+
 Which prompts: one gait that goes on along a line (``typical_pace.lined_gait``: "jogs", "trots
 along slowly", "walks forward quickly"; no course, turn, place, second thing or way other than
 forward asked; ``straight_asked``); "jogs in a circle" or "jogs to the left" keeps the takes' bends.
@@ -33,6 +40,7 @@ from ..motion.skeleton_ops import facing_directions, gaussian_smooth, heading_an
 from .track import HEADING_SIGMA
 
 STRAIGHTENED = ("walk", "jog", "run")   # the plain gaits whose takes are played off their bends
+LINE_BAND = np.radians(45.0)            # another gait's take asked along a line: its stretch within this heading band
 LEAN_SIGMA = 8.0                        # frames: the lean without the sway of each step
 NECK, FEET = 12, (7, 8, 10, 11)         # the lean: the neck over the ankles' and toes' middle
 
@@ -43,6 +51,18 @@ def straight_asked(words) -> bool:
     from .typical_pace import lined_gait
 
     return lined_gait(words) is not None
+
+
+def line_asked(words) -> bool:
+    """Whether the words (``plan.words.Words``) ask one gait of the plan's (``vocabulary.GAITS``: a
+    march, a limp) going along a line: no course, turn, place or second thing, no way but forward."""
+    from ..plan.vocabulary import GAITS
+
+    if words is None or len(words.actions) != 1 or words.actions[0] not in GAITS:
+        return False
+    if any(a not in (None, False) for a in (words.course, words.turn, words.parts)) or words.in_place:
+        return False
+    return not (words.travel.forward < 0 or words.travel.side or words.travel.sideways)
 
 
 def straightened(rotations, root, joints) -> tuple[np.ndarray, np.ndarray]:
@@ -78,6 +98,26 @@ def heading_gained(joints, sigma: float = HEADING_SIGMA) -> np.ndarray:
     y0, y1 = w @ raw, (w * d) @ raw
     fit = (s2 * y0 - s1 * y1) / np.maximum(s0 * s2 - s1 * s1, 1e-12)
     return fit - fit[0]
+
+
+def line_stretch(joints, band: float = LINE_BAND) -> tuple[int, int]:
+    """(lo, hi): the longest stretch of frames of posed ``joints`` (T,J,3) whose heading
+    (``heading_gained``) stays within ``band`` radians, its first such stretch on a tie; (0, T) for a
+    take that never turns so far."""
+    h = heading_gained(joints)
+    best = (0, len(h))
+    if len(h) == 0 or h.max() - h.min() <= band:
+        return best
+    size = 0
+    for lo in range(len(h)):
+        if len(h) - lo <= size:
+            break
+        spread = np.maximum.accumulate(h[lo:]) - np.minimum.accumulate(h[lo:])
+        over = np.flatnonzero(spread > band)
+        hi = lo + (int(over[0]) if len(over) else len(h) - lo)
+        if hi - lo > size:
+            size, best = hi - lo, (lo, hi)
+    return best
 
 
 def lean(joints, facing=None) -> np.ndarray:
