@@ -118,6 +118,9 @@ def test_vocabulary():
     ("he slides over to the left", ["sidestep"]), ("a woman steps back", ["walk backward"]),
     ("a man steps back and waves", ["walk backward", "wave"]), ("she steps back and forth", []),
     ("he steps backward and forward", []), ("a man steps forward", ["walk"]),
+    # jumping over something goes forward; over and over is no obstacle
+    ("a woman jumps over a puddle", ["jump forward"]), ("the dog leaps over the fence", ["jump forward"]),
+    ("a boy jumps over and over", ["jump"]),
     # CMU's descriptions keep their labels: sitting with the legs dangling is no hang, a dancer's lean no bend
     ("playground - climb, sit, dangle legs, descend", ["climb", "sit"]),
     ("dance - lean forward, bring back leg forward, arching arms", ["dance"]),

@@ -78,7 +78,7 @@ _EVERYDAY = {
     ),
     "jump": (r"\bsprings? (up|into the air)\b", r"\bvault(s|ed|ing)?\b", r"\bskip\w* (a |the )?rope\b",),
     "jump forward": (r"\b(broad|standing long) jumps?\b", r"\bleap\w* as far\b", r"\bleap\w* (forward|ahead|across)\b",
-                     r"\bjump\w* across\b",),
+                     r"\bjump\w* across\b", r"\b(jump|leap)\w* over (a|an|the|some|his|her|their)\b",),
     "spin jump": (r"\b(jump|leap)\w* (up )?and (twirl|spin|turn|rotat)\w*",
                   r"\b(jump|leap)\w*( \w+){0,3} (a |an )?(full|360|180|half)[- ]?(degree )?(turn|spin|rotation|twist)\b",),
     "hop": (r"\bskip\w* (along )?on one (leg|foot)\b", r"\bbounc\w* on (both|two) feet\b",
