@@ -77,6 +77,9 @@ from shapemove.core.plan.segments import SEGMENT_SECONDS, split_segments
     ("she jumps, squats and waves", ["she jumps", "she squats", "she waves"]),
     ("a woman walks forward, turns around and walks back", ["a woman walks forward, turns around", "a woman walks back"]),
     ("a person squats down, subsequently stands up and runs", ["a person squats down", "a person runs"]),
+    # with no "and" that orders, a list of verbs of actions one after the other is cut at its commas
+    ("a boy runs, jumps and lands on both feet", ["a boy runs", "a boy jumps and lands on both feet"]),
+    ("a woman walks, sits down", ["a woman walks", "a woman sits down"]),
     # a turn after a gait that counts its steps or a distance comes after them
     ("the man walks 10 steps and turns left", ["the man walks 10 steps", "the man turns left"]),
     ("a man walks 3 metres and turns around", ["a man walks 3 metres", "a man turns around"]),
@@ -117,6 +120,8 @@ def test_ordering_words_make_segments_in_the_order_they_happen(prompt, segments)
     "a man walks and throws a ball", "a man walks and turns left", "a person turns around and walks away",
     # a sit and an arm gesture at once: waving seated
     "a woman sits down and waves", "he sits and raises his hand",
+    # a list without an order word: at once by body part, a squat's own standing up, the arms of a jump
+    "a woman walks, waves", "he squats, stands up", "vertical jump, arms swinging up",
 ])
 def test_and_alone_courses_and_things_at_once_stay_one_segment(prompt):
     assert split_segments(prompt) == [prompt]

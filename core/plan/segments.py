@@ -38,7 +38,7 @@ from __future__ import annotations
 
 import re
 
-from ..data.actions import find_actions
+from ..data.actions import action_spans, find_actions
 from .part_prompts import SUBJECT, _has_verb, _subject, _with_subject, at_once, named_side
 from .reader import stop_request
 from .vocabulary import (AND, BEFORE_AFTER as MIDDLE, FIRST, LEADING_BEFORE_AFTER as LEADING, LIST_STEP, PARTICIPLE,
@@ -121,7 +121,9 @@ def _and_steps(piece: str, before: str = "") -> list[str]:
     jumps in", "walks forward, turns around and walks back"), or a turn after a gait that counts its
     steps or a distance ("walks 10 steps and turns left": the steps, then the turn), and, where it
     cuts, at the commas of a
-    list of steps before it ("jumps, squats and waves": three); the piece itself otherwise. Standing
+    list of steps before it ("jumps, squats and waves": three); where no "and" cuts, at the commas of a
+    list of verbs of actions done one after the other ("runs, jumps and lands on both feet": two);
+    the piece itself otherwise. Standing
     up after a squat or a bend (``before``: what precedes the piece) is that action's own end, no
     action of its own: "squats, then stands up and waves" is two, the squat (which stands up again)
     and "waves". A sit and a gesture are done at once ("sits down and waves": waving seated,
@@ -139,7 +141,29 @@ def _and_steps(piece: str, before: str = "") -> list[str]:
         counted = then[0] == "turn" and stop_request(a) is not None   # "walks 10 steps and turns left"
         if posture or counted or _one_after_other(first, then, whole):   # an order: the list of steps before it cuts too
             return _list_steps(a) + _and_steps(b, a)
+    steps = _list_steps(piece)   # no "and" orders it: a list of verbs of actions ("runs, jumps and lands")
+    if len(steps) > 1 and all(_leads_with_action(y) and _follows(find_actions(x), find_actions(y), whole)
+                              for x, y in zip(steps, steps[1:])):
+        return steps
     return [piece]
+
+
+def _follows(first: list[str], then: list[str], whole: list[str]) -> bool:
+    """Whether a step of a list doing ``then`` follows one doing ``first``: one after the other
+    (``_one_after_other``), or a change of posture between two actions not done at once ("walks,
+    sits down")."""
+    if not first or not then:
+        return False
+    posture = first[0] != then[0] and not at_once(first[-1], then[0]) and \
+        (_changes_posture(then[0], first) or _changes_posture(first[-1], []))
+    return posture or _one_after_other(first, then, whole)
+
+
+def _leads_with_action(step: str) -> bool:
+    """Whether a step of a list begins with the word of an action ("jumps and lands"), not a part of
+    the body doing it ("arms swinging up")."""
+    spans = action_spans(step.strip())
+    return bool(spans) and spans[0][0] == 0
 
 
 def _says_something(piece: str) -> bool:
