@@ -77,6 +77,10 @@ from shapemove.core.plan.segments import SEGMENT_SECONDS, split_segments
     ("she jumps, squats and waves", ["she jumps", "she squats", "she waves"]),
     ("a woman walks forward, turns around and walks back", ["a woman walks forward, turns around", "a woman walks back"]),
     ("a person squats down, subsequently stands up and runs", ["a person squats down", "a person runs"]),
+    # a stop between two things is the gait's own stop, then the next thing
+    ("a man walks forward, stops, and waves", ["a man walks forward, then stops", "a man waves"]),
+    ("she walks forward and stops and then waves", ["she walks forward, then stops", "she waves"]),
+    ("he walks, stops, then turns around", ["he walks, then stops", "he turns around"]),
     # with no "and" that orders, a list of verbs of actions one after the other is cut at its commas
     ("a boy runs, jumps and lands on both feet", ["a boy runs", "a boy jumps and lands on both feet"]),
     ("a woman walks, sits down", ["a woman walks", "a woman sits down"]),
@@ -122,6 +126,8 @@ def test_ordering_words_make_segments_in_the_order_they_happen(prompt, segments)
     "a woman sits down and waves", "he sits and raises his hand",
     # a list without an order word: at once by body part, a squat's own standing up, the arms of a jump
     "a woman walks, waves", "he squats, stands up", "vertical jump, arms swinging up",
+    # a stop that ends the prompt, a bus stop, a stop denied
+    "he jogs to the corner and stops", "a man walks to the bus stops and waits", "she runs without stopping and waves",
 ])
 def test_and_alone_courses_and_things_at_once_stay_one_segment(prompt):
     assert split_segments(prompt) == [prompt]

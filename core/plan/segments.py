@@ -41,8 +41,8 @@ import re
 from ..data.actions import action_spans, find_actions
 from .part_prompts import SUBJECT, _has_verb, _subject, _with_subject, at_once, named_side
 from .reader import stop_request
-from .vocabulary import (AND, BEFORE_AFTER as MIDDLE, FIRST, LEADING_BEFORE_AFTER as LEADING, LIST_STEP, PARTICIPLE,
-                         POSTURE_CHANGES, RISEN_FROM, STOP, THEN, WAY_ALONE)
+from .vocabulary import (AND, BEFORE_AFTER as MIDDLE, FIRST, LEADING_BEFORE_AFTER as LEADING, LIST_STEP, MID_STOP,
+                         PARTICIPLE, POSTURE_CHANGES, RISEN_FROM, STOP, THEN, WAY_ALONE)
 
 DEFAULT_SUBJECT = "a person"
 SEGMENT_SECONDS = 3.0       # a segment's length when the prompt's length is the model's to choose
@@ -210,6 +210,7 @@ def split_segments(prompt: str) -> list[str]:
     """The prompts of ``prompt``'s segments in the order they happen (module doc); one when no word
     orders it, the prompt itself."""
     t = re.sub(r"\s+", " ", str(prompt)).strip().lower()
+    t = MID_STOP.sub(r", then \1, then ", t)   # "walks, stops, and waves": the walk's stop, then the wave
     pieces = []
     for p in (_tidy(p) for p in THEN.split(t)):
         subject = SUBJECT.match(p)
