@@ -132,12 +132,37 @@ def test_a_retrieved_clip_of_another_action_than_the_words_ask_does_not_compete(
         assert m.retrieved_clips == []                      # neither a walk nor a punch sits: the samples
         m = gen.generate_batch([Request("a person walks forward", seconds=4, seed=0, retrieval_first=0.0)])[0]
         assert m.retrieved_clips == ["walk_1"]
-        m = gen.generate_batch([Request("somebody is here", seconds=4, seed=0, retrieval_first=0.0)])[0]
-        assert m.retrieved_clips in (["walk_1"], ["punch_1"])   # no action asked: any clip competes
     finally:
         gen.t5.memory = old
     real = gen.t5.memory
     assert real.main_action("dataset-2_walk_elderly_014") == "walk"   # the shipped memory's labels
+
+
+def test_words_naming_no_action_keep_only_a_clip_whose_caption_says_them(gen):
+    """"a woman does aerobics" walked 5.6 m on an active walk's codes: with no action named, a clip
+    competes only from ``NAMELESS_FLOOR`` (a named action keeps any clip of it)."""
+    from shapemove.core.generation.generate import Request
+    from shapemove.core.generation.retrieved_candidates import NAMELESS_FLOOR
+    from shapemove.core.models.motion_memory import MotionMemory
+
+    walk = gen.tokens_for([Request("a person walks backwards", seconds=4, seed=0, candidates=1)])[0][0]
+    guitar = gen.tokens_for([Request("a person raises both hands", seconds=4, seed=0, candidates=1)])[0][0]
+    mem = MotionMemory.empty()
+    mem.add_clips(["back_1", "guitar_1"], [["a person walks backwards."], ["a person plays the guitar."]],
+                  [walk, guitar], gen._text_encoder())
+    near = {p: retrieved_codes(mem, gen._text_encoder(), p, 1, 4, 50)[0] for p in
+            ("a woman looks back", "somebody plays the guitar", "a woman walks backwards slowly")}
+    assert near["a woman looks back"][0] == "back_1" and near["a woman looks back"][1] < NAMELESS_FLOOR
+    assert near["somebody plays the guitar"][0] == "guitar_1" and near["somebody plays the guitar"][1] >= NAMELESS_FLOOR
+    old = gen.t5.memory
+    gen.t5.memory = mem
+    try:   # retrieval first from similarity 0: the retrieved windows alone, when any is offered
+        got = {p: gen.generate_batch([Request(p, seconds=4, seed=0, retrieval_first=0.0)])[0].retrieved_clips
+               for p in near}
+    finally:
+        gen.t5.memory = old
+    assert got == {"a woman looks back": [], "somebody plays the guitar": ["guitar_1"],
+                   "a woman walks backwards slowly": ["back_1"]}, got
 
 
 def test_a_judge_does_not_find_the_retrieved_take_itself():

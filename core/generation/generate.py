@@ -51,7 +51,7 @@ from ..plan.plan import plan_text, read_plan
 from ..plan.reader import without_numbers
 from ..plan.segments import MIN_SEGMENT_SECONDS
 from ..plan.words import read_words
-from .retrieved_candidates import library_codes, retrieved_codes
+from .retrieved_candidates import NAMELESS_FLOOR, library_codes, retrieved_codes
 from .stop_words import (DISTANCE_PACE, DISTANCE_SECONDS, OVERSHOOT, STAND_SECONDS, distance_cut, distance_keeps,
                          from_start, standing_after, standing_code, stop_cut, shortened_to)
 from .sampling_params import (DEFAULT_GUIDANCE, check_candidates, check_guidance, check_retrieval_first,
@@ -356,8 +356,11 @@ class Generator:
             beta = out.betas[0] if beta is None else beta  # [BETA] precedes the codes: one body for all
         sources = [None] * len(cands)
         if n > 1:  # real clips nearest by caption compete with the samples, or replace them
+            named = bool((r.words if r.words is not None else read_words(r.prompt)).actions)
             found = [f for f in self._retrieved(r, lo, hi, library)
-                     if action_credit(asked, self.t5.memory.main_action(f[0])) is not None]
+                     if action_credit(asked, self.t5.memory.main_action(f[0])) is not None
+                     and (named or f[1] >= NAMELESS_FLOOR or f[0] in self.library_files)]   # no action named:
+            # only a caption that says it, or the user's own clip (its own floor: retrieved_candidates.LIBRARY_FLOOR)
             if found and r.retrieval_first is not None and found[0][1] >= r.retrieval_first:
                 cands, sources = [], []
             for cid, _, c in found:

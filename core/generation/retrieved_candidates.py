@@ -15,7 +15,11 @@ about as close to "throws punches" as a captured punch, so best-of-N alone would
 tokens are decoded by the SA-VAE for the requested body, so the motion has that body's proportions
 and its feet are planted as for any sample. A clip shorter than the requested length is skipped,
 and so is one labelled with another action than the words ask (``Generator._sampled``, by
-``captured_takes.action_credit``: "an old man sits down slowly" found an elderly walk).
+``captured_takes.action_credit``: "an old man sits down slowly" found an elderly walk). Where the
+words name no action the plan knows, a clip competes only when its caption says nearly what the
+prompt says (``NAMELESS_FLOOR``, as ``captured_takes.NAMELESS_FLOOR`` for the takes): "a woman does
+aerobics" (4 s) walked 5.6 m on an active walk's codes, "a man dodges to the side" 4.9 m on a
+veering walk's.
 A user's library (``Generator.add_library``) is in the same memory, where thousands of training
 captions can be nearer to a prompt than the user's own: ``library_codes`` offers the library's
 nearest clip beside them when its caption is nearly as near, and its nearest clip of an action the
@@ -33,6 +37,7 @@ WINDOWS = 3   # windows of a clip longer than the requested length: its start, m
 LIBRARY_MARGIN = 0.08   # a user's library clip competes when its caption is this near the nearest caption's
 LIBRARY_FLOOR = 0.4     # ... and at least this near the prompt (MiniLM cosine)
 LIBRARY_SHORTEST = 0.5  # a library clip shorter than asked competes whole when it covers this share of the length
+NAMELESS_FLOOR = 0.7    # words naming no action: a clip competes from this caption similarity (MiniLM cosine)
 
 
 def windows(codes, min_codes: int, max_codes: int) -> list[list[int]]:
