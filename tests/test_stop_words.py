@@ -134,6 +134,23 @@ def test_three_steps_and_a_stop(gen_default):
     assert speeds(taller)[-30:].mean() < 0.08 and taller.joints[:, 0, 1].mean() > m.joints[:, 0, 1].mean()
 
 
+def test_a_gait_asked_to_stop_goes_a_while_first(gen_default):
+    """No length asked, no steps or distance counted: the gait goes ``GOING_SECONDS`` before it
+    stops, then stands ``STAND_SECONDS``. "he jogs to the corner and stops" went 0.5 m in the half
+    of the model's length it kept, the start of a jog from standing."""
+    from shapemove.core.generation.generate import Request
+    from shapemove.core.generation.stop_words import GOING_SECONDS, STAND_SECONDS
+
+    for text in ("he jogs to the corner and stops", "a man runs forward and stops"):
+        m = gen_default.generate_batch([Request(text, seed=0)])[0]
+        assert m.num_frames == round((GOING_SECONDS + STAND_SECONDS) * m.fps), (text, m.num_frames)
+        r = m.joints[:, 0, [0, 2]]
+        going = round(GOING_SECONDS * m.fps)
+        assert np.linalg.norm(r[going] - r[0]) > 4.0, text                  # a jog, a run: metres, not a start
+        assert np.linalg.norm(r[-1] - r[going + 12]) < 0.15, text            # then standing
+        assert m.tokens[-8:].tolist() == [gen_default.rest_code] * 8
+
+
 @pytest.mark.usefixtures("codes_only")
 def test_a_timeline_segment_that_stands_still_stands(gen_default):
     """"walks forward" -> "stands still" -> "walks forward": the T5 has no standing caption and its

@@ -52,8 +52,8 @@ from ..plan.reader import without_numbers
 from ..plan.segments import MIN_SEGMENT_SECONDS
 from ..plan.words import read_words
 from .retrieved_candidates import NAMELESS_FLOOR, library_codes, retrieved_codes
-from .stop_words import (DISTANCE_PACE, DISTANCE_SECONDS, OVERSHOOT, STAND_SECONDS, distance_cut, distance_keeps,
-                         from_start, standing_after, standing_code, stop_cut, shortened_to)
+from .stop_words import (DISTANCE_PACE, DISTANCE_SECONDS, GOING_SECONDS, OVERSHOOT, STAND_SECONDS, distance_cut,
+                         distance_keeps, from_start, standing_after, standing_code, stop_cut, shortened_to)
 from .sampling_params import (DEFAULT_GUIDANCE, check_candidates, check_guidance, check_retrieval_first,
                               check_retrieval_prefix, check_retrieved, check_sampling)
 from .request import Request
@@ -598,8 +598,11 @@ class Generator:
             edited = r.plan is not None
             stop = (words.gait_text, words.steps) if words is not None and words.stop else None   # "takes three steps"
             metres = words.distance_m if stop else None      # "walks 3 metres": that far, then stands
+            going = 2 * GOING_SECONDS if stop and stop[1] is None and words.seconds is None else None   # cut at half
             asked = dataclasses.replace(r, prompt=stop[0], seconds=r.seconds if r.seconds or not metres else
                                         min(DISTANCE_SECONDS, metres / DISTANCE_PACE + 1.0)) if stop else r
+            if stop and not metres and asked.seconds is None and going is not None:   # "jogs and stops": a while
+                asked = dataclasses.replace(asked, seconds=going)                      # going, then standing
             asked = dataclasses.replace(asked, plan=None, words=None)
             if asked.seconds is None and words is not None and words.seconds is not None:   # "for ten seconds"
                 asked = dataclasses.replace(asked, seconds=words.seconds)

@@ -7,7 +7,9 @@ standing still, and the decoder's own transition from walking codes into them br
 a halt within about half a second, feet planted. So a prompt that says the gait stops is generated
 without its stop clause, its codes are cut after the step the words count (or at half the length
 when they name no count), and the model's standing code fills the rest of the length (``STAND_SECONDS``
-of it when no length was asked); the whole is decoded again as one sequence. The motion keeps those tokens, so a new body decodes the same stop.
+of it when no length was asked; the gait then goes at least ``GOING_SECONDS`` first: "he jogs to the
+corner and stops" went 0.5 m, half of the model's 1.8 s, the start of a jog from standing, before it
+stood); the whole is decoded again as one sequence. The motion keeps those tokens, so a new body decodes the same stop.
 A timeline's segment that only asks to stand still ("stands still", "waits", "pauses";
 ``plan.words.Words.stand_still``) is that code too (``sequence._segment``).
 
@@ -49,6 +51,7 @@ REST_RUN = 4       # codes in a row: a code held this long in a real clip is a c
 REST_PROBE = 10    # codes the candidate is repeated for when it is decoded
 DISTANCE_EARLIER = 2   # codes before a distance's cut also tried (``distance_keeps``)
 STAND_SECONDS = 1.6   # standing after the stop when the model decides the length (none was asked)
+GOING_SECONDS = 3.0   # ... and at least this long going before it, when no steps or distance are counted
 
 
 def standing_code(memory, vae) -> int | None:
