@@ -121,6 +121,9 @@ def test_vocabulary():
     # jumping over something goes forward; over and over is no obstacle
     ("a woman jumps over a puddle", ["jump forward"]), ("the dog leaps over the fence", ["jump forward"]),
     ("a boy jumps over and over", ["jump"]),
+    # a thing thrown that was named before, a throw by its manner; punches, throwing up and oneself are not
+    ("a man picks up a ball and throws it", ["pick up", "throw"]), ("she throws overhand", ["throw"]),
+    ("she throws up", []), ("he throws himself on the floor", []),
     # CMU's descriptions keep their labels: sitting with the legs dangling is no hang, a dancer's lean no bend
     ("playground - climb, sit, dangle legs, descend", ["climb", "sit"]),
     ("dance - lean forward, bring back leg forward, arching arms", ["dance"]),

@@ -156,7 +156,8 @@ _EVERYDAY = {
     "throw": (r"\bhurl", r"\btoss", r"\bpitch\w* (a|the) (base)?ball\b", r"\bfling", r"\blob(s|bed|bing)?\b",
               r"\b(throw\w*|threw) (a |the )?(\w+ )?(base|basket|soft|snow|beach|foot)balls?\b",
               r"\bthrow\w* (a|an|the|his|her|their|some) (\w+ )?(stick|stone|rock|frisbee|javelin|spear|dart|disc|"
-              r"discus|bottle|snowball|pillow|bag|box|object|rope|bone)s?\b",),
+              r"discus|bottle|snowball|pillow|bag|box|object|rope|bone)s?\b",
+              r"\b(throw\w*|threw) (it|them)\b", r"\bthrow\w* (overhand|underhand|overarm|sidearm)\b",),
     "dribble": (r"\bbounc\w* the (basket)?ball\b",),
     "shoot": (r"\bjump shot\b", r"\bshot at the (hoop|basket)\b", r"\bfree throw", r"\blay-?up\b",),
     "dance": (r"\bgroov", r"\bboogie", r"\bhip[- ]?hop\b", r"\b(mov|sway|bounc|bob|step)\w* to the (beat|music|rhythm)\b", r"\bbust\w* a move\b", r"\bbreak[- ]?danc", r"\btwerk",
