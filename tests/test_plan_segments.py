@@ -77,6 +77,9 @@ from shapemove.core.plan.segments import SEGMENT_SECONDS, split_segments
     ("she jumps, squats and waves", ["she jumps", "she squats", "she waves"]),
     ("a woman walks forward, turns around and walks back", ["a woman walks forward, turns around", "a woman walks back"]),
     ("a person squats down, subsequently stands up and runs", ["a person squats down", "a person runs"]),
+    # a turn before a gait starts it (one segment); before anything else it is done first, on the spot
+    ("a woman turns to the right and waves", ["a woman turns to the right", "a woman waves"]),
+    ("she turns around and kicks", ["she turns around", "she kicks"]),
     # a stop between two things is the gait's own stop, then the next thing
     ("a man walks forward, stops, and waves", ["a man walks forward, then stops", "a man waves"]),
     ("she walks forward and stops and then waves", ["she walks forward, then stops", "she waves"]),

@@ -39,7 +39,7 @@ from __future__ import annotations
 import re
 
 from ..data.actions import action_spans, find_actions
-from .part_prompts import SUBJECT, _has_verb, _subject, _with_subject, at_once, named_side
+from .part_prompts import LEGS, SUBJECT, _has_verb, _subject, _with_subject, at_once, named_side
 from .reader import stop_request
 from .vocabulary import (AND, BEFORE_AFTER as MIDDLE, FIRST, LEADING_BEFORE_AFTER as LEADING, LIST_STEP, MID_STOP,
                          PARTICIPLE, POSTURE_CHANGES, RISEN_FROM, STOP, THEN, WAY_ALONE)
@@ -103,11 +103,11 @@ def _one_after_other(first: list[str], then: list[str], whole: list[str]) -> boo
     last of the one and the first of the other are two actions one body does not do at once
     (``part_prompts.at_once``: "jogs and waves" is one segment made by body part), each its own in
     the ``whole`` piece ("jumps and twirls" is one spin jump), the second no turn ("walks and turns
-    left": the turn ends the gait) and the first no turn alone ("turns around and walks away": the
-    turn starts the gait); a change of posture on either side has its own rule ("squats and stands
-    up" is one squat)."""
+    left": the turn ends the gait) and the first no turn alone before a gait ("turns around and walks
+    away": the turn starts the gait; "turns to the right and waves" is two, the turn on the spot);
+    a change of posture on either side has its own rule ("squats and stands up" is one squat)."""
     last, nxt = first[-1], then[0]
-    if nxt == "turn" or first == ["turn"] or last == nxt or at_once(last, nxt):
+    if nxt == "turn" or first == ["turn"] and nxt in LEGS or last == nxt or at_once(last, nxt):
         return False
     if last in POSTURE_CHANGES or nxt in POSTURE_CHANGES:   # said by the posture's own rule (``_and_steps``)
         return False
