@@ -36,7 +36,7 @@ from .floor_reach import floor_reached
 from .hands_asked import both_kept
 from .pace_words import fastest, gait_speed, going, staying
 from .posture_change import posture_kept
-from .stop_words import reaching
+from .stop_words import reaching, striking
 from .travel_words import allowed
 
 
@@ -74,6 +74,8 @@ class CandidatePicker:
         keep = staying(words, speeds, keep)   # an exercise or a gesture: not one that walks off
         if words.pace == "fast":
             keep = fastest(speeds, keep)
+        if words.steps is not None:   # "takes three steps": candidates that step that many times
+            keep = striking(feats, words.steps, keep)
         if words.count is not None:
             action, want = words.count
             keep = nearest_count([counter(action)(f) for f in feats], want, keep)
