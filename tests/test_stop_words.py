@@ -295,26 +295,3 @@ def test_a_prompt_that_stands_still_stands(gen_default):
     assert np.linalg.norm(np.diff(r, axis=0), axis=1).mean() * m.fps < 0.05
     assert m.tokens.tolist() == [gen_default.rest_code] * 10 and m.provenance == "generated"
 
-
-def _ankles(left, right, frames=60):
-    """(frames, 263) features whose ankles (joints 7, 8) are 8 cm up, 18 cm during the frame spans given."""
-    f = np.zeros((frames, 263), np.float32)
-    for joint, spans in ((7, left), (8, right)):
-        h = np.full(frames, 0.08, np.float32)
-        for a, b in spans:
-            h[a:b] = 0.18
-        f[:, 4 + (joint - 1) * 3 + 1] = h
-    return f
-
-
-def test_foot_strikes_count_the_feet_coming_down():
-    from shapemove.core.generation.stop_words import FIRST_STRIKE, foot_strikes, striking
-
-    f = _ankles([(10, 20), (30, 40)], [(20, 30)])
-    assert foot_strikes(f) == 3
-    assert foot_strikes(_ankles([(0, FIRST_STRIKE - 1), (30, 40)], [(50, 60)])) == 1   # coming down at the start; still up at the end
-    assert foot_strikes(_ankles([(10, 12)], [])) == 0                                # a twitch is no step
-    slide = _ankles([], [])                                                           # "takes three steps backwards" slid 5.2 m
-    keep = striking([slide, f, _ankles([(10, 20)], [])], 3, np.array([True, True, True]))
-    assert keep.tolist() == [False, True, False]
-    assert striking([slide, slide], 3, np.array([True, False])).tolist() == [True, False]   # none does: all stay

@@ -33,10 +33,11 @@ import numpy as np
 from ..plan.words import read_words
 from .count_words import counter, nearest_count
 from .floor_reach import floor_reached
+from .gait_steps import stepping, striking
 from .hands_asked import both_kept
 from .pace_words import fastest, gait_speed, going, staying
 from .posture_change import posture_kept
-from .stop_words import reaching, striking
+from .stop_words import reaching
 from .travel_words import allowed
 
 
@@ -71,6 +72,7 @@ class CandidatePicker:
             keep = reaching(feats, reach, keep)
         speeds = np.array([gait_speed(f) for f in feats])
         keep = going(words, speeds, keep)   # a gait asked to go somewhere: not one that stands about
+        keep = stepping(words, feats, keep)   # ... nor one that slides along without stepping
         keep = staying(words, speeds, keep)   # an exercise or a gesture: not one that walks off
         if words.pace == "fast":
             keep = fastest(speeds, keep)

@@ -42,6 +42,7 @@ import numpy as np
 import torch
 
 from ..motion.contacts import runs
+from .gait_steps import FIRST_STRIKE
 from .pace_words import path_length
 
 REACH_SLACK = 0.1          # m: a gait this close to the distance has got there
@@ -52,9 +53,6 @@ REST_PROBE = 10    # codes the candidate is repeated for when it is decoded
 DISTANCE_EARLIER = 2   # codes before a distance's cut also tried (``distance_keeps``)
 STAND_SECONDS = 1.6   # standing after the stop when the model decides the length (none was asked)
 GOING_SECONDS = 3.0   # ... and at least this long going before it, when no steps or distance are counted
-STEP_LIFT = 0.04      # m: an ankle this far over its floor is off it (a walk's: 8-10 cm)
-STEP_FRAMES = 3       # frames: the shortest swing counted as a step
-FIRST_STRIKE = 5      # frames: a foot that comes down before this was coming down at the start, no step taken
 
 
 def standing_code(memory, vae) -> int | None:
@@ -124,32 +122,6 @@ def reaching(feats: list, metres: float, among: np.ndarray) -> np.ndarray:
     if not among.any():
         return among
     return among & (path >= min(metres, path[among].max()))
-
-
-def foot_strikes(features) -> int:
-    """How many times the feet of a (T, 263) feature clip come down: for each ankle, the runs of at
-    least ``STEP_FRAMES`` frames it is more than ``STEP_LIFT`` above its own floor (its 10th
-    percentile) that end from frame ``FIRST_STRIKE`` on and before the clip does."""
-    from .count_words import ANKLES, _height
-
-    f = np.asarray(features, dtype=np.float64)
-    n = 0
-    for joint in ANKLES:
-        h = _height(f, joint)
-        n += sum(1 for a, b in runs(h > np.percentile(h, 10) + STEP_LIFT)
-                 if b - a >= STEP_FRAMES and FIRST_STRIKE <= b < len(h))
-    return n
-
-
-def striking(feats: list, steps: int, among: np.ndarray) -> np.ndarray:
-    """(N,) bool: of the candidates ``among`` (bool), those whose feet come down at least ``steps``
-    times (``foot_strikes``), which a count of steps can be cut after; ``among`` itself where none
-    does. "A man takes three steps backwards" chose a backward walk's codes that slid 5.2 m with the
-    ankles never 3 cm off the floor: no strike to cut after, so it slid on."""
-    if not among.any():
-        return among
-    keep = among & (np.array([foot_strikes(f) for f in feats]) >= steps)
-    return keep if keep.any() else among
 
 
 def distance_keeps(keep: int, n: int) -> list[int]:
