@@ -406,6 +406,15 @@ class TakePool:
                       provenance + (", mirrored" if flip else ""), held, flip, looped,
                       max(0, n - want) if exact else 0, seated=from_seat, manner=self.manner(i))
 
+    def held_from(self, w: Window, k: int, frames: int, said: str) -> Window:
+        """``w`` cut at frame ``k`` and held there, standing, to ``frames`` (a stop played on the take:
+        ``take_stop.py``), its features made again; ``said`` joins its provenance."""
+        t = self.take(self.ids.index(w.clip_id))
+        rot, root, con = hold(w.rotations[:k], w.root[:k], w.contacts[:k], frames)
+        joints = self.proc.pose_on(rot, root, t["betas"], 1.0, con)
+        return Window(rot, root, con, w.rest, self.proc.features(joints, rot, con), w.action, w.clip_id,
+                      f"{w.provenance}, {said}", frames - k, w.mirrored, manner=w.manner)
+
     def windows(self, text: np.ndarray, action: str | None, seed: int, frames: int, side=None,
                 longest: int | None = None, count: int = TAKES, times: int | None = None,
                 straight: bool = False, hands: bool | None = None, seated: bool = False,

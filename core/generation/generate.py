@@ -38,6 +38,7 @@ from .manner_words import ANY, manner_kept, shown, slower_note, too_slow, unmet_
 from .course_shapes import ACTIONS as COURSE_ACTIONS, unasked_seconds
 from .course_walk import course_motion
 from .decode import decode_features, decode_tokens, redecode
+from .gait_steps import MIN_CADENCE, foot_strikes
 from .library_takes import captured_window, read_take, window_fit
 from .model_bundle import model_files, part_warnings, resolve_model_dir
 from .parts import CLAUSE_NEAR, generate_by_parts, is_by_parts, redecode_parts
@@ -47,6 +48,8 @@ from .retrieval_seeds import seed_prefixes, seeded_count
 from .held_arms import held_motion
 from .held_repetition import performed
 from .on_the_spot import on_the_spot
+from ..motion.features import motion_features
+from ..plan.part_prompts import LEGS
 from ..plan.plan import plan_text, read_plan
 from ..plan.reader import without_numbers
 from ..plan.segments import MIN_SEGMENT_SECONDS
@@ -62,8 +65,10 @@ from .slow_steps import slow_motion
 from .still_take import still_take
 from .travel_words import SIDEWAYS_ACTIONS, backward_taken, goes_sideways
 from .hands_asked import hands_wanted
-from .typical_pace import fast_take, leg_ratio, load_typical_speeds, slow_take, typical_paced, unplain_take
+from .typical_pace import (fast_take, leg_length, leg_ratio, load_typical_speeds, rest_of, slow_take, typical_paced,
+                           unplain_take)
 from .straight_gait import line_asked, straight_asked
+from .take_stop import stop_frame
 from .turn_words import turn_motion
 
 
@@ -635,8 +640,12 @@ class Generator:
                 betas, source = choice.body, choice.body_source
                 motion = self.chosen_motion(choice, betas, r.prompt)
                 came_from = motion.provenance
-                if stop is not None:   # stop_words.py: cut, then stand
+                if stop is not None:   # stop_words.py: cut, then stand; take_stop.py where the codes slide
                     motion = self.stopped(motion, stop[1], r.seconds, metres)
+                    taken = self._stopped_take(sampled, choice, motion, stop[1], metres, r.seconds)
+                    if taken is not None:
+                        choice, motion = taken, self.chosen_motion(taken, betas, r.prompt)
+                        came_from = motion.provenance
                 motion.shape_source = source
                 motion.retrieved_clips = choice.clips
                 self._say_if_short(motion, choice.kept, r.seconds)
@@ -705,6 +714,42 @@ class Generator:
         """The code that decodes to standing still (``stop_words.standing_code``, found once); None
         for a model without a memory or such a code."""
         return standing_code(self.t5.memory if self.t5 is not None else None, self.vae)
+
+    def _stopped_take(self, r: Request, choice: Choice, motion: Motion, steps: int | None, metres: float | None,
+                      seconds: float | None) -> Choice | None:
+        """Where the chosen codes of a gait asked to stop (``r``: its words without the stop), cut where
+        they stop (``motion``), did not step (``steps`` strikes, or ``gait_steps.MIN_CADENCE``
+        a second, before the standing code and its first code, where the last step lands; a backward
+        walk's slide), the captured take of that gait
+        the TMA finds nearest, cut where the words stop it and held (``take_stop.py``); ``seconds``:
+        the length asked (None: the cut and ``STAND_SECONDS``). None where the codes step, or no take
+        of the gait gets that far."""
+        words = r.words if r.words is not None else read_words(r.prompt)
+        gait = words.actions[0] if len(words.actions) == 1 else None
+        if choice.window is not None or gait not in LEGS or self.pool is None or not self.captured_on:
+            return None
+        codes = [int(c) for c in motion.tokens] if motion.tokens is not None else []
+        going = len(codes)
+        while going and codes[going - 1] == self.rest_code:
+            going -= 1
+        feats = motion_features(motion)[: (going + 1) * self.vae.cfg.downsample]   # the last step lands on
+        if len(feats) and foot_strikes(feats) >= (steps if steps else MIN_CADENCE * len(feats) / FPS):
+            return None
+        lo, hi = self._length(r.seconds)
+        stand = round(STAND_SECONDS * FPS)
+        leg = leg_length(rest_of(self.body, choice.body))   # a distance on the body asked: on the performer's
+        held = []
+        for w in self._windows(r, gait, lo, hi):
+            going = round(GOING_SECONDS * FPS) if seconds is None else len(w.root) // 2
+            there = None if metres is None else metres * leg_length(w.rest) / leg
+            k = stop_frame(w.contacts, w.root, steps, there, going) if w.action == gait else None
+            if k is not None:
+                frames = k + stand if seconds is None else max(k, round(seconds * FPS))
+                held.append(self.pool.held_from(w, k, frames, f"stopped at {k / FPS:.1f} s (its codes slide)"))
+        if not held:
+            return None
+        return choice._replace(codes=None, kept=None, window=held[self.picker.pick(r.prompt, [w.features for w in held],
+                                                                                   words=words)])
 
     def stopped(self, motion: Motion, steps: int | None, seconds: float | None = None,
                 metres: float | None = None) -> Motion:
