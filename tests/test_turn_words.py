@@ -18,6 +18,9 @@ from test_course_walk import _straight_walk
     ("a person makes a quarter turn to the right", -np.pi / 2),
     ("someone spins around", 2 * np.pi),
     ("someone turns around twice", 2 * np.pi),
+    ("a kid spins around three times", 6 * np.pi),     # a count of turns ("three times": one turn was made)
+    ("a woman turns around 3 times", 3 * np.pi),
+    ("a dancer spins 10 times", 10 * np.pi),           # at most MAX_TURNS turns of what is asked
     ("turn clockwise all the way around", -2 * np.pi),
     ("he turns his head", None),                       # a part turns, not the body
     ("back away slowly without turning around", None),  # negated

@@ -24,6 +24,7 @@ from . import vocabulary as V
 from .part_prompts import LEGS, named_side
 
 STEPPING = LEGS - {"jog", "run", "sprint"}   # gaits without a flight phase
+MAX_TURNS = 5   # "spins ten times": at most this many
 
 
 # -- count ------------------------------------------------------------------------------------
@@ -229,7 +230,11 @@ def angle_of(text: str) -> float | None:
         a = np.pi / 2
     else:
         return None
-    if V.TURN_TWICE.search(t):
+    times = V.TURN_TIMES.search(t)
+    if times:   # "spins around three times", "four full turns"
+        n = 3 if times.group(1) else int(times.group(2)) if times.group(2).isdigit() else V.NUMBERS[times.group(2)]
+        a *= max(1, min(n, MAX_TURNS))
+    elif V.TURN_TWICE.search(t):
         a *= 2
     right = bool(V.TURN_RIGHT.search(V.COUNTER_CLOCKWISE.sub(" ", t)))
     return float(-a if right else a)
@@ -320,7 +325,7 @@ def without_numbers(prompt: str) -> str:
 _TAKEN = (V.COUNT_TIMES, V.FAST, V.SLOW, V.STOP, V.STEPS, V.STEPS_ALONE, V.STILL, V.SPOKEN_DISTANCE, V.CLOCKWISE,
           V.COUNTER_CLOCKWISE, V.BACK_AND_FORTH, V.ZIGZAG, V.DIAGONAL, V.COURSE_WORDS, V.COURSE_WAY, V.TURN_WHOLE,
           V.TURN_HALF, V.TURN_QUARTER, V.FORWARD, V.BACKWARD, V.IN_PLACE, V.TRAVEL_SIDE, V.SIDEWAYS, V.SIDE,
-          V.DIRECTION, V.SUBJECT, V.TURN_TWICE, V.ARMS_HELD, V.BOTH_HANDS, V.ONE_HAND, V.DURATION, V.ASIDE,
+          V.DIRECTION, V.SUBJECT, V.TURN_TWICE, V.TURN_TIMES, V.ARMS_HELD, V.BOTH_HANDS, V.ONE_HAND, V.DURATION, V.ASIDE,
           V.CONNECTOR, V.THEN, V.MANNER, V.ONE_FOOT, V.JUMP_IN_PLACE, V.AGAIN)
 
 
