@@ -1,6 +1,5 @@
 """tools/gpu_t5.py: the pack that travels to a lent GPU (float16 MiniLM with the word pieces the
 texts use, the clips' tokens of one named VAE), a run there, and the model folder made from it here."""
-import importlib.util
 import json
 from argparse import Namespace
 from dataclasses import asdict
@@ -11,15 +10,13 @@ import pytest
 import torch
 
 from tiny_models import tiny_bundle  # noqa: F401  (session fixture)
+from tool_module import load_tool
 
 ROOT = Path(__file__).resolve().parents[1]
 
 
 def _tool():
-    spec = importlib.util.spec_from_file_location("gpu_t5_tool", ROOT / "tools" / "gpu_t5.py")
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
+    return load_tool("gpu_t5", "gpu_t5_tool")
 
 
 def test_pack_train_unpack_round_trip(tiny_bundle, tmp_path, monkeypatch):  # noqa: F811

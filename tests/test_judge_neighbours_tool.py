@@ -1,19 +1,8 @@
 """tools/judge_neighbours.py: a motion's nearest references under the TMA judge, its own take left out."""
-import importlib.util
-from pathlib import Path
-
 import numpy as np
+from tool_module import load_tool
 
 from shapemove.core.eval.action_classifier import ActionClassifier
-
-ROOT = Path(__file__).resolve().parents[1]
-
-
-def _tool():
-    spec = importlib.util.spec_from_file_location("judge_neighbours_tool", ROOT / "tools" / "judge_neighbours.py")
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
 
 
 def test_nearest_references_leave_out_the_motions_own_take():
@@ -23,7 +12,7 @@ def test_nearest_references_leave_out_the_motions_own_take():
     emb = np.stack([np.cos(angles), np.sin(angles)], 1)
     judge = ActionClassifier(emb, labels, k=3, sources=ids)
     judge.ids = ids
-    tool = _tool()
+    tool = load_tool("judge_neighbours")
     vote, near = tool.neighbours(judge, np.array([1.0, 0.0]), [], k=3)
     assert vote == "walk in a figure eight" and [c for _, c, _ in near] == ids[:3]
     assert abs(near[2][2] - np.cos(np.radians(10.0))) < 1e-6
