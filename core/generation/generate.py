@@ -214,7 +214,8 @@ class Generator:
         down = self.vae.cfg.downsample
         text = self._embed_texts([r.prompt])[0]
         words = r.words if r.words is not None else read_words(r.prompt)
-        straight, hands = straight_asked(words) or line_asked(words), hands_wanted(words, action)   # a gesture's hands as said
+        straight = straight_asked(words) or line_asked(words)   # a gait on a line (straight_gait.py)
+        hands = hands_wanted(words, action)   # a gesture's hands as said
         if r.seconds is None:   # the model's length: a take plays whole, at least UNASKED_SECONDS
             return pool.windows(text, action, r.seed, self._length(UNASKED_SECONDS)[0] * down, side, hi * down,
                                 times=times, straight=straight, hands=hands, seated=r.seated, competes=competes,
@@ -603,11 +604,10 @@ class Generator:
             edited = r.plan is not None
             stop = (words.gait_text, words.steps) if words is not None and words.stop else None   # "takes three steps"
             metres = words.distance_m if stop else None      # "walks 3 metres": that far, then stands
-            going = 2 * GOING_SECONDS if stop and stop[1] is None and words.seconds is None else None   # cut at half
             asked = dataclasses.replace(r, prompt=stop[0], seconds=r.seconds if r.seconds or not metres else
                                         min(DISTANCE_SECONDS, metres / DISTANCE_PACE + 1.0)) if stop else r
-            if stop and not metres and asked.seconds is None and going is not None:   # "jogs and stops": a while
-                asked = dataclasses.replace(asked, seconds=going)                      # going, then standing
+            if stop and stop[1] is None and not metres and asked.seconds is None and words.seconds is None:
+                asked = dataclasses.replace(asked, seconds=2 * GOING_SECONDS)   # "jogs and stops": going a while (cut at half)
             asked = dataclasses.replace(asked, plan=None, words=None)
             if asked.seconds is None and words is not None and words.seconds is not None:   # "for ten seconds"
                 asked = dataclasses.replace(asked, seconds=words.seconds)
@@ -718,21 +718,20 @@ class Generator:
     def _stopped_take(self, r: Request, choice: Choice, motion: Motion, steps: int | None, metres: float | None,
                       seconds: float | None) -> Choice | None:
         """Where the chosen codes of a gait asked to stop (``r``: its words without the stop), cut where
-        they stop (``motion``), did not step (``steps`` strikes, or ``gait_steps.MIN_CADENCE``
-        a second, before the standing code and its first code, where the last step lands; a backward
-        walk's slide), the captured take of that gait
-        the TMA finds nearest, cut where the words stop it and held (``take_stop.py``); ``seconds``:
-        the length asked (None: the cut and ``STAND_SECONDS``). None where the codes step, or no take
-        of the gait gets that far."""
+        they stop (``motion``), do not step (fewer than ``steps`` strikes, or ``gait_steps.MIN_CADENCE``
+        a second, before the standing code and over its first code, where the last step lands: a
+        backward walk's slide), the captured take of that gait the TMA finds nearest, cut where the
+        words stop it and held (``take_stop.py``); ``seconds``: the length asked (None: the cut and
+        ``STAND_SECONDS``). None where the codes step, or no take of the gait gets that far."""
         words = r.words if r.words is not None else read_words(r.prompt)
         gait = words.actions[0] if len(words.actions) == 1 else None
         if choice.window is not None or gait not in LEGS or self.pool is None or not self.captured_on:
             return None
         codes = [int(c) for c in motion.tokens] if motion.tokens is not None else []
-        going = len(codes)
-        while going and codes[going - 1] == self.rest_code:
-            going -= 1
-        feats = motion_features(motion)[: (going + 1) * self.vae.cfg.downsample]   # the last step lands on
+        kept = len(codes)
+        while kept and codes[kept - 1] == self.rest_code:
+            kept -= 1
+        feats = motion_features(motion)[: (kept + 1) * self.vae.cfg.downsample]   # the last step lands on
         if len(feats) and foot_strikes(feats) >= (steps if steps else MIN_CADENCE * len(feats) / FPS):
             return None
         lo, hi = self._length(r.seconds)
@@ -748,8 +747,8 @@ class Generator:
                 held.append(self.pool.held_from(w, k, frames, f"stopped at {k / FPS:.1f} s (its codes slide)"))
         if not held:
             return None
-        return choice._replace(codes=None, kept=None, window=held[self.picker.pick(r.prompt, [w.features for w in held],
-                                                                                   words=words)])
+        best = self.picker.pick(r.prompt, [w.features for w in held], words=words)
+        return choice._replace(codes=None, kept=None, window=held[best])
 
     def stopped(self, motion: Motion, steps: int | None, seconds: float | None = None,
                 metres: float | None = None) -> Motion:

@@ -179,7 +179,8 @@ TURN_QUARTER = re.compile(r"\b(?:quarter turn|90|turns? (?:to (?:the|his|her|the
 TURN_RIGHT = re.compile(r"\b(?:right|clockwise|rightward)\b")
 TURN_NOT_BODY = re.compile(r"\bturn(?:s|ing|ed)? (?:his|her|their|the|its|one's|a) (?!body\b|whole\b)\w+")
 TURN_TWICE = re.compile(r"\b(?:twice|two times|two full)\b")
-TURN_TIMES = re.compile(rf"\b(?:(thrice)|({QUANTITY}|\d{{1,2}})\s+(?:full\s+)?(?:times|turns|spins|rotations))\b")   # "spins three times"
+# a count of turns: "spins three times", "turns around 3 times", "four full turns"
+TURN_TIMES = re.compile(rf"\b(?:(thrice)|({QUANTITY}|\d{{1,2}})\s+(?:full\s+)?(?:times|turns|spins|rotations))\b")
 TURN_NEGATED = re.compile(r"\b(?:without|not|no|never|don't|doesn't|do not|does not|stop)\s+(?:\w+\s+)?(?:turn|spin)")
 
 # -- travel -----------------------------------------------------------------------------------
