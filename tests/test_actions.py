@@ -124,6 +124,9 @@ def test_vocabulary():
     # a thing thrown that was named before, a throw by its manner; punches, throwing up and oneself are not
     ("a man picks up a ball and throws it", ["pick up", "throw"]), ("she throws overhand", ["throw"]),
     ("she throws up", []), ("he throws himself on the floor", []),
+    # hurrying somewhere is a walk (its pace: fast), unless a faster gait is named; ducking down is a crouch
+    ("a man hurries to the bus", ["walk"]), ("someone hurrying forward at a run", ["run"]),
+    ("he ducks down behind the wall", ["squat"]), ("a woman feeds the ducks", []),
     # CMU's descriptions keep their labels: sitting with the legs dangling is no hang, a dancer's lean no bend
     ("playground - climb, sit, dangle legs, descend", ["climb", "sit"]),
     ("dance - lean forward, bring back leg forward, arching arms", ["dance"]),

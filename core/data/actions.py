@@ -38,6 +38,7 @@ _EVERYDAY = {
         r"\bdrag\w* (his|her|their|your) feet\b", r"\btoddl(e|es|ed|ing)\b", r"\bstrut", r"\bswagger", r"\bplod", r"\bmosey",
         r"\bmeander", r"\bpromenad", r"\btramp(s|ing|ed)?\b", r"\bwaddl", r"\btotter", r"\bhik(e|es|ing)\b",
         r"\bshuffl\w* (forward|along|ahead|slowly|down|across|through|toward|towards)\b",
+        r"\bhurr(y|ies|ied|ying) (down|ahead|along|across|off|away|forward|to|after|home)\b(?!.*\b(run|jog|trot|sprint|dash))",
         r"(?<!side-)(?<!side )\bstep(s|ping|ped)? (forward|ahead|along)\b",
         r"\btak(e|es|ing) (a |some |a few |a couple of |two |three |four |several |small |little |tiny |slow )*steps?\b"
         r"(?! (to the side|sideways|back|backwards?|to (the|his|her|their|your) (left|right))\b)",
@@ -103,7 +104,8 @@ _EVERYDAY = {
     ),
     "climb": (r"\bscal(e|es|ing) (a|the) (\w+ )?(ladder|wall|rope|cliff|rock|fence)\b", r"\bladder\b",
               r"\bclamber\w* (up|over|onto)\b",),
-    "squat": (r"\bknee bends?\b", r"\bhunker", r"\bcrouch(es)?\b(?! (over|forward)\b)", r"\bcrouch\w* down\b", r"\blower\w* the hips\b", r"\bsink\w* down by bending\b",),
+    "squat": (r"\bknee bends?\b", r"\bhunker", r"\bcrouch(es)?\b(?! (over|forward)\b)", r"\bcrouch\w* down\b", r"\blower\w* the hips\b", r"\bsink\w* down by bending\b",
+              r"\bduck(s|ed|ing)? (down|under|low|behind)\b",),
     "bend over": (r"\bfold\w* forward\b", r"\btouch\w* (his|her|their|your|the) toes\b", r"\bstoop(s|ed|ing)? (over|down)\b",
                   r"\blean\w* down\b", r"\blean\w* (over|forward) (at|from) the (waist|hips)\b",),
     "pick up": (
