@@ -737,11 +737,12 @@ class Generator:
         lo, hi = self._length(r.seconds)
         stand = round(STAND_SECONDS * FPS)
         leg = leg_length(rest_of(self.body, choice.body))   # a distance on the body asked: on the performer's
+        manner = manner_kept(words.manner, self.pool.manners_of(gait))   # done as asked, else plainly (manner_words.py)
         held = []
-        for w in self._windows(r, gait, lo, hi):
+        for w in self._windows(r, gait, lo, hi, competes=lambda w: w.action == gait and manner in (ANY, w.manner)):
             going = round(GOING_SECONDS * FPS) if seconds is None else len(w.root) // 2
             there = None if metres is None else metres * leg_length(w.rest) / leg
-            k = stop_frame(w.contacts, w.root, steps, there, going) if w.action == gait else None
+            k = stop_frame(w.contacts, w.root, steps, there, going)
             if k is not None:
                 frames = k + stand if seconds is None else max(k, round(seconds * FPS))
                 held.append(self.pool.held_from(w, k, frames, f"stopped at {k / FPS:.1f} s (its codes slide)"))
