@@ -165,3 +165,23 @@ def test_the_tuning_set_holds_trained_pairs_only_and_says_so(tmp_path):
     p.write_text(json.dumps({"tuning": True, "prompts": [{"text": "a man walks and waves", "legs": "walk",
                                                           "arms": "wave"}]}))
     assert load_two_things(p)[0]["tuning"] is True
+
+
+def test_a_tuning_sides_set_is_balanced_and_apart_from_the_held_out_one():
+    """configs/tuning_sides.json is marked "tuning", balanced like the held-out set, and shares no
+    prompt with it; a tuning two-things run judges it instead of the held-out sides."""
+    from shapemove.core.eval.parts_eval import TUNING_SIDES
+
+    tune = load_sides(TUNING_SIDES)
+    assert len(tune) == 32 and all(t["tuning"] for t in tune) and not any(t["tuning"] for t in SIDES)
+    for key, values in (("side", ("left", "right")), ("part", ("hand", "foot"))):
+        assert [sum(p[key] == v for p in tune) for v in values] == [16, 16], key
+    for p in tune:
+        words = set(norm(p["text"]).split())
+        assert p["side"] in words and ({"left", "right"} - {p["side"]}).isdisjoint(words), p["text"]
+    assert not {norm(t["text"]) for t in tune} & {norm(t["text"]) for t in SIDES}
+    from shapemove.core.eval.parts_eval import sides_beside
+
+    tuning_two = load_two_things(Path(__file__).resolve().parents[1] / "configs" / "tuning_two_things.json")
+    assert sides_beside(None, tuning_two) == TUNING_SIDES and sides_beside(None, TWO) is None
+    assert sides_beside("mine.json", tuning_two) == "mine.json"             # a file named wins

@@ -14,6 +14,10 @@ training caption: ``tests/test_heldout_parts.py``):
   the judged gait is the expected one ("walk in a circle": the path circles while the legs move),
   arms right when the judged gesture is; both right when both are.
 
+Their tuning sets, ``configs/tuning_two_things.json`` and ``configs/tuning_sides.json``, say
+``"tuning": true``; given a tuning two-things file and no sides file, the tuning sides are judged
+beside it (``TUNING_SIDES``), so a tuning run shows no held-out prompt.
+
 One generated motion per prompt (seed ``seed + i`` for the i-th prompt of each set; the product's
 best-of-N TMA choice among token samples unless ``candidates`` says otherwise), its features
 computed from what the rig plays (``motion_features`` of the planted Motion), judged by
@@ -40,18 +44,12 @@ from ..errors import ShapeMoveError
 CONFIGS = Path(__file__).resolve().parents[2] / "configs"
 DEFAULT_SIDES = CONFIGS / "heldout_sides.json"
 DEFAULT_TWO_THINGS = CONFIGS / "heldout_two_things.json"
+TUNING_SIDES = CONFIGS / "tuning_sides.json"   # the sides judged beside a tuning two-things set, unless named
 MAX_PROMPTS_BYTES = 1 << 20
 TARGETS = {"sides": 0.90, "both": 0.70, "legs": 0.85, "arms": 0.85}
 BAR_TAKES = 3      # a class with fewer captured takes is reported, not barred
 BAR_SHARE = 0.9    # the bar: this share of what real performances are credited with
 SIDES, PARTS = ("left", "right"), ("hand", "foot")
-
-
-def _items(path: Path, what: str) -> list:
-    from .report import prompt_items
-
-    _, items = prompt_items(path, path, what, MAX_PROMPTS_BYTES)
-    return _prompts({"prompts": items}, path)
 
 
 def _prompts(doc, path: Path) -> list:
@@ -62,15 +60,21 @@ def _prompts(doc, path: Path) -> list:
 
 
 def load_sides(path=None) -> list[dict]:
-    """The left/right prompts [{text, side, part, action}] of a JSON file."""
+    """The left/right prompts [{text, side, part, action, tuning}] of a JSON file (``tuning``: the
+    file says ``"tuning": true``, a set to tune on: ``configs/tuning_sides.json``)."""
+    from ..io.limits import read_json
+
     path = Path(path) if path else DEFAULT_SIDES
+    doc = read_json(path, "left/right prompt list", MAX_PROMPTS_BYTES)
+    tuning = isinstance(doc, dict) and doc.get("tuning") is True
     out = []
-    for i, it in enumerate(_items(path, "left/right prompt list")):
+    for i, it in enumerate(_prompts(doc, path)):
         if not (isinstance(it, dict) and isinstance(it.get("text"), str) and it.get("side") in SIDES
                 and it.get("part") in PARTS):
             raise ShapeMoveError(f"{path}: prompt {i} must be {{\"text\": ..., \"side\": \"left\"|\"right\", "
                                  f"\"part\": \"hand\"|\"foot\"}}")
-        out.append({"text": it["text"], "side": it["side"], "part": it["part"], "action": str(it.get("action", ""))})
+        out.append({"text": it["text"], "side": it["side"], "part": it["part"], "action": str(it.get("action", "")),
+                    "tuning": tuning})
     return out
 
 
@@ -94,6 +98,14 @@ def load_two_things(path=None) -> list[dict]:
                                  "held-out pairs of core/data/compose_parts.py (HELD_OUT_PAIRS)")
         out.append({"text": it["text"], "legs": it["legs"], "arms": it["arms"], "tuning": tuning})
     return out
+
+
+def sides_beside(sides, two_items: list[dict]):
+    """The left/right prompt file judged beside ``two_items``: ``sides`` when named, else the
+    tuning sides beside a tuning two-things set (``TUNING_SIDES``), else None (the held-out ones)."""
+    if sides is None and two_items and two_items[0]["tuning"]:
+        return TUNING_SIDES
+    return sides
 
 
 def _share(flags: list[bool]) -> float | None:
@@ -121,7 +133,9 @@ def eval_parts(model_dir=None, data=None, sides=None, two_things=None, seed: int
     from .part_judge import PartJudge, arms_right, legs_right
     from .part_judge_accuracy import leave_one_out, real_accuracy
 
-    side_items, two_items = load_sides(sides), load_two_things(two_things)
+    two_items = load_two_things(two_things)
+    sides = sides_beside(sides, two_items)
+    side_items = load_sides(sides)
     candidates, retrieved, retrieval_first, _ = or_defaults(candidates, retrieved, retrieval_first)
     if judge is None:
         data = built_dir(data, "eval parts judges generated motions against real clips")
@@ -157,6 +171,7 @@ def eval_parts(model_dir=None, data=None, sides=None, two_things=None, seed: int
     reach = reachable_parts(leave_one_out(judge), two_items)
     return {
         "sides": {"named_side_moves_most": _share([r["right"] for r in side_rows]), "prompts": len(side_rows),
+                  "tuning_set": bool(side_items and side_items[0]["tuning"]),
                   "per_part": _by(side_rows, "part", ("right",)), "per_side": _by(side_rows, "side", ("right",))},
         "two_things": {"both": _share([r["both_right"] for r in two_rows]),
                        "legs": _share([r["legs_right"] for r in two_rows]),
@@ -218,7 +233,7 @@ def _pct(v) -> str:
 
 def format_results(res: dict) -> str:
     s, t, tg = res["sides"], res["two_things"], res["targets"]
-    lines = [f"Held-out left/right prompts ({s['prompts']}): the named side moves most {_pct(s['named_side_moves_most'])} "
+    lines = [f"{'Tuning-set' if s.get('tuning_set') else 'Held-out'} left/right prompts ({s['prompts']}): the named side moves most {_pct(s['named_side_moves_most'])} "
              f"(target {_pct(tg['sides'])}); " + ", ".join(f"{k} {_pct(v['right'])} of {v['n']}" for k, v in s["per_part"].items()),
              f"{'Tuning-set' if t.get('tuning_set') else 'Held-out'} two-things prompts ({t['prompts']}): both parts right {_pct(t['both'])} (target {_pct(tg['both'])}), "
              f"legs {_pct(t['legs'])}, arms {_pct(t['arms'])} (target {_pct(tg['legs'])} each)"]
@@ -265,7 +280,9 @@ def add_arguments(p) -> None:
     p.add_argument("--data", type=Path, default=None,
                    help="built dataset: its real training clips are the judge's references, its test clips check the "
                         "judge (default $SHAPEMOVE_BUILT, else data/built)")
-    p.add_argument("--sides", type=Path, default=None, help="left/right prompts (default configs/heldout_sides.json)")
+    p.add_argument("--sides", type=Path, default=None,
+                   help="left/right prompts (default configs/heldout_sides.json; configs/tuning_sides.json beside a "
+                        "tuning two-things file)")
     p.add_argument("--two-things", type=Path, default=None,
                    help="two-things prompts (default configs/heldout_two_things.json)")
     p.add_argument("--seconds", type=float, default=4.0, help="length of each generated motion")
