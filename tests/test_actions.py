@@ -127,6 +127,10 @@ def test_vocabulary():
     # hurrying somewhere is a walk (its pace: fast), unless a faster gait is named; ducking down is a crouch
     ("a man hurries to the bus", ["walk"]), ("someone hurrying forward at a run", ["run"]),
     ("he ducks down behind the wall", ["squat"]), ("a woman feeds the ducks", []),
+    # a hand shot up is raised, not a basketball shot; an arm lifted, a hand waggled; a ball cleared or nudged
+    ("a kid shoots her left hand up", ["raise hand"]), ("a player shoots a three-pointer", ["shoot"]),
+    ("a volunteer lifts the right arm", ["raise hand"]), ("he waggles his right hand", ["wave"]),
+    ("a goalkeeper clears the ball", ["kick ball"]), ("she nudges a ball with her foot", ["kick ball"]),
     # CMU's descriptions keep their labels: sitting with the legs dangling is no hang, a dancer's lean no bend
     ("playground - climb, sit, dangle legs, descend", ["climb", "sit"]),
     ("dance - lean forward, bring back leg forward, arching arms", ["dance"]),

@@ -128,7 +128,7 @@ _EVERYDAY = {
     "balance": (r"\bflamingo\b", r"\bsingle[- ]leg stance\b", r"\bstand\w* on one (foot|leg)\b", r"\bteeter",
                 r"\btightrope",),
     "wave": (
-        r"\bsignals? hello\b", r"\bsay(s)? hi\b", r"\bflaps? a hand\b", r"\bwaggl\w* a hand\b",
+        r"\bsignals? hello\b", r"\bsay(s)? hi\b", r"\bflaps? a hand\b", r"\bwaggl\w* (a|one|his|her|their|the) (\w+ )?hand\b",
         r"\bgreet\w* (\w+ ){0,3}with a (\w+ )?(hand|arm)\b", r"(?<!to )\bgreet(s|ed|ing)?\b", r"\bsays? hello\b",
     ),
     "wave goodbye": (r"\bfarewell\b", r"\bsee[- ]you[- ]later\b",),
@@ -137,7 +137,7 @@ _EVERYDAY = {
     "hang": (r"\bdangl\w* from\b", r"\bmonkey bars\b",),
     "wash": (r"\bscrub", r"\brins(e|es|ing)\b", r"\blather", r"\bbath(e|es|ing)\b",),
     "raise hand": (r"\bhold\w* (one|an|both|a) arms? (straight )?up\b", r"\barms? (straight )?up in the air\b",
-                   r"\blift\w* (one|a|both|his|her|their|the) (\w+ )?hands?\b",
+                   r"\blift\w* (one|a|both|his|her|their|the) (\w+ )?(hands?|arms?)\b",
                    r"\b(arms?|hands?|fists?) (thrust|shot|flung|stretched|reaching) (straight )?((up|upward|skyward)"
                    r"( (in|into) the air)?|overhead|into the air)\b",
                    r"\b(arms?|hands?) (held )?(raised|lifted|aloft|up high)\b",
@@ -154,7 +154,8 @@ _EVERYDAY = {
     "spin kick": (r"\bwhirl\w* around and kicks?\b", r"\bspinning (back |heel |hook )kick", r"\btornado kick",),
     "slash": (r"\bblade\b", r"\b\w*sword\b", r"\bswing\w* (a |an |the )?\w*sword\b", r"\bkatana", r"\bmachete",
               r"\bsab(re|er)\b", r"\bcutlass", r"\bslic(e|es|ing)\b", r"\bhack\w* at\b",),
-    "kick ball": (r"\bstrik\w* the ball\b", r"\bpunt", r"\bkick\w* (a |the )?football",),
+    "kick ball": (r"\bstrik\w* the ball\b", r"\bpunt", r"\bkick\w* (a |the )?football", r"\bclear\w* the ball\b",
+                  r"\bnudg\w* (a|the) ball\b",),
     "throw": (r"\bhurl", r"\btoss", r"\bpitch\w* (a|the) (base)?ball\b", r"\bfling", r"\blob(s|bed|bing)?\b",
               r"\b(throw\w*|threw) (a |the )?(\w+ )?(base|basket|soft|snow|beach|foot)balls?\b",
               r"\bthrow\w* (a|an|the|his|her|their|some) (\w+ )?(stick|stone|rock|frisbee|javelin|spear|dart|disc|"
@@ -262,7 +263,8 @@ _LIST = [
     _a("kick ball", "sport", ["kicks a ball"], [r"\bkick\w* (a |the )?(soccer )?ball", r"\bsoccer"]),
     _a("throw", "sport", ["throws a ball"], [r"\b(throw\w*|threw) (a |the )?(\w+ )?ball", r"\bthrowbasketball"]),
     _a("dribble", "sport", ["dribbles a basketball"], [r"\bdribbl"]),
-    _a("shoot", "sport", ["shoots a basketball"], [r"\bshoot(s|ing)?\b"]),
+    _a("shoot", "sport", ["shoots a basketball"],
+       [r"\bshoot(s|ing)?\b(?! up\b| (his|her|their|your|a|one|the|both)( left| right)? (hand|arm|fist)s?\b)"]),
     # dance
     _a("dance", "dance", ["dances", "does a dance"],
        [r"\bdanc(e|es|ed|ing|er)\b", r"\bsalsa", r"\blambada", r"\blindy ?hop"]),
