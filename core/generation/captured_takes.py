@@ -356,7 +356,7 @@ class TakePool:
             lo, hi = line_stretch(pose(rot, root, con))
             if hi - lo < len(rot):
                 rot, root, con = rot[lo:hi], root[lo:hi], con[lo:hi]
-                provenance += f", {lo / FPS:.1f}-{hi / FPS:.1f} s (its way along a line)"
+                provenance += f", its {lo / FPS:.1f}-{hi / FPS:.1f} s along a line"
         if cut_for(action, times):
             def posed(r, rt, c):
                 j = pose(r, rt, c)

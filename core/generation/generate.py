@@ -745,7 +745,7 @@ class Generator:
             k = stop_frame(w.contacts, w.root, steps, there, going)
             if k is not None:
                 frames = k + stand if seconds is None else max(k, round(seconds * FPS))
-                held.append(self.pool.held_from(w, k, frames, f"stopped at {k / FPS:.1f} s (its codes slide)"))
+                held.append(self.pool.held_from(w, k, frames, f"stopped at {k / FPS:.1f} s, then standing"))
         if not held:
             return None
         best = self.picker.pick(r.prompt, [w.features for w in held], words=words)
