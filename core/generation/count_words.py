@@ -45,7 +45,8 @@ def _spans(mask) -> list[tuple[int, int]]:
     return [(a, b) for a, b in runs(mask) if b - a >= MIN_RUN]
 
 
-def _height(f, joint: int) -> np.ndarray:
+def joint_height(f, joint: int) -> np.ndarray:
+    """(T,) height (m) of joint ``joint`` (1..21) in (T, 263) features (its root-relative position channels)."""
     return f[:, 4 + (joint - 1) * 3 + 1]
 
 
@@ -53,7 +54,7 @@ def flight_spans(features) -> list[tuple[int, int]]:
     """[(start, end)) of the flights of a (T, 263) feature clip: runs of at least ``MIN_RUN``
     frames with every foot joint more than ``LIFT`` above the clip's floor."""
     f = np.asarray(features, dtype=np.float64)
-    heights = np.stack([_height(f, j) for j in FOOT_JOINTS], axis=1).min(axis=1)
+    heights = np.stack([joint_height(f, j) for j in FOOT_JOINTS], axis=1).min(axis=1)
     return _spans(heights > np.percentile(heights, 10) + LIFT)
 
 
@@ -61,8 +62,8 @@ def raise_spans(features) -> list[tuple[int, int]]:
     """[(start, end)) of the raises of both hands over the head: runs of at least ``MIN_RUN`` frames
     with both wrists above the head joint."""
     f = np.asarray(features, dtype=np.float64)
-    wrists = np.minimum(_height(f, WRISTS[0]), _height(f, WRISTS[1]))
-    return _spans(wrists > _height(f, HEAD))
+    wrists = np.minimum(joint_height(f, WRISTS[0]), joint_height(f, WRISTS[1]))
+    return _spans(wrists > joint_height(f, HEAD))
 
 
 def dip_spans(features) -> list[tuple[int, int]]:
@@ -77,9 +78,9 @@ def kick_spans(features) -> list[tuple[int, int]]:
     one ankle more than ``KICK_LIFT`` above the clip's floor while the other stays under
     ``KICK_STANCE`` (a run's heels also swing high, but both feet are never down then for long)."""
     f = np.asarray(features, dtype=np.float64)
-    feet = np.stack([_height(f, j) for j in FOOT_JOINTS], axis=1)
+    feet = np.stack([joint_height(f, j) for j in FOOT_JOINTS], axis=1)
     floor = np.percentile(feet.min(axis=1), 10)
-    left, right = _height(f, ANKLES[0]) - floor, _height(f, ANKLES[1]) - floor
+    left, right = joint_height(f, ANKLES[0]) - floor, joint_height(f, ANKLES[1]) - floor
     spans = _spans((left > KICK_LIFT) & (right < KICK_STANCE)) + _spans((right > KICK_LIFT) & (left < KICK_STANCE))
     return sorted(spans)
 

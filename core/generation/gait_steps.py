@@ -22,7 +22,7 @@ import numpy as np
 
 from ..constants import FPS
 from ..motion.contacts import runs
-from .count_words import ANKLES, _height
+from .count_words import ANKLES, joint_height
 
 STEP_LIFT = 0.04      # m: an ankle this far over its floor is off it (a walk's: 8-10 cm)
 STEP_FRAMES = 3       # frames: the shortest swing counted as a step
@@ -37,10 +37,18 @@ def foot_strikes(features) -> int:
     f = np.asarray(features, dtype=np.float64)
     n = 0
     for joint in ANKLES:
-        h = _height(f, joint)
+        h = joint_height(f, joint)
         n += sum(1 for a, b in runs(h > np.percentile(h, 10) + STEP_LIFT)
                  if b - a >= STEP_FRAMES and FIRST_STRIKE <= b < len(h))
     return n
+
+
+def contact_strikes(contacts) -> list[int]:
+    """The frames, in order, where a foot comes down in (T, 4) contacts of joints 7, 8, 10, 11: a new
+    contact of an ankle (joints 7, 8) from frame ``FIRST_STRIKE`` on (a foot already coming down at
+    the start is no step taken)."""
+    c = np.asarray(contacts, bool)
+    return sorted(a for k in (0, 1) for a, _ in runs(c[:, k]) if a >= FIRST_STRIKE)
 
 
 def striking(feats: list, steps: int, among: np.ndarray) -> np.ndarray:

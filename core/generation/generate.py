@@ -65,7 +65,7 @@ from .slow_steps import slow_motion
 from .still_take import still_take
 from .travel_words import SIDEWAYS_ACTIONS, backward_taken, goes_sideways
 from .hands_asked import hands_wanted
-from .typical_pace import (fast_take, leg_length, leg_ratio, load_typical_speeds, rest_of, slow_take, typical_paced,
+from .typical_pace import (fast_take, leg_ratio, load_typical_speeds, on_performer, slow_take, typical_paced,
                            unplain_take)
 from .straight_gait import line_asked, straight_asked
 from .take_stop import stop_frame
@@ -213,7 +213,7 @@ class Generator:
             return []
         down = self.vae.cfg.downsample
         text = self._embed_texts([r.prompt])[0]
-        words = r.words if r.words is not None else read_words(r.prompt)
+        words = r.reading()
         straight = straight_asked(words) or line_asked(words)   # a gait on a line (straight_gait.py)
         hands = hands_wanted(words, action)   # a gesture's hands as said
         if r.seconds is None:   # the model's length: a take plays whole, at least UNASKED_SECONDS
@@ -267,7 +267,7 @@ class Generator:
             found = self._action_clips(r, lo, hi)
             requested = self._asked(r)
             wanted = self._taken(requested)   # a take of another action than the words ask does not compete
-            words = r.words if r.words is not None else read_words(r.prompt)
+            words = r.reading()
             backward = backward_taken(words, wanted)   # "runs backwards": the data's backward gait is a walk
             asked = backward or wanted
             times = words.count[1] if words.count is not None else None          # "three jumping jacks"
@@ -325,7 +325,7 @@ class Generator:
         (``plan.words.Words.actions``, an edited plan's when it has one)."""
         from ..data.actions import specific
 
-        actions = (r.words if r.words is not None else read_words(r.prompt)).actions
+        actions = r.reading().actions
         return r.action or (specific(list(actions)) or [None])[0]
 
     def _taken(self, action: str | None) -> str | None:
@@ -362,7 +362,7 @@ class Generator:
             beta = out.betas[0] if beta is None else beta  # [BETA] precedes the codes: one body for all
         sources = [None] * len(cands)
         if n > 1:  # real clips nearest by caption compete with the samples, or replace them
-            named = bool((r.words if r.words is not None else read_words(r.prompt)).actions)
+            named = bool(r.reading().actions)
             found = [f for f in self._retrieved(r, lo, hi, library)
                      if action_credit(asked, self.t5.memory.main_action(f[0])) is not None
                      and (named or f[1] >= NAMELESS_FLOOR or f[0] in self.library_files)]   # no action named:
@@ -723,7 +723,7 @@ class Generator:
         backward walk's slide), the captured take of that gait the TMA finds nearest, cut where the
         words stop it and held (``take_stop.py``); ``seconds``: the length asked (None: the cut and
         ``STAND_SECONDS``). None where the codes step, or no take of the gait gets that far."""
-        words = r.words if r.words is not None else read_words(r.prompt)
+        words = r.reading()
         gait = words.actions[0] if len(words.actions) == 1 else None
         if choice.window is not None or gait not in LEGS or self.pool is None or not self.captured_on:
             return None
@@ -736,12 +736,11 @@ class Generator:
             return None
         lo, hi = self._length(r.seconds)
         stand = round(STAND_SECONDS * FPS)
-        leg = leg_length(rest_of(self.body, choice.body))   # a distance on the body asked: on the performer's
         manner = manner_kept(words.manner, self.pool.manners_of(gait))   # done as asked, else plainly (manner_words.py)
         held = []
         for w in self._windows(r, gait, lo, hi, competes=lambda w: w.action == gait and manner in (ANY, w.manner)):
             going = round(GOING_SECONDS * FPS) if seconds is None else len(w.root) // 2
-            there = None if metres is None else metres * leg_length(w.rest) / leg
+            there = None if metres is None else on_performer(metres, w, self.body, choice.body)   # the body asked's
             k = stop_frame(w.contacts, w.root, steps, there, going)
             if k is not None:
                 frames = k + stand if seconds is None else max(k, round(seconds * FPS))

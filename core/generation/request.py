@@ -31,3 +31,10 @@ class Request:
     words: object | None = None  # the reading the candidates are chosen by (``plan.words.Words``; None: the prompt's)
     whole_course: bool = False  # a timeline's segment: a course walks whole periods fitted to its travel (course_walk.py)
     seated: bool = False  # a timeline's segment after one that ends seated: a lie-down goes on from a sit (floor_sit.py)
+
+    def reading(self):
+        """What the candidates are chosen by: ``words`` when given, else the prompt's reading
+        (``plan.words.read_words``, cached)."""
+        from ..plan.words import read_words
+
+        return self.words if self.words is not None else read_words(self.prompt)

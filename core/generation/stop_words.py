@@ -41,8 +41,7 @@ from collections import Counter
 import numpy as np
 import torch
 
-from ..motion.contacts import runs
-from .gait_steps import FIRST_STRIKE
+from .gait_steps import contact_strikes
 from .pace_words import path_length
 
 REACH_SLACK = 0.1          # m: a gait this close to the distance has got there
@@ -87,13 +86,12 @@ def standing_code(memory, vae) -> int | None:
 
 def stop_cut(contacts, steps: int | None, n: int, down: int) -> int | None:
     """How many of a gait's ``n`` codes are kept: up to the code that lands its ``steps``-th foot
-    strike (a new contact of joints 7-8 from frame ``FIRST_STRIKE`` on, read from the planted
-    ``contacts``: a foot already coming down at the start is no step taken) and the next; half of
-    them when ``steps`` is None; None when the gait strikes fewer times than counted."""
+    strike (``gait_steps.contact_strikes`` of the planted ``contacts``: a foot already coming down
+    at the start is no step taken) and the next; half of them when ``steps`` is None; None when the
+    gait strikes fewer times than counted."""
     if steps is None:
         return max(1, n // 2)
-    c = np.asarray(contacts, bool)
-    strikes = sorted(a for k in (0, 1) for a, _ in runs(c[:, k]) if a >= FIRST_STRIKE)
+    strikes = contact_strikes(contacts)
     if len(strikes) < steps:
         return None
     return min(n, strikes[steps - 1] // down + 2)

@@ -57,12 +57,9 @@ def line_asked(words) -> bool:
     """Whether the words (``plan.words.Words``) ask one gait of the plan's (``vocabulary.GAITS``: a
     march, a limp) going along a line: no course, turn, place or second thing, no way but forward."""
     from ..plan.vocabulary import GAITS
+    from .typical_pace import along_a_line
 
-    if words is None or len(words.actions) != 1 or words.actions[0] not in GAITS:
-        return False
-    if any(a not in (None, False) for a in (words.course, words.turn, words.parts)) or words.in_place:
-        return False
-    return not (words.travel.forward < 0 or words.travel.side or words.travel.sideways)
+    return words is not None and len(words.actions) == 1 and words.actions[0] in GAITS and along_a_line(words)
 
 
 def straightened(rotations, root, joints) -> tuple[np.ndarray, np.ndarray]:

@@ -7,9 +7,8 @@ no ankle 4 cm off the floor; so did every candidate of "a man walks backwards 3 
 chosen candidate of a gait asked to stop does not step, the captured takes of that gait compete
 instead, each cut where the words stop it and held there, standing (``stop_frame``):
 
-- after the counted step: ``SETTLE`` frames after the take's ``steps``-th foot strike (a new
-  contact of an ankle from frame ``gait_steps.FIRST_STRIKE`` on, as the take's measured contacts
-  say), the feet both down;
+- after the counted step: ``SETTLE`` frames after the take's ``steps``-th foot strike
+  (``gait_steps.contact_strikes`` of the take's measured contacts), the feet both down;
 - where its root is ``metres`` from where it started;
 - else after ``stop_words.GOING_SECONDS`` when no length is asked, at half the length when one is.
 
@@ -22,8 +21,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..motion.contacts import runs
-from .gait_steps import FIRST_STRIKE
+from .gait_steps import contact_strikes
+from .stop_words import from_start
 
 SETTLE = 4    # frames after the counted strike: the foot settles, the other still down
 
@@ -32,13 +31,11 @@ def stop_frame(contacts, root, steps: int | None, metres: float | None, going: i
     """The frame a captured take is cut at for its stop (module doc): ``contacts`` (T, 4) of joints
     7, 8, 10, 11, ``root`` (T, 3) metres; ``going``: the frames it goes when neither ``steps`` nor
     ``metres`` is asked. None when the take strikes fewer times or never gets that far."""
-    c = np.asarray(contacts, bool)
-    n = len(c)
+    n = len(contacts)
     if steps is not None:
-        strikes = sorted(a for k in (0, 1) for a, _ in runs(c[:, k]) if a >= FIRST_STRIKE)
+        strikes = contact_strikes(contacts)
         return min(n, strikes[steps - 1] + SETTLE) if len(strikes) >= steps else None
     if metres is not None:
-        r = np.asarray(root, np.float64)[:, [0, 2]]
-        far = np.flatnonzero(np.linalg.norm(r - r[0], axis=1) >= metres)
+        far = np.flatnonzero(from_start(np.asarray(root)[:, None]) >= metres)
         return int(far[0]) + 1 if len(far) else None
     return max(1, min(n, int(going)))

@@ -96,13 +96,15 @@ def lined_gait(words) -> str | None:
     """The one gait of ``GAITS`` the words ask to go on along a line (``going_gait``, with no course,
     turn, place, second thing or way other than forward asked), at any pace; None otherwise."""
     gait = going_gait(words)   # one gait, no stop, steps, distance or standing
-    if gait is None:
-        return None
+    return gait if gait is not None and along_a_line(words) else None
+
+
+def along_a_line(words) -> bool:
+    """Whether the words (``plan.words.Words``) ask no course, turn, place or second thing, and no
+    way other than forward."""
     if any(a not in (None, False) for a in (words.course, words.turn, words.parts)) or words.in_place:
-        return None
-    if words.travel.forward < 0 or words.travel.side or words.travel.sideways:
-        return None
-    return gait
+        return False
+    return not (words.travel.forward < 0 or words.travel.side or words.travel.sideways)
 
 
 def leg_length(rest) -> float:
@@ -271,7 +273,7 @@ def take_speed(window) -> float:
     return gait_speed(np.asarray(window.features)[: max(1, len(window.features) - window.held)])
 
 
-def on_performer(speed: float, window, body) -> float:
-    """A ``speed`` on the average body (m/s) on the performer of the take ``window``: scaled by its
-    leg's length against the average body's."""
-    return speed * leg_length(window.rest) / leg_length(rest_of(body, None))
+def on_performer(speed: float, window, body, betas=None) -> float:
+    """A ``speed`` (or a length) on the body ``betas`` (None: the average body) on the performer of the
+    take ``window``: scaled by its leg's length against that body's."""
+    return speed * leg_length(window.rest) / leg_length(rest_of(body, betas))

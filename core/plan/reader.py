@@ -28,6 +28,13 @@ MAX_TURNS = 5   # "spins ten times": at most this many
 
 
 # -- count ------------------------------------------------------------------------------------
+def number_of(word: str) -> int:
+    """A count said in digits or words: "3", "three", "a couple of", "twice" (``vocabulary.NUMBERS``,
+    ``vocabulary.TIMES``)."""
+    word = word.lower()
+    return int(word) if word.isdigit() else {**V.NUMBERS, **V.TIMES}[word]
+
+
 def asked_count(prompt: str) -> tuple[str, int] | None:
     """(the countable action named, how many times it is asked): "a man jumps forward twice" ->
     ("jump forward", 2); None when the words name no countable action (``vocabulary.COUNTED``), no
@@ -36,8 +43,7 @@ def asked_count(prompt: str) -> tuple[str, int] | None:
     m = V.COUNT_TIMES.search(prompt)
     if not named or m is None:
         return None
-    word = (m.group(1) or m.group(2)).lower()
-    n = int(word) if word.isdigit() else {**V.NUMBERS, **V.TIMES}[word]
+    n = number_of(m.group(1) or m.group(2))
     return (named[0], n) if 1 <= n <= V.MAX_COUNT else None
 
 
@@ -111,8 +117,7 @@ def stop_request(text: str) -> tuple[str, int | None] | None:
     gait = re.sub(r"\s+([,.;])", r"\1", V.SPOKEN_DISTANCE.sub("", gait)).strip() or gait   # the cut goes that far
     steps = None
     if counted is not None:
-        word = counted.group(1) or counted.group(2)
-        steps = int(word) if word.isdigit() else V.NUMBERS[word]
+        steps = number_of(counted.group(1) or counted.group(2))
         steps = steps if 1 <= steps <= V.MAX_STEPS else None
     return gait, steps
 
@@ -232,8 +237,7 @@ def angle_of(text: str) -> float | None:
         return None
     times = V.TURN_TIMES.search(t)
     if times:   # "spins around three times", "four full turns"
-        n = 3 if times.group(1) else int(times.group(2)) if times.group(2).isdigit() else V.NUMBERS[times.group(2)]
-        a *= max(1, min(n, MAX_TURNS))
+        a *= max(1, min(number_of(times.group(1) or times.group(2)), MAX_TURNS))
     elif V.TURN_TWICE.search(t):
         a *= 2
     right = bool(V.TURN_RIGHT.search(V.COUNTER_CLOCKWISE.sub(" ", t)))
