@@ -131,6 +131,16 @@ def test_vocabulary():
     ("a kid shoots her left hand up", ["raise hand"]), ("a player shoots a three-pointer", ["shoot"]),
     ("a volunteer lifts the right arm", ["raise hand"]), ("he waggles his right hand", ["wave"]),
     ("a goalkeeper clears the ball", ["kick ball"]), ("she nudges a ball with her foot", ["kick ball"]),
+    # arms rolled or spun in loops circle, the body does not roll or spin; "in turn" is no turn
+    ("loosen up by rolling your arms in big loops", ["arm circles"]), ("the swimmer spins both arms around", ["arm circles"]),
+    ("she rolls across the floor", ["roll"]), ("bring each elbow down to the opposite knee in turn", ["elbow to knee"]),
+    ("she brings her right elbow to her left knee", ["elbow to knee"]), ("they take turns", []),
+    ("she springs straight up", ["jump"]), ("the boy bounces up off the ground", ["jump"]),
+    ("he bounces the ball", ["dribble"]), ("a girl holds herself steady on one foot", ["balance"]),
+    ("he curls his finger to call her over", ["beckon"]), ("a man folds at the waist", ["bend over"]),
+    ("a woman scrambles up a steep slope", ["climb"]), ("she directs the visitors", ["guide"]),
+    ("he gestures toward the door", ["guide"]), ("the attendant points out the exits", ["guide"]),
+    ("a kid boots the football", ["kick ball"]), ("a man rotates his upper body", ["side twist"]),
     # CMU's descriptions keep their labels: sitting with the legs dangling is no hang, a dancer's lean no bend
     ("playground - climb, sit, dangle legs, descend", ["climb", "sit"]),
     ("dance - lean forward, bring back leg forward, arching arms", ["dance"]),
