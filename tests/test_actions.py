@@ -141,6 +141,7 @@ def test_vocabulary():
     ("a woman scrambles up a steep slope", ["climb"]), ("she directs the visitors", ["guide"]),
     ("he gestures toward the door", ["guide"]), ("the attendant points out the exits", ["guide"]),
     ("a kid boots the football", ["kick ball"]), ("a man rotates his upper body", ["side twist"]),
+    ("she does a spin jump", ["spin jump"]), ("he spins and jumps", ["spin", "jump"]),
     # CMU's descriptions keep their labels: sitting with the legs dangling is no hang, a dancer's lean no bend
     ("playground - climb, sit, dangle legs, descend", ["climb", "sit"]),
     ("dance - lean forward, bring back leg forward, arching arms", ["dance"]),

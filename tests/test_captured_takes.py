@@ -103,6 +103,9 @@ def test_a_take_of_another_action_than_the_words_name_does_not_compete():
     assert action_credit(None, "lie down") == 0.0 and action_credit("sit", "") == 0.0   # nothing named, no label
     assert action_credit("walk", "sneak") == ACTION_BONUS and action_credit("walk", "walk backward") is None
     assert action_credit("walk backward", "walk backward") == ACTION_BONUS   # a backward walk only asked by name
+    for generic, turning in (("jump", "spin jump"), ("spin", "spin jump"), ("kick", "spin kick"), ("turn", "cartwheel")):
+        assert action_credit(generic, turning) is None                   # no turn the words do not ask
+        assert action_credit(turning, turning) == ACTION_BONUS
 
 
 def test_sitting_down_plays_a_lie_down_to_where_it_sits():

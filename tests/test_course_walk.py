@@ -232,21 +232,45 @@ def test_a_straight_walk_goes_round_the_eight():
     assert np.allclose(root_centre(read.joints), c)
 
 
-def test_generation_walks_the_eight_at_a_walking_pace():
-    """"walks in a figure eight" is generated as a plain walk ("a person walks": the captured eights
-    decode at a third of a walk's pace) and bent round both loops; the feet stay on the floor."""
+def test_generation_walks_a_captured_eight_on_its_own_path():
+    """"walks in a figure eight" plays one of CMU subject 105's captured eights on its own path (the
+    codec loses turning; a walk bent onto the course is steered): round one loop, back round the
+    other, the first loop to the left unless "clockwise" is said (its mirror image then); the feet
+    on the floor. A jog on an eight is no take's gait: the jog is bent onto the course."""
+    from shapemove.core.generation.course_takes import first_turn_right
     from shapemove.core.generation.generate import Generator, Request
-    from shapemove.core.generation.track import travel
 
     gen = Generator(None)
-    m = gen.generate_batch([Request("a person walks in a figure eight", seconds=10, seed=0)])[0]
-    c = root_centre(m.joints)
-    assert travel(m.joints)[-1] > 8.0 and c[:, 0].max() > 1.5 and c[:, 0].min() < -1.5
-    assert m.tokens is None and m.prompt == "a person walks in a figure eight"
-    assert m.joints[:, :, 1].min() > -0.05
+    for text, right in (("a person walks in a figure eight", False), ("a woman walks a figure-8 clockwise", True)):
+        m = gen.generate_batch([Request(text, seconds=10, seed=0)])[0]
+        assert m.provenance.startswith("captured: CMU cmu_105_") and m.num_frames == 200
+        h = np.unwrap(headings(m.joints))
+        assert np.ptp(h) > 1.2 * np.pi                                        # most of a loop in 10 s
+        assert first_turn_right(m.joints[:, 0]) is right
+        assert m.joints[:, :, 1].min() > -0.05
+    j = gen.generate_batch([Request("he jogs in a figure eight", seconds=8, seed=0)])[0]
+    c = root_centre(j.joints)
+    assert "cmu_105_" not in j.provenance and c[:, 0].max() > 1.0 and c[:, 0].min() < -1.0   # both bent loops
     d = gen.generate_batch([Request("a woman walks diagonally to the right", seconds=4, seed=0)])[0]
     r = root_centre(d.joints)
+    from shapemove.core.generation.track import travel
     assert -55 < np.degrees(np.arctan2(*(r[-1] - r[0]))) < -35 and travel(d.joints)[-1] > 3.0   # before: -3 degrees
+
+
+def test_first_turn_right_reads_the_way_a_path_first_turns():
+    """Hand-derived: a circle of radius 1 m walked at 1 m/s, counter-clockwise seen from above
+    (x = 1 - cos t, z = sin t: heading from +z toward +x, the body's left) turns left; its mirror
+    image (x negated) right; a straight line, or a turn under 45 degrees, neither."""
+    from shapemove.core.generation.course_takes import first_turn_right
+
+    t = np.arange(200) / 20.0
+    left = np.stack([1 - np.cos(t), np.zeros_like(t), np.sin(t)], 1)
+    assert first_turn_right(left) is False
+    assert first_turn_right(left * np.array([-1, 1, 1])) is True
+    line = np.stack([np.zeros_like(t), np.zeros_like(t), t], 1)
+    assert first_turn_right(line) is None
+    assert first_turn_right(left[:12]) is None                     # 0.55 rad: under 45 degrees
+    assert first_turn_right(np.zeros((50, 3))) is None            # standing: no heading
 
 
 def test_a_course_asked_no_length_gets_the_time_to_go_once_round():
@@ -279,13 +303,19 @@ def test_generation_goes_once_round_with_no_length_asked(text, turn):
 
 
 def test_generation_goes_round_the_whole_eight_with_no_length_asked():
+    """No length asked: the captured eight plays whole (15-23 s), round both loops and back where it
+    started."""
     from shapemove.core.generation.generate import Generator, Request
 
     gen = Generator(None)
-    m = gen.generate_batch([Request("he walks in a figure eight", seed=0)])[0]
-    h = np.unwrap(headings(m.joints))
-    assert h.max() - h[0] > 1.75 * np.pi and abs(h[-1] - h[0]) < 0.3   # round one loop, back round the other
-    assert m.joints[:, :, 1].min() > -0.05
+    for seed in (0, 1):
+        m = gen.generate_batch([Request("he walks in a figure eight", seed=seed)])[0]
+        h = np.unwrap(headings(m.joints))
+        r = m.joints[:, 0, [0, 2]]
+        assert m.provenance.startswith("captured: CMU cmu_105_") and m.num_frames >= 300
+        assert np.ptp(h) > 1.4 * np.pi and np.linalg.norm(r[-1] - r[0]) < 0.5
+        assert np.abs(r - r[0]).max() > 4.0                                # the eight's length, about 4.4 m
+        assert m.joints[:, :, 1].min() > -0.05
 
 
 def test_a_course_too_short_to_go_round_is_noted():

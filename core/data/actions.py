@@ -216,7 +216,7 @@ _LIST = [
     _a("jump forward", "acrobatics", ["jumps forward", "does a long jump"],
        [r"\b(forward|far|long) jumps?\b", r"\bjump\w*\s+(\w+ )?forward", r"\bjump\w* far\b", r"\bmakes a far jump"]),
     _a("spin jump", "acrobatics", ["jumps and turns in the air", "does a spinning jump"],
-       [r"\bjump ?turn", r"\bjump\w* (up )?(and|while) (turn|spin)", r"\bspinning jump", r"^(90|180|270|360)\b(?![- ]?degree)",
+       [r"\bjump ?turn", r"\bjump\w* (up )?(and|while) (turn|spin)", r"\bspinning jump", r"\bspin[- ]?jumps?\b", r"^(90|180|270|360)\b(?![- ]?degree)",
         r"\b(90|180|270|360)[- ]?(degrees? )?(\w+ ){0,3}jump"]),
     _a("hop", "acrobatics", ["hops", "hops on both feet"], [r"\bhop(s|ping|ped)?\b"]),
     _a("jumping jacks", "exercise", ["does jumping jacks"], [r"\bjumping[- ]jacks?\b"]),

@@ -47,7 +47,7 @@ import random
 from collections import OrderedDict
 from collections.abc import Callable
 from itertools import islice
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -70,7 +70,8 @@ ACTION_BONUS = 0.3     # TMA cosine credited to a take of the asked action (tuni
 UNASKED_SECONDS = 4.0  # the least a take plays when the length is the model's
 BUSIEST = 2            # a long take's busiest windows, one drawn by the seed
 KEPT = 16              # takes kept read at once (rotations as matrices)
-OTHER_WAY = frozenset({"walk backward"})   # specific forms that compete only when asked by name
+OTHER_WAY = frozenset({"walk backward"})   # specific forms that compete only when asked by name: another way,
+ADDS_TURN = frozenset({"spin jump", "spin kick", "cartwheel"})   # or a turn the generic words do not ask
 NAMELESS_FLOOR = 0.9   # TMA caption cosine from which a take competes when the words name no action
 USER_FLOOR = 0.5       # TMA caption cosine from which the user's nearest clip is offered whatever its action
 
@@ -415,6 +416,15 @@ class TakePool:
         return Window(rot, root, con, w.rest, self.proc.features(joints, rot, con), w.action, w.clip_id,
                       f"{w.provenance}, {said}", frames - k, w.mirrored, manner=w.manner)
 
+    def mirrored_window(self, w: Window) -> Window:
+        """``w``'s mirror image (``mirrored``: left and right swapped), its features made again."""
+        t = self.take(self.ids.index(w.clip_id))
+        rot, root, con = mirrored(w.rotations, w.root, w.contacts)
+        joints = self.proc.pose_on(rot, root, t["betas"], 1.0, con)
+        said = w.provenance.replace(", mirrored", "") if w.mirrored else w.provenance + ", mirrored"
+        return replace(w, rotations=rot, root=root, contacts=con, features=self.proc.features(joints, rot, con),
+                       mirrored=not w.mirrored, provenance=said)
+
     def windows(self, text: np.ndarray, action: str | None, seed: int, frames: int, side=None,
                 longest: int | None = None, count: int = TAKES, times: int | None = None,
                 straight: bool = False, hands: bool | None = None, seated: bool = False,
@@ -456,12 +466,13 @@ def action_credit(asked: str | None, action: str) -> float | None:
     jump), nothing when the words name no action or the take has no label, and None for a take of
     another action, which does not compete (no sit take: a lying-down take is not a sit), nor does a
     take of a specific form that travels another way than its generic action (``OTHER_WAY``: a walk
-    backward is no walk)."""
+    backward is no walk) or turns where it does not (``ADDS_TURN``: "bounces up off the ground" is
+    no spin jump, "kicks" no spinning kick, "turns around" no cartwheel)."""
     from ..data.actions import GENERIC_OF
 
     if not asked or not action:
         return 0.0
-    if action in OTHER_WAY and asked != action:   # "walks back" after a turn goes back the way it came
+    if action in OTHER_WAY | ADDS_TURN and asked != action:   # "walks back" after a turn goes back the way it came
         return None
     return ACTION_BONUS if action == asked or asked in GENERIC_OF.get(action, ()) else None
 

@@ -36,6 +36,7 @@ from .captured_takes import TakePool, Window, action_credit, captured_motion, de
 from .one_foot import one_foot_note
 from .manner_words import ANY, manner_kept, shown, slower_note, too_slow, unmet_note
 from .course_shapes import ACTIONS as COURSE_ACTIONS, unasked_seconds
+from .course_takes import course_take
 from .course_walk import course_motion
 from .decode import decode_features, decode_tokens, redecode
 from .gait_steps import MIN_CADENCE, foot_strikes
@@ -636,7 +637,9 @@ class Generator:
                 # (straight_gait.py) as read from the straight words (an edited plan's course: samples alone)
                 turn = words.turn if words is not None else None   # turn_words.py: given back after
                 captured = stop is None and turn is None and (course is None or not edited)
-                choice = self.choose(sampled, captured=captured, reach=metres, body_of=r)
+                own = (course_take(self, asked, words, course, r.seconds is None and words.seconds is None, r)
+                       if course is not None and captured and not r.whole_course else None)   # course_takes.py
+                choice = own or self.choose(sampled, captured=captured, reach=metres, body_of=r)
                 betas, source = choice.body, choice.body_source
                 motion = self.chosen_motion(choice, betas, r.prompt)
                 came_from = motion.provenance
@@ -655,7 +658,7 @@ class Generator:
                     motion = slow_motion(motion, self.body, words, self.ik_refine_iters)      # slow_steps.py
                     motion = slowed(motion, self.body, words, r.seconds is not None, self.ik_refine_iters)   # slow_action.py
                     motion = (course_motion(motion, self.body, course, words.course_right, self.ik_refine_iters, r.whole_course)
-                              if course is not None else                                          # course_walk.py
+                              if course is not None and own is None else                          # course_walk.py
                               turn_motion(motion, self.body, turn, self.ik_refine_iters))         # turn_words.py
             if words is not None and words.arms_held and words.gestures_only and words.parts is None:
                 motion = held_motion(motion, self.body, self.ik_refine_iters)   # "stands with her arms raised"
