@@ -84,12 +84,15 @@ from shapemove.core.plan.segments import SEGMENT_SECONDS, split_segments
     ("a man walks forward, stops, and waves", ["a man walks forward, then stops", "a man waves"]),
     ("she walks forward and stops and then waves", ["she walks forward, then stops", "she waves"]),
     ("he walks, stops, then turns around", ["he walks, then stops", "he turns around"]),
+    ("a man runs, stops suddenly and looks around", ["a man runs, then stops", "a man looks around"]),
     # with no "and" that orders, a list of verbs of actions one after the other is cut at its commas
     ("a boy runs, jumps and lands on both feet", ["a boy runs", "a boy jumps and lands on both feet"]),
     ("a woman walks, sits down", ["a woman walks", "a woman sits down"]),
     # a turn after a gait that counts its steps or a distance comes after them
     ("the man walks 10 steps and turns left", ["the man walks 10 steps", "the man turns left"]),
     ("a man walks 3 metres and turns around", ["a man walks 3 metres", "a man turns around"]),
+    ("a man walks 10 steps, turns around", ["a man walks 10 steps", "a man turns around"]),   # or a comma
+    ("she walks three steps, turns left and walks on", ["she walks three steps", "she turns left", "she walks on"]),
     # "once" opening a clause and "having" with its comma come first; a past tense names its action
     ("once she has waved, she runs off", ["she has waved", "she runs off"]),
     ("having bowed, the actor walks away", ["the actor bowed", "the actor walks away"]),
@@ -125,6 +128,7 @@ def test_ordering_words_make_segments_in_the_order_they_happen(prompt, segments)
     "after the warm-up the man runs", "a man walks ahead, waves, and nods",
     # a gait and an arm gesture at once, a turn beside its gait
     "a man walks and throws a ball", "a man walks and turns left", "a person turns around and walks away",
+    "a man walks forward, turns around", "he jogs and stops suddenly",
     # a sit and an arm gesture at once: waving seated
     "a woman sits down and waves", "he sits and raises his hand",
     # a list without an order word: at once by body part, a squat's own standing up, the arms of a jump

@@ -31,6 +31,9 @@ from shapemove.core.plan.reader import asked_distance, stop_request
     ("a woman walks 2 m forward, waving", ("a woman walks forward, waving", None)),   # a gesture stops with it
     ("a man walks 3 metres and spins", None),      # another action after the distance
     ("a six foot man walks forward", None),        # a height, not a distance
+    ("a man runs and stops suddenly", ("a man runs", None)),      # how it stops, said after
+    ("she jogs and comes to a sudden halt", ("she jogs", None)),
+    ("he walks and stops dead in his tracks", ("he walks", None)),
 ])
 def test_the_words_that_stop_a_gait(text, want):
     assert stop_request(text) == want

@@ -142,8 +142,8 @@ def _and_steps(piece: str, before: str = "") -> list[str]:
         if posture or counted or _one_after_other(first, then, whole):   # an order: the list of steps before it cuts too
             return _list_steps(a) + _and_steps(b, a)
     steps = _list_steps(piece)   # no "and" orders it: a list of verbs of actions ("runs, jumps and lands")
-    if len(steps) > 1 and all(_leads_with_action(y) and _follows(find_actions(x), find_actions(y), whole)
-                              for x, y in zip(steps, steps[1:])):
+    if len(steps) > 1 and all(_leads_with_action(y) and (_follows(find_actions(x), find_actions(y), whole)
+                                                        or _counted_turn(x, y)) for x, y in zip(steps, steps[1:])):
         return steps
     return [piece]
 
@@ -193,14 +193,22 @@ def _gone_on(before: str, way: str) -> str:
     return f"{subject.group(0) if subject else ''} {verb.group(1) if verb else 'walks'} {way}".strip()
 
 
+def _counted_turn(before: str, step: str) -> bool:
+    """Whether ``step`` is a turn alone after a gait that counts its steps or a distance (``before``:
+    "walks three steps", "turns left"): the steps, then the turn."""
+    return find_actions(step) == ["turn"] and stop_request(before) is not None
+
+
 def _list_steps(piece: str) -> list[str]:
     """A piece cut at its commas where a verb of an action of its own follows ("she walks ahead, spins
     around" -> two); "jogs, waving" (two things at once) is one, and so is a gait's turn ("walks
-    forward, turns around": the turn ends the walk, as a stop does)."""
+    forward, turns around": the turn ends the walk, as a stop does), unless the gait counts its steps
+    or a distance ("walks three steps, turns left": the steps, then the turn, as with "and")."""
     out, start = [], 0
     for m in LIST_STEP.finditer(piece):
         step = re.split(r",", piece[m.end():], maxsplit=1)[0]
-        if set(find_actions(step)) - {"turn"} and find_actions(piece[start:m.start()]) and _has_verb(step):
+        before = piece[start:m.start()]
+        if (set(find_actions(step)) - {"turn"} or _counted_turn(before, step)) and find_actions(before) and _has_verb(step):
             out.append(piece[start:m.start()])
             start = m.end()
     return out + [piece[start:]]

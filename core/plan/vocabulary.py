@@ -88,13 +88,17 @@ MANNER_SAID = {"youthful": "youthfully", "old": "like an old person", "stiff": "
                "clumsy": "clumsily", "careful": "carefully", "seductive": "seductively"}
 
 # -- stop, steps, distance, standing still ------------------------------------------------------
+# how a stop is made, said after it ("stops suddenly", "comes to a sudden halt", "stops dead in his tracks")
+STOP_HOW = r"(?:\s+(?:suddenly|abruptly|sharply|quickly|short|dead|immediately|briefly|slowly|gradually|completely))?" \
+           r"(?:\s+in (?:his|her|their|its) tracks)?"
+STOP_NOUN = r"(?:(?:sudden|quick|full|complete|abrupt|dead|gradual)\s+)?(?:stop|halt|standstill)"
 STOP = re.compile(r"\s*(?:,\s*)?(?:\b(?:and|then)\s+)*(?:\b(?:he|she|they|it)\s+)?"
-                  r"\b(?:stops?(?:\s+(?:walking|running|jogging|moving))?|halts?|comes? to a (?:stop|halt)|"
-                  r"stands? still|stays? still)\b(?:\s+(?:there|still))?\s*\.?\s*$")
+                  r"\b(?:stops?(?:\s+(?:walking|running|jogging|moving))?|halts?|comes? to a " + STOP_NOUN + r"|"
+                  r"stands? still|stays? still)\b" + STOP_HOW + r"(?:\s+(?:there|still))?\s*\.?\s*$")
 # a stop between two things ("walks forward, stops, and waves", "runs, stops and looks back"): the gait's
 # own stop, then what follows (``segments.split_segments`` orders it as "walks forward, then stops, then waves")
-MID_STOP = re.compile(r"(?:\s*,\s*|\s+and\s+)(?:(?:he|she|they|it)\s+)?(stops?|halts?|comes?\s+to\s+a\s+(?:stop|halt))"
-                      r"\s*(?:,\s*)?(?:and\s+)?(?:then\s+)?(?=[a-z])")
+MID_STOP = re.compile(r"(?:\s*,\s*|\s+and\s+)(?:(?:he|she|they|it)\s+)?(stops?|halts?|comes?\s+to\s+an?\s+" + STOP_NOUN + r")"
+                      + STOP_HOW + r"\b\s*(?:,\s*)?(?:and\s+)?(?:then\s+)?(?=[a-z])")
 NOT_STOPPING = re.compile(r"\b(?:without stopping|non-?stop|never stops?|doesn't stop|does not stop)\b")
 STEPS = re.compile(r"\b(" + NUMBER_WORDS + r"|\d{1,2})\s+"
                    r"(?:\w+\s+)?(?:steps?|strides?|paces?)\b")
