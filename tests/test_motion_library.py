@@ -154,3 +154,36 @@ def test_a_take_too_short_to_train_on_is_kept_unless_it_is_a_stride_of_a_gait(tm
         (tmp_path / "meta" / f"{cid}.json").write_text(json.dumps({"id": cid, "split": split,
                                                                     "labels": {"actions": [action]}}))
     assert [m["id"] for m in library_metas(tmp_path)] == ["hop", "run"]
+
+
+def test_a_take_whose_root_jumps_from_frame_to_frame_is_left_out(tmp_path):
+    """Hand-derived: a root walking 1.4 m/s changes its speed by nothing from frame to frame; one whose
+    steps alternate 0.01 and 0.13 m at 20 fps changes it by 2.4 m/s a frame, 48 m/s^2 (a broken
+    capture, ``jerky``); a run speeding up 4 m/s in 1 s, 4 m/s^2, is no jump."""
+    import json
+
+    from shapemove.core.data.library_build import JERK, jerky
+
+    walk = np.stack([np.arange(40) * 0.07, np.full(40, 0.9), np.zeros(40)], 1)
+    broken = walk.copy()
+    broken[:, 0] = np.cumsum(np.where(np.arange(40) % 2, 0.13, 0.01))
+    speeding = walk.copy()
+    speeding[:, 0] = np.cumsum(np.linspace(2.0, 6.0, 40) / 20)
+    assert not jerky(walk, 20) and jerky(broken, 20) and not jerky(speeding, 20) and 4 < JERK < 48
+    (tmp_path / "meta").mkdir()
+    (tmp_path / "transl").mkdir()
+    for cid, root in (("steady", walk), ("broken", broken)):
+        (tmp_path / "meta" / f"{cid}.json").write_text(json.dumps({"id": cid, "split": "train", "fps": 20,
+                                                                    "labels": {"actions": ["walk"]}}))
+        np.save(tmp_path / "transl" / f"{cid}.npy", root)
+    assert [m["id"] for m in library_metas(tmp_path)] == ["steady"]
+
+
+def test_the_shipped_library_holds_no_take_whose_root_jumps():
+    from shapemove.core.data.library_build import jerky
+    from shapemove.core.generation.model_bundle import DEFAULT_MODEL_DIR
+
+    lib = MotionLibrary.load(DEFAULT_MODEL_DIR / "library.npz")
+    starts, root, fps = lib.a["starts"], lib.a["root"], lib.a["fps"]
+    assert len(starts) > 700
+    assert not [str(c) for k, c in enumerate(lib.a["clip_ids"]) if jerky(root[starts[k]:starts[k + 1]], float(fps[k]))]

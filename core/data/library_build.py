@@ -9,7 +9,8 @@ a take itself when the words name the other side), never the test split (held ou
 rotations, root path, measured contacts, fitted betas, captions, main action, performer and
 licence. The frequent actions (``FREQUENT``: walks, runs, jogs, raised hands, waves) keep
 ``FREQUENT_TAKES`` takes each, drawn round-robin over their (source, label) groups so that the
-kept ones differ from each other; every take of every other action is kept. With the model's TMA
+kept ones differ from each other; every take of every other action is kept. A take whose root jumps
+from frame to frame (``jerky``: a broken capture) is left out. With the model's TMA
 each take also gets the unit mean of its captions' TMA text embeddings (what a prompt is compared
 with when takes compete, ``generation/captured_takes.py``).
 """
@@ -29,12 +30,25 @@ from .motion_library import MotionLibrary, mean_caption_vectors, source_name
 SPLITS = ("train", "val", LIBRARY_SPLIT)
 FREQUENT = ("walk", "run", "jog", "raise hand", "wave")
 FREQUENT_TAKES = 96
+JERK = 15.0   # m/s^2: the median change of a take's root speed from frame to frame over which its capture is broken
+
+
+def jerky(root, fps: float) -> bool:
+    """Whether a take's root jumps from frame to frame: the median change of its horizontal speed
+    between frames over ``JERK`` m/s^2 (CMU 07_12, "brisk walk": 28, its pelvis from 0.58 to 0.90 m
+    and its speed 0.1 to 5.5 m/s from one frame to the next; the data's other takes, dashes and
+    flips included, at most 5.4)."""
+    r = np.asarray(root, np.float64)[:, [0, 2]]
+    if len(r) < 3:
+        return False
+    speed = np.linalg.norm(np.diff(r, axis=0), axis=1) * fps
+    return float(np.median(np.abs(np.diff(speed)))) * fps > JERK
 
 
 def library_metas(data) -> list[dict]:
     """The metas of the captured takes a library holds (see the module docstring), sorted by id: of
     the clips too short to train on, not those of a gait (a 0.65 s sprint is a stride, not a take to
-    walk on from)."""
+    walk on from); no take whose root jumps from frame to frame (``jerky``)."""
     from ..plan.vocabulary import GAITS
 
     data = Path(data)
@@ -44,8 +58,11 @@ def library_metas(data) -> list[dict]:
     for p in sorted((data / "meta").glob("*.json")):
         m = json.loads(p.read_text(encoding="utf-8"))
         if m.get("split") in SPLITS and is_real(m):
-            if not (m["split"] == LIBRARY_SPLIT and main_action(m) in GAITS):
-                out.append(m)
+            path = data / "transl" / f"{m['id']}.npy"
+            if m["split"] == LIBRARY_SPLIT and main_action(m) in GAITS or \
+                    path.is_file() and jerky(np.load(path, allow_pickle=False), float(m.get("fps", 20))):
+                continue
+            out.append(m)
     return out
 
 
