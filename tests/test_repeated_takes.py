@@ -164,3 +164,27 @@ def test_a_kick_is_cut_to_its_repetitions_only_when_a_number_is_asked():
     assert cut_for("kick", 2) and not cut_for("kick", None)          # "a man kicks": the take's busiest window
     assert cut_for("squat", None) and cut_for("jumping jacks", 3)     # done over and over: its bout
     assert not cut_for("walk", 2) and not cut_for("punch", 3)         # not counted
+
+
+def _kicks(joints) -> int:
+    """Runs of frames with an ankle over 0.45 m above the other: one per kick."""
+    lift = np.abs(joints[:, 7, 1] - joints[:, 8, 1])
+    return len(runs(lift > 0.45))
+
+
+def test_a_length_asked_keeps_a_punch_or_a_kick_going_on_the_spot():
+    """"She kicks for eight seconds" kicked once and stood 6.7 s; an action a length keeps going
+    (``vocabulary.KEPT_UP``) plays on as its repetitions, on the spot (a punch's take that steps
+    forward went 10.5 m in 10 s of shadowboxing); a squat asked a length is held, not repeated."""
+    from shapemove.core.generation.generate import Generator, Request
+    from shapemove.core.plan.words import read_words
+
+    assert read_words("a man shadowboxes for ten seconds").again and read_words("she kicks for 8 seconds").again
+    assert not read_words("a woman squats for 5 seconds").again and not read_words("he kicks twice for 8 seconds").again
+    assert not read_words("she walks for ten seconds").again
+    gen = Generator(None)
+    kicks = gen.generate_batch([Request("she kicks for eight seconds", seed=0)])[0]
+    assert kicks.num_frames == 160 and _kicks(kicks.joints) >= 3, _kicks(kicks.joints)
+    assert np.linalg.norm(kicks.joints[-1, 0, [0, 2]] - kicks.joints[0, 0, [0, 2]]) < 0.5
+    once = gen.generate_batch([Request("she kicks", seed=0, seconds=8)])[0]   # no length in the words: as before
+    assert _kicks(once.joints) < _kicks(kicks.joints)

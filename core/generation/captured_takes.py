@@ -56,7 +56,7 @@ from ..constants import FPS
 from ..errors import ShapeMoveError
 from ..scene.motion_file import Motion
 from ..data.actions import MOVES_ON, REPEATED
-from ..plan.vocabulary import COUNTED, GAITS, POSTURE_CHANGES
+from ..plan.vocabulary import COUNTED, GAITS, KEPT_UP, POSTURE_CHANGES
 from .floor_sit import SIT, SIT_FROM, sit_end
 from .stand_in_takes import STAND_IN, played_as, stand_in_span
 from .repeated_takes import cut_for, repeated_stretch
@@ -389,10 +389,11 @@ class TakePool:
                         again = looped_gait(rot, root, con, posed_joints, want) or \
                             looped_steps(rot, root, con, posed_joints, want, mirrored)   # and the step's mirror image
                 goes_on = action not in MOVES_ON or action == asked   # a hop loops for "hops" only
-                repeats = action in REPEATED or repeat and action in COUNTED   # "jumps up and down"
+                repeats = action in REPEATED or repeat and (action in COUNTED or action in KEPT_UP)   # "jumps up and down"
                 if again is None and (repeats and goes_on or action in GAITS):
-                    again = looped_repetition(rot, root, con, posed_joints, want,   # one arm circle, one gait
-                                              action in GAITS or action in MOVES_ON or repeat)   # cycle
+                    again = looped_repetition(rot, root, con, posed_joints, want,   # one arm circle, one gait cycle,
+                                              action in GAITS or action in MOVES_ON or   # a jump forward moving on;
+                                              repeat and COUNTED.get(action) == "flights")   # a punch on the spot
             if again is not None:
                 rot, root, con, first = again
                 looped = want - first

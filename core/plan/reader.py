@@ -296,9 +296,14 @@ def hands_asked(prompt: str) -> str | None:
 
 def again(prompt: str) -> bool:
     """Whether the words ask a counted action (``vocabulary.COUNTED``) again and again without a
-    number ("jumps up and down", "squats repeatedly", "keeps kicking")."""
+    number ("jumps up and down", "squats repeatedly", "keeps kicking"), or give an action a length
+    keeps going a length ("shadowboxes for ten seconds", "jumps for 5 seconds": ``vocabulary.KEPT_UP``)."""
     t = str(prompt).lower()
-    return bool(V.AGAIN.search(t)) and asked_count(t) is None and any(sp[2] in V.COUNTED for sp in action_spans(t))
+    if asked_count(t) is not None:
+        return False
+    acts = [sp[2] for sp in action_spans(t)]
+    return bool(V.AGAIN.search(t)) and any(a in V.COUNTED for a in acts) or \
+        asked_seconds(t) is not None and any(a in V.KEPT_UP for a in acts)
 
 
 def one_foot(prompt: str) -> bool:

@@ -201,6 +201,9 @@ IN_PLACE = re.compile(r"\b(in place|on the spot)\b", re.I)
 # a jump kept where it is: "jumps straight up", "jumps up and down", "a vertical jump" (not "walks up and down")
 JUMP_IN_PLACE = re.compile(r"\b(?:jump|hop|bounc|leap|spring)\w*(?:\s+\w+){0,3}?\s+(?:straight up|up and down|vertically)\b|"
                            r"\bvertical(?:ly)?\s+(?:jump|leap|hop)\w*|\b(?:jump|skip)\w* (?:a |the )?rope\b", re.I)
+# actions a length asked keeps going, one after another ("punches for ten seconds": punch after punch);
+# not a squat, a pose or a change of posture, which a length may hold
+KEPT_UP = frozenset({"punch", "kick", "jump", "jump forward", "hop", "slash"})
 # a counted action done again and again, as long as the motion lasts ("jumps up and down", "squats repeatedly")
 AGAIN = re.compile(r"\b(?:repeatedly|over and over(?: again)?|again and again|several times|many times|continuously|"
                    r"keeps? (?:on )?\w+ing|up and down|(?:jump|skip)\w* (?:a |the )?rope)\b", re.I)
