@@ -18,6 +18,7 @@ pytestmark = pytest.mark.usefixtures("one_thread")
     ("A person walks forward energetically, with youthful vigour.", "youthful"),   # the first of the order
     ("A person walks forward stiffly, like an old person.", "old"),
     ("A person walks with exaggerated strides.", "exaggerated"), ("a man paces nervously", "timid"),
+    ("a girl waves both hands excitedly", "energetic"), ("she cheers enthusiastically", "energetic"),
     ("a heavy man walks", None), ("a man walks", None), ("a person walks slowly", None),   # a body word, a pace
 ])
 def test_the_manner_the_words_say(text, manner):

@@ -69,7 +69,7 @@ MANNERS = {
     "childish": r"childish(?:ly)?|childlike|like a (?:little )?(?:child|kid)",
     "masculine": r"masculine|in a (?:manly|masculine) (?:way|manner)|manly|macho",
     "feminine": r"feminine|in a (?:feminine|girlish|ladylike) (?:way|manner)|girlish(?:ly)?|ladylike",
-    "energetic": r"energetic(?:ally)?|active(?:ly)?|vigorous(?:ly)?|lively",
+    "energetic": r"energetic(?:ally)?|active(?:ly)?|vigorous(?:ly)?|lively|excited(?:ly)?|enthusiastic(?:ally)?|eager(?:ly)?",
     "rhythmic": r"rhythmic(?:al)?(?:ly)?|like in a musical",
     "giant": r"like a giant|with heavy steps|heavy-footed|lumbering",
     "swagger": r"(?:with a )?swagger(?:ing|s)?|like a (?:street )?thug|coolly",
