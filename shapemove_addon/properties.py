@@ -89,7 +89,7 @@ _SIDES = [("NONE", "No side", "No side named"), ("left hand", "Left hand", ""), 
           ("left foot", "Left foot", ""), ("right foot", "Right foot", "")]
 _COURSES = [("NONE", "No course", "Straight, as the words go"), ("walk in a circle", "Circle", ""),
             ("walk in a figure eight", "Figure eight", ""), ("back and forth", "Back and forth", ""),
-            ("zigzag", "Zigzag", ""), ("diagonal", "Diagonal", ""),
+            ("zigzag", "Zigzag", ""), ("square", "Square", ""), ("diagonal", "Diagonal", ""),
             ("aside", "To the side", "")]
 _MANNERS = [("NONE", "No manner", "As the captures do it plainly")] + [
     (m, m.replace("_", " ").capitalize(), said) for m, said in MANNER_SAID.items()]

@@ -83,6 +83,15 @@ def test_the_plan_is_shown_edited_and_generated_from(addon, tmp_path, monkeypatc
     assert bpy.ops.shapemove.clear_plan() == {"FINISHED"} and len(s.plan_segments) == 0
 
 
+def test_the_panel_offers_every_course_the_plan_takes(addon):
+    import bpy
+
+    from shapemove.core.plan.vocabulary import COURSE_KINDS
+
+    seg = bpy.context.scene.shapemove.plan_segments.add()
+    assert set(COURSE_KINDS) <= {item.identifier for item in seg.bl_rna.properties["course"].enum_items}
+
+
 def test_a_course_segment_shows_the_time_to_go_once_round(addon):
     """Read Plan gives a course's segment the time to go once round at the active model's typical
     walk (2 pi / (0.9 x 1.194 m/s) = 5.85 s), as generating makes it, without torch in the panel's

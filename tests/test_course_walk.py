@@ -3,8 +3,9 @@ forth, a zigzag, walked by a straight track the named way; a motion that does no
 import numpy as np
 import pytest
 
-from shapemove.core.generation.course_shapes import (ASIDE, BACK_AND_FORTH, CIRCLE, DIAGONAL, EIGHT, MAX_RADIUS, MIN_RADIUS,
-                                                    U_RADIUS, ZIG, ZIG_ANGLE, ZIGZAG, radius_for)
+from shapemove.core.generation.course_shapes import (ASIDE, BACK_AND_FORTH, CIRCLE, CORNER, DIAGONAL, EIGHT, MAX_RADIUS,
+                                                    MIN_RADIUS, SIDE_MAX, SIDE_MIN, SQUARE, U_RADIUS, ZIG, ZIG_ANGLE, ZIGZAG,
+                                                    radius_for)
 from shapemove.core.generation.course_walk import course_line, course_turn
 from shapemove.core.generation.course_walk import on_course as _on_course
 from shapemove.core.plan.reader import course_named, straight_gait, turns_right
@@ -138,6 +139,12 @@ def test_generation_walks_the_circle_the_prompt_asks_for():
     ("he steps to the left", None, None),                            # a step aside is a sidestep
     ("a woman sidesteps to the right", None, None),
     ("a man turns to the left", None, None),                         # a turn, no gait
+    ("a person walks in a square", SQUARE, ("a person walks", "walk")),
+    ("a man jogs around a small square clockwise", SQUARE, ("a man jogs", "jog")),
+    ("she goes around in a square", SQUARE, ("she walks", "walk")),  # no gait, a way gone: walked
+    ("he walks across the town square", None, None),                 # a place, not a course
+    ("a man walks around the square", None, None),
+    ("a woman stands in a square", None, None),
 ])
 def test_the_words_name_the_course_and_the_gait_walked_straight(text, course, straight):
     assert course_named(text) == course and straight_gait(text) == straight
@@ -177,6 +184,26 @@ def test_back_and_forth_and_zigzag_lines():
     assert zig.point([ZIG, 2 * ZIG, 4 * ZIG])[:, 1] == pytest.approx([d, 2 * d, 4 * d], rel=0.05)   # on along +Z (eased corners: a little more)
     assert zig.point([ZIG])[0][0] == pytest.approx(d, abs=0.1) and abs(zig.point([2 * ZIG])[0][0]) < 0.05
     assert zig.heading([ZIG / 2, 1.5 * ZIG]) == pytest.approx([ZIG_ANGLE, -ZIG_ANGLE], abs=0.02)
+
+
+def test_the_square_goes_four_equal_sides_and_back_to_its_start():
+    """Hand-derived: 12 m walked on a square is once round sides of 3 m (SIDE_MIN <= 12 / 4 <= SIDE_MAX),
+    a quarter turn left at the end of each over CORNER m: the first side along +Z, the second
+    towards +X (the body's left), back at the start heading +Z; to the right, the second side
+    towards -X. A short walk still gets SIDE_MIN sides, a long one SIDE_MAX."""
+    side = 3.0
+    line = course_line(4 * side, SQUARE, right=False)
+    mid = [side / 2, 1.5 * side, 2.5 * side, 3.5 * side]                     # the middle of each side
+    assert line.heading(mid) == pytest.approx([0.0, np.pi / 2, np.pi, 1.5 * np.pi], abs=0.01)
+    a = CORNER / (np.pi / 2)                  # a corner as a quarter circle of CORNER m: a 0.38 m radius
+    second = line.point([1.5 * side])[0]      # straight on to the first corner, round it, half the second side
+    assert second == pytest.approx([a + side / 2, side - CORNER + a], abs=0.05)
+    assert line.point([4 * side])[0] == pytest.approx([0.0, 0.0], abs=0.05)  # once round, back where it began
+    assert line.heading([4 * side - 0.01])[0] > 1.9 * np.pi                 # heading +Z again: the fourth corner
+    right = course_line(4 * side, SQUARE, right=True)
+    assert right.point([1.5 * side])[0][0] < -side / 2
+    assert course_line(2.0, SQUARE, False).length >= 4 * SIDE_MIN - 0.01
+    assert course_line(40.0, SQUARE, False).point([4 * SIDE_MAX])[0] == pytest.approx([0.0, 0.0], abs=0.05)
 
 
 def test_the_diagonal_turns_to_45_degrees_and_keeps_it():
@@ -255,6 +282,20 @@ def test_generation_walks_a_captured_eight_on_its_own_path():
     r = root_centre(d.joints)
     from shapemove.core.generation.track import travel
     assert -55 < np.degrees(np.arctan2(*(r[-1] - r[0]))) < -35 and travel(d.joints)[-1] > 3.0   # before: -3 degrees
+
+
+def test_generation_walks_a_square_round_and_back_to_its_start():
+    """"a person walks in a square" (no length asked: once round) turns four quarter turns the same
+    way and ends where it began, its feet on the floor; clockwise, the other way."""
+    from shapemove.core.generation.generate import Generator, Request
+
+    gen = Generator(None)
+    for text, sign in (("a person walks in a square", 1.0), ("a man walks in a square clockwise", -1.0)):
+        m = gen.generate_batch([Request(text, seed=0)])[0]
+        h = np.unwrap(headings(m.joints))
+        r = root_centre(m.joints)
+        assert sign * (h[-1] - h[0]) > 1.7 * np.pi and np.linalg.norm(r[-1] - r[0]) < 0.8
+        assert np.abs(r - r[0]).max() > 1.2 and m.joints[:, :, 1].min() > -0.05
 
 
 def test_first_turn_right_reads_the_way_a_path_first_turns():

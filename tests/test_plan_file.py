@@ -76,7 +76,7 @@ def test_actions_taken_out_of_a_plan_lose_their_words_and_actions_put_in_are_sai
 
 
 @pytest.mark.parametrize("plan, field", [
-    ({"segments": [{"text": "a man walks", "understood": {"course": "square"}}]}, "segments[0].understood.course"),
+    ({"segments": [{"text": "a man walks", "understood": {"course": "triangle"}}]}, "segments[0].understood.course"),
     ({"segments": [{"text": "a man walks", "seconds": 0.1}]}, "segments[0].seconds"),
     ({"segments": [{"text": "a man walks", "understood": {"count": 2}}]}, "segments[0].understood.count"),
     ({"segments": [{"text": "a man walks", "understood": {"colour": "red"}}]}, "segments[0].understood.colour"),

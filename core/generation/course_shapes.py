@@ -4,7 +4,7 @@ read the times without loading a model; ``course_walk.py`` walks a track along t
 A course is one heading profile over a period of it (``Course.heading``: the yaw at a fraction u of
 the period, turning left positive, 0 at u = 0) and the period's length for a motion that travels so
 far (``Course.period_for``); ``COURSES`` holds the circle, the figure eight, back and forth, the
-zigzag, the diagonal and a gait to one side (``course_walk.py`` says how each is walked). With no
+zigzag, the square, the diagonal and a gait to one side (``course_walk.py`` says how each is walked). With no
 length asked, a course that goes round gets the time to go once round at its gait's typical pace
 (``course_seconds``, ``unasked_seconds``); ``round_share`` is how much of once round a motion that
 travels so far goes.
@@ -20,12 +20,14 @@ from typing import Callable
 import numpy as np
 
 from ..plan.vocabulary import (ASIDE_COURSE as ASIDE, BACK_AND_FORTH_COURSE as BACK_AND_FORTH, CIRCLE,
-                               COURSE_ACTIONS as ACTIONS, DIAGONAL_COURSE as DIAGONAL, EIGHT, ZIGZAG_COURSE as ZIGZAG)
+                               COURSE_ACTIONS as ACTIONS, DIAGONAL_COURSE as DIAGONAL, EIGHT, SQUARE_COURSE as SQUARE,
+                               ZIGZAG_COURSE as ZIGZAG)
 
 MIN_RADIUS, MAX_RADIUS = 1.0, 3.0   # m: a circle's, an eight's loops'
 U_RADIUS = 0.3                      # m: back and forth's U-turns
 LEG_MIN, LEG_MAX = 1.0, 5.0         # m: back and forth's legs
 ZIG, ZIG_ANGLE, ZIG_TURN = 1.5, np.pi / 4, 0.15   # m, radians, share of a leg
+SIDE_MIN, SIDE_MAX, CORNER = 1.5, 4.0, 0.6        # m: a square's sides, and the walk round each corner
 DIAGONAL_ANGLE, DIAGONAL_EASE = np.pi / 4, 0.6   # radians, m
 ASIDE_ANGLE, ASIDE_EASE = np.pi / 2, 1.2         # radians, m
 STEP = 0.005                        # m: a course's heading integrated at this step
@@ -58,6 +60,13 @@ def _stadium(u, period):
     turn = min(np.pi * U_RADIUS / period, 0.5)       # each U-turn's share of the period
     leg = 0.5 - turn
     return np.pi * (np.clip((u - leg) / turn, 0.0, 1.0) + np.clip((u - 2 * leg - turn) / turn, 0.0, 1.0))
+
+
+def _square(u, period):
+    """Four equal sides, a quarter turn left at the end of each, walked round over ``CORNER``
+    metres (eased): from the start of a side, back to it after the fourth corner."""
+    w = min(CORNER / period, 0.2)                     # one corner's share of the period
+    return 0.5 * np.pi * sum(_ease((u - k / 4 + w) / w) for k in range(1, 5))
 
 
 def _ease(x):
@@ -98,6 +107,7 @@ COURSES = {
     EIGHT: Course(_eight, 0.0, lambda d: 4 * np.pi * radius_for(d / 2)),
     BACK_AND_FORTH: Course(_stadium, 2 * np.pi, lambda d: 2 * _leg_for(d) + 2 * np.pi * U_RADIUS),
     ZIGZAG: Course(_zigzag, 0.0, lambda d: 2 * ZIG),
+    SQUARE: Course(_square, 2 * np.pi, lambda d: 4 * float(np.clip(d / 4, SIDE_MIN, SIDE_MAX))),
     DIAGONAL: Course(_veer(DIAGONAL_ANGLE, DIAGONAL_EASE), DIAGONAL_ANGLE, lambda d: 2 * d + 10.0),
     ASIDE: Course(_veer(ASIDE_ANGLE, ASIDE_EASE), ASIDE_ANGLE, lambda d: 2 * d + 10.0),
 }
@@ -114,7 +124,7 @@ def course_seconds(course: str, speed: float) -> float | None:
     return float(np.clip(period / (UNASKED_PACE * speed), UNASKED_LEAST, UNASKED_MOST))
 
 
-ROUND = {CIRCLE: "circle", EIGHT: "figure eight", BACK_AND_FORTH: "way out and back"}   # the courses gone round
+ROUND = {CIRCLE: "circle", EIGHT: "figure eight", BACK_AND_FORTH: "way out and back", SQUARE: "square"}   # gone round
 NOTE_BELOW = 0.9   # a course gone round less than this share of once is noted
 
 

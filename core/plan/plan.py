@@ -222,8 +222,7 @@ def _edited_words(seg: dict, where: str, text: str) -> tuple[str, Words]:
     from ..data.actions import ACTIONS, find_actions
     from .part_prompts import PartPlan, named_side, plan_parts
     from .reader import TRAVEL_WAYS
-    from .vocabulary import COUNTED, COURSE_NAMES, MAX_METRES, MAX_STEPS, MAX_COUNT
-    from .vocabulary import ASIDE_COURSE, BACK_AND_FORTH_COURSE, DIAGONAL_COURSE, ZIGZAG_COURSE
+    from .vocabulary import COUNTED, COURSE_KINDS, MAX_METRES, MAX_STEPS, MAX_COUNT
 
     said = seg.get("understood", {})
     if not isinstance(said, dict):
@@ -271,8 +270,7 @@ def _edited_words(seg: dict, where: str, text: str) -> tuple[str, Words]:
             raise _bad(f"{where}.understood.side", f"must be 'left hand', 'right hand', 'left foot' or 'right foot', "
                        f"got {said['side']!r}")
         side = (bits[0], bits[1])
-    courses = tuple(COURSE_NAMES) + (BACK_AND_FORTH_COURSE, ZIGZAG_COURSE, DIAGONAL_COURSE, ASIDE_COURSE)
-    course = None if said.get("course") is None else _choice(said["course"], f"{where}.understood.course", courses)
+    course = None if said.get("course") is None else _choice(said["course"], f"{where}.understood.course", COURSE_KINDS)
     way = _choice(said.get("course_way", "left"), f"{where}.understood.course_way", ("left", "right"))
     turn = None if said.get("turn_degrees") is None else math.radians(
         _number(said["turn_degrees"], f"{where}.understood.turn_degrees", -1080, 1080))

@@ -161,12 +161,14 @@ def course_named(text: str) -> str | None:
     """The course the words name (``EIGHT`` before ``CIRCLE``: "a figure eight" is not a circle;
     not the circles the arms make: "walks forward rotating the arms in circles"; back and forth and a
     zigzag only with a gait to walk it, or as the verb: "sways back and forth" names none; a gait
-    to one side, ``ASIDE_COURSE``: "runs to the left", not a sidestep or a walk backward), else
-    None."""
+    to one side, ``ASIDE_COURSE``: "runs to the left", not a sidestep or a walk backward; a square
+    with a gait or a verb of going: "walks in a square", "goes around a small square"), else None."""
     acts = find_actions(text)
     if V.EIGHT in acts or (V.CIRCLE in acts and not V.ARM_CIRCLES.search(str(text))):
         return V.EIGHT if V.EIGHT in acts else V.CIRCLE
     gait = any(a in LEGS_ACTIONS for a in acts) or V.COURSE_VERB.search(str(text)) is not None
+    if V.SQUARE.search(str(text)) and (gait or V.GOING.search(str(text))):
+        return V.SQUARE_COURSE   # "walks in a square", "goes around a small square"
     for name, words in ((V.BACK_AND_FORTH_COURSE, V.BACK_AND_FORTH), (V.ZIGZAG_COURSE, V.ZIGZAG),
                         (V.DIAGONAL_COURSE, V.DIAGONAL)):
         if gait and words.search(str(text)):
@@ -186,8 +188,8 @@ def straight_gait(text: str) -> tuple[str, str] | None:
     """(the words without the course they name and its way round, the gait left in them) --
     "someone jogs in a figure eight clockwise, waving" -> ("someone jogs, waving", "jog"), "a man
     paces back and forth" -> ("a man walks", "walk") -- or None when the words name no course
-    (``course_named``). A circle or an eight whose words name no gait is walked ("a man goes around in
-    a circle", "she circles the room" -> ("a man walks", "walk"), ("she walks", "walk"))."""
+    (``course_named``). A circle, an eight or a square whose words name no gait is walked ("a man goes
+    around in a circle", "she circles the room" -> ("a man walks", "walk"), ("she walks", "walk"))."""
     text = str(text)
     course = course_named(text)
     if course is None:
@@ -197,7 +199,7 @@ def straight_gait(text: str) -> tuple[str, str] | None:
     gaits = [a for a in find_actions(straight) if a in LEGS_ACTIONS and a not in V.COURSE_ACTIONS]
     if gaits:
         return straight, gaits[0]
-    if course in V.COURSE_ACTIONS:
+    if course in V.COURSE_ACTIONS or course == V.SQUARE_COURSE:
         subject = V.SUBJECT.match(straight.lower())
         return f"{subject.group(0) if subject else 'a person'} walks", "walk"
     return None
@@ -332,7 +334,7 @@ def without_numbers(prompt: str) -> str:
 
 # -- words no reader took ---------------------------------------------------------------------
 _TAKEN = (V.COUNT_TIMES, V.FAST, V.SLOW, V.STOP, V.STEPS, V.STEPS_ALONE, V.STILL, V.SPOKEN_DISTANCE, V.CLOCKWISE,
-          V.COUNTER_CLOCKWISE, V.BACK_AND_FORTH, V.ZIGZAG, V.DIAGONAL, V.COURSE_WORDS, V.COURSE_WAY, V.TURN_WHOLE,
+          V.COUNTER_CLOCKWISE, V.BACK_AND_FORTH, V.ZIGZAG, V.DIAGONAL, V.SQUARE, V.COURSE_WORDS, V.COURSE_WAY, V.TURN_WHOLE,
           V.TURN_HALF, V.TURN_QUARTER, V.FORWARD, V.BACKWARD, V.IN_PLACE, V.TRAVEL_SIDE, V.SIDEWAYS, V.SIDE,
           V.DIRECTION, V.SUBJECT, V.TURN_TWICE, V.TURN_TIMES, V.ARMS_HELD, V.BOTH_HANDS, V.ONE_HAND, V.DURATION, V.ASIDE,
           V.CONNECTOR, V.THEN, V.MANNER, V.ONE_FOOT, V.JUMP_IN_PLACE, V.AGAIN)

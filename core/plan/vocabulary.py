@@ -144,6 +144,10 @@ _PACE = (r"\bpac(?:es|ing)\b(?=\s+(?:(?:around|about|round)\s+)?(?:the|a|his|her
 BACK_AND_FORTH = re.compile(rf"\b(?:{_TO_AND_FRO}|{_UP_AND_DOWN})\b|{_PACE}", re.I)
 ZIGZAG = re.compile(r"\bzig[- ]?zag(?:s|ging|ged)?\b", re.I)
 DIAGONAL = re.compile(r"\bdiagonal(?:ly)?\b|\bat an angle\b", re.I)
+# a square walked: "in a square", "around a small square", "a square path" -- not "the town square"
+SQUARE = re.compile(r"\b(?:in|around|round|along)\s+a\s+(?:(?:small|big|large|wide|tight)\s+)?square\b(?![- ]?(?:met|foot|feet))"
+                    r"|\bsquare[- ](?:shaped\s+)?(?:path|route|pattern|course|loop)\b", re.I)
+GOING = re.compile(r"\b(?:go|goes|going|went|move|moves|moving|moved|travel\w*|head\w*)\b", re.I)   # a way gone, no gait named
 # a gait that goes to one side: the walker turns that way and goes on ("runs to the left", "jogs off to his
 # right"); a step, a shuffle or a slide to one side is a sidestep (``TRAVEL_SIDE``), not a turn
 ASIDE = re.compile(r"\b(?:walk|run|jog|sprint|march|sneak|limp|stroll|trot|dash|hurr(?:y|ie)|head|go)(?:s|es|ing|ed)?\b"
@@ -154,7 +158,7 @@ COURSE_VERB = re.compile(rf"{_PACE}|\bzig[- ]?zag(?:s|ging|ged)\b", re.I)   # th
 # "in a zigzag", "back and forth", "up and down the room"
 COURSE_WORDS = re.compile(
     r"(?:\s+(?:around|round|along|on|in|into|through|doing|making|tracing|following))*\s+(?:(?:a|an|the)\s+)?"
-    r"(?:(?:small|big|large|wide|tight|full)\s+)?(?:figure[- ]?(?:of[- ])?(?:8|eight)|circles?|zig[- ]?zag)"
+    r"(?:(?:small|big|large|wide|tight|full)\s+)?(?:figure[- ]?(?:of[- ])?(?:8|eight)|circles?|zig[- ]?zag|square)"
     r"(?:[- ]shaped)?(?:\s+(?:path|route|pattern|course|shape|loop|line))?\b"
     r"|(?:\s+(?:around|round|in))*\s+an?\s+(?:(?:small|big|large|wide|tight|full)\s+)?loop\b"
     rf"|\s+(?:{_TO_AND_FRO}|diagonally|at an angle)\b|\s+{_UP_AND_DOWN}\b", re.I)
@@ -169,10 +173,12 @@ CIRCLE = "walk in a circle"
 EIGHT = "walk in a figure eight"
 BACK_AND_FORTH_COURSE = "back and forth"
 ZIGZAG_COURSE = "zigzag"
+SQUARE_COURSE = "square"
 ASIDE_COURSE = "aside"
 DIAGONAL_COURSE = "diagonal"
 COURSE_ACTIONS = (CIRCLE, EIGHT)     # the courses that are actions of the data (``data.actions``)
 COURSE_NAMES = {CIRCLE: "in a circle", EIGHT: "in a figure eight"}   # as people say them
+COURSE_KINDS = (CIRCLE, EIGHT, BACK_AND_FORTH_COURSE, ZIGZAG_COURSE, SQUARE_COURSE, DIAGONAL_COURSE, ASIDE_COURSE)   # every course
 
 # -- turns ------------------------------------------------------------------------------------
 TURN_WHOLE = re.compile(r"\b(?:spins?|spinning|full (?:turn|circle|rotation)|360|all the way (?:a)?round|pirouettes?)\b")
