@@ -129,6 +129,8 @@ def test_ordering_words_make_segments_in_the_order_they_happen(prompt, segments)
     # a gait and an arm gesture at once, a turn beside its gait
     "a man walks and throws a ball", "a man walks and turns left", "a person turns around and walks away",
     "a man walks forward, turns around", "he jogs and stops suddenly",
+    # the arms brought down after a raise: the raise's own end, which its takes perform
+    "a woman raises her arms, then lowers them slowly", "he raises his right hand, then drops it",
     # a sit and an arm gesture at once: waving seated
     "a woman sits down and waves", "he sits and raises his hand",
     # a list without an order word: at once by body part, a squat's own standing up, the arms of a jump

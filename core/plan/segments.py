@@ -41,8 +41,8 @@ import re
 from ..data.actions import action_spans, find_actions
 from .part_prompts import LEGS, SUBJECT, _has_verb, _subject, _with_subject, at_once, named_side
 from .reader import stop_request
-from .vocabulary import (AND, BEFORE_AFTER as MIDDLE, FIRST, LEADING_BEFORE_AFTER as LEADING, LIST_STEP, MID_STOP,
-                         PARTICIPLE, POSTURE_CHANGES, RISEN_FROM, STOP, THEN, WAY_ALONE)
+from .vocabulary import (AND, BEFORE_AFTER as MIDDLE, FIRST, LEADING_BEFORE_AFTER as LEADING, LIST_STEP, LOWERED, MID_STOP,
+                         PARTICIPLE, POSTURE_CHANGES, RAISES, RISEN_FROM, STOP, THEN, WAY_ALONE)
 
 DEFAULT_SUBJECT = "a person"
 SEGMENT_SECONDS = 3.0       # a segment's length when the prompt's length is the model's to choose
@@ -225,8 +225,9 @@ def split_segments(prompt: str) -> list[str]:
         rest = p[subject.end():] if subject else p
         if pieces and p and WAY_ALONE.match(rest):
             pieces.append(_gone_on(pieces[-1], rest))   # "runs to the left, then to the right"
-        elif pieces and p and (STOP.match(rest) or not (find_actions(rest) or _has_verb(rest))):
-            pieces[-1] = f"{pieces[-1]}, then {p}"   # the gait's own stop, or no motion of its own ("then straighten")
+        elif pieces and p and (STOP.match(rest) or not (find_actions(rest) or _has_verb(rest))
+                               or LOWERED.match(rest) and set(find_actions(pieces[-1])) & RAISES):
+            pieces[-1] = f"{pieces[-1]}, then {p}"   # the gait's own stop, a raise's lowering, or no motion of its own
         else:
             pieces.append(p)
     if len(pieces) > 1:   # a list of steps: "walks ahead, spins around, then waves"

@@ -88,6 +88,12 @@ MANNER_SAID = {"youthful": "youthfully", "old": "like an old person", "stiff": "
                "clumsy": "clumsily", "careful": "carefully", "seductive": "seductively"}
 
 # -- stop, steps, distance, standing still ------------------------------------------------------
+# the arms brought down after a raise ("raises her arms, then lowers them slowly"): the raise's own end,
+# which its captured takes perform (``segments.split_segments``)
+RAISES = frozenset({"raise hand", "reach up"})
+LOWERED = re.compile(r"(?:slowly\s+)?(?:lower(?:s|ing)?|drop(?:s|ping)?|brings?\s+(?:them|it|(?:his|her|their|both|the)\s+"
+                     r"(?:arms?|hands?))\s+(?:back\s+)?down)\b(?:\s+(?:them|it|(?:his|her|their|both|the)\s+(?:arms?|hands?)))?"
+                     r"(?:\s+(?:again|slowly|back down|down|to (?:his|her|their) sides?))*\s*$")
 # how a stop is made, said after it ("stops suddenly", "comes to a sudden halt", "stops dead in his tracks")
 STOP_HOW = r"(?:\s+(?:suddenly|abruptly|sharply|quickly|short|dead|immediately|briefly|slowly|gradually|completely))?" \
            r"(?:\s+in (?:his|her|their|its) tracks)?"
