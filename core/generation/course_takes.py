@@ -1,8 +1,9 @@
 """A course walked by a capture of it: "a man walks in a figure eight" plays a captured figure eight.
 
 The codec does not carry turning, so a course is a plain gait bent onto it (``course_walk.py``). Where
-the built-in library holds takes of the course's own action (CMU subject 105's figure eights: about
-4.4 x 2 m, walked in 15-33 s, plainly and as a mummy), those takes compete with the samples of the
+the takes that compete (``captured_takes.TakePool``: the built-in library's, the user's) hold takes of
+the course's own action (the built-in CMU subject 105's figure eights: about 4.4 x 2 m, walked in
+15-33 s, plainly and as a mummy; a user's captured circle), those takes compete with the samples of the
 whole prompt (``Generator.choose``), and a take of the course that wins is played on its own path:
 
 - whole when no length is asked (once round, as the take goes), else a window of the length asked,
