@@ -93,6 +93,9 @@ from shapemove.core.plan.segments import SEGMENT_SECONDS, split_segments
     ("a man walks 3 metres and turns around", ["a man walks 3 metres", "a man turns around"]),
     ("a man walks 10 steps, turns around", ["a man walks 10 steps", "a man turns around"]),   # or a comma
     ("she walks three steps, turns left and walks on", ["she walks three steps", "she turns left", "she walks on"]),
+    ("a man walks 2 metres, turns right, walks 2 metres, turns right again",   # a list of measured legs and turns
+     ["a man walks 2 metres", "a man turns right", "a man walks 2 metres", "a man turns right again"]),
+    ("he walks 3 steps, turns around, walks 3 steps back", ["he walks 3 steps", "he turns around", "he walks 3 steps back"]),
     # "once" opening a clause and "having" with its comma come first; a past tense names its action
     ("once she has waved, she runs off", ["she has waved", "she runs off"]),
     ("having bowed, the actor walks away", ["the actor bowed", "the actor walks away"]),
@@ -128,7 +131,7 @@ def test_ordering_words_make_segments_in_the_order_they_happen(prompt, segments)
     "after the warm-up the man runs", "a man walks ahead, waves, and nods",
     # a gait and an arm gesture at once, a turn beside its gait
     "a man walks and throws a ball", "a man walks and turns left", "a person turns around and walks away",
-    "a man walks forward, turns around", "he jogs and stops suddenly",
+    "a man walks forward, turns around", "he jogs and stops suddenly", "a person turns around, walks away",
     # the arms brought down after a raise: the raise's own end, which its takes perform
     "a woman raises her arms, then lowers them slowly", "he raises his right hand, then drops it",
     # a sit and an arm gesture at once: waving seated

@@ -14,7 +14,7 @@ What each reading does to the motion is said where it is done (``generation/stop
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -272,13 +272,18 @@ TRAVEL_WAYS = {None: Travel(), "forward": Travel(forward=1), "backward": Travel(
 
 
 def travel_of(prompt: str) -> Travel:
-    """The travel ``prompt`` names (nothing for a prompt that names none or contradicts itself)."""
+    """The travel ``prompt`` names (nothing for a prompt that names none or contradicts itself); a
+    turn or a spin alone, no way named, is done on the spot ("a man turns right" walked 2.8-3.1 m in
+    3 s on the samples' walks)."""
     fw, bw = bool(V.FORWARD.search(prompt)), bool(V.BACKWARD.search(prompt))
     sides = {m.group(1).lower() for m in V.TRAVEL_SIDE.finditer(prompt)}
-    return Travel(forward=(fw and not bw) - (bw and not fw),
-                  side=int(sides == {"left"}) - int(sides == {"right"}),
-                  sideways=bool(V.SIDEWAYS.search(prompt)) and not sides,
-                  in_place=bool(V.IN_PLACE.search(prompt) or V.JUMP_IN_PLACE.search(prompt)))
+    way = Travel(forward=(fw and not bw) - (bw and not fw), side=int(sides == {"left"}) - int(sides == {"right"}),
+                 sideways=bool(V.SIDEWAYS.search(prompt)) and not sides,
+                 in_place=bool(V.IN_PLACE.search(prompt) or V.JUMP_IN_PLACE.search(prompt)))
+    acts = set(specific(find_actions(prompt)))
+    if acts and acts <= {"turn", "spin"} and way == Travel():
+        return replace(way, in_place=True)   # turning on the spot
+    return way
 
 
 def asks_on_the_spot(prompt: str) -> bool:

@@ -143,7 +143,8 @@ def _and_steps(piece: str, before: str = "") -> list[str]:
             return _list_steps(a) + _and_steps(b, a)
     steps = _list_steps(piece)   # no "and" orders it: a list of verbs of actions ("runs, jumps and lands")
     if len(steps) > 1 and all(_leads_with_action(y) and (_follows(find_actions(x), find_actions(y), whole)
-                                                        or _counted_turn(x, y)) for x, y in zip(steps, steps[1:])):
+                                                        or _counted_turn(x, y) or _turn_then_counted(x, y))
+                              for x, y in zip(steps, steps[1:])):
         return steps
     return [piece]
 
@@ -197,6 +198,12 @@ def _counted_turn(before: str, step: str) -> bool:
     """Whether ``step`` is a turn alone after a gait that counts its steps or a distance (``before``:
     "walks three steps", "turns left"): the steps, then the turn."""
     return find_actions(step) == ["turn"] and stop_request(before) is not None
+
+
+def _turn_then_counted(before: str, step: str) -> bool:
+    """Whether ``step`` is a gait that counts its steps or a distance after a turn alone in a list
+    ("..., turns right, walks 2 metres, ..."): the turn, then the measured walk."""
+    return find_actions(before) == ["turn"] and stop_request(step) is not None
 
 
 def _list_steps(piece: str) -> list[str]:
