@@ -57,6 +57,10 @@ def test_edited_fields_are_what_the_plan_holds():
     assert sit["segments"][0]["understood"]["slowly"] is True and plan_from_json(sit).segments[0].words.slowly
     del sit["segments"][0]["understood"]["slowly"]
     assert not plan_from_json(sit).segments[0].words.slowly            # taken out: played at its own speed
+    squat = plan_json("a man squats and holds it")
+    assert squat["segments"][0]["understood"]["held_low"] is True and plan_from_json(squat).segments[0].words.held_low
+    squat["segments"][0]["understood"]["held_low"] = False
+    assert not plan_from_json(squat).segments[0].words.held_low        # turned off: it stands up again
 
 
 def test_actions_taken_out_of_a_plan_lose_their_words_and_actions_put_in_are_said():
@@ -84,6 +88,7 @@ def test_actions_taken_out_of_a_plan_lose_their_words_and_actions_put_in_are_sai
     ({"segments": [{"text": "a man walks", "understood": {"actions": ["levitate"]}}]}, "segments[0].understood.actions[0]"),
     ({"segments": [{"text": "a man walks", "understood": {"steps": 3, "stop": False}}]}, "segments[0].understood.stop"),
     ({"segments": [{"text": "a man sits", "understood": {"slowly": "yes"}}]}, "segments[0].understood.slowly"),
+    ({"segments": [{"text": "a man squats", "understood": {"held_low": "yes"}}]}, "segments[0].understood.held_low"),
     ({"segments": [{"text": ""}]}, "segments[0].text"),
     ({"segments": []}, "segments"),
     ({"segments": [{"text": "a man walks"}, {"text": "a man jumps", "understood": {"count": 20}}]},

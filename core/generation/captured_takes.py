@@ -70,6 +70,7 @@ ACTION_BONUS = 0.3     # TMA cosine credited to a take of the asked action (tuni
 UNASKED_SECONDS = 4.0  # the least a take plays when the length is the model's
 BUSIEST = 2            # a long take's busiest windows, one drawn by the seed
 KEPT = 16              # takes kept read at once (rotations as matrices)
+LAST_POSE_HELD = "its last pose is held"   # said of a take shorter than asked (``captured_motion``)
 OTHER_WAY = frozenset({"walk backward"})   # specific forms that compete only when asked by name: another way,
 ADDS_TURN = frozenset({"spin jump", "spin kick", "cartwheel"})   # or a turn the generic words do not ask
 NAMELESS_FLOOR = 0.9   # TMA caption cosine from which a take competes when the words name no action
@@ -446,6 +447,11 @@ class TakePool:
         return [of(i) for i in self.nearest(text, action, seed, count, hands, test)]
 
 
+def without_last_pose_held(notes: list[str]) -> list[str]:
+    """``notes`` but the one saying a take's last pose is held (a motion held elsewhere instead)."""
+    return [n for n in notes if LAST_POSE_HELD not in n]
+
+
 def take_manner(captions: list[str]) -> str | None:
     """The manner a take's ``captions`` give it (``plan.reader.manner_of``, the prompt's reader): the
     one at least half of them say ("A person bows happily." / "A human takes a bow cheerfully."), else
@@ -514,6 +520,6 @@ def captured_motion(w: Window, body, betas, ik_refine_iters: int = 10, prompt: s
         digits = 1 if need - have >= 0.1 else 2   # "take 3.05 s: the 3.00 s asked", never "3.0 ... 3.0"
         out.notes.append(f"the repetitions asked take {need:.{digits}f} s: the {have:.{digits}f} s asked hold fewer of them")
     if w.held:
-        out.notes.append(f"the captured take lasts {(len(w.rotations) - w.held) / FPS:.1f} s: its last pose is held "
+        out.notes.append(f"the captured take lasts {(len(w.rotations) - w.held) / FPS:.1f} s: {LAST_POSE_HELD} "
                          f"for the remaining {w.held / FPS:.1f} s")
     return out

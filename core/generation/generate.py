@@ -46,7 +46,7 @@ from .parts import CLAUSE_NEAR, generate_by_parts, is_by_parts, redecode_parts
 from .prompts import check_prompt
 from .rerank import CandidatePicker
 from .retrieval_seeds import seed_prefixes, seeded_count
-from .held_arms import held_motion
+from .held_pose import held_motion
 from .held_repetition import performed
 from .on_the_spot import on_the_spot
 from ..motion.features import motion_features
@@ -662,6 +662,8 @@ class Generator:
                               turn_motion(motion, self.body, turn, self.ik_refine_iters))         # turn_words.py
             if words is not None and words.arms_held and words.gestures_only and words.parts is None:
                 motion = held_motion(motion, self.body, self.ik_refine_iters)   # "stands with her arms raised"
+            if words is not None and words.held_low and words.parts is None:   # "squats and holds it"
+                motion = held_motion(motion, self.body, self.ik_refine_iters, low=True)
             if words is not None:   # "jogs in place", "hops on the spot": the data's gaits and hops travel
                 motion = on_the_spot(motion, self.body, words.travel.in_place, self.ik_refine_iters)   # on_the_spot.py
             motion.plan = plan_text(plan) if plan is not None else None

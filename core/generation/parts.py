@@ -41,7 +41,7 @@ from .course_walk import course_motion, course_note, on_course
 from .decode import motion_from_joints
 from .part_compose import compose_arms, mirror_track, needs_mirror
 from .retarget import shaped_take
-from .held_arms import held_from_peak, held_note
+from .held_pose import held_from_peak, held_note
 from .track import Track, decoded_track, fitted
 
 

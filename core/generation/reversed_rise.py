@@ -24,6 +24,7 @@ import numpy as np
 
 from ..body.skeleton import JOINT_NAMES
 from ..plan.vocabulary import RISEN_FROM
+from .captured_takes import without_last_pose_held
 from .posture_change import ENDS, LYING, MIN_CHANGE, height_change
 
 HEAD = JOINT_NAMES.index("head")
@@ -79,7 +80,7 @@ def held_low(motion, contacts):
     return dataclasses.replace(
         motion, joints=np.concatenate([j[:low + 1], np.repeat(j[low:low + 1], held, 0)]),
         contacts=np.concatenate([c[:low + 1], np.repeat(c[low:low + 1], held, 0)]), tokens=None, features=None,
-        notes=[n for n in motion.notes if "its last pose is held" not in n]   # held low instead
+        notes=without_last_pose_held(motion.notes)   # held low instead
         + [f"held at its lowest from {low / motion.fps:.1f} s: the next segment stands up"])
 
 

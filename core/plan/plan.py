@@ -13,7 +13,7 @@ may change, add or remove: ``actions`` (the first is the segment's action: a new
 action's words in the text the model reads), ``side`` ("left hand"), ``course`` and ``course_way``,
 ``turn_degrees``, ``travel``, ``in_place``, ``distance_m``, ``steps``, ``stop``, ``stand_still``,
 ``count``, ``pace``, ``seconds`` (the length its words ask), ``arms_held`` (the raised arms kept
-up), ``hands`` (a gesture's hands: "both" or "one"), ``one_foot`` (a hop or jump asked on one foot:
+up), ``held_low`` (a squat kept down), ``hands`` (a gesture's hands: "both" or "one"), ``one_foot`` (a hop or jump asked on one foot:
 said not to be met), ``again`` (a counted action repeated for the whole length), ``manner`` (how it
 is done: a name of
 ``vocabulary.MANNERS``, "proud"); a segment's ``text`` and ``seconds``
@@ -174,7 +174,7 @@ def _choice(value, where: str, options) -> str:
 
 UNDERSTOOD_KEYS = ("actions", "legs", "arms", "course", "course_way", "turn_degrees", "travel", "in_place",
                    "distance_m", "steps", "stop", "stand_still", "count", "pace", "slowly", "seconds", "side",
-                   "arms_held", "hands", "one_foot", "again", "manner", "unused")
+                   "arms_held", "held_low", "hands", "one_foot", "again", "manner", "unused")
 
 
 def _swap_action(text: str, old: str | None, new: str) -> str:
@@ -286,6 +286,7 @@ def _edited_words(seg: dict, where: str, text: str) -> tuple[str, Words]:
     stand = _flag(said.get("stand_still", False), f"{where}.understood.stand_still")
     hands = None if said.get("hands") is None else _choice(said["hands"], f"{where}.understood.hands", ("both", "one"))
     held = _flag(said.get("arms_held", False), f"{where}.understood.arms_held")
+    low = _flag(said.get("held_low", False), f"{where}.understood.held_low")
     one_foot = _flag(said.get("one_foot", False), f"{where}.understood.one_foot")
     again = _flag(said.get("again", False), f"{where}.understood.again")
     count = None
@@ -308,7 +309,7 @@ def _edited_words(seg: dict, where: str, text: str) -> tuple[str, Words]:
                          in_place=in_place and any(a in LEGS for a in (actions or read.actions)),   # a gait's strides
                          stop=stop, steps=steps, distance_m=metres, gait_text=gait_text,
                          stand_still=stand and not stop, count=count, pace=pace, slow_flight=flight, slowly=slowly,
-                         seconds=length, hands=hands, arms_held=held, one_foot=one_foot, again=again,
+                         seconds=length, hands=hands, arms_held=held, held_low=low, one_foot=one_foot, again=again,
                          manner=manner)
 
 

@@ -324,6 +324,12 @@ def arms_held(prompt: str) -> bool:
     return bool(V.ARMS_HELD.search(str(prompt).lower()))
 
 
+def held_low(prompt: str) -> bool:
+    """Whether the words keep a squat down ("squats and holds it", "crouches and stays there")."""
+    t = str(prompt).lower()
+    return bool(V.HELD_LOW.search(t)) and bool(V.HELD_LOW_ACTIONS & set(find_actions(t)))
+
+
 def gestures_only(prompt: str) -> bool:
     """Whether the words name actions and all of them are arms actions ("he waves")."""
     found = set(find_actions(str(prompt).lower()))
@@ -341,7 +347,7 @@ def without_numbers(prompt: str) -> str:
 _TAKEN = (V.COUNT_TIMES, V.FAST, V.SLOW, V.STOP, V.STEPS, V.STEPS_ALONE, V.STILL, V.SPOKEN_DISTANCE, V.CLOCKWISE,
           V.COUNTER_CLOCKWISE, V.BACK_AND_FORTH, V.ZIGZAG, V.DIAGONAL, V.SQUARE, V.COURSE_WORDS, V.COURSE_WAY, V.TURN_WHOLE,
           V.TURN_HALF, V.TURN_QUARTER, V.FORWARD, V.BACKWARD, V.IN_PLACE, V.TRAVEL_SIDE, V.SIDEWAYS, V.SIDE,
-          V.DIRECTION, V.SUBJECT, V.TURN_TWICE, V.TURN_TIMES, V.ARMS_HELD, V.BOTH_HANDS, V.ONE_HAND, V.DURATION, V.ASIDE,
+          V.DIRECTION, V.SUBJECT, V.TURN_TWICE, V.TURN_TIMES, V.ARMS_HELD, V.HELD_LOW, V.BOTH_HANDS, V.ONE_HAND, V.DURATION, V.ASIDE,
           V.CONNECTOR, V.THEN, V.MANNER, V.ONE_FOOT, V.JUMP_IN_PLACE, V.AGAIN)
 
 

@@ -63,6 +63,8 @@ def said(reading: dict) -> str:
         bits.append(f"side: {reading['side']}")
     if reading.get("arms_held"):
         bits.append("arms held raised")
+    if reading.get("held_low"):
+        bits.append("held at its lowest")
     if reading.get("hands"):
         bits.append("both hands" if reading["hands"] == "both" else "one hand")
     if reading.get("one_foot"):

@@ -239,6 +239,11 @@ ONE_HAND = re.compile(r"\b(?:a|one|his|her|their|the|its|your|one's)\s+(?:hand|a
 ARMS_HELD = re.compile(r"\b(?:with|keeps?|keeping|holds?|holding)\s+(?:[\w-]+\s+){0,2}?(?:arms?|hands?)\s+(?:held\s+)?"
                        r"(?:raised|lifted|up|high|aloft|above(?:\s+(?:his|her|their|the)\s+heads?)?|overhead|in the air)\b|"
                        r"\b(?:arms?|hands?)\s+(?:held\s+)?(?:raised|lifted|aloft|up high)\b")
+# a squat held low ("squats and holds it", "crouches down and stays there", "holds the squat")
+HELD_LOW = re.compile(r"\b(?:holds?|holding)\s+(?:it|that|this|there|still|(?:the|that|this|her|his|their)\s+"
+                      r"(?:position|pose|squat|crouch))\b|\b(?:stays?|staying|remains?|remaining)\s+(?:down|low|there|"
+                      r"crouched|squatting|in\s+(?:the|that|this)\s+(?:position|squat|crouch))\b")
+HELD_LOW_ACTIONS = frozenset({"squat"})
 
 # -- body parts, sides, subjects, clauses -----------------------------------------------------------
 # "and" joins two clauses, not the pairs "back and forth", "to and fro", "up and down", "round and round"

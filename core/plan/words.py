@@ -46,6 +46,7 @@ class Words:
     slowly: bool = False                       # an action that is no gait done slowly ("sits down slowly")
     gestures_only: bool = False                # every action named is an arms action ("he waves")
     arms_held: bool = False                    # the arms kept raised ("with both arms raised")
+    held_low: bool = False                     # a squat kept down ("squats and holds it")
     hands: str | None = None                   # a gesture's hands: "both" ("waves with both hands"), "one" ("a hand")
     one_foot: bool = False                     # a hop or a jump on one foot (no capture does one)
     again: bool = False                        # a counted action again and again, no number ("squats repeatedly")
@@ -103,6 +104,8 @@ class Words:
             out["side"] = f"{self.side[0]} {self.side[1]}"
         if self.arms_held:
             out["arms_held"] = True
+        if self.held_low:
+            out["held_low"] = True
         if self.hands is not None:
             out["hands"] = self.hands
         if self.one_foot:
@@ -138,7 +141,7 @@ def read_words(text: str) -> Words:
         gait_text=None if stop is None else stop[0],
         stand_still=stop is None and R.asks_stand_still(low), count=R.asked_count(low), pace=pace,
         slow_flight=pace == "slow" and R.asks_slow_flight(low), slowly=slowly, gestures_only=R.gestures_only(low),
-        arms_held=R.arms_held(low), hands=R.hands_asked(low), one_foot=R.one_foot(low), again=again,
+        arms_held=R.arms_held(low), held_low=R.held_low(low), hands=R.hands_asked(low), one_foot=R.one_foot(low), again=again,
         seconds=R.asked_seconds(low),
         manner=R.manner_of(low),
         unused=tuple(R.unused_words(low, _body_words(low), (() if pace or slowly else (V.FAST, V.SLOW))

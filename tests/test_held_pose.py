@@ -1,10 +1,10 @@
-"""Arms held raised: words of a state keep the raise at its top (core/generation/held_arms.py)."""
+"""A pose the words keep: the raise at its top, a squat at its lowest (core/generation/held_pose.py)."""
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from shapemove.core.generation.held_arms import held_from_peak, peak_frame
+from shapemove.core.generation.held_pose import held_from, held_from_peak, lowest_frame, peak_frame
 from shapemove.core.generation.track import Track
 from shapemove.core.plan.reading import said
 from shapemove.core.plan.words import read_words
@@ -84,3 +84,41 @@ def test_the_default_model_keeps_the_arms_raised():
     assert coded.provenance.startswith("generated") or "legs: generated" in coded.provenance
     assert any("held from" in n for n in coded.notes) and _above_head(coded)[last].min() > 0.0
     assert (coded.tokens is None or len(coded.tokens) == 0) and coded.arms_tokens is None
+
+
+@pytest.mark.parametrize("text, held", [
+    ("a man does a deep squat and holds it", True), ("a woman squats down and stays there", True),
+    ("she crouches and holds the position", True), ("he squats and remains in that position", True),
+    ("a man squats", False), ("she walks and stays there", False),   # no squat to keep down
+    ("he squats, then stands up", False),
+])
+def test_the_words_of_a_held_squat(text, held):
+    w = read_words(text)
+    assert w.held_low is held and ("held at its lowest" in said(w.understood())) is held
+    if held:
+        assert not {"holds", "stays", "remains", "position", "there", "it"} & set(w.unused)
+
+
+def test_the_track_is_held_at_its_lowest():
+    """Hand-derived: a pelvis going 1.0 -> 0.5 -> 1.0 m is lowest at frame 3; held from there, the
+    rest of the track is that frame's pose."""
+    t = _track([0.1] * 7)
+    t.joints[:, 0, 1] = [1.0, 0.8, 0.6, 0.5, 0.6, 0.8, 1.0]
+    assert lowest_frame(t.joints) == 3
+    h = held_from(t, lowest_frame(t.joints))
+    assert len(h) == len(t) and np.allclose(h.joints[3:], t.joints[3]) and np.allclose(h.joints[:4], t.joints[:4])
+
+
+def test_generation_keeps_a_squat_down_when_the_words_hold_it():
+    """"a man does a deep squat and holds it" went down and stood up again in 1.8 s, then stood; now
+    the pelvis stays at its lowest to the end (no note that the take's last pose is held)."""
+    from shapemove.core.generation.generate import Generator, Request
+
+    gen = Generator(None)
+    held = gen.generate_batch([Request("a man does a deep squat and holds it", seed=0, seconds=4)])[0]
+    plain = gen.generate_batch([Request("a man does a squat", seed=0, seconds=4)])[0]
+    pelvis, stand = held.joints[:, 0, 1], plain.joints[-1, 0, 1]
+    assert pelvis[-1] == pytest.approx(pelvis.min(), abs=0.02) and pelvis[-1] < plain.joints[0, 0, 1] - 0.3
+    assert stand > plain.joints[:, 0, 1].min() + 0.3                      # the plain squat stands up again
+    assert any("held at its lowest" in n for n in held.notes) and not any("last pose is held" in n for n in held.notes)
+    assert held.joints[:, :, 1].min() > -0.05
