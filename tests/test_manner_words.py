@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from shapemove.core.generation.captured_takes import take_manner
-from shapemove.core.generation.manner_words import ANY, manner_kept, unmet_note
+from shapemove.core.generation.manner_words import ANY, MILD_ONLY, done_as, manner_kept, unmet_note
 from shapemove.core.plan.words import read_words
 
 pytestmark = pytest.mark.usefixtures("one_thread")
@@ -37,10 +37,13 @@ def test_which_takes_compete():
     plain_and_styled = {None, "happy", "proud"}
     assert manner_kept("proud", plain_and_styled) == "proud"      # asked and offered: those takes
     assert manner_kept("sad", plain_and_styled) is None          # asked, none done so: the plain takes
-    assert manner_kept("sad", {"happy", "proud"}) is ANY         # ... and no plain take: every take
+    assert manner_kept("sad", {"happy", "proud"}) is MILD_ONLY   # ... and no plain take: the mild styles
     assert manner_kept(None, plain_and_styled) is None           # none asked: the plain takes
-    assert manner_kept(None, {"happy", "sad"}) is ANY            # no plain take: every take
+    assert manner_kept(None, {"happy", "sad"}) is MILD_ONLY      # no plain take: the mild styles
+    assert manner_kept(None, {"swagger", "sad"}) is ANY          # ... and none of those: every take
     assert manner_kept(None, set()) is ANY and manner_kept("sad", set()) is ANY
+    assert done_as("happy", MILD_ONLY) and done_as("energetic", MILD_ONLY) and not done_as("swagger", MILD_ONLY)
+    assert not done_as(None, MILD_ONLY) and done_as("swagger", ANY) and done_as(None, None) and not done_as("sad", None)
 
     class W:
         def __init__(self, manner):
@@ -49,6 +52,21 @@ def test_which_takes_compete():
     assert unmet_note("proud", "sit", [W(None)]) == (
         "not done proudly: no captured take of 'sit' is done so (the words are read as a whole)")
     assert unmet_note("proud", "walk", [W("proud")]) == "" and unmet_note(None, "walk", [W(None)]) == ""
+
+
+def test_an_action_with_no_plain_take_plays_a_mild_style():
+    """The library's waves goodbye and walks backward are all styled (Bandai): "a small child waves
+    goodbye" played the street thug's wave ("with a swagger"); with no manner asked, the takes done
+    energetically, happily or proudly compete."""
+    from shapemove.core.generation.generate import Generator, Request
+    from shapemove.core.generation.manner_words import MILD
+
+    gen = Generator(None)
+    for text in ("a small child waves goodbye", "a man walks backwards"):
+        for seed in range(2):
+            m = gen.generate_batch([Request(text, seed=seed)])[0]
+            if m.provenance.startswith("captured: "):
+                assert gen.pool.manner(gen.pool.ids.index(m.provenance.split()[2])) in MILD, m.provenance
 
 
 def test_generating_plays_the_takes_done_as_asked():

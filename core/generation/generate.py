@@ -34,7 +34,7 @@ from ..torch_threads import one_torch_thread
 from .action_clips import ACTION_CLIPS, UNASKED_SECONDS, action_clips
 from .captured_takes import TakePool, Window, action_credit, captured_motion, decoded_provenance
 from .one_foot import one_foot_note
-from .manner_words import ANY, manner_kept, shown, slower_note, too_slow, unmet_note
+from .manner_words import done_as, manner_kept, shown, slower_note, too_slow, unmet_note
 from .course_shapes import ACTIONS as COURSE_ACTIONS, unasked_seconds
 from .course_takes import course_take
 from .course_walk import course_motion
@@ -280,7 +280,7 @@ class Generator:
 
             def competes(w: Window) -> bool:   # of the asked action, at a plain gait's pace, done as asked
                 return (action_credit(asked, w.action) is not None
-                        and (not asked or w.manner == manner or manner is ANY)
+                        and (not asked or done_as(w.manner, manner))
                         and (not aside or goes_sideways(w.features))
                         and not slow_take(w, words, self.typical_speeds, self.body)
                         and not fast_take(w, words, self.typical_speeds, self.body)
@@ -743,7 +743,7 @@ class Generator:
         stand = round(STAND_SECONDS * FPS)
         manner = manner_kept(words.manner, self.pool.manners_of(gait))   # done as asked, else plainly (manner_words.py)
         held = []
-        for w in self._windows(r, gait, lo, hi, competes=lambda w: w.action == gait and manner in (ANY, w.manner)):
+        for w in self._windows(r, gait, lo, hi, competes=lambda w: w.action == gait and done_as(w.manner, manner)):
             going = round(GOING_SECONDS * FPS) if seconds is None else len(w.root) // 2
             there = None if metres is None else on_performer(metres, w, self.body, choice.body)   # the body asked's
             k = stop_frame(w.contacts, w.root, steps, there, going)

@@ -11,12 +11,17 @@ tired man walks": the plan's ``Words.manner``) against the manners of the takes 
 - A manner asked with a fast pace ("an old man walks quickly") whose takes that compete all go
   slower than the action's typical pace: the plain takes compete, and the motion says why
   (``too_slow``, ``slower_note``); the elderly walks went at 0.75 m/s, quickly or not.
-- None asked: the plain takes (no manner in their captions) compete where the action has any, else
-  all of them: "a man bows" drew the bow "like in a musical", or "with a swagger, like a street
-  thug", as readily as the plain one; a plain walk, CMU's "walk, exaggerated stride".
+- None asked: the plain takes (no manner in their captions) compete where the action has any: "a
+  man bows" drew the bow "like in a musical", or "with a swagger, like a street thug", as readily as
+  the plain one; a plain walk, CMU's "walk, exaggerated stride".
+- No plain take of the action (the library's waves goodbye, walks backward, sprints and guides are
+  all Bandai's styled ones), and none asked or the one asked not among them: the takes done in the
+  styles nearest a plain performance compete (``MILD``: energetically, happily, proudly), where the
+  action has any, else every take. "A small child waves goodbye" played the street thug's wave,
+  "a scared woman backs away slowly" his walk backward.
 
     manner = manner_kept(words.manner, pool.manners_of("walk"))
-    competes = window.manner == manner or manner is ANY
+    competes = done_as(window.manner, manner)
 """
 from __future__ import annotations
 
@@ -31,13 +36,29 @@ class _Any:
 ANY = _Any()   # every take competes, whatever its manner
 
 
+class _Mild:
+    def __repr__(self) -> str:
+        return "MILD"
+
+
+MILD_ONLY = _Mild()   # the takes done in a ``MILD`` style compete
+MILD = frozenset({"energetic", "happy", "proud"})   # the styles nearest a plain performance
+
+
 def manner_kept(asked: str | None, manners: set):
-    """The manner of the takes that compete (None: the plain ones), or ``ANY``; ``asked``: the
+    """The manner of the takes that compete (None: the plain ones), ``MILD_ONLY`` or ``ANY``; ``asked``: the
     manner the words ask (None: none); ``manners``: those of the action's takes (None for a plain
     one; empty when the words name no action or it has no take)."""
     if asked is not None and asked in manners:
         return asked
-    return None if None in manners else ANY
+    if None in manners:
+        return None
+    return MILD_ONLY if MILD & set(manners) else ANY
+
+
+def done_as(manner: str | None, kept) -> bool:
+    """Whether a take done in ``manner`` (None: plainly) competes where ``manner_kept`` gave ``kept``."""
+    return kept is ANY or manner == kept or (kept is MILD_ONLY and manner in MILD)
 
 
 def shown(asked: str | None, windows) -> bool:
