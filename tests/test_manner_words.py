@@ -19,6 +19,7 @@ pytestmark = pytest.mark.usefixtures("one_thread")
     ("A person walks forward stiffly, like an old person.", "old"),
     ("A person walks with exaggerated strides.", "exaggerated"), ("a man paces nervously", "timid"),
     ("a girl waves both hands excitedly", "energetic"), ("she cheers enthusiastically", "energetic"),
+    ("a confident woman struts", "proud"), ("a man walks, not confident", None), ("she walks unconfidently", "timid"),
     ("a heavy man walks", None), ("a man walks", None), ("a person walks slowly", None),   # a body word, a pace
 ])
 def test_the_manner_the_words_say(text, manner):

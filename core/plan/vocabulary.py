@@ -62,7 +62,7 @@ MANNERS = {
     "happy": r"happ(?:y|ily)|cheerful(?:ly)?|joyful(?:ly)?|gleeful(?:ly)?",
     "sad": r"sad(?:ly)?|gloom(?:y|ily)|dejected(?:ly)?|depressed|sorrowful(?:ly)?|mournful(?:ly)?",
     "angry": r"angr(?:y|ily)|furious(?:ly)?|in anger|enraged",
-    "proud": r"proud(?:ly)?|with pride",
+    "proud": r"proud(?:ly)?|with pride|(?<!not )confident(?:ly)?|strut(?:s|ting|ted)?",
     "timid": r"timid(?:ly)?|without confidence|unconfident(?:ly)?|shy(?:ly)?|nervous(?:ly)?|hesitant(?:ly)?",
     "scared": r"fearful(?:ly)?|scared|afraid|frightened",
     "tired": r"tired(?:ly)?|wear(?:y|ily)|exhausted|with exhaustion",
