@@ -42,6 +42,7 @@ def test_which_takes_compete():
     assert manner_kept(None, plain_and_styled) is None           # none asked: the plain takes
     assert manner_kept(None, {"happy", "sad"}) is MILD_ONLY      # no plain take: the mild styles
     assert manner_kept(None, {"swagger", "sad"}) is ANY          # ... and none of those: every take
+    assert manner_kept(None, {"happy", "sad"}, "sprint") is ANY  # a sprint's mild dashes go at a run's pace
     assert manner_kept(None, set()) is ANY and manner_kept("sad", set()) is ANY
     assert done_as("happy", MILD_ONLY) and done_as("energetic", MILD_ONLY) and not done_as("swagger", MILD_ONLY)
     assert not done_as(None, MILD_ONLY) and done_as("swagger", ANY) and done_as(None, None) and not done_as("sad", None)

@@ -276,7 +276,7 @@ class Generator:
             aside = (asked in SIDEWAYS_ACTIONS and pool is not None   # a sidestep that goes to the side
                      and any(pool.sideways(i) for i in range(len(pool)) if pool.actions[i] == asked))
             manners = pool.manners_of(asked, pool.sideways if aside else None) if pool is not None else set()
-            manner = manner_kept(words.manner, manners)   # how the takes that compete are done (manner_words.py)
+            manner = manner_kept(words.manner, manners, asked)   # how the takes that compete are done (manner_words.py)
 
             def competes(w: Window) -> bool:   # of the asked action, at a plain gait's pace, done as asked
                 return (action_credit(asked, w.action) is not None
@@ -290,7 +290,7 @@ class Generator:
             windows = self._windows(r, asked, lo, hi, side, times, competes) if captured else []
             slower = too_slow(words, asked, manner, windows, self.typical_speeds, self.body)
             if slower:   # "an old man walks quickly": no take done so is quick, a quick plain one is
-                manner = manner_kept(None, manners)
+                manner = manner_kept(None, manners, asked)
                 windows = self._windows(r, asked, lo, hi, side, times, competes)
             windows = performed(windows, asked, times, words.again)   # arm circles that stop half way: not when others go on
             for w in windows if backward else []:
@@ -741,7 +741,7 @@ class Generator:
             return None
         lo, hi = self._length(r.seconds)
         stand = round(STAND_SECONDS * FPS)
-        manner = manner_kept(words.manner, self.pool.manners_of(gait))   # done as asked, else plainly (manner_words.py)
+        manner = manner_kept(words.manner, self.pool.manners_of(gait), gait)   # done as asked, else plainly (manner_words.py)
         held = []
         for w in self._windows(r, gait, lo, hi, competes=lambda w: w.action == gait and done_as(w.manner, manner)):
             going = round(GOING_SECONDS * FPS) if seconds is None else len(w.root) // 2

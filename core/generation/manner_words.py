@@ -17,7 +17,8 @@ tired man walks": the plan's ``Words.manner``) against the manners of the takes 
 - No plain take of the action (the library's waves goodbye, walks backward, sprints and guides are
   all Bandai's styled ones), and none asked or the one asked not among them: the takes done in the
   styles nearest a plain performance compete (``MILD``: energetically, happily, proudly), where the
-  action has any, else every take. "A small child waves goodbye" played the street thug's wave,
+  action has any, else every take; a sprint's every take competes (its mild dashes go at a run's
+  pace, and the fastest are the angry, the thug's and the masculine one). "A small child waves goodbye" played the street thug's wave,
   "a scared woman backs away slowly" his walk backward.
 
     manner = manner_kept(words.manner, pool.manners_of("walk"))
@@ -43,17 +44,19 @@ class _Mild:
 
 MILD_ONLY = _Mild()   # the takes done in a ``MILD`` style compete
 MILD = frozenset({"energetic", "happy", "proud"})   # the styles nearest a plain performance
+SPEED_IS_THE_POINT = frozenset({"sprint"})   # no mild style: Bandai's mild dashes go 2.5-3.2 m/s, a run's pace
 
 
-def manner_kept(asked: str | None, manners: set):
+def manner_kept(asked: str | None, manners: set, action: str | None = None):
     """The manner of the takes that compete (None: the plain ones), ``MILD_ONLY`` or ``ANY``; ``asked``: the
     manner the words ask (None: none); ``manners``: those of the action's takes (None for a plain
-    one; empty when the words name no action or it has no take)."""
+    one; empty when the words name no action or it has no take); ``action``: theirs (a sprint: no
+    mild style alone)."""
     if asked is not None and asked in manners:
         return asked
     if None in manners:
         return None
-    return MILD_ONLY if MILD & set(manners) else ANY
+    return MILD_ONLY if MILD & set(manners) and action not in SPEED_IS_THE_POINT else ANY
 
 
 def done_as(manner: str | None, kept) -> bool:
