@@ -129,7 +129,8 @@ _EVERYDAY = {
                     r"(around )?in (\w+ )?circles\b",
                     r"\b(roll|spin|swing|swung|rotat|whirl|twirl|circl)\w* (his|her|their|the|both|your|one's)( \w+)? arms "
                     r"(a?round|in (\w+ )?(loops|circles))\b",),
-    "balance": (r"\b(hold|keep|stay)\w* (\w+ ){0,2}(steady|still|balanced) on one (foot|leg)\b", r"\bflamingo\b", r"\bsingle[- ]leg stance\b", r"\bstand\w* on one (foot|leg)\b", r"\bteeter",
+    "balance": (r"\b(hold|keep|stay)\w* (\w+ ){0,2}(steady|still|balanced) on one (foot|leg)\b",
+                r"\bflamingo\b", r"\bsingle[- ]leg stance\b", r"\bstand\w* on one (foot|leg)\b", r"\bteeter",
                 r"\btightrope",),
     "wave": (
         r"\bsignals? hello\b", r"\bsay(s)? hi\b", r"\bflaps? a hand\b", r"\bwaggl\w* (a|one|his|her|their|the) (\w+ )?hand\b",
@@ -216,14 +217,16 @@ _LIST = [
     _a("jump forward", "acrobatics", ["jumps forward", "does a long jump"],
        [r"\b(forward|far|long) jumps?\b", r"\bjump\w*\s+(\w+ )?forward", r"\bjump\w* far\b", r"\bmakes a far jump"]),
     _a("spin jump", "acrobatics", ["jumps and turns in the air", "does a spinning jump"],
-       [r"\bjump ?turn", r"\bjump\w* (up )?(and|while) (turn|spin)", r"\bspinning jump", r"\bspin[- ]?jumps?\b", r"^(90|180|270|360)\b(?![- ]?degree)",
+       [r"\bjump ?turn", r"\bjump\w* (up )?(and|while) (turn|spin)", r"\bspinning jump",
+        r"\bspin[- ]?jumps?\b", r"^(90|180|270|360)\b(?![- ]?degree)",
         r"\b(90|180|270|360)[- ]?(degrees? )?(\w+ ){0,3}jump"]),
     _a("hop", "acrobatics", ["hops", "hops on both feet"], [r"\bhop(s|ping|ped)?\b"]),
     _a("jumping jacks", "exercise", ["does jumping jacks"], [r"\bjumping[- ]jacks?\b"]),
     _a("backflip", "acrobatics", ["does a backflip", "flips backward"], [r"\bback ?flip", r"\bflip\w* backwards?"]),
     _a("sideflip", "acrobatics", ["does a side flip", "flips sideways"], [r"\bside ?flip", r"\bflip\w* sideways"]),
     _a("cartwheel", "acrobatics", ["does a cartwheel", "turns a cartwheel"], [r"\bcartwheel", r"\bturn\w* a cartwheel"]),
-    _a("roll", "floor", ["rolls on the ground", "does a forward roll"], [r"\broll(s|ing|ed)?\b(?! de| (his|her|their|your|the|both|one's) (\w+ )?(arms?|shoulders?)\b)"]),
+    _a("roll", "floor", ["rolls on the ground", "does a forward roll"],   # not the arms or shoulders rolled
+       [r"\broll(s|ing|ed)?\b(?! de| (his|her|their|your|the|both|one's) (\w+ )?(arms?|shoulders?)\b)"]),
     _a("get up", "floor", ["gets up from the ground", "stands up from the floor"],
        [r"\b(get(s|ting)?|got) (back )?up\b", r"\b(stand(s|ing)?|stood) (back )?up\b", r"\bgetup\b"]),
     _a("lie down", "floor", ["lies down on the floor", "lies down"],
@@ -278,7 +281,9 @@ _LIST = [
        [r"\bdanc(e|es|ed|ing|er)\b", r"\bsalsa", r"\blambada", r"\blindy ?hop"]),
     _a("ballet", "dance", ["does ballet moves", "dances ballet"],
        [r"\bballet", r"\barabesque", r"\bjetes?\b", r"\bglissade", r"\bplie\b", r"\bpirouettes?\b"]),
-    _a("spin", "dance", ["spins around", "turns on the spot"], [r"\bspin(s|ning)?\b(?! (his|her|their|your|the|both|one's) (\w+ )?arms?\b)", r"\bspun\b", r"\bwhirl", r"\bpirouettes?\b", r"\bturns? on the spot"]),
+    _a("spin", "dance", ["spins around", "turns on the spot"],   # not the arms spun round
+       [r"\bspin(s|ning)?\b(?! (his|her|their|your|the|both|one's) (\w+ )?arms?\b)", r"\bspun\b", r"\bwhirl",
+        r"\bpirouettes?\b", r"\bturns? on the spot"]),
     _a("pose", "dance", ["holds a pose", "strikes a pose"], [r"\bposes?\b", r"\byoga"]),
     _a("wash", "gesture", ["washes", "takes a shower"], [r"\bwash", r"\bshower"]),
 ]

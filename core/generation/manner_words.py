@@ -18,8 +18,8 @@ tired man walks": the plan's ``Words.manner``) against the manners of the takes 
   all Bandai's styled ones), and none asked or the one asked not among them: the takes done in the
   styles nearest a plain performance compete (``MILD``: energetically, happily, proudly), where the
   action has any, else every take; a sprint's every take competes (its mild dashes go at a run's
-  pace, and the fastest are the angry, the thug's and the masculine one). "A small child waves goodbye" played the street thug's wave,
-  "a scared woman backs away slowly" his walk backward.
+  pace, and the fastest are the angry, the thug's and the masculine one). "A small child waves
+  goodbye" played the street thug's wave, "a scared woman backs away slowly" his walk backward.
 
     manner = manner_kept(words.manner, pool.manners_of("walk"))
     competes = done_as(window.manner, manner)

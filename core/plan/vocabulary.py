@@ -184,7 +184,8 @@ ASIDE_COURSE = "aside"
 DIAGONAL_COURSE = "diagonal"
 COURSE_ACTIONS = (CIRCLE, EIGHT)     # the courses that are actions of the data (``data.actions``)
 COURSE_NAMES = {CIRCLE: "in a circle", EIGHT: "in a figure eight"}   # as people say them
-COURSE_KINDS = (CIRCLE, EIGHT, BACK_AND_FORTH_COURSE, ZIGZAG_COURSE, SQUARE_COURSE, DIAGONAL_COURSE, ASIDE_COURSE)   # every course
+COURSE_KINDS = (CIRCLE, EIGHT, BACK_AND_FORTH_COURSE, ZIGZAG_COURSE, SQUARE_COURSE, DIAGONAL_COURSE,
+                ASIDE_COURSE)   # every course the plan takes (and the panel offers)
 
 # -- turns ------------------------------------------------------------------------------------
 TURN_WHOLE = re.compile(r"\b(?:spins?|spinning|full (?:turn|circle|rotation)|360|all the way (?:a)?round|pirouettes?)\b")
