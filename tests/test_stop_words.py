@@ -34,6 +34,7 @@ from shapemove.core.plan.reader import asked_distance, stop_request
     ("a man runs and stops suddenly", ("a man runs", None)),      # how it stops, said after
     ("she jogs and comes to a sudden halt", ("she jogs", None)),
     ("he walks and stops dead in his tracks", ("he walks", None)),
+    ("a woman walks quickly to the bus stop", None), ("he runs to the next stop", None),   # a stop as a place
 ])
 def test_the_words_that_stop_a_gait(text, want):
     assert stop_request(text) == want

@@ -37,6 +37,8 @@ def allowed(prompt, feats):
     ("a woman circles her arms backwards", Travel()),              # the way the arms go, not the body
     ("he swings his arms forward", Travel()),
     ("she walks backwards, circling her arms", Travel(forward=-1)),
+    ("a woman does a cartwheel to the right", Travel(side=-1)), ("he rolls to the left", Travel(side=1)),
+    ("a man turns right", Travel(in_place=True)),                  # a turn alone: on the spot
 ])
 def test_travel_of_reads_the_words(prompt, expected):
     assert travel_of(prompt) == expected
@@ -184,3 +186,19 @@ def test_a_sidestep_plays_a_take_that_goes_to_the_side():
         assert any(gen.pool.ids[i] in m.provenance for i in aside), m.provenance
         fwd, side = legs_descriptor(np.asarray(m.joints)[:, :22])["root"][:2]   # leg lengths a second, body frame
         assert abs(side) >= abs(fwd) > 0.2, (fwd, side)                           # the plain take's: 1.39 / 0.47
+
+
+def test_a_take_going_the_other_side_is_offered_as_its_mirror_image():
+    """Hand-derived: 0.9 m to the left (0.0225 m a frame, 40 frames) is the other side for "to the
+    right" (beyond the 0.5 m slack), not for "to the left" or no side; the captured cartwheel goes
+    0.9 m to its left, and "a cartwheel to the right" plays its mirror image."""
+    from shapemove.core.generation.generate import Generator, Request
+    from shapemove.core.generation.travel_words import other_side
+    from shapemove.core.motion.features import motion_features
+
+    left = _clip(0.0, 0.0225)
+    assert other_side(Travel(side=-1), left) and not other_side(Travel(side=1), left)
+    assert not other_side(Travel(), left) and not other_side(Travel(side=-1), _clip(0.0, 0.01))
+    gen = Generator(None)
+    m = gen.generate_batch([Request("a woman does a cartwheel to the right", seed=0)])[0]
+    assert m.provenance.endswith("mirrored") and body_frame_travel(motion_features(m))[1] < -0.5

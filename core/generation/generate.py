@@ -64,7 +64,7 @@ from .request import Request
 from .slow_action import slowed
 from .slow_steps import slow_motion
 from .still_take import still_take
-from .travel_words import SIDEWAYS_ACTIONS, backward_taken, goes_sideways
+from .travel_words import SIDEWAYS_ACTIONS, backward_taken, goes_sideways, other_side
 from .hands_asked import hands_wanted
 from .typical_pace import (fast_take, leg_ratio, load_typical_speeds, on_performer, slow_take, typical_paced,
                            unplain_take)
@@ -293,6 +293,8 @@ class Generator:
                 manner = manner_kept(None, manners, asked)
                 windows = self._windows(r, asked, lo, hi, side, times, competes)
             windows = performed(windows, asked, times, words.again)   # arm circles that stop half way: not when others go on
+            if side is None and pool is not None:   # "a cartwheel to the right": a take going left, mirrored
+                windows = [pool.mirrored_window(w) if other_side(words.travel, w.features) else w for w in windows]
             for w in windows if backward else []:
                 w.note = f"no capture {action_verb(requested)} backwards: a walk backward is played"
             cands, sources, beta = (self._from_action_clips(r, found) if found    # the user's clips: as captured

@@ -12,7 +12,9 @@ still counts as forward. A word only rules out what goes against it by more than
 metres: "punches forward" does not ask a punch to travel, it refuses one that walks backward; "in
 place" refuses more than ``SLACK`` metres of travel any way (a hop of a metre forward for "hops on
 the spot").
-The words are read by the plan (``plan/reader.travel_of``). Both ways named ("forward and back", "left and right") is no direction at all.
+A captured take that goes to the other side than the words name is offered as its mirror image
+(``other_side``; not where a hand or a foot is named, which its own side decides). The words are read
+by the plan (``plan/reader.travel_of``). Both ways named ("forward and back", "left and right") is no direction at all.
 A gait other than a walk asked backwards ("runs backwards") has the walk backward's captured takes
 offered (``backward_taken``): the data hold no other gait going backwards.
 """
@@ -43,6 +45,13 @@ def obeys(travel: Travel, features: np.ndarray, slack: float = SLACK) -> bool:
     if travel.in_place and np.hypot(fwd, left) > slack:
         return False
     return True
+
+
+def other_side(travel: Travel, features: np.ndarray, slack: float = SLACK) -> bool:
+    """Whether a clip goes to the other side than ``travel`` names by more than ``slack`` metres:
+    its mirror image goes the side asked ("a woman does a cartwheel to the right": the captured
+    cartwheel goes 0.9 m to its left)."""
+    return bool(travel.side) and travel.side * body_frame_travel(features)[1] < -slack
 
 
 def allowed(travel: Travel, feats: list) -> np.ndarray:

@@ -99,6 +99,7 @@ STOP_HOW = r"(?:\s+(?:suddenly|abruptly|sharply|quickly|short|dead|immediately|b
            r"(?:\s+in (?:his|her|their|its) tracks)?"
 STOP_NOUN = r"(?:(?:sudden|quick|full|complete|abrupt|dead|gradual)\s+)?(?:stop|halt|standstill)"
 STOP = re.compile(r"\s*(?:,\s*)?(?:\b(?:and|then)\s+)*(?:\b(?:he|she|they|it)\s+)?"
+                  r"(?<!bus )(?<!the )(?<!\ba )(?<!next )(?<!last )(?<!first )(?<!pit )(?<!full )(?<!tram )(?<!train )"
                   r"\b(?:stops?(?:\s+(?:walking|running|jogging|moving))?|halts?|comes? to a " + STOP_NOUN + r"|"
                   r"stands? still|stays? still)\b" + STOP_HOW + r"(?:\s+(?:there|still))?\s*\.?\s*$")
 # a stop between two things ("walks forward, stops, and waves", "runs, stops and looks back"): the gait's
@@ -226,7 +227,7 @@ ONE_FOOT = re.compile(r"\b(?:on|with|using) (?:just |only )?(?:one|a single|(?:h
 ONE_FOOT_ACTIONS = frozenset({"hop", "jump", "jump forward"})
 # a side named for travel: a verb of going, then within three words "to the left" / "to his right"
 _GOING = (r"\b(?:steps?|stepping|shuffl\w*|walk\w*|mov\w*|slid\w*|glid\w*|crab\w*|strafe\w*|side-?step\w*|run\w*|"
-          r"jog\w*|hop\w*|go(?:es|ing)?)\b")
+          r"jog\w*|hop\w*|go(?:es|ing)?|cartwheel\w*|roll(?:s|ing|ed)?|jump\w*|leap\w*|tumbl\w*)\b")
 TRAVEL_SIDE = re.compile(_GOING + r"(?:\W+\w+){0,3}?\W+(?:to|towards?|over to) (?:the|his|her|their|its|your) (left|right)\b",
                          re.I)
 SIDEWAYS = re.compile(_GOING + r"(?:\W+\w+){0,3}?\W+(sideways|sidewards)\b", re.I)
