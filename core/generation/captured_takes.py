@@ -412,20 +412,22 @@ class TakePool:
     def held_from(self, w: Window, k: int, frames: int, said: str) -> Window:
         """``w`` cut at frame ``k`` and held there, standing, to ``frames`` (a stop played on the take:
         ``take_stop.py``), its features made again; ``said`` joins its provenance."""
-        t = self.take(self.ids.index(w.clip_id))
         rot, root, con = hold(w.rotations[:k], w.root[:k], w.contacts[:k], frames)
-        joints = self.proc.pose_on(rot, root, t["betas"], 1.0, con)
-        return Window(rot, root, con, w.rest, self.proc.features(joints, rot, con), w.action, w.clip_id,
+        return Window(rot, root, con, w.rest, self._features_of(w.clip_id, rot, root, con), w.action, w.clip_id,
                       f"{w.provenance}, {said}", frames - k, w.mirrored, manner=w.manner)
 
     def mirrored_window(self, w: Window) -> Window:
         """``w``'s mirror image (``mirrored``: left and right swapped), its features made again."""
-        t = self.take(self.ids.index(w.clip_id))
         rot, root, con = mirrored(w.rotations, w.root, w.contacts)
-        joints = self.proc.pose_on(rot, root, t["betas"], 1.0, con)
         said = w.provenance.replace(", mirrored", "") if w.mirrored else w.provenance + ", mirrored"
-        return replace(w, rotations=rot, root=root, contacts=con, features=self.proc.features(joints, rot, con),
+        return replace(w, rotations=rot, root=root, contacts=con, features=self._features_of(w.clip_id, rot, root, con),
                        mirrored=not w.mirrored, provenance=said)
+
+    def _features_of(self, clip_id: str, rot, root, con) -> np.ndarray:
+        """The features of a window's frames ``rot``, ``root``, ``con`` of take ``clip_id``, posed on
+        its performer's body (as ``window`` makes them)."""
+        t = self.take(self.ids.index(clip_id))
+        return self.proc.features(self.proc.pose_on(rot, root, t["betas"], 1.0, con), rot, con)
 
     def windows(self, text: np.ndarray, action: str | None, seed: int, frames: int, side=None,
                 longest: int | None = None, count: int = TAKES, times: int | None = None,

@@ -29,20 +29,18 @@ from __future__ import annotations
 from ..plan.vocabulary import MANNER_SAID
 
 
-class _Any:
+class _Kept:
+    """Which takes compete, where it is no one manner (``manner_kept``)."""
+
+    def __init__(self, name: str):
+        self.name = name
+
     def __repr__(self) -> str:
-        return "ANY"
+        return self.name
 
 
-ANY = _Any()   # every take competes, whatever its manner
-
-
-class _Mild:
-    def __repr__(self) -> str:
-        return "MILD"
-
-
-MILD_ONLY = _Mild()   # the takes done in a ``MILD`` style compete
+ANY = _Kept("ANY")         # every take competes, whatever its manner
+MILD_ONLY = _Kept("MILD")  # the takes done in a ``MILD`` style compete
 MILD = frozenset({"energetic", "happy", "proud"})   # the styles nearest a plain performance
 SPEED_IS_THE_POINT = frozenset({"sprint"})   # no mild style: Bandai's mild dashes go 2.5-3.2 m/s, a run's pace
 

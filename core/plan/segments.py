@@ -216,7 +216,7 @@ def _list_steps(piece: str) -> list[str]:
         step = re.split(r",", piece[m.end():], maxsplit=1)[0]
         before = piece[start:m.start()]
         if (set(find_actions(step)) - {"turn"} or _counted_turn(before, step)) and find_actions(before) and _has_verb(step):
-            out.append(piece[start:m.start()])
+            out.append(before)
             start = m.end()
     return out + [piece[start:]]
 
